@@ -1,0 +1,80 @@
+/* icoac: real-number type, sizes and status codes shared by every header. */
+#ifndef ICOAC_TYPES_H
+#define ICOAC_TYPES_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Bump when a public struct layout or an enum value changes. */
+#define ICOAC_ABI_VERSION 1
+
+/* Real-number type: float by default; define ICOAC_REAL_DOUBLE=1 for double. */
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+typedef double icoac_real_t;
+#define ICOAC_R(x) (x)
+#define ICOAC_EXP exp
+#define ICOAC_SQRT sqrt
+#define ICOAC_LOG log
+#define ICOAC_COS cos
+#define ICOAC_FABS fabs
+#else
+typedef float icoac_real_t;
+#define ICOAC_R(x) (x##f)
+#define ICOAC_EXP expf
+#define ICOAC_SQRT sqrtf
+#define ICOAC_LOG logf
+#define ICOAC_COS cosf
+#define ICOAC_FABS fabsf
+#endif
+
+/* Observation layout: (x, x_dot, theta, theta_dot). */
+#define ICOAC_N_INPUTS 4
+#define ICOAC_IDX_X 0
+#define ICOAC_IDX_X_DOT 1
+#define ICOAC_IDX_THETA 2
+#define ICOAC_IDX_THETA_DOT 3
+
+/* Critic grid: 3 x 3 x 6 x 3 normalized Gaussian units. */
+#define ICOAC_CRITIC_N_X 3
+#define ICOAC_CRITIC_N_X_DOT 3
+#define ICOAC_CRITIC_N_THETA 6
+#define ICOAC_CRITIC_N_THETA_DOT 3
+#define ICOAC_CRITIC_UNITS \
+    (ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT * ICOAC_CRITIC_N_THETA * ICOAC_CRITIC_N_THETA_DOT)
+#define ICOAC_CRITIC_FACTORS \
+    (ICOAC_CRITIC_N_X + ICOAC_CRITIC_N_X_DOT + ICOAC_CRITIC_N_THETA + ICOAC_CRITIC_N_THETA_DOT)
+
+/* Compile-time assertion usable in C99 and C11. */
+#if defined(__STDC_VERSION__) && __STDC_VERSION__ >= 201112L
+#define ICOAC_STATIC_ASSERT(cond, name) _Static_assert(cond, #name)
+#else
+#define ICOAC_STATIC_ASSERT(cond, name) typedef char icoac_static_assert_##name[(cond) ? 1 : -1]
+#endif
+
+/* Result of every icoac function. Values are stable across releases. */
+typedef enum {
+    ICOAC_OK = 0,
+    ICOAC_ERR_NULL = 1,             /* a required pointer was NULL */
+    ICOAC_ERR_NOT_INITIALISED = 2,  /* state not set up by icoac_init */
+    ICOAC_ERR_NONFINITE_INPUT = 3,  /* observation had NaN/Inf: safe output, no learning */
+    ICOAC_ERR_BAD_MODE = 10,        /* mode, reflex_mode, ico_timing or another switch out of range */
+    ICOAC_ERR_BAD_SCALE = 11,       /* input_range not finite and > 0 */
+    ICOAC_ERR_BAD_GAIN = 12,        /* gain or reflex_force not finite and >= 0 */
+    ICOAC_ERR_BAD_ZONE = 13,        /* zone_theta / zone_x not finite and > 0 */
+    ICOAC_ERR_BAD_ICO_RATE = 14,    /* ico_rate not finite and >= 0 */
+    ICOAC_ERR_BAD_CRITIC = 15,      /* critic rate, discount, ranges, clip or threshold invalid */
+    ICOAC_ERR_BAD_ACTOR = 16,       /* noise_std, actor_scale or forgetting invalid */
+    ICOAC_ERR_BAD_PRIOR = 17        /* prior mean not finite or covariance not symmetric PD */
+} icoac_status_t;
+
+/* Static, human-readable name of a status (never NULL). */
+const char *icoac_status_str(icoac_status_t status);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* ICOAC_TYPES_H */

@@ -1,0 +1,122 @@
+/* Bayesian actor (spec 7): rank-1 Gaussian posterior step on (mu_w, Sigma_w),
+ * covariance in Joseph form so it stays symmetric positive definite. */
+#include "icoac_internal.h"
+
+#define N ICOAC_N_INPUTS
+
+icoac_real_t icoac_trace4(const icoac_real_t m[N][N])
+{
+    return (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
+}
+
+/* m = L L^T; returns 0 when m is not positive definite. */
+int icoac_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
+{
+    int i;
+    int j;
+    int k;
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            lower[i][j] = ICOAC_R(0.0);
+        }
+    }
+    for (j = 0; j < N; ++j) {
+        icoac_real_t diag = m[j][j];
+        for (k = 0; k < j; ++k) {
+            diag -= lower[j][k] * lower[j][k];
+        }
+        if (!(diag > ICOAC_R(0.0))) {
+            return 0;
+        }
+        lower[j][j] = ICOAC_SQRT(diag);
+        for (i = j + 1; i < N; ++i) {
+            icoac_real_t sum = m[i][j];
+            for (k = 0; k < j; ++k) {
+                sum -= lower[i][k] * lower[j][k];
+            }
+            lower[i][j] = sum / lower[j][j];
+        }
+    }
+    return 1;
+}
+
+void icoac_actor_sample(icoac_state_t *state)
+{
+    icoac_real_t lower[N][N];
+    icoac_real_t normal[N];
+    int i;
+    int j;
+    for (i = 0; i < N; ++i) {
+        normal[i] = icoac_rng_normal(&state->rng);
+    }
+    if (!icoac_cholesky4(ICOAC_CONST_MAT4(state->cov), lower)) {
+        for (i = 0; i < N; ++i) {
+            state->w_act[i] = state->w[i];
+        }
+        return;
+    }
+    for (i = 0; i < N; ++i) {
+        icoac_real_t sum = state->w[i];
+        for (j = 0; j <= i; ++j) {
+            sum += lower[i][j] * normal[j];
+        }
+        state->w_act[i] = sum;
+    }
+}
+
+void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,
+                        const icoac_real_t h[N], icoac_real_t innovation)
+{
+    const icoac_real_t noise_var = cfg->noise_std * cfg->noise_std;
+    icoac_real_t (*cov)[N] = state->cov;
+    icoac_real_t cov_h[N];
+    icoac_real_t gain[N];
+    icoac_real_t reduce[N][N]; /* A = I - k h^T */
+    icoac_real_t a_cov[N][N];  /* A Sigma */
+    icoac_real_t innovation_var;
+    int i;
+    int j;
+    int k;
+
+    if (cfg->forgetting < ICOAC_R(1.0)) {
+        const icoac_real_t inflate = ICOAC_R(1.0) / cfg->forgetting;
+        for (i = 0; i < N; ++i) {
+            for (j = 0; j < N; ++j) {
+                cov[i][j] *= inflate;
+            }
+        }
+    }
+    for (i = 0; i < N; ++i) {
+        cov_h[i] = icoac_dot4(cov[i], h);
+    }
+    innovation_var = icoac_dot4(h, cov_h) + noise_var;
+    for (i = 0; i < N; ++i) {
+        gain[i] = cov_h[i] / innovation_var;
+        state->w[i] += gain[i] * innovation;
+    }
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            reduce[i][j] = (i == j ? ICOAC_R(1.0) : ICOAC_R(0.0)) - gain[i] * h[j];
+        }
+    }
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            icoac_real_t sum = ICOAC_R(0.0);
+            for (k = 0; k < N; ++k) {
+                sum += reduce[i][k] * cov[k][j];
+            }
+            a_cov[i][j] = sum;
+        }
+    }
+    /* Sigma' = A Sigma A^T + sigma_u^2 k k^T, upper triangle mirrored: exactly symmetric. */
+    for (i = 0; i < N; ++i) {
+        for (j = i; j < N; ++j) {
+            icoac_real_t sum = noise_var * gain[i] * gain[j];
+            for (k = 0; k < N; ++k) {
+                sum += a_cov[i][k] * reduce[j][k];
+            }
+            cov[i][j] = sum;
+            cov[j][i] = sum;
+        }
+    }
+}

@@ -1,0 +1,118 @@
+#include "icoac/icoac.h"
+
+#include <math.h>
+
+static int is_finite(icoac_real_t v)
+{
+    return isfinite(v) ? 1 : 0;
+}
+
+static int positive(icoac_real_t v)
+{
+    return is_finite(v) && v > ICOAC_R(0.0);
+}
+
+static int non_negative(icoac_real_t v)
+{
+    return is_finite(v) && v >= ICOAC_R(0.0);
+}
+
+static int is_flag(int32_t v)
+{
+    return v == 0 || v == 1;
+}
+
+const char *icoac_status_str(icoac_status_t status)
+{
+    switch (status) {
+    case ICOAC_OK: return "ok";
+    case ICOAC_ERR_NULL: return "null pointer";
+    case ICOAC_ERR_NOT_INITIALISED: return "state not initialised (call icoac_init)";
+    case ICOAC_ERR_NONFINITE_INPUT: return "non-finite observation (ignored, no learning)";
+    case ICOAC_ERR_BAD_MODE: return "invalid switch (mode, reflex_mode, ico_timing or a 0/1 flag)";
+    case ICOAC_ERR_BAD_SCALE: return "invalid input_range (must be finite and > 0)";
+    case ICOAC_ERR_BAD_GAIN: return "invalid gain or reflex_force (must be finite and >= 0)";
+    case ICOAC_ERR_BAD_ZONE: return "invalid zone_theta or zone_x (must be finite and > 0)";
+    case ICOAC_ERR_BAD_ICO_RATE: return "invalid ico_rate (must be finite and >= 0)";
+    case ICOAC_ERR_BAD_CRITIC: return "invalid critic parameter (rate, discount, td_clip, range, threshold)";
+    case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std > 0, actor_scale >= 0, forgetting in (0, 1])";
+    case ICOAC_ERR_BAD_PRIOR: return "invalid prior (mean not finite or covariance not symmetric positive definite)";
+    default: return "unknown status";
+    }
+}
+
+void icoac_config_default(icoac_config_t *cfg)
+{
+    if (cfg == 0) {
+        return;
+    }
+    cfg->mode = ICOAC_MODE_ICO;
+    cfg->reflex_mode = ICOAC_REFLEX_UNIT;
+    cfg->ico_timing = ICOAC_ICO_TIMING_CODE;
+    cfg->clip_inputs = 1;
+    cfg->input_range[ICOAC_IDX_X] = ICOAC_R(2.4);
+    cfg->input_range[ICOAC_IDX_X_DOT] = ICOAC_R(3.5);
+    cfg->input_range[ICOAC_IDX_THETA] = ICOAC_R(0.2094384);
+    cfg->input_range[ICOAC_IDX_THETA_DOT] = ICOAC_R(2.0);
+    cfg->gain = ICOAC_R(10.0);
+    cfg->reflex_force = ICOAC_R(1.0);
+    cfg->zone_theta = ICOAC_R(0.20071286397934788); /* 11.5 deg */
+    cfg->zone_x = ICOAC_R(2.35);
+    cfg->ico_rate = ICOAC_R(1.0e-4);
+    cfg->critic_rate = ICOAC_R(0.6);
+    cfg->discount = ICOAC_R(0.95);
+    cfg->td_clip = ICOAC_R(1.0);
+    cfg->critic_range[ICOAC_IDX_X] = ICOAC_R(2.4);
+    cfg->critic_range[ICOAC_IDX_X_DOT] = ICOAC_R(3.5);
+    cfg->critic_range[ICOAC_IDX_THETA] = ICOAC_R(0.2094384);
+    cfg->critic_range[ICOAC_IDX_THETA_DOT] = ICOAC_R(2.0);
+    cfg->critic_threshold = ICOAC_R(0.0);
+    cfg->noise_std = ICOAC_R(1.0);
+    cfg->actor_scale = ICOAC_R(0.5);
+    cfg->forgetting = ICOAC_R(1.0);
+    cfg->rl_reflex = 1;
+    cfg->act_with_sample = 0;
+}
+
+icoac_status_t icoac_config_check(const icoac_config_t *cfg)
+{
+    int i;
+    if (cfg == 0) {
+        return ICOAC_ERR_NULL;
+    }
+    if ((cfg->mode != ICOAC_MODE_ICO && cfg->mode != ICOAC_MODE_RL) ||
+        (cfg->reflex_mode != ICOAC_REFLEX_UNIT && cfg->reflex_mode != ICOAC_REFLEX_GAIN) ||
+        (cfg->ico_timing != ICOAC_ICO_TIMING_CODE && cfg->ico_timing != ICOAC_ICO_TIMING_LITERAL) ||
+        !is_flag(cfg->clip_inputs) || !is_flag(cfg->rl_reflex) || !is_flag(cfg->act_with_sample)) {
+        return ICOAC_ERR_BAD_MODE;
+    }
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        if (!positive(cfg->input_range[i])) {
+            return ICOAC_ERR_BAD_SCALE;
+        }
+    }
+    if (!non_negative(cfg->gain) || !non_negative(cfg->reflex_force)) {
+        return ICOAC_ERR_BAD_GAIN;
+    }
+    if (!positive(cfg->zone_theta) || !positive(cfg->zone_x)) {
+        return ICOAC_ERR_BAD_ZONE;
+    }
+    if (!non_negative(cfg->ico_rate)) {
+        return ICOAC_ERR_BAD_ICO_RATE;
+    }
+    if (!non_negative(cfg->critic_rate) || cfg->critic_rate > ICOAC_R(10.0) ||
+        !non_negative(cfg->discount) || cfg->discount > ICOAC_R(1.0) || !positive(cfg->td_clip) ||
+        !non_negative(cfg->critic_threshold) || cfg->critic_threshold >= ICOAC_R(1.0)) {
+        return ICOAC_ERR_BAD_CRITIC;
+    }
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        if (!positive(cfg->critic_range[i])) {
+            return ICOAC_ERR_BAD_CRITIC;
+        }
+    }
+    if (!positive(cfg->noise_std) || !non_negative(cfg->actor_scale) || !positive(cfg->forgetting) ||
+        cfg->forgetting > ICOAC_R(1.0)) {
+        return ICOAC_ERR_BAD_ACTOR;
+    }
+    return ICOAC_OK;
+}

@@ -1,0 +1,42 @@
+/* Private helpers of the icoac library; not installed, not part of the API. */
+#ifndef ICOAC_INTERNAL_H
+#define ICOAC_INTERNAL_H
+
+#include <math.h>
+
+#include "icoac/icoac.h"
+
+/* C99 will not pass T[4][4] to const T[4][4] implicitly. */
+#define ICOAC_CONST_MAT4(m) ((const icoac_real_t(*)[ICOAC_N_INPUTS])(m))
+
+#define ICOAC_STATE_MAGIC 0x1C0AC001u
+
+/* Reflex U and penalty r of one observation (Eq. 4). */
+typedef struct {
+    icoac_real_t reflex;
+    icoac_real_t penalty;
+} icoac_zone_t;
+
+void icoac_scale_inputs(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_N_INPUTS],
+                        icoac_real_t scaled[ICOAC_N_INPUTS]);
+icoac_zone_t icoac_zone(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_N_INPUTS]);
+icoac_real_t icoac_reflex_force(const icoac_config_t *cfg, icoac_real_t reflex);
+icoac_real_t icoac_dot4(const icoac_real_t a[ICOAC_N_INPUTS], const icoac_real_t b[ICOAC_N_INPUTS]);
+
+/* Critic (icoac_critic.c). */
+void icoac_critic_factors(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_N_INPUTS],
+                          icoac_real_t factors[ICOAC_CRITIC_FACTORS]);
+icoac_real_t icoac_critic_value(const icoac_config_t *cfg, const icoac_real_t v[ICOAC_CRITIC_UNITS],
+                                const icoac_real_t factors[ICOAC_CRITIC_FACTORS]);
+void icoac_critic_update(const icoac_config_t *cfg, icoac_real_t v[ICOAC_CRITIC_UNITS],
+                         const icoac_real_t factors[ICOAC_CRITIC_FACTORS], icoac_real_t step);
+
+/* Actor (icoac_actor.c). */
+void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,
+                        const icoac_real_t h[ICOAC_N_INPUTS], icoac_real_t innovation);
+void icoac_actor_sample(icoac_state_t *state);
+icoac_real_t icoac_trace4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+int icoac_cholesky4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS],
+                    icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+
+#endif /* ICOAC_INTERNAL_H */

@@ -1,0 +1,131 @@
+/* icoac_sim: cart-pole plant, benchmark trial loop and grid runner for the icoac controller.
+ * Host-only C11; exported as a shared library for the Python harness. */
+#ifndef ICOAC_SIM_H
+#define ICOAC_SIM_H
+
+#include <stdint.h>
+
+#include "icoac/icoac.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define ICOAC_SIM_ABI_VERSION 1
+
+/* Status of sim functions: values below 100 are icoac_status_t, passed through. */
+typedef enum {
+    ICOAC_SIM_OK = 0,
+    ICOAC_SIM_ERR_BAD_PLANT = 100,    /* plant parameter not finite / out of range */
+    ICOAC_SIM_ERR_BAD_RUN = 101,      /* run parameter out of range */
+    ICOAC_SIM_ERR_BAD_ARGUMENT = 102, /* NULL pointer, zero length or bad cell */
+    ICOAC_SIM_ERR_THREAD = 103,       /* a worker thread could not be started */
+    ICOAC_SIM_CANCELLED = 104         /* the cancel flag was raised; finished cells are kept */
+} icoac_sim_status_t;
+
+typedef enum {
+    ICOAC_SIM_EULER = 0, /* explicit Euler, Sutton's update order (spec 3) */
+    ICOAC_SIM_RK4 = 1    /* classical Runge-Kutta, same dt */
+} icoac_sim_integrator_t;
+
+/* Frictionless cart-pole (Barto, Sutton & Anderson 1983 without friction). */
+typedef struct {
+    double gravity;     /* m/s^2, > 0. 9.8 */
+    double cart_mass;   /* kg, > 0. 1.0 */
+    double pole_mass;   /* kg, > 0. 0.1 */
+    double half_length; /* m, > 0. 0.5 */
+    double dt;          /* s, (0, 1]. 0.01 */
+    double x_limit;     /* m, > 0: failure when |x| > x_limit. 2.4 */
+    double theta_limit; /* rad, > 0: failure when |theta| > theta_limit. 12 deg */
+    int32_t integrator; /* icoac_sim_integrator_t */
+    int32_t reserved;   /* 0 */
+} icoac_sim_plant_t;
+
+/* Benchmark protocol of one cell (spec 9). */
+typedef struct {
+    int64_t max_trials;          /* trials before a cell counts as failed, >= 1. 1e5 */
+    int64_t success_steps;       /* steps of one trial that make a success, >= 1. 1e5 (1000 s) */
+    double init_velocity_noise;  /* initial x_dot, theta_dot ~ U(-a, a), a >= 0. 1e-4 */
+} icoac_sim_run_t;
+
+typedef enum {
+    ICOAC_SIM_PENDING = 0, /* not run yet (or cancelled mid-run) */
+    ICOAC_SIM_SUCCESS = 1, /* a trial lasted success_steps */
+    ICOAC_SIM_FAILED = 2,  /* max_trials trials, none successful */
+    ICOAC_SIM_ERROR = 3    /* the controller reported an error; see status */
+} icoac_sim_outcome_t;
+
+/* One cell: the caller fills x0, theta0, seed; the run fills the rest. */
+typedef struct {
+    double x0;                  /* m */
+    double theta0;              /* rad */
+    uint64_t seed;              /* drives initial velocities and exploration */
+    int32_t outcome;            /* icoac_sim_outcome_t */
+    int32_t status;             /* icoac_status_t / icoac_sim_status_t of the run */
+    int64_t trials;             /* trials run, the successful one included */
+    int64_t total_steps;        /* steps over all trials */
+    int64_t last_trial_steps;   /* length of the final trial */
+    double elapsed_time;        /* s: dt * total_steps */
+    double weights[ICOAC_N_INPUTS];              /* final w (ICO) or mu_w (RL) */
+    double cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS];  /* final Sigma_w (RL) */
+} icoac_sim_cell_t;
+
+/* Indices of the progress array given to icoac_sim_run_grid. */
+#define ICOAC_SIM_PROGRESS_CELLS 0  /* cells finished */
+#define ICOAC_SIM_PROGRESS_TRIALS 1 /* trials finished */
+#define ICOAC_SIM_PROGRESS_STEPS 2  /* plant steps finished (updated per trial) */
+#define ICOAC_SIM_PROGRESS_LEN 3
+
+/* Paper grid: 25 angles (-12..12 deg) x 49 positions (-2.4..2.4 m). */
+#define ICOAC_SIM_GRID_THETAS 25
+#define ICOAC_SIM_GRID_XS 49
+#define ICOAC_SIM_GRID_CELLS (ICOAC_SIM_GRID_THETAS * ICOAC_SIM_GRID_XS)
+
+const char *icoac_sim_status_str(int32_t status);
+uint32_t icoac_sim_abi_version(void);
+uint32_t icoac_sim_sizeof_plant(void);
+uint32_t icoac_sim_sizeof_run(void);
+uint32_t icoac_sim_sizeof_cell(void);
+
+void icoac_sim_plant_default(icoac_sim_plant_t *plant);
+int32_t icoac_sim_plant_check(const icoac_sim_plant_t *plant);
+void icoac_sim_run_default(icoac_sim_run_t *run);
+int32_t icoac_sim_run_check(const icoac_sim_run_t *run);
+
+/* Advance state (x, x_dot, theta, theta_dot) by one dt under force (N). */
+int32_t icoac_sim_plant_step(const icoac_sim_plant_t *plant, double state[ICOAC_N_INPUTS], double force);
+
+/* 1 when state is outside the strict limits (or not finite), else 0. */
+int32_t icoac_sim_failed(const icoac_sim_plant_t *plant, const double state[ICOAC_N_INPUTS]);
+
+/* Fill the paper's grid, row-major over theta (row i: theta0 = (-12 + i) deg) then x
+ * (column j: x0 = -2.4 + 0.1 j m); cell seeds derive from seed; outcomes set PENDING. */
+int32_t icoac_sim_paper_grid(icoac_sim_cell_t *cells, int64_t n_cells, uint64_t seed);
+
+/* One independent run of a cell from a fresh controller (prior NULL: icoac_init default). */
+int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                           icoac_sim_cell_t *cell, const volatile int32_t *cancel,
+                           volatile int64_t *progress);
+
+/* Run every PENDING cell on n_threads threads (0: all cores). Finished cells are final,
+ * so a cancelled grid resumes by calling again. cancel and progress may be NULL;
+ * progress has ICOAC_SIM_PROGRESS_LEN counters, updated atomically. */
+int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                           icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
+                           const volatile int32_t *cancel, volatile int64_t *progress);
+
+/* One trial from (x0, theta0) with the controller initialised from prior (learning on),
+ * recording up to max_steps ticks: states[(max_steps + 1) * 4] (the start included),
+ * forces[max_steps]. *n_steps receives the ticks run (fewer if the pole fell). */
+int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                             const icoac_prior_t *prior, double x0, double theta0,
+                             double init_velocity_noise, uint64_t seed, int64_t max_steps,
+                             double *states, double *forces, int64_t *n_steps);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* ICOAC_SIM_H */

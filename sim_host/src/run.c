@@ -1,0 +1,254 @@
+/* The benchmark trial loop of one cell (spec 8-9) and the Fig. 1g trajectory recorder. */
+#include <math.h>
+#include <string.h>
+
+#include "icoac_sim/icoac_sim.h"
+#include "sim_internal.h"
+
+#define SIM_PI 3.14159265358979323846
+
+void icoac_sim_run_default(icoac_sim_run_t *run)
+{
+    if (run == 0) {
+        return;
+    }
+    run->max_trials = 100000;
+    run->success_steps = 100000;
+    run->init_velocity_noise = 1.0e-4;
+}
+
+int32_t icoac_sim_run_check(const icoac_sim_run_t *run)
+{
+    if (run == 0) {
+        return ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
+    if (run->max_trials < 1 || run->success_steps < 1 || !isfinite(run->init_velocity_noise) ||
+        run->init_velocity_noise < 0.0) {
+        return ICOAC_SIM_ERR_BAD_RUN;
+    }
+    return ICOAC_SIM_OK;
+}
+
+int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                      const icoac_sim_run_t *run)
+{
+    int32_t status;
+    if (cfg == 0 || plant == 0) {
+        return ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
+    status = (int32_t)icoac_config_check(cfg);
+    if (status == ICOAC_SIM_OK) {
+        status = icoac_sim_plant_check(plant);
+    }
+    if (status == ICOAC_SIM_OK && run != 0) {
+        status = icoac_sim_run_check(run);
+    }
+    return status;
+}
+
+int32_t icoac_sim_paper_grid(icoac_sim_cell_t *cells, int64_t n_cells, uint64_t seed)
+{
+    int64_t i;
+    if (cells == 0 || n_cells != ICOAC_SIM_GRID_CELLS) {
+        return ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
+    memset(cells, 0, (size_t)n_cells * sizeof *cells);
+    for (i = 0; i < n_cells; ++i) {
+        const int64_t row = i / ICOAC_SIM_GRID_XS;
+        const int64_t col = i % ICOAC_SIM_GRID_XS;
+        cells[i].theta0 = (double)(-12 + row) * SIM_PI / 180.0;
+        cells[i].x0 = -2.4 + 0.1 * (double)col;
+        cells[i].seed = icoac_mix_seed(seed, (uint64_t)i);
+        cells[i].outcome = ICOAC_SIM_PENDING;
+    }
+    return ICOAC_SIM_OK;
+}
+
+/* Uniform in (-a, a) from the plant's own generator, in double. */
+static double uniform_symmetric(icoac_rng_t *rng, double a)
+{
+    const double u = (double)icoac_rng_next_u32(rng) * (1.0 / 4294967296.0);
+    return a * (2.0 * u - 1.0);
+}
+
+static void start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t *rng, double s[4])
+{
+    s[0] = cell->x0;
+    s[1] = uniform_symmetric(rng, noise);
+    s[2] = cell->theta0;
+    s[3] = uniform_symmetric(rng, noise);
+}
+
+static void to_input(const double s[4], uint32_t flags, icoac_input_t *in)
+{
+    int i;
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        in->s[i] = (icoac_real_t)s[i];
+    }
+    in->flags = flags;
+}
+
+static void store_posterior(const icoac_state_t *ctrl, icoac_sim_cell_t *cell)
+{
+    icoac_prior_t post;
+    int i, j;
+    (void)icoac_get_posterior(ctrl, &post);
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        cell->weights[i] = (double)post.mean[i];
+        for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+            cell->cov[i][j] = (double)post.cov[i][j];
+        }
+    }
+}
+
+/* One trial; returns steps run (success_steps on success) or -1 on a controller error. */
+static int64_t run_trial(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                         const icoac_sim_run_t *run, icoac_state_t *ctrl, const icoac_sim_cell_t *cell,
+                         icoac_rng_t *rng, int32_t *status)
+{
+    double s[4];
+    icoac_input_t in;
+    icoac_output_t out;
+    int64_t steps = 0;
+    start_trial(cell, run->init_velocity_noise, rng, s);
+    *status = (int32_t)icoac_reset(cfg, ctrl);
+    while (*status == ICOAC_SIM_OK && steps < run->success_steps) {
+        to_input(s, 0u, &in);
+        *status = (int32_t)icoac_step(cfg, ctrl, &in, &out);
+        if (*status != ICOAC_SIM_OK) {
+            break;
+        }
+        icoac_sim_plant_step(plant, s, (double)out.force);
+        ++steps;
+        if (icoac_sim_failed(plant, s)) {
+            /* Let the controller learn from the failure state (it ignores NaN plant states). */
+            to_input(s, ICOAC_INPUT_TERMINAL, &in);
+            (void)icoac_step(cfg, ctrl, &in, &out);
+            return steps;
+        }
+    }
+    return *status == ICOAC_SIM_OK ? steps : -1;
+}
+
+static int cancelled(const volatile int32_t *cancel)
+{
+    return cancel != 0 && __atomic_load_n(cancel, __ATOMIC_RELAXED) != 0;
+}
+
+static void add_progress(volatile int64_t *progress, int index, int64_t amount)
+{
+    if (progress != 0) {
+        (void)__atomic_fetch_add(&progress[index], amount, __ATOMIC_RELAXED);
+    }
+}
+
+int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                             const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                             icoac_sim_cell_t *cell, const volatile int32_t *cancel,
+                             volatile int64_t *progress)
+{
+    icoac_state_t ctrl;
+    icoac_rng_t rng;
+    int32_t status;
+    int64_t trials = 0;
+    int64_t total = 0;
+    int64_t steps = 0;
+
+    status = (int32_t)icoac_init(cfg, &ctrl, prior, icoac_mix_seed(cell->seed, 1u));
+    if (status != ICOAC_SIM_OK) {
+        return status;
+    }
+    icoac_rng_seed(&rng, cell->seed, 2u);
+    while (trials < run->max_trials) {
+        if (cancelled(cancel)) {
+            return ICOAC_SIM_CANCELLED;
+        }
+        steps = run_trial(cfg, plant, run, &ctrl, cell, &rng, &status);
+        if (steps < 0) {
+            cell->outcome = ICOAC_SIM_ERROR;
+            cell->status = status;
+            break;
+        }
+        ++trials;
+        total += steps;
+        add_progress(progress, ICOAC_SIM_PROGRESS_TRIALS, 1);
+        add_progress(progress, ICOAC_SIM_PROGRESS_STEPS, steps);
+        if (steps >= run->success_steps) {
+            break;
+        }
+    }
+    if (cell->outcome != ICOAC_SIM_ERROR) {
+        cell->outcome = steps >= run->success_steps ? ICOAC_SIM_SUCCESS : ICOAC_SIM_FAILED;
+        cell->status = ICOAC_SIM_OK;
+    }
+    cell->trials = trials;
+    cell->total_steps = total;
+    cell->last_trial_steps = steps < 0 ? 0 : steps;
+    cell->elapsed_time = plant->dt * (double)total;
+    store_posterior(&ctrl, cell);
+    add_progress(progress, ICOAC_SIM_PROGRESS_CELLS, 1);
+    return ICOAC_SIM_OK;
+}
+
+int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                           icoac_sim_cell_t *cell, const volatile int32_t *cancel,
+                           volatile int64_t *progress)
+{
+    int32_t status = sim_check_all(cfg, plant, run);
+    if (status != ICOAC_SIM_OK) {
+        return status;
+    }
+    if (run == 0 || cell == 0 || !isfinite(cell->x0) || !isfinite(cell->theta0)) {
+        return ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
+    return sim_run_cell_checked(cfg, plant, run, prior, cell, cancel, progress);
+}
+
+int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                             const icoac_prior_t *prior, double x0, double theta0,
+                             double init_velocity_noise, uint64_t seed, int64_t max_steps,
+                             double *states, double *forces, int64_t *n_steps)
+{
+    icoac_state_t ctrl;
+    icoac_rng_t rng;
+    icoac_sim_cell_t cell;
+    icoac_input_t in;
+    icoac_output_t out;
+    double s[4];
+    int64_t k;
+    int32_t status = sim_check_all(cfg, plant, 0);
+    if (status != ICOAC_SIM_OK) {
+        return status;
+    }
+    if (states == 0 || forces == 0 || n_steps == 0 || max_steps < 1 || !isfinite(x0) ||
+        !isfinite(theta0) || !isfinite(init_velocity_noise) || init_velocity_noise < 0.0) {
+        return ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
+    status = (int32_t)icoac_init(cfg, &ctrl, prior, icoac_mix_seed(seed, 1u));
+    if (status != ICOAC_SIM_OK) {
+        return status;
+    }
+    memset(&cell, 0, sizeof cell);
+    cell.x0 = x0;
+    cell.theta0 = theta0;
+    icoac_rng_seed(&rng, seed, 2u);
+    start_trial(&cell, init_velocity_noise, &rng, s);
+    memcpy(states, s, sizeof s);
+    *n_steps = 0;
+    for (k = 0; k < max_steps; ++k) {
+        to_input(s, 0u, &in);
+        status = (int32_t)icoac_step(cfg, &ctrl, &in, &out);
+        if (status != ICOAC_SIM_OK) {
+            return status;
+        }
+        forces[k] = (double)out.force;
+        icoac_sim_plant_step(plant, s, forces[k]);
+        memcpy(states + 4 * (k + 1), s, sizeof s);
+        *n_steps = k + 1;
+        if (icoac_sim_failed(plant, s)) {
+            break;
+        }
+    }
+    return ICOAC_SIM_OK;
+}

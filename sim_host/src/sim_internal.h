@@ -1,0 +1,17 @@
+/* Private helpers shared by the sim_host sources. */
+#ifndef SIM_INTERNAL_H
+#define SIM_INTERNAL_H
+
+#include "icoac_sim/icoac_sim.h"
+
+/* Check the controller configuration, plant and (if not NULL) run parameters. */
+int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                      const icoac_sim_run_t *run);
+
+/* icoac_sim_run_cell without the argument checks. */
+int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                             const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                             icoac_sim_cell_t *cell, const volatile int32_t *cancel,
+                             volatile int64_t *progress);
+
+#endif /* SIM_INTERNAL_H */
