@@ -1,0 +1,221 @@
+"""The paper's figures (Fig. 1b, 1c-f, 1g) as byte-stable PNGs (matplotlib Agg, fixed style)."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib import colors  # noqa: E402
+from matplotlib.patches import Rectangle  # noqa: E402
+
+from . import _binding as B  # noqa: E402
+from . import metrics  # noqa: E402
+
+DPI = 150
+STYLE = {
+    "font.family": "DejaVu Sans",
+    "font.size": 9,
+    "axes.titlesize": 10,
+    "axes.labelsize": 9,
+    "xtick.labelsize": 8,
+    "ytick.labelsize": 8,
+    "image.interpolation": "nearest",
+    "savefig.dpi": DPI,
+    "figure.dpi": DPI,
+    "path.simplify": False,
+    "svg.hashsalt": "icoac",
+}
+# Map extent: cell centres x0 = -2.4..2.4 m (0.1 m), theta0 = -12..12 deg (1 deg).
+MAP_EXTENT = (-2.45, 2.45, -12.5, 12.5)
+PRIOR_FRAME = (1.2, 6.0)  # |x0| <= 1.2 m, |theta0| <= 6 deg
+# Paper panel order of Fig. 1c-f and index into (w_x, w_xdot, w_theta, w_thetadot).
+WEIGHT_PANELS = (("c", r"$w_\theta$", 2), ("d", r"$w_x$", 0), ("e", r"$w_{\dot\theta}$", 3), ("f", r"$w_{\dot x}$", 1))
+FIG1G_START = (-0.5, -4.0)  # x0 m, theta0 deg
+
+
+def save_figure(fig, path: str | Path) -> Path:
+    """Save without time stamps or version strings so identical data gives identical bytes."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=DPI, format="png", metadata={"Software": None})
+    plt.close(fig)
+    return path
+
+
+def _figure(size):
+    with plt.rc_context(STYLE):
+        return plt.figure(figsize=size)
+
+
+def draw_frame(ax, half_x: float, half_theta_deg: float, **kw) -> None:
+    """Dashed rectangle |x0| <= half_x, |theta0| <= half_theta_deg on a map axis."""
+    style = dict(fill=False, linestyle="--", linewidth=1.2, edgecolor="black")
+    style.update(kw)
+    ax.add_patch(Rectangle((-half_x - 0.05, -half_theta_deg - 0.5), 2 * half_x + 0.1, 2 * half_theta_deg + 1, **style))
+
+
+def draw_outline(ax, mask: np.ndarray, **kw) -> None:
+    """Outline of a (25, 49) boolean domain (e.g. the ICO success domain on an RL map)."""
+    style = dict(colors="black", linewidths=1.0, linestyles="--")
+    style.update(kw)
+    x = np.linspace(MAP_EXTENT[0], MAP_EXTENT[1], B.GRID_XS + 1)
+    y = np.linspace(MAP_EXTENT[2], MAP_EXTENT[3], B.GRID_THETAS + 1)
+    m = np.asarray(mask, dtype=bool)
+    for i in range(B.GRID_THETAS):
+        for j in range(B.GRID_XS):
+            if not m[i, j]:
+                continue
+            if i == 0 or not m[i - 1, j]:
+                ax.hlines(y[i], x[j], x[j + 1], **style)
+            if i == B.GRID_THETAS - 1 or not m[i + 1, j]:
+                ax.hlines(y[i + 1], x[j], x[j + 1], **style)
+            if j == 0 or not m[i, j - 1]:
+                ax.vlines(x[j], y[i], y[i + 1], **style)
+            if j == B.GRID_XS - 1 or not m[i, j + 1]:
+                ax.vlines(x[j + 1], y[i], y[i + 1], **style)
+
+
+def plot_map(ax, values: np.ndarray, *, cmap="viridis", norm=None, title: str | None = None,
+             colorbar_label: str | None = None, frame: tuple[float, float] | None = None,
+             outline: np.ndarray | None = None):
+    """A (25, 49) map, x0 horizontal and theta0 vertical; NaN cells are white. Returns the image."""
+    cm = plt.get_cmap(cmap).copy()
+    cm.set_bad("white")
+    img = ax.imshow(np.ma.masked_invalid(values), origin="lower", extent=MAP_EXTENT, aspect="auto",
+                    cmap=cm, norm=norm, interpolation="nearest")
+    ax.set_xlabel(r"$x_0$ (m)")
+    ax.set_ylabel(r"$\theta_0$ (deg)")
+    ax.set_xticks([-2.4, -1.2, 0.0, 1.2, 2.4])
+    ax.set_yticks([-12, -6, 0, 6, 12])
+    for side in ax.spines.values():
+        side.set_linewidth(0.8)
+    if title:
+        ax.set_title(title)
+    if frame is not None:
+        draw_frame(ax, *frame)
+    if outline is not None:
+        draw_outline(ax, outline)
+    if colorbar_label is not None:
+        cb = ax.figure.colorbar(img, ax=ax, fraction=0.046, pad=0.03)
+        cb.set_label(colorbar_label)
+    return img
+
+
+def success_title(label: str, summary: Mapping) -> str:
+    def pct(v):
+        return "n/a" if v is None else f"{100 * v:.1f}%"
+    return (f"{label}: success {pct(summary['success_rate'])} ({summary['n_cells']} cells), "
+            f"interior {pct(summary['success_rate_interior'])}")
+
+
+def plot_success_map(cells: np.ndarray, path: str | Path, *, label: str = "ICO",
+                     frame: tuple[float, float] | None = None, outline: np.ndarray | None = None,
+                     vmax: float | None = None) -> Path:
+    """Fig. 1b style: colour = trials to success (log scale), failed cells white."""
+    trials = metrics.trials_to_success(cells)
+    grid = metrics.to_grid(cells, trials)
+    finite = grid[np.isfinite(grid)]
+    hi = vmax if vmax is not None else (max(10.0, float(finite.max())) if finite.size else 10.0)
+    norm = colors.LogNorm(vmin=1.0, vmax=hi)
+    with plt.rc_context(STYLE):
+        fig, ax = plt.subplots(figsize=(6.4, 3.6))
+        plot_map(ax, grid, cmap="viridis", norm=norm, title=success_title(label, metrics.summary(cells)),
+                 colorbar_label="trials to success", frame=frame, outline=outline)
+        fig.tight_layout()
+        return save_figure(fig, path)
+
+
+def plot_weight_maps(cells: np.ndarray, path: str | Path, *, label: str = "ICO",
+                     frame: tuple[float, float] | None = PRIOR_FRAME) -> Path:
+    """Fig. 1c-f: learned weights per cell (w_theta, w_x, w_thetadot, w_xdot); failed cells blank."""
+    w = metrics.weights(cells, successful_only=True)
+    with plt.rc_context(STYLE):
+        fig, axes = plt.subplots(2, 2, figsize=(9.0, 5.8))
+        for ax, (letter, name, idx) in zip(axes.flat, WEIGHT_PANELS):
+            grid = metrics.to_grid(cells, w[:, idx])
+            finite = grid[np.isfinite(grid)]
+            lim = float(np.max(np.abs(finite))) if finite.size else 1.0
+            lim = lim if lim > 0 else 1.0
+            plot_map(ax, grid, cmap="RdBu_r", norm=colors.Normalize(-lim, lim),
+                     title=f"({letter}) {label} {name}", colorbar_label=name, frame=frame)
+        fig.tight_layout()
+        return save_figure(fig, path)
+
+
+def plot_trajectory(traj, path: str | Path, *, title: str | None = None, cfg=None) -> Path:
+    """Fig. 1g: trajectory in (x, theta in degrees) space."""
+    x = traj.states[:, 0]
+    th = np.degrees(traj.states[:, 2])
+    with plt.rc_context(STYLE):
+        fig, ax = plt.subplots(figsize=(5.0, 3.6))
+        ax.plot(x, th, color="tab:blue", linewidth=0.8)
+        ax.plot(x[:1], th[:1], "o", color="tab:green", markersize=5, label="start")
+        ax.plot(x[-1:], th[-1:], "s", color="tab:red", markersize=4, label="end")
+        if cfg is not None:
+            xl, tl = cfg.plant.x_limit, math.degrees(cfg.plant.theta_limit)
+            ax.add_patch(Rectangle((-xl, -tl), 2 * xl, 2 * tl, fill=False, linestyle=":", edgecolor="grey"))
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel(r"$\theta$ (deg)")
+        ax.set_title(title or f"trajectory, {traj.n_steps * traj.dt:.0f} s")
+        ax.legend(loc="best", frameon=False)
+        fig.tight_layout()
+        return save_figure(fig, path)
+
+
+def plot_bars(path: str | Path, labels: Sequence[str], values: Sequence[float],
+              errors: Sequence[float] | None = None, *, ylabel: str = "", title: str | None = None) -> Path:
+    """Bar chart over conditions (e.g. mean +- sd success rate over seeds)."""
+    with plt.rc_context(STYLE):
+        fig, ax = plt.subplots(figsize=(4.0, 3.2))
+        pos = np.arange(len(labels))
+        ax.bar(pos, values, yerr=errors, color="tab:blue", capsize=3, width=0.6)
+        ax.set_xticks(pos)
+        ax.set_xticklabels(labels)
+        ax.set_ylabel(ylabel)
+        if title:
+            ax.set_title(title)
+        fig.tight_layout()
+        return save_figure(fig, path)
+
+
+def fig1g_trajectory(cells: np.ndarray, cfg, duration: float = 30.0, seed: int = 0):
+    """Trajectory from x0 = -0.5 m, theta0 = -4 deg with the final weights of that grid cell as prior mean.
+    Returns None when the grid has no such cell."""
+    from .config import make_prior
+    from .grid import trajectory
+
+    x0, th0 = FIG1G_START
+    rows, cols = metrics.grid_index(cells)
+    row = int(round(th0 - metrics.THETA_MIN_DEG))
+    col = int(round((x0 - metrics.X_MIN) / metrics.X_STEP))
+    hit = np.flatnonzero((rows == row) & (cols == col))
+    if hit.size == 0:
+        return None, None
+    cell = cells[hit[0]]
+    cfg.prior = make_prior(cell["weights"], np.eye(B.N_INPUTS))
+    traj = trajectory(cfg, x0, math.radians(th0), duration=duration, seed=seed)
+    return traj, cell
+
+
+def make_figures(cells: np.ndarray, record: Mapping, out: str | Path, *, label: str | None = None,
+                 prefix: str = "fig1", duration: float = 30.0) -> list[Path]:
+    """Fig. 1b, 1c-f and 1g of one ICO results set; returns the files written."""
+    from .config import config_from_dict
+
+    out = Path(out)
+    label = label or str(record.get("condition", "ICO")).upper()
+    written = [plot_success_map(cells, out / f"{prefix}b_success_map.png", label=label),
+               plot_weight_maps(cells, out / f"{prefix}cf_weights.png", label=label)]
+    cfg = config_from_dict(record["config"])
+    traj, cell = fig1g_trajectory(cells, cfg, duration=duration, seed=int(record.get("seed", 0)))
+    if traj is not None:
+        state = B.OUTCOME_NAMES.get(int(cell["outcome"]), "?")
+        title = (f"(g) {label}: x0 = -0.5 m, theta0 = -4 deg, {traj.n_steps * traj.dt:.1f} s "
+                 f"(cell {state})")
+        written.append(plot_trajectory(traj, out / f"{prefix}g_trajectory.png", title=title, cfg=cfg))
+    return written

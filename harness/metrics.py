@@ -1,0 +1,115 @@
+"""Benchmark metrics (spec sections 9-10) from a cell array."""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from . import _binding as B
+
+THETA_STEP_DEG = 1.0
+X_STEP = 0.1
+THETA_MIN_DEG = -12.0
+X_MIN = -2.4
+# Cells on the failure threshold rows/columns: |theta0| = 12 deg or |x0| = 2.4 m.
+_EDGE_TOL = 1e-9
+
+
+def grid_index(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(row, column) of each cell in the 25 x 49 paper grid: row = theta0 + 12 deg, column = (x0 + 2.4) / 0.1."""
+    rows = np.rint(np.degrees(cells["theta0"]) - THETA_MIN_DEG).astype(int)
+    cols = np.rint((cells["x0"] - X_MIN) / X_STEP).astype(int)
+    return rows, cols
+
+
+def interior_mask(cells: np.ndarray) -> np.ndarray:
+    """True for the 23 x 47 interior cells (theta0 = +-12 deg rows and x0 = +-2.4 m columns excluded)."""
+    rows, cols = grid_index(cells)
+    return (rows > 0) & (rows < B.GRID_THETAS - 1) & (cols > 0) & (cols < B.GRID_XS - 1)
+
+
+def success_mask(cells: np.ndarray) -> np.ndarray:
+    return cells["outcome"] == B.SUCCESS
+
+
+def trials_to_success(cells: np.ndarray) -> np.ndarray:
+    """Trials to success per cell (successful trial included); NaN for cells that did not succeed."""
+    out = cells["trials"].astype(float)
+    out[~success_mask(cells)] = np.nan
+    return out
+
+
+def weights(cells: np.ndarray, successful_only: bool = False) -> np.ndarray:
+    """Learned weights per cell (w_x, w_xdot, w_theta, w_thetadot); NaN rows for unsuccessful cells if asked."""
+    w = cells["weights"].astype(float).copy()
+    if successful_only:
+        w[~success_mask(cells)] = np.nan
+    return w
+
+
+def to_grid(cells: np.ndarray, values: np.ndarray, fill: float = np.nan) -> np.ndarray:
+    """Scatter per-cell values into a (25, 49) map (rows theta0 ascending, columns x0 ascending)."""
+    values = np.asarray(values, dtype=float)
+    out = np.full((B.GRID_THETAS, B.GRID_XS) + values.shape[1:], fill, dtype=float)
+    rows, cols = grid_index(cells)
+    out[rows, cols] = values
+    return out
+
+
+def _rate(num: int, den: int) -> float:
+    return float(num) / den if den else float("nan")
+
+
+def summary(cells: np.ndarray) -> dict[str, Any]:
+    """Aggregate metrics. Success rates use the full paper grid as denominator when every cell is
+    present (1225 / 1081), otherwise the cells given."""
+    ok = success_mask(cells)
+    inner = interior_mask(cells)
+    trials = cells["trials"][ok]
+    elapsed = cells["elapsed_time"][ok]
+    counts = {name: int(np.count_nonzero(cells["outcome"] == code)) for code, name in B.OUTCOME_NAMES.items()}
+    out: dict[str, Any] = {
+        "n_cells": int(cells.size),
+        "n_interior": int(np.count_nonzero(inner)),
+        "outcomes": counts,
+        "n_success": int(np.count_nonzero(ok)),
+        "n_success_interior": int(np.count_nonzero(ok & inner)),
+        "success_rate": _rate(np.count_nonzero(ok), cells.size),
+        "success_rate_interior": _rate(np.count_nonzero(ok & inner), np.count_nonzero(inner)),
+        "median_trials_to_success": float(np.median(trials)) if trials.size else None,
+        "mean_trials_to_success": float(np.mean(trials)) if trials.size else None,
+        "max_trials_to_success": int(np.max(trials)) if trials.size else None,
+        "mean_elapsed_time_success": float(np.mean(elapsed)) if elapsed.size else None,
+        "total_elapsed_time": float(np.sum(cells["elapsed_time"])),
+        "total_trials": int(np.sum(cells["trials"])),
+    }
+    if trials.size:
+        w = cells["weights"][ok]
+        out["mean_weights_success"] = [float(v) for v in w.mean(axis=0)]
+    else:
+        out["mean_weights_success"] = None
+    for key, value in list(out.items()):
+        if isinstance(value, float) and math.isnan(value):
+            out[key] = None
+    return out
+
+
+def format_summary(name: str, s: dict[str, Any]) -> str:
+    def pct(v):
+        return "n/a" if v is None else f"{100.0 * v:.1f}%"
+
+    lines = [
+        f"{name}: success {pct(s['success_rate'])} of {s['n_cells']} cells "
+        f"({s['n_success']}), interior {pct(s['success_rate_interior'])} of {s['n_interior']} "
+        f"({s['n_success_interior']})",
+    ]
+    if s["median_trials_to_success"] is not None:
+        lines.append(f"  trials to success: median {s['median_trials_to_success']:g}, "
+                     f"max {s['max_trials_to_success']}; mean simulated time of successful cells "
+                     f"{s['mean_elapsed_time_success']:.1f} s")
+    if s["outcomes"].get("pending"):
+        lines.append(f"  {s['outcomes']['pending']} cells still PENDING")
+    if s["outcomes"].get("error"):
+        lines.append(f"  {s['outcomes']['error']} cells reported a controller ERROR")
+    return "\n".join(lines)
