@@ -1,0 +1,108 @@
+/* Shared helpers of the cmocka tests. */
+#ifndef ICOAC_TEST_COMMON_H
+#define ICOAC_TEST_COMMON_H
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "icoac/icoac.h"
+
+#define TEST_PI 3.14159265358979323846
+#define DEG(d) ((d) * TEST_PI / 180.0)
+
+/* 1 when the library under test uses float. */
+#define REAL_IS_FLOAT (sizeof(icoac_real_t) == sizeof(float))
+/* Machine epsilon of icoac_real_t. */
+#define REAL_EPS (REAL_IS_FLOAT ? 1.1920928955078125e-7 : 2.220446049250313e-16)
+
+static inline void assert_close_at(double actual, double expected, double tol, const char *expr,
+                                   const char *file, int line)
+{
+    if (!(fabs(actual - expected) <= tol)) {
+        print_error("%s = %.17g, expected %.17g (|diff| %.3g > tol %.3g)\n", expr, actual, expected,
+                    fabs(actual - expected), tol);
+        _fail(file, line);
+    }
+}
+
+/* |actual - expected| <= tol, NaN fails. */
+#define assert_close(actual, expected, tol) \
+    assert_close_at((double)(actual), (double)(expected), (double)(tol), #actual, __FILE__, __LINE__)
+
+/* Deterministic test-side random numbers (xorshift64*), independent of the library RNG. */
+typedef struct {
+    uint64_t s;
+} test_rng_t;
+
+static inline uint64_t test_rng_u64(test_rng_t *r)
+{
+    r->s ^= r->s >> 12;
+    r->s ^= r->s << 25;
+    r->s ^= r->s >> 27;
+    return r->s * 2685821657736338717ULL;
+}
+
+/* Uniform in [lo, hi). */
+static inline double test_uniform(test_rng_t *r, double lo, double hi)
+{
+    return lo + (hi - lo) * ((double)(test_rng_u64(r) >> 11) * (1.0 / 9007199254740992.0));
+}
+
+/* Configuration with paper defaults and a checked status. */
+static inline icoac_config_t test_default_config(void)
+{
+    icoac_config_t cfg;
+    memset(&cfg, 0, sizeof cfg);
+    icoac_config_default(&cfg);
+    assert_int_equal(icoac_config_check(&cfg), ICOAC_OK);
+    return cfg;
+}
+
+/* Prior with the given mean and covariance c * I. */
+static inline icoac_prior_t test_prior(double w0, double w1, double w2, double w3, double c)
+{
+    icoac_prior_t p;
+    int i;
+    memset(&p, 0, sizeof p);
+    p.mean[0] = (icoac_real_t)w0;
+    p.mean[1] = (icoac_real_t)w1;
+    p.mean[2] = (icoac_real_t)w2;
+    p.mean[3] = (icoac_real_t)w3;
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        p.cov[i][i] = (icoac_real_t)c;
+    }
+    return p;
+}
+
+static inline icoac_input_t test_input(double x, double xd, double th, double thd, uint32_t flags)
+{
+    icoac_input_t in;
+    memset(&in, 0, sizeof in);
+    in.s[0] = (icoac_real_t)x;
+    in.s[1] = (icoac_real_t)xd;
+    in.s[2] = (icoac_real_t)th;
+    in.s[3] = (icoac_real_t)thd;
+    in.flags = flags;
+    return in;
+}
+
+/* Paper scaling (spec 4), written independently of the library, on the stored input. */
+static inline double test_scale(int i, double value, int clip)
+{
+    static const double range[ICOAC_N_INPUTS] = {2.4, 3.5, 0.2094384, 2.0};
+    double a = value / range[i];
+    if (clip) {
+        a = a > 1.0 ? 1.0 : (a < -1.0 ? -1.0 : a);
+    }
+    return a;
+}
+
+#endif /* ICOAC_TEST_COMMON_H */
