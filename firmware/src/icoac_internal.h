@@ -17,11 +17,54 @@ typedef struct {
     icoac_real_t penalty;
 } icoac_zone_t;
 
-void icoac_scale_inputs(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_N_INPUTS],
-                        icoac_real_t scaled[ICOAC_N_INPUTS]);
-icoac_zone_t icoac_zone(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_N_INPUTS]);
-icoac_real_t icoac_reflex_force(const icoac_config_t *cfg, icoac_real_t reflex);
-icoac_real_t icoac_dot4(const icoac_real_t a[ICOAC_N_INPUTS], const icoac_real_t b[ICOAC_N_INPUTS]);
+/* Hot-path helpers: static inline so every tick is one straight-line function. */
+static inline icoac_real_t icoac_clip_unit(icoac_real_t a)
+{
+    return a > ICOAC_R(1.0) ? ICOAC_R(1.0) : (a < ICOAC_R(-1.0) ? ICOAC_R(-1.0) : a);
+}
+
+/* x~_i = clip(s_i / range_i), with 1 / range_i precomputed by icoac_init. */
+static inline void icoac_scale_inputs(const icoac_config_t *cfg, const icoac_state_t *state,
+                                      const icoac_real_t s[ICOAC_N_INPUTS],
+                                      icoac_real_t scaled[ICOAC_N_INPUTS])
+{
+    int i;
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        const icoac_real_t a = s[i] * state->inv_range[i];
+        scaled[i] = cfg->clip_inputs ? icoac_clip_unit(a) : a;
+    }
+}
+
+/* Eq. (4); the first branch wins when both apply. */
+static inline icoac_zone_t icoac_zone(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_N_INPUTS])
+{
+    icoac_zone_t zone;
+    const icoac_real_t x = s[ICOAC_IDX_X];
+    const icoac_real_t theta = s[ICOAC_IDX_THETA];
+    zone.reflex = ICOAC_R(0.0);
+    zone.penalty = ICOAC_R(0.0);
+    if (theta > cfg->zone_theta || x < -cfg->zone_x) {
+        zone.reflex = ICOAC_R(1.0);
+        zone.penalty = ICOAC_R(-1.0);
+    } else if (theta < -cfg->zone_theta || x > cfg->zone_x) {
+        zone.reflex = ICOAC_R(-1.0);
+        zone.penalty = ICOAC_R(-1.0);
+    }
+    return zone;
+}
+
+/* Force of the reflex U (spec A2). */
+static inline icoac_real_t icoac_reflex_force(const icoac_config_t *cfg, icoac_real_t reflex)
+{
+    return cfg->reflex_mode == ICOAC_REFLEX_GAIN ? cfg->gain * reflex : cfg->reflex_force * reflex;
+}
+
+/* Fixed pairwise order: the same result on every target. */
+static inline icoac_real_t icoac_dot4(const icoac_real_t a[ICOAC_N_INPUTS],
+                                      const icoac_real_t b[ICOAC_N_INPUTS])
+{
+    return (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
+}
 
 /* Critic (icoac_critic.c). */
 void icoac_critic_factors(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_N_INPUTS],

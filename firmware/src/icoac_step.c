@@ -55,6 +55,10 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state,
             state->cov[i][i] = ICOAC_R(1.0);
         }
     }
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        state->inv_range[i] = ICOAC_R(1.0) / cfg->input_range[i];
+    }
+    state->weight_norm = ICOAC_SQRT(icoac_dot4(state->w, state->w));
     icoac_rng_seed(&state->rng, seed, 0x1C0ACu);
     state->magic = ICOAC_STATE_MAGIC;
     return icoac_reset(cfg, state);
@@ -90,6 +94,7 @@ static void ico_code_timing(const icoac_config_t *cfg, icoac_state_t *state,
         for (i = 0; i < ICOAC_N_INPUTS; ++i) {
             state->w[i] += step * ICOAC_FABS(scaled[i]);
         }
+        state->weight_norm = ICOAC_SQRT(icoac_dot4(state->w, state->w));
         out->q = drop;
     }
     state->penalty_prev = penalty;
@@ -108,6 +113,7 @@ static void ico_literal_timing(const icoac_config_t *cfg, icoac_state_t *state,
             for (i = 0; i < ICOAC_N_INPUTS; ++i) {
                 state->w[i] += step * ICOAC_FABS(state->x_prev[i]);
             }
+            state->weight_norm = ICOAC_SQRT(icoac_dot4(state->w, state->w));
             out->q = drop;
         }
     }
@@ -126,7 +132,6 @@ static void ico_tick(const icoac_config_t *cfg, icoac_state_t *state,
     } else if (!terminal) {
         ico_code_timing(cfg, state, scaled, penalty, out);
     }
-    memcpy(state->w_act, state->w, sizeof state->w_act);
     if (!terminal) {
         out->force = cfg->gain * out->z + icoac_reflex_force(cfg, out->reflex);
     }
@@ -161,6 +166,7 @@ static void rl_tick(const icoac_config_t *cfg, icoac_state_t *state, const icoac
         innovation = icoac_dot4(h, state->w_act) - icoac_dot4(h, state->w) +
                      cfg->actor_scale * delta * state->noise_prev;
         icoac_actor_update(cfg, state, h, innovation);
+        state->weight_norm = ICOAC_SQRT(icoac_dot4(state->w, state->w));
         if (!cfg->act_with_sample) {
             memcpy(state->w_act, state->w, sizeof state->w_act);
         }
@@ -188,10 +194,11 @@ static void rl_tick(const icoac_config_t *cfg, icoac_state_t *state, const icoac
 icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
                           const icoac_input_t *in, icoac_output_t *out)
 {
+    static const icoac_real_t zeros[ICOAC_N_INPUTS] = {ICOAC_R(0.0), ICOAC_R(0.0), ICOAC_R(0.0),
+                                                        ICOAC_R(0.0)};
     icoac_real_t scaled[ICOAC_N_INPUTS];
     icoac_zone_t zone;
     int terminal;
-    int i;
     if (out != 0) {
         memset(out, 0, sizeof *out);
     }
@@ -206,16 +213,15 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
         return ICOAC_ERR_NOT_INITIALISED;
     }
     state->ticks++;
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-        if (!isfinite(in->s[i])) {
-            state->nonfinite_count++;
-            out->weight_norm = ICOAC_SQRT(icoac_dot4(state->w, state->w));
-            out->status = ICOAC_ERR_NONFINITE_INPUT;
-            return ICOAC_ERR_NONFINITE_INPUT;
-        }
+    /* s_i * 0 is 0 for finite s_i and NaN for NaN or Inf: one test for all four. */
+    if (!(icoac_dot4(in->s, zeros) == ICOAC_R(0.0))) {
+        state->nonfinite_count++;
+        out->weight_norm = state->weight_norm;
+        out->status = ICOAC_ERR_NONFINITE_INPUT;
+        return ICOAC_ERR_NONFINITE_INPUT;
     }
     terminal = (in->flags & ICOAC_INPUT_TERMINAL) != 0u;
-    icoac_scale_inputs(cfg, in->s, scaled);
+    icoac_scale_inputs(cfg, state, in->s, scaled);
     zone = icoac_zone(cfg, in->s);
     out->reflex = zone.reflex;
     out->penalty = zone.penalty;
@@ -224,7 +230,7 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
     } else {
         ico_tick(cfg, state, scaled, zone.penalty, terminal, out);
     }
-    out->weight_norm = ICOAC_SQRT(icoac_dot4(state->w, state->w));
+    out->weight_norm = state->weight_norm;
     out->status = ICOAC_OK;
     return ICOAC_OK;
 }

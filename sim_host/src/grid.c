@@ -24,6 +24,7 @@ typedef struct {
 static void *worker(void *arg)
 {
     grid_job_t *job = (grid_job_t *)arg;
+    (void)sim_fpu_flush_subnormals(); /* a fresh thread: nothing to restore */
     for (;;) {
         const int64_t i = __atomic_fetch_add(&job->next_cell, 1, __ATOMIC_RELAXED);
         int32_t status;
@@ -40,8 +41,8 @@ static void *worker(void *arg)
             break;
         }
         if (status != ICOAC_SIM_OK) {
-            job->cells[i].outcome = ICOAC_SIM_ERROR;
             job->cells[i].status = status;
+            __atomic_store_n(&job->cells[i].outcome, ICOAC_SIM_ERROR, __ATOMIC_RELEASE);
         }
     }
     return 0;

@@ -4,6 +4,7 @@
 #define SIM_PI 3.14159265358979323846
 
 #include "icoac_sim/icoac_sim.h"
+#include "sim_internal.h"
 
 void icoac_sim_plant_default(icoac_sim_plant_t *plant)
 {
@@ -41,16 +42,16 @@ int32_t icoac_sim_plant_check(const icoac_sim_plant_t *plant)
 }
 
 /* d/dt (x, x_dot, theta, theta_dot) under force. */
-static void derivatives(const icoac_sim_plant_t *p, const double s[4], double force, double ds[4])
+static inline void derivatives(const icoac_sim_plant_t *p, const double s[4], double force, double ds[4])
 {
-    const double total_mass = p->cart_mass + p->pole_mass;
+    const double inv_total_mass = 1.0 / (p->cart_mass + p->pole_mass);
     const double pole_moment = p->pole_mass * p->half_length;
     const double sin_t = sin(s[2]);
     const double cos_t = cos(s[2]);
-    const double temp = (force + pole_moment * s[3] * s[3] * sin_t) / total_mass;
+    const double temp = (force + pole_moment * s[3] * s[3] * sin_t) * inv_total_mass;
     const double theta_acc = (p->gravity * sin_t - cos_t * temp) /
-                             (p->half_length * (4.0 / 3.0 - p->pole_mass * cos_t * cos_t / total_mass));
-    const double x_acc = temp - pole_moment * theta_acc * cos_t / total_mass;
+                             (p->half_length * (4.0 / 3.0 - p->pole_mass * cos_t * cos_t * inv_total_mass));
+    const double x_acc = temp - pole_moment * theta_acc * cos_t * inv_total_mass;
     ds[0] = s[1];
     ds[1] = x_acc;
     ds[2] = s[3];
@@ -93,7 +94,5 @@ int32_t icoac_sim_plant_step(const icoac_sim_plant_t *plant, double state[4], do
 
 int32_t icoac_sim_failed(const icoac_sim_plant_t *plant, const double s[4])
 {
-    /* Written so that NaN counts as failure. */
-    return !(s[0] >= -plant->x_limit && s[0] <= plant->x_limit && s[2] >= -plant->theta_limit &&
-             s[2] <= plant->theta_limit);
+    return sim_failed(plant, s);
 }

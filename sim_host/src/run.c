@@ -120,7 +120,7 @@ static int64_t run_trial(const icoac_config_t *cfg, const icoac_sim_plant_t *pla
         }
         icoac_sim_plant_step(plant, s, (double)out.force);
         ++steps;
-        if (icoac_sim_failed(plant, s)) {
+        if (sim_failed(plant, s)) {
             /* Let the controller learn from the failure state (it ignores NaN plant states). */
             to_input(s, ICOAC_INPUT_TERMINAL, &in);
             (void)icoac_step(cfg, ctrl, &in, &out);
@@ -165,8 +165,6 @@ int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t 
         }
         steps = run_trial(cfg, plant, run, &ctrl, cell, &rng, &status);
         if (steps < 0) {
-            cell->outcome = ICOAC_SIM_ERROR;
-            cell->status = status;
             break;
         }
         ++trials;
@@ -177,15 +175,17 @@ int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t 
             break;
         }
     }
-    if (cell->outcome != ICOAC_SIM_ERROR) {
-        cell->outcome = steps >= run->success_steps ? ICOAC_SIM_SUCCESS : ICOAC_SIM_FAILED;
-        cell->status = ICOAC_SIM_OK;
-    }
     cell->trials = trials;
     cell->total_steps = total;
     cell->last_trial_steps = steps < 0 ? 0 : steps;
     cell->elapsed_time = plant->dt * (double)total;
     store_posterior(&ctrl, cell);
+    cell->status = status;
+    /* Outcome last, with release order: a reader that sees it non-PENDING sees the rest. */
+    __atomic_store_n(&cell->outcome,
+                     steps < 0 ? ICOAC_SIM_ERROR
+                               : (steps >= run->success_steps ? ICOAC_SIM_SUCCESS : ICOAC_SIM_FAILED),
+                     __ATOMIC_RELEASE);
     add_progress(progress, ICOAC_SIM_PROGRESS_CELLS, 1);
     return ICOAC_SIM_OK;
 }
@@ -195,6 +195,7 @@ int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *p
                            icoac_sim_cell_t *cell, const volatile int32_t *cancel,
                            volatile int64_t *progress)
 {
+    uint32_t fpu_mode;
     int32_t status = sim_check_all(cfg, plant, run);
     if (status != ICOAC_SIM_OK) {
         return status;
@@ -202,7 +203,10 @@ int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *p
     if (run == 0 || cell == 0 || !isfinite(cell->x0) || !isfinite(cell->theta0)) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
-    return sim_run_cell_checked(cfg, plant, run, prior, cell, cancel, progress);
+    fpu_mode = sim_fpu_flush_subnormals();
+    status = sim_run_cell_checked(cfg, plant, run, prior, cell, cancel, progress);
+    sim_fpu_restore(fpu_mode);
+    return status;
 }
 
 int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
@@ -217,6 +221,7 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t 
     icoac_output_t out;
     double s[4];
     int64_t k;
+    uint32_t fpu_mode;
     int32_t status = sim_check_all(cfg, plant, 0);
     if (status != ICOAC_SIM_OK) {
         return status;
@@ -229,6 +234,7 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t 
     if (status != ICOAC_SIM_OK) {
         return status;
     }
+    fpu_mode = sim_fpu_flush_subnormals();
     memset(&cell, 0, sizeof cell);
     cell.x0 = x0;
     cell.theta0 = theta0;
@@ -240,15 +246,16 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t 
         to_input(s, 0u, &in);
         status = (int32_t)icoac_step(cfg, &ctrl, &in, &out);
         if (status != ICOAC_SIM_OK) {
-            return status;
+            break;
         }
         forces[k] = (double)out.force;
         icoac_sim_plant_step(plant, s, forces[k]);
         memcpy(states + 4 * (k + 1), s, sizeof s);
         *n_steps = k + 1;
-        if (icoac_sim_failed(plant, s)) {
+        if (sim_failed(plant, s)) {
             break;
         }
     }
-    return ICOAC_SIM_OK;
+    sim_fpu_restore(fpu_mode);
+    return status;
 }

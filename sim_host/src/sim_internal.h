@@ -4,6 +4,13 @@
 
 #include "icoac_sim/icoac_sim.h"
 
+/* Failure test of spec 3 with strict limits; written so that NaN counts as failure. */
+static inline int32_t sim_failed(const icoac_sim_plant_t *plant, const double s[ICOAC_N_INPUTS])
+{
+    return !(s[0] >= -plant->x_limit && s[0] <= plant->x_limit && s[2] >= -plant->theta_limit &&
+             s[2] <= plant->theta_limit);
+}
+
 /* Check the controller configuration, plant and (if not NULL) run parameters. */
 int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
                       const icoac_sim_run_t *run);
@@ -13,5 +20,9 @@ int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t 
                              const icoac_sim_run_t *run, const icoac_prior_t *prior,
                              icoac_sim_cell_t *cell, const volatile int32_t *cancel,
                              volatile int64_t *progress);
+
+/* Flush subnormals to zero on this thread; returns the previous mode for sim_fpu_restore. */
+uint32_t sim_fpu_flush_subnormals(void);
+void sim_fpu_restore(uint32_t mode);
 
 #endif /* SIM_INTERNAL_H */

@@ -68,7 +68,9 @@ typedef struct {
 typedef struct {
     uint32_t magic;                                 /* set by icoac_init */
     int32_t has_prev;                               /* a previous tick of this trial is cached */
+    icoac_real_t inv_range[ICOAC_N_INPUTS];         /* 1 / input_range, derived by icoac_init */
     icoac_real_t w[ICOAC_N_INPUTS];                 /* ICO weights, or actor mean mu_w */
+    icoac_real_t weight_norm;                       /* |w|, refreshed when w changes */
     icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* actor covariance Sigma_w */
     icoac_real_t w_act[ICOAC_N_INPUTS];             /* weights used to act (mu_w or a sample) */
     icoac_real_t v[ICOAC_CRITIC_UNITS];             /* critic weights */
