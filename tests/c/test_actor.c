@@ -1,2 +1,329 @@
+/* Bayesian actor (spec 7): icoac_actor_update against the closed-form Gaussian posterior,
+ * long-run symmetry / positive definiteness, forgetting, and the Eq. 7-8 wiring in icoac_step. */
 #include "test_common.h"
-int main(void){return 0;}
+
+#include "icoac_internal.h"
+
+#define N ICOAC_N_INPUTS
+
+typedef struct {
+    double mean[N];
+    double cov[N][N];
+} gauss_t;
+
+/* Posterior of w ~ N(mean, cov) after observing y = h^T w + e, e ~ N(0, r), with
+ * innovation y - h^T mean. Textbook form (not Joseph form). */
+static void closed_form(const gauss_t *prior, const double h[N], double innovation, double r, gauss_t *post)
+{
+    double ch[N], s = r;
+    int i, j;
+    for (i = 0; i < N; ++i) {
+        ch[i] = 0;
+        for (j = 0; j < N; ++j) {
+            ch[i] += prior->cov[i][j] * h[j];
+        }
+        s += h[i] * ch[i];
+    }
+    for (i = 0; i < N; ++i) {
+        post->mean[i] = prior->mean[i] + ch[i] * innovation / s;
+        for (j = 0; j < N; ++j) {
+            post->cov[i][j] = prior->cov[i][j] - ch[i] * ch[j] / s;
+        }
+    }
+}
+
+/* Random SPD matrix A A^T + 0.05 I scaled by `scale`, and a random mean. */
+static void random_gauss(test_rng_t *rng, double scale, gauss_t *g)
+{
+    double a[N][N];
+    int i, j, k;
+    for (i = 0; i < N; ++i) {
+        g->mean[i] = test_uniform(rng, -0.5, 0.5);
+        for (j = 0; j < N; ++j) {
+            a[i][j] = test_uniform(rng, -1, 1);
+        }
+    }
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j <= i; ++j) {
+            double sum = i == j ? 0.05 : 0.0;
+            for (k = 0; k < N; ++k) {
+                sum += a[i][k] * a[j][k];
+            }
+            g->cov[i][j] = g->cov[j][i] = scale * sum;
+        }
+    }
+}
+
+/* Store g in the state (rounded to icoac_real_t) and read the rounded values back into g. */
+static void load_state(icoac_state_t *state, gauss_t *g)
+{
+    int i, j;
+    for (i = 0; i < N; ++i) {
+        state->w[i] = (icoac_real_t)g->mean[i];
+        g->mean[i] = (double)state->w[i];
+        for (j = 0; j < N; ++j) {
+            state->cov[i][j] = (icoac_real_t)g->cov[i][j];
+            g->cov[i][j] = (double)state->cov[i][j];
+        }
+    }
+}
+
+static icoac_state_t rl_state(icoac_config_t *cfg)
+{
+    icoac_state_t state;
+    *cfg = test_default_config();
+    cfg->mode = ICOAC_MODE_RL;
+    assert_int_equal(icoac_init(cfg, &state, NULL, 1u), ICOAC_OK);
+    return state;
+}
+
+static double max_abs(const double m[N][N])
+{
+    double v = 0;
+    int i, j;
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            v = fabs(m[i][j]) > v ? fabs(m[i][j]) : v;
+        }
+    }
+    return v;
+}
+
+static void compare_with_closed_form(const icoac_config_t *cfg, test_rng_t *rng, double h_scale)
+{
+    icoac_config_t c2;
+    icoac_state_t state = rl_state(&c2);
+    gauss_t prior, post;
+    icoac_real_t h[N];
+    double hd[N], innovation, r, tol;
+    int i, j;
+    random_gauss(rng, test_uniform(rng, 0.01, 2.0), &prior);
+    load_state(&state, &prior);
+    for (i = 0; i < N; ++i) {
+        h[i] = (icoac_real_t)test_uniform(rng, -h_scale, h_scale);
+        hd[i] = (double)h[i];
+    }
+    innovation = (double)(icoac_real_t)test_uniform(rng, -3, 3);
+    r = (double)cfg->noise_std * (double)cfg->noise_std;
+    closed_form(&prior, hd, innovation, r, &post);
+    icoac_actor_update(cfg, &state, h, (icoac_real_t)innovation);
+    /* float: a few hundred ulps of the largest prior entry (the update subtracts nearly equal terms) */
+    tol = (REAL_IS_FLOAT ? 2e-5 : 1e-12) * (1.0 + max_abs(prior.cov));
+    for (i = 0; i < N; ++i) {
+        assert_close(state.w[i], post.mean[i], tol * (1.0 + fabs(innovation)));
+        for (j = 0; j < N; ++j) {
+            assert_close(state.cov[i][j], post.cov[i][j], tol);
+            assert_true(state.cov[i][j] == state.cov[j][i]);
+        }
+    }
+}
+
+static void test_update_matches_closed_form(void **unused)
+{
+    icoac_config_t cfg;
+    test_rng_t rng = {0xACu};
+    int n;
+    (void)unused;
+    (void)rl_state(&cfg);
+    for (n = 0; n < 300; ++n) {
+        cfg.noise_std = (icoac_real_t)(n % 3 == 0 ? 1.0 : (n % 3 == 1 ? 0.5 : 3.0));
+        compare_with_closed_form(&cfg, &rng, n % 2 ? 10.0 : 1.0);
+    }
+}
+
+static void test_zero_innovation_keeps_mean(void **unused)
+{
+    icoac_config_t cfg;
+    icoac_state_t state = rl_state(&cfg);
+    test_rng_t rng = {3u};
+    gauss_t prior;
+    icoac_real_t h[N] = {(icoac_real_t)3.0, (icoac_real_t)-7.0, (icoac_real_t)10.0, (icoac_real_t)0.5};
+    icoac_real_t mean_before[N];
+    double trace_before;
+    (void)unused;
+    random_gauss(&rng, 1.0, &prior);
+    load_state(&state, &prior);
+    memcpy(mean_before, state.w, sizeof mean_before);
+    trace_before = (double)icoac_trace4(ICOAC_CONST_MAT4(state.cov));
+    icoac_actor_update(&cfg, &state, h, (icoac_real_t)0.0);
+    assert_memory_equal(state.w, mean_before, sizeof mean_before);
+    /* the covariance still shrinks */
+    assert_true((double)icoac_trace4(ICOAC_CONST_MAT4(state.cov)) < trace_before);
+}
+
+static void test_forgetting_inflates_first(void **unused)
+{
+    icoac_config_t cfg;
+    icoac_state_t state = rl_state(&cfg);
+    test_rng_t rng = {4u};
+    gauss_t prior, inflated, post;
+    icoac_real_t h[N];
+    double hd[N];
+    const double lambda = 0.9;
+    int i, j;
+    (void)unused;
+    cfg.forgetting = (icoac_real_t)lambda;
+    random_gauss(&rng, 0.5, &prior);
+    load_state(&state, &prior);
+    for (i = 0; i < N; ++i) {
+        h[i] = (icoac_real_t)test_uniform(&rng, -10, 10);
+        hd[i] = (double)h[i];
+    }
+    inflated = prior;
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            inflated.cov[i][j] = prior.cov[i][j] / (double)cfg.forgetting;
+        }
+    }
+    closed_form(&inflated, hd, 0.7, 1.0, &post);
+    icoac_actor_update(&cfg, &state, h, (icoac_real_t)0.7);
+    for (i = 0; i < N; ++i) {
+        assert_close(state.w[i], post.mean[i], REAL_IS_FLOAT ? 1e-4 : 1e-12);
+        for (j = 0; j < N; ++j) {
+            assert_close(state.cov[i][j], post.cov[i][j], REAL_IS_FLOAT ? 1e-4 : 1e-12);
+        }
+    }
+    /* with h = 0 (no information) the step is pure inflation: Sigma / lambda */
+    load_state(&state, &prior);
+    memset(h, 0, sizeof h);
+    icoac_actor_update(&cfg, &state, h, (icoac_real_t)0.3);
+    for (i = 0; i < N; ++i) {
+        assert_true(state.w[i] == (icoac_real_t)prior.mean[i]);
+        for (j = 0; j < N; ++j) {
+            assert_close(state.cov[i][j], prior.cov[i][j] / lambda, 4.0 * REAL_EPS * (1.0 + fabs(prior.cov[i][j])));
+        }
+    }
+}
+
+/* Sigma stays exactly symmetric and positive definite over many updates; it matches the
+ * information-form accumulation Sigma^-1 = Sigma_0^-1 + sum h h^T / sigma_u^2. */
+static void run_long(double forgetting, int n_updates)
+{
+    icoac_config_t cfg;
+    icoac_state_t state = rl_state(&cfg);
+    icoac_real_t lower[N][N];
+    test_rng_t rng = {0x5EEDu};
+    double info[N][N];
+    int n, i, j;
+    cfg.forgetting = (icoac_real_t)forgetting;
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            info[i][j] = i == j ? 1.0 : 0.0; /* Sigma_0 = I from icoac_init */
+        }
+    }
+    for (n = 0; n < n_updates; ++n) {
+        icoac_real_t h[N];
+        double prev_trace = (double)icoac_trace4(ICOAC_CONST_MAT4(state.cov));
+        for (i = 0; i < N; ++i) {
+            h[i] = (icoac_real_t)(10.0 * test_uniform(&rng, -1, 1)); /* G x~, |x~| <= 1 */
+        }
+        icoac_actor_update(&cfg, &state, h, (icoac_real_t)test_uniform(&rng, -3, 3));
+        for (i = 0; i < N; ++i) {
+            for (j = 0; j < N; ++j) {
+                if (state.cov[i][j] != state.cov[j][i]) {
+                    print_error("update %d: cov not symmetric at (%d, %d)\n", n, i, j);
+                    fail();
+                }
+                info[i][j] = forgetting * info[i][j] + (double)h[i] * (double)h[j];
+            }
+        }
+        if (!icoac_cholesky4(ICOAC_CONST_MAT4(state.cov), lower)) {
+            print_error("update %d: cov not positive definite\n", n);
+            fail();
+        }
+        if (forgetting == 1.0) {
+            /* without forgetting Sigma never grows (up to rounding) */
+            assert_true((double)icoac_trace4(ICOAC_CONST_MAT4(state.cov)) <= prev_trace * (1.0 + 64.0 * REAL_EPS));
+        }
+    }
+    for (i = 0; i < N; ++i) {
+        assert_true(isfinite(state.w[i]));
+    }
+    /* Sigma * info should be I: check the trace and the largest off-diagonal. */
+    {
+        double tr = 0, off = 0;
+        int k;
+        for (i = 0; i < N; ++i) {
+            for (j = 0; j < N; ++j) {
+                double p = 0;
+                for (k = 0; k < N; ++k) {
+                    p += (double)state.cov[i][k] * info[k][j];
+                }
+                if (i == j) {
+                    tr += p;
+                } else {
+                    off = fabs(p) > off ? fabs(p) : off;
+                }
+            }
+        }
+        assert_close(tr, 4.0, REAL_IS_FLOAT ? 0.05 : 1e-6);
+        assert_close(off, 0.0, REAL_IS_FLOAT ? 0.05 : 1e-6);
+    }
+}
+
+static void test_long_run_symmetric_pd(void **unused)
+{
+    (void)unused;
+    run_long(1.0, 1000000);
+}
+
+static void test_long_run_with_forgetting(void **unused)
+{
+    (void)unused;
+    run_long(0.999, 100000);
+}
+
+/* Eq. 7-8 through icoac_step: u_ob - h^T mu = alpha * delta * eps, h = G x~(s_t). */
+static void test_step_wiring(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_state_t state;
+    icoac_output_t out;
+    icoac_prior_t p = test_prior(0.1, 0.05, 0.3, 0.1, 0.5);
+    icoac_input_t s1 = test_input(0.4, -0.2, 0.08, 0.6, 0);
+    icoac_input_t s2 = test_input(0.41, -0.2, 0.25, 0.6, ICOAC_INPUT_TERMINAL);
+    gauss_t prior, post;
+    double hd[N], z = 0, eps;
+    int i, j;
+    (void)unused;
+    cfg.mode = ICOAC_MODE_RL;
+    p.cov[0][2] = p.cov[2][0] = (icoac_real_t)0.1;
+    assert_int_equal(icoac_init(&cfg, &state, &p, 2024u), ICOAC_OK);
+    for (i = 0; i < N; ++i) {
+        prior.mean[i] = (double)p.mean[i];
+        for (j = 0; j < N; ++j) {
+            prior.cov[i][j] = (double)p.cov[i][j];
+        }
+        hd[i] = 10.0 * test_scale(i, (double)s1.s[i], 1);
+        z += prior.mean[i] * test_scale(i, (double)s1.s[i], 1);
+    }
+    assert_int_equal(icoac_step(&cfg, &state, &s1, &out), ICOAC_OK);
+    eps = (double)out.noise;
+    assert_true(eps != 0.0);
+    assert_close(out.z, z, 1e-5);
+    assert_close(out.force, 10.0 * z + eps, 1e-4); /* no reflex at s1 */
+    assert_int_equal(icoac_step(&cfg, &state, &s2, &out), ICOAC_OK);
+    assert_close(out.td_error, -1.0, 0.0);
+    closed_form(&prior, hd, 0.5 * -1.0 * eps, 1.0, &post);
+    for (i = 0; i < N; ++i) {
+        assert_close(state.w[i], post.mean[i], REAL_IS_FLOAT ? 1e-5 : 1e-12);
+        for (j = 0; j < N; ++j) {
+            assert_close(state.cov[i][j], post.cov[i][j], REAL_IS_FLOAT ? 1e-5 : 1e-12);
+        }
+    }
+    assert_close(out.cov_trace, post.cov[0][0] + post.cov[1][1] + post.cov[2][2] + post.cov[3][3],
+                 REAL_IS_FLOAT ? 1e-5 : 1e-12);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_update_matches_closed_form),
+        cmocka_unit_test(test_zero_innovation_keeps_mean),
+        cmocka_unit_test(test_forgetting_inflates_first),
+        cmocka_unit_test(test_long_run_symmetric_pd),
+        cmocka_unit_test(test_long_run_with_forgetting),
+        cmocka_unit_test(test_step_wiring),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,2 +1,267 @@
+/* NGnet critic (spec 6): separable evaluation against the direct 4-D formula, and the
+ * TD(0) update through icoac_step in RL mode. */
 #include "test_common.h"
-int main(void){return 0;}
+
+#include "icoac_internal.h"
+
+#define K ICOAC_CRITIC_UNITS
+
+static const double ranges[4] = {2.4, 3.5, 0.2094384, 2.0};
+static const int sizes[4] = {3, 3, 6, 3};
+
+/* b_k(s) from the 4-D definition: a_k = exp(-1/2 sum_i ((s_i - c_ki)/sigma_i)^2), normalised.
+ * Computed in log space (shifted by the largest exponent) in long double, so far-out states
+ * do not turn into 0/0; the shift cancels in the ratio. */
+static void direct_b(const icoac_real_t s_in[4], double b[K])
+{
+    long double logs[K], top = -1e300L, total = 0;
+    int a, bb, c, d, k;
+    for (a = 0; a < sizes[0]; ++a) {
+        for (bb = 0; bb < sizes[1]; ++bb) {
+            for (c = 0; c < sizes[2]; ++c) {
+                for (d = 0; d < sizes[3]; ++d) {
+                    const int idx[4] = {a, bb, c, d};
+                    long double e = 0;
+                    int i;
+                    k = ((a * 3 + bb) * 6 + c) * 3 + d;
+                    for (i = 0; i < 4; ++i) {
+                        const long double sigma = (long double)ranges[i] / sizes[i];
+                        const long double centre = -(long double)ranges[i] + (2 * idx[i] + 1) * sigma;
+                        const long double u = ((long double)s_in[i] - centre) / sigma;
+                        e += u * u;
+                    }
+                    logs[k] = -0.5L * e;
+                    top = logs[k] > top ? logs[k] : top;
+                }
+            }
+        }
+    }
+    for (k = 0; k < K; ++k) {
+        total += expl(logs[k] - top);
+    }
+    for (k = 0; k < K; ++k) {
+        b[k] = (double)(expl(logs[k] - top) / total);
+    }
+}
+
+/* b_k(s) from the library: a critic update with step 1 on v = 0 writes b into v. */
+static void library_b(const icoac_config_t *cfg, const icoac_real_t s[4], double b[K])
+{
+    icoac_real_t factors[ICOAC_CRITIC_FACTORS];
+    icoac_real_t v[K];
+    int k;
+    memset(v, 0, sizeof v);
+    icoac_critic_factors(cfg, s, factors);
+    icoac_critic_update(cfg, v, factors, (icoac_real_t)1.0);
+    for (k = 0; k < K; ++k) {
+        b[k] = (double)v[k];
+    }
+}
+
+static double b_tol(void)
+{
+    return REAL_IS_FLOAT ? 2e-6 : 1e-12;
+}
+
+static void random_state(test_rng_t *rng, int far, icoac_real_t s[4])
+{
+    int i;
+    for (i = 0; i < 4; ++i) {
+        const double scale = far ? (i == 2 ? 20.0 : 15.0) : 1.3;
+        s[i] = (icoac_real_t)test_uniform(rng, -scale * ranges[i], scale * ranges[i]);
+    }
+}
+
+static void test_centres_of_spec(void **unused)
+{
+    /* the spec's listed centres: x {-1.6, 0, 1.6}; theta +-2, +-6, +-10 deg (to 4 digits) */
+    const double x_c[3] = {-1.6, 0.0, 1.6};
+    const double th_c[6] = {-10, -6, -2, 2, 6, 10};
+    int j;
+    (void)unused;
+    for (j = 0; j < 3; ++j) {
+        assert_close(-2.4 + (2 * j + 1) * 2.4 / 3, x_c[j], 1e-12);
+    }
+    for (j = 0; j < 6; ++j) {
+        assert_close(-0.2094384 + (2 * j + 1) * 0.2094384 / 6, DEG(th_c[j]), 1e-5);
+    }
+}
+
+static void test_separable_equals_direct(void **unused)
+{
+    const icoac_config_t cfg = test_default_config();
+    test_rng_t rng = {0xC0FFEEu};
+    double bl[K], bd[K];
+    int n, k;
+    (void)unused;
+    for (n = 0; n < 400; ++n) {
+        icoac_real_t s[4];
+        double sum = 0;
+        random_state(&rng, n >= 200, s);
+        if (n == 0) {
+            s[0] = s[1] = s[2] = s[3] = 0; /* between centres in theta */
+        } else if (n == 1) {
+            s[0] = (icoac_real_t)1.6; /* on a centre in x */
+            s[1] = (icoac_real_t)-1e6;
+            s[2] = (icoac_real_t)100.0;
+            s[3] = (icoac_real_t)-1e4;
+        }
+        library_b(&cfg, s, bl);
+        direct_b(s, bd);
+        for (k = 0; k < K; ++k) {
+            if (!(fabs(bl[k] - bd[k]) <= b_tol())) {
+                print_error("state %d (%g, %g, %g, %g) unit %d: %.10g vs %.10g\n", n, (double)s[0],
+                            (double)s[1], (double)s[2], (double)s[3], k, bl[k], bd[k]);
+                fail();
+            }
+            assert_true(bl[k] >= 0.0);
+            sum += bl[k];
+        }
+        assert_close(sum, 1.0, REAL_IS_FLOAT ? 1e-5 : 1e-12);
+    }
+}
+
+static void test_value_is_weighted_sum(void **unused)
+{
+    const icoac_config_t cfg = test_default_config();
+    test_rng_t rng = {31u};
+    icoac_real_t v[K], factors[ICOAC_CRITIC_FACTORS], s[4];
+    double bd[K];
+    int n, k;
+    (void)unused;
+    for (n = 0; n < 50; ++n) {
+        double expected = 0;
+        for (k = 0; k < K; ++k) {
+            v[k] = (icoac_real_t)test_uniform(&rng, -1, 1);
+        }
+        random_state(&rng, n & 1, s);
+        icoac_critic_factors(&cfg, s, factors);
+        direct_b(s, bd);
+        for (k = 0; k < K; ++k) {
+            expected += (double)v[k] * bd[k];
+        }
+        assert_close(icoac_critic_value(&cfg, v, factors), expected, REAL_IS_FLOAT ? 1e-5 : 1e-12);
+    }
+}
+
+static void test_threshold_drops_small_activations(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    test_rng_t rng = {8u};
+    double bl[K], bd[K];
+    int n, k, dropped = 0;
+    (void)unused;
+    cfg.critic_threshold = (icoac_real_t)0.001;
+    for (n = 0; n < 50; ++n) {
+        icoac_real_t s[4];
+        random_state(&rng, 0, s);
+        library_b(&cfg, s, bl);
+        direct_b(s, bd);
+        for (k = 0; k < K; ++k) {
+            if (fabs(bd[k] - 0.001) < 1e-5) {
+                continue; /* too close to the threshold to call */
+            }
+            if (bd[k] < 0.001) {
+                assert_true(bl[k] == 0.0);
+                ++dropped;
+            } else {
+                assert_close(bl[k], bd[k], b_tol());
+            }
+        }
+    }
+    assert_true(dropped > 0);
+}
+
+static void step_ok(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
+{
+    assert_int_equal(icoac_step(cfg, state, in, out), ICOAC_OK);
+}
+
+static void test_td_update_through_step(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_state_t state;
+    icoac_output_t out;
+    icoac_input_t st = test_input(0.3, -0.4, 0.05, 0.2, 0);
+    icoac_input_t fail_in = test_input(0.31, -0.4, 0.22, 0.2, ICOAC_INPUT_TERMINAL);
+    icoac_input_t sa = test_input(0.25, -0.3, 0.06, 0.1, 0);
+    icoac_input_t sb = test_input(0.2, -0.35, 0.07, 0.15, 0);
+    double b_t[K], b_a[K], b_b[K], v1[K];
+    double va = 0, vb = 0, delta;
+    int k;
+    (void)unused;
+    cfg.mode = ICOAC_MODE_RL;
+    assert_int_equal(icoac_init(&cfg, &state, NULL, 77u), ICOAC_OK);
+
+    /* tick 1: non-terminal s_t, v = 0, nothing to learn yet */
+    step_ok(&cfg, &state, &st, &out);
+    assert_true(out.value == 0 && out.td_error == 0);
+    for (k = 0; k < K; ++k) {
+        assert_true(state.v[k] == 0);
+    }
+    /* tick 2: terminal: delta = -1 + 0 - V(s_t) = -1, v += eta * delta * b(s_t) */
+    step_ok(&cfg, &state, &fail_in, &out);
+    assert_close(out.td_error, -1.0, 0.0);
+    assert_true(out.force == 0);
+    direct_b(st.s, b_t);
+    for (k = 0; k < K; ++k) {
+        assert_close(state.v[k], -0.6 * b_t[k], b_tol());
+        v1[k] = (double)state.v[k];
+    }
+
+    /* a non-terminal transition s_a -> s_b: delta = gamma V(s_b) - V(s_a) */
+    assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+    direct_b(sa.s, b_a);
+    direct_b(sb.s, b_b);
+    for (k = 0; k < K; ++k) {
+        va += v1[k] * b_a[k];
+        vb += v1[k] * b_b[k];
+    }
+    assert_true(va < -0.01); /* close to s_t: clearly negative */
+    step_ok(&cfg, &state, &sa, &out);
+    assert_close(out.value, va, REAL_IS_FLOAT ? 1e-6 : 1e-12);
+    step_ok(&cfg, &state, &sb, &out);
+    assert_close(out.value, vb, REAL_IS_FLOAT ? 1e-6 : 1e-12);
+    delta = 0.95 * vb - va;
+    assert_true(fabs(delta) < 1.0);
+    assert_close(out.td_error, delta, REAL_IS_FLOAT ? 2e-6 : 1e-12);
+    for (k = 0; k < K; ++k) {
+        assert_close(state.v[k], v1[k] + 0.6 * delta * b_a[k], REAL_IS_FLOAT ? 2e-6 : 1e-12);
+    }
+}
+
+static void test_td_clip(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_state_t state;
+    icoac_output_t out;
+    icoac_input_t st = test_input(-1.0, 0.4, -0.1, 0.5, 0);
+    icoac_input_t fail_in = test_input(-2.41, 0.4, -0.1, 0.5, ICOAC_INPUT_TERMINAL);
+    double b_t[K];
+    int k;
+    (void)unused;
+    cfg.mode = ICOAC_MODE_RL;
+    cfg.td_clip = (icoac_real_t)0.25;
+    cfg.critic_rate = (icoac_real_t)0.5;
+    assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
+    step_ok(&cfg, &state, &st, &out);
+    step_ok(&cfg, &state, &fail_in, &out);
+    assert_close(out.td_error, -0.25, 0.0);
+    direct_b(st.s, b_t);
+    for (k = 0; k < K; ++k) {
+        assert_close(state.v[k], -0.5 * 0.25 * b_t[k], b_tol());
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_centres_of_spec),
+        cmocka_unit_test(test_separable_equals_direct),
+        cmocka_unit_test(test_value_is_weighted_sum),
+        cmocka_unit_test(test_threshold_drops_small_activations),
+        cmocka_unit_test(test_td_update_through_step),
+        cmocka_unit_test(test_td_clip),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
