@@ -84,8 +84,10 @@ def plot_map(ax, values: np.ndarray, *, cmap="viridis", norm=None, title: str | 
              colorbar_label: str | None = None, frame: tuple[float, float] | None = None,
              outline: np.ndarray | None = None):
     """A (25, 49) map, x0 horizontal and theta0 vertical; NaN cells are white. Returns the image."""
-    cm = plt.get_cmap(cmap).copy()
-    cm.set_bad("white")
+    cm = plt.get_cmap(cmap)
+    cm = cm.with_extremes(bad="white") if hasattr(cm, "with_extremes") else cm.copy()
+    if not hasattr(cm, "with_extremes"):  # matplotlib < 3.4
+        cm.set_bad("white")
     img = ax.imshow(np.ma.masked_invalid(values), origin="lower", extent=MAP_EXTENT, aspect="auto",
                     cmap=cm, norm=norm, interpolation="nearest")
     ax.set_xlabel(r"$x_0$ (m)")

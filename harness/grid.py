@@ -98,7 +98,7 @@ class _Progress:
         if enabled:
             from tqdm import tqdm
             self.bar = tqdm(total=total, initial=initial, unit="cell", desc=desc, file=sys.stderr,
-                            dynamic_ncols=True, smoothing=0.05)
+                            dynamic_ncols=True, smoothing=0.05, mininterval=0.5)
         self.last_cells = 0
         self.t0 = time.monotonic()
 
@@ -110,7 +110,7 @@ class _Progress:
             self.bar.update(cells - self.last_cells)
             self.last_cells = cells
         elapsed = max(time.monotonic() - self.t0, 1e-9)
-        self.bar.set_postfix_str(f"trials={trials} ticks/s={steps / elapsed:.3g}", refresh=True)
+        self.bar.set_postfix_str(f"trials={trials} ticks/s={steps / elapsed:.3g}", refresh=False)
 
     def close(self) -> None:
         if self.bar is not None:

@@ -1,0 +1,88 @@
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+SMALL_ARGS = ["--max-trials", "6000", "--success-steps", "2000", "--quiet"]
+
+
+def run(*args, timeout=60):
+    return subprocess.run([sys.executable, "-m", "harness", *args], cwd=REPO, capture_output=True, text=True,
+                          timeout=timeout)
+
+
+@pytest.mark.parametrize("args, words", [
+    (["grid", "--out", "{tmp}/a", "--set", "gain=-1"], "gain"),
+    (["grid", "--out", "{tmp}/a", "--set", "gian=1"], "unknown parameter 'gian'"),
+    (["grid", "--out", "{tmp}/a", "--set", "gain"], "name=value"),
+    (["grid", "--out", "{tmp}/a", "--set", "reflex_mode=huge"], "unit, gain"),
+    (["grid", "--out", "{tmp}/a", "--set", "dt=nan"], "plant"),
+    (["grid", "--out", "{tmp}/a", "--max-trials", "0"], "max-trials"),
+    (["grid", "--out", "{tmp}/a", "--cells", "5000"], "out of range"),
+    (["grid", "--out", "{tmp}/a", "--bogus"], "unrecognized"),
+    (["grid", "--out", "{tmp}/a", "--resume"], "no results to resume"),
+    (["grid"], "--out"),
+    (["figures", "--results", "{tmp}/missing", "--out", "{tmp}/f"], "does not exist"),
+    (["bench", "--profile", "huge", "--out", "{tmp}/b"], "invalid choice"),
+    ([], "required"),
+])
+def test_user_errors_one_line_exit_2(tmp_path, args, words):
+    res = run(*[a.format(tmp=tmp_path) for a in args])
+    assert res.returncode == 2, res.stderr
+    assert "Traceback" not in res.stderr and "Traceback" not in res.stdout
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("icoac-harness: error: ")
+    assert words in lines[0]
+
+
+def test_grid_resume_and_mismatch(tmp_path):
+    out = tmp_path / "g"
+    res = run("grid", "--out", str(out), "--cells", "610,611", "--seed", "4", *SMALL_ARGS)
+    assert res.returncode == 0, res.stderr
+    record = json.loads((out / "run.json").read_text())
+    assert record["complete"] and record["cells"] == [610, 611] and record["seed"] == 4
+    res = run("grid", "--out", str(out), "--resume", "--quiet")
+    assert res.returncode == 0, res.stderr
+    res = run("grid", "--out", str(out), "--cells", "610,611", "--seed", "4", "--set", "gain=5", *SMALL_ARGS)
+    assert res.returncode == 2 and "does not match" in res.stderr and "gain" in res.stderr
+    assert "Traceback" not in res.stderr
+
+
+def test_sigint_then_resume(tmp_path):
+    out = tmp_path / "s"
+    args = [sys.executable, "-m", "harness", "grid", "--out", str(out), "--cells", "590-640", "--threads", "1",
+            "--max-trials", "20000", "--success-steps", "5000", "--checkpoint-every", "0.2", "--quiet"]
+    proc = subprocess.Popen(args, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 20
+    while not (out / "run.json").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.6)
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=30)
+    assert "Traceback" not in stderr
+    assert proc.returncode in (0, 130)
+    with np.load(out / "cells.npz") as data:
+        partial = data["cells"]
+    if proc.returncode == 130:
+        assert (partial["outcome"] == 0).any()
+    res = subprocess.run(args[:4] + ["--out", str(out), "--resume", "--quiet"], cwd=REPO, capture_output=True,
+                         text=True, timeout=60)
+    assert res.returncode == 0, res.stderr
+    with np.load(out / "cells.npz") as data:
+        final = data["cells"]
+    assert (final["outcome"] != 0).all()
+    done = partial["outcome"] != 0
+    assert np.array_equal(final[done], partial[done])
+    # Same result as an uninterrupted run.
+    from harness import grid
+    from harness.config import build_config
+    ref = grid.make_cells(0, range(590, 641))
+    grid.run_grid(build_config({"max_trials": 20000, "success_steps": 5000}), ref, progress=False)
+    assert np.array_equal(ref, final)

@@ -1,0 +1,49 @@
+import json
+
+import numpy as np
+import pytest
+
+from harness import _binding as B
+from harness import results
+from harness.config import build_config, make_prior
+
+from conftest import SMALL, SMALL_CELLS
+
+
+def test_save_load_round_trip(tmp_path, small_cfg, small_run):
+    rec = results.save(tmp_path / "r", small_run, small_cfg, condition="ico", seed=7, wall_time=1.5,
+                       threads=2, cell_indices=SMALL_CELLS)
+    cells, record = results.load(tmp_path / "r")
+    assert cells.dtype == B.CELL_DTYPE
+    assert all(np.array_equal(cells[f], small_run[f]) for f in B.CELL_DTYPE.names)
+    assert record == json.loads(json.dumps(rec))
+    for key in ("condition", "seed", "config", "git", "abi", "timestamp", "wall_time", "threads", "summary"):
+        assert key in record
+    assert record["config"]["run"]["max_trials"] == SMALL["max_trials"]
+    assert record["config"]["controller"]["gain"] == 10.0
+    assert set(record["git"]) == {"commit", "dirty"}
+    assert record["abi"]["abi_version"] == 1 and record["complete"] is True
+    assert record["summary"]["n_success"] == int((small_run["outcome"] == B.SUCCESS).sum())
+    cfg = results.load_config(record)
+    assert cfg.to_dict() == small_cfg.to_dict()
+    results.check_resumable(record, condition="ico", seed=7, cfg=cfg, cell_indices=SMALL_CELLS)
+    with pytest.raises(results.ResultsError, match="gain"):
+        results.check_resumable(record, condition="ico", seed=7, cfg=build_config(dict(SMALL, gain=5)),
+                                cell_indices=SMALL_CELLS)
+    with pytest.raises(results.ResultsError, match="seed"):
+        results.check_resumable(record, condition="ico", seed=8, cfg=cfg, cell_indices=SMALL_CELLS)
+
+
+def test_prior_recorded(tmp_path, small_run):
+    cfg = build_config(SMALL, prior=make_prior([0.1, 0.05, 0.3, 0.08], np.eye(4) * 0.5))
+    results.save(tmp_path, small_run, cfg, condition="rl", seed=0, wall_time=0, threads=1)
+    _, record = results.load(tmp_path)
+    assert record["config"]["prior"]["mean"] == pytest.approx([0.1, 0.05, 0.3, 0.08])
+    assert results.load_config(record).to_dict() == cfg.to_dict()
+
+
+def test_load_missing(tmp_path):
+    with pytest.raises(results.ResultsError, match="does not exist"):
+        results.load(tmp_path / "nope")
+    with pytest.raises(results.ResultsError, match="not a results directory"):
+        results.load(tmp_path)
