@@ -64,6 +64,9 @@ void icoac_actor_sample(icoac_state_t *state)
     }
 }
 
+/* Sigma' = A Sigma A^T + sigma_u^2 k k^T with A = I - k h^T (Joseph form), evaluated as
+ * A Sigma = Sigma - k (Sigma h)^T and (A Sigma) A^T = A Sigma - (A Sigma h) k^T; the upper
+ * triangle is mirrored, so Sigma stays exactly symmetric. */
 void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,
                         const icoac_real_t h[N], icoac_real_t innovation)
 {
@@ -71,12 +74,11 @@ void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,
     icoac_real_t (*cov)[N] = state->cov;
     icoac_real_t cov_h[N];
     icoac_real_t gain[N];
-    icoac_real_t reduce[N][N]; /* A = I - k h^T */
-    icoac_real_t a_cov[N][N];  /* A Sigma */
+    icoac_real_t a_cov[N][N];
+    icoac_real_t a_cov_h[N];
     icoac_real_t innovation_var;
     int i;
     int j;
-    int k;
 
     if (cfg->forgetting < ICOAC_R(1.0)) {
         const icoac_real_t inflate = ICOAC_R(1.0) / cfg->forgetting;
@@ -96,27 +98,17 @@ void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,
     }
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
-            reduce[i][j] = (i == j ? ICOAC_R(1.0) : ICOAC_R(0.0)) - gain[i] * h[j];
+            a_cov[i][j] = cov[i][j] - gain[i] * cov_h[j];
         }
     }
     for (i = 0; i < N; ++i) {
-        for (j = 0; j < N; ++j) {
-            icoac_real_t sum = ICOAC_R(0.0);
-            for (k = 0; k < N; ++k) {
-                sum += reduce[i][k] * cov[k][j];
-            }
-            a_cov[i][j] = sum;
-        }
+        a_cov_h[i] = icoac_dot4(a_cov[i], h);
     }
-    /* Sigma' = A Sigma A^T + sigma_u^2 k k^T, upper triangle mirrored: exactly symmetric. */
     for (i = 0; i < N; ++i) {
         for (j = i; j < N; ++j) {
-            icoac_real_t sum = noise_var * gain[i] * gain[j];
-            for (k = 0; k < N; ++k) {
-                sum += a_cov[i][k] * reduce[j][k];
-            }
-            cov[i][j] = sum;
-            cov[j][i] = sum;
+            const icoac_real_t value = a_cov[i][j] - a_cov_h[i] * gain[j] + noise_var * gain[i] * gain[j];
+            cov[i][j] = value;
+            cov[j][i] = value;
         }
     }
 }

@@ -3,21 +3,19 @@
  * activation is b_k = prod_i g_i(k_i) with per-dimension normalized factors g. */
 #include "icoac_internal.h"
 
-static const int grid_size[ICOAC_N_INPUTS] = {
-    ICOAC_CRITIC_N_X, ICOAC_CRITIC_N_X_DOT, ICOAC_CRITIC_N_THETA, ICOAC_CRITIC_N_THETA_DOT};
-
-/* Normalized 1-D Gaussian factors of one coordinate; the smallest exponent is shifted
- * to 0 before exp, so far-away states never underflow to 0/0. */
+/* Normalized 1-D Gaussian factors of one coordinate. With centres c_j = -R + (2j+1)R/n and
+ * width sigma = R/n, (s - c_j)/sigma = s*n/R + n - 1 - 2j. The smallest squared distance is
+ * subtracted before exp, so far-away states never underflow to 0/0. */
 static void dimension_factors(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
 {
-    const icoac_real_t width = range / (icoac_real_t)n; /* sigma = centre spacing / 2 */
+    const icoac_real_t offset = value * ((icoac_real_t)n / range) + (icoac_real_t)(n - 1);
     icoac_real_t dist[ICOAC_CRITIC_N_THETA];
     icoac_real_t nearest;
     icoac_real_t total = ICOAC_R(0.0);
+    icoac_real_t inv_total;
     int j;
     for (j = 0; j < n; ++j) {
-        const icoac_real_t centre = -range + (icoac_real_t)(2 * j + 1) * width;
-        const icoac_real_t d = (value - centre) / width;
+        const icoac_real_t d = offset - (icoac_real_t)(2 * j);
         dist[j] = d * d;
     }
     nearest = dist[0];
@@ -28,23 +26,26 @@ static void dimension_factors(icoac_real_t value, icoac_real_t range, int n, ico
         g[j] = ICOAC_EXP(ICOAC_R(-0.5) * (dist[j] - nearest));
         total += g[j];
     }
+    inv_total = ICOAC_R(1.0) / total;
     for (j = 0; j < n; ++j) {
-        g[j] /= total;
+        g[j] *= inv_total;
     }
 }
 
 void icoac_critic_factors(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_N_INPUTS],
                           icoac_real_t factors[ICOAC_CRITIC_FACTORS])
 {
-    int offset = 0;
-    int i;
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-        dimension_factors(s[i], cfg->critic_range[i], grid_size[i], factors + offset);
-        offset += grid_size[i];
-    }
+    dimension_factors(s[ICOAC_IDX_X], cfg->critic_range[ICOAC_IDX_X], ICOAC_CRITIC_N_X, factors);
+    factors += ICOAC_CRITIC_N_X;
+    dimension_factors(s[ICOAC_IDX_X_DOT], cfg->critic_range[ICOAC_IDX_X_DOT], ICOAC_CRITIC_N_X_DOT, factors);
+    factors += ICOAC_CRITIC_N_X_DOT;
+    dimension_factors(s[ICOAC_IDX_THETA], cfg->critic_range[ICOAC_IDX_THETA], ICOAC_CRITIC_N_THETA, factors);
+    factors += ICOAC_CRITIC_N_THETA;
+    dimension_factors(s[ICOAC_IDX_THETA_DOT], cfg->critic_range[ICOAC_IDX_THETA_DOT],
+                      ICOAC_CRITIC_N_THETA_DOT, factors);
 }
 
-/* Calls visit(k, b_k) over all units in index order k = ((a*3 + b)*6 + c)*3 + d. */
+/* Slow path with the activity threshold: visits every unit with b_k >= threshold. */
 #define ICOAC_FOR_EACH_UNIT(factors, threshold, BODY)                                            \
     do {                                                                                         \
         const icoac_real_t *gx_ = (factors);                                                     \
@@ -54,11 +55,9 @@ void icoac_critic_factors(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_
         int a_, b_, c_, d_, k_ = 0;                                                              \
         for (a_ = 0; a_ < ICOAC_CRITIC_N_X; ++a_) {                                              \
             for (b_ = 0; b_ < ICOAC_CRITIC_N_X_DOT; ++b_) {                                      \
-                const icoac_real_t pab_ = gx_[a_] * gxd_[b_];                                    \
                 for (c_ = 0; c_ < ICOAC_CRITIC_N_THETA; ++c_) {                                  \
-                    const icoac_real_t pabc_ = pab_ * gth_[c_];                                  \
                     for (d_ = 0; d_ < ICOAC_CRITIC_N_THETA_DOT; ++d_, ++k_) {                    \
-                        const icoac_real_t unit_b = pabc_ * gthd_[d_];                           \
+                        const icoac_real_t unit_b = gx_[a_] * gxd_[b_] * gth_[c_] * gthd_[d_];   \
                         const int unit_k = k_;                                                   \
                         if (unit_b >= (threshold)) {                                             \
                             BODY;                                                                \
@@ -69,16 +68,64 @@ void icoac_critic_factors(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_
         }                                                                                        \
     } while (0)
 
+/* Units are stored with theta_dot fastest: k = ((a*3 + b)*6 + c)*3 + d. The fast paths
+ * walk the 54 (a, b, c) prefixes and handle the 3 theta_dot units of each inline. */
+#define ICOAC_PREFIXES (ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT * ICOAC_CRITIC_N_THETA)
+ICOAC_STATIC_ASSERT(ICOAC_CRITIC_N_THETA_DOT == 3, fast_path_expects_three_theta_dot_units);
+
 icoac_real_t icoac_critic_value(const icoac_config_t *cfg, const icoac_real_t v[ICOAC_CRITIC_UNITS],
                                 const icoac_real_t factors[ICOAC_CRITIC_FACTORS])
 {
+    const icoac_real_t *gx = factors;
+    const icoac_real_t *gxd = gx + ICOAC_CRITIC_N_X;
+    const icoac_real_t *gth = gxd + ICOAC_CRITIC_N_X_DOT;
+    const icoac_real_t *gthd = gth + ICOAC_CRITIC_N_THETA;
     icoac_real_t value = ICOAC_R(0.0);
-    ICOAC_FOR_EACH_UNIT(factors, cfg->critic_threshold, value += v[unit_k] * unit_b);
+    int a;
+    int b;
+    int c;
+    if (cfg->critic_threshold > ICOAC_R(0.0)) {
+        ICOAC_FOR_EACH_UNIT(factors, cfg->critic_threshold, value += v[unit_k] * unit_b);
+        return value;
+    }
+    for (a = 0; a < ICOAC_CRITIC_N_X; ++a) {
+        for (b = 0; b < ICOAC_CRITIC_N_X_DOT; ++b) {
+            const icoac_real_t pab = gx[a] * gxd[b];
+            for (c = 0; c < ICOAC_CRITIC_N_THETA; ++c) {
+                const icoac_real_t *u = v + ((a * ICOAC_CRITIC_N_X_DOT + b) * ICOAC_CRITIC_N_THETA + c) *
+                                                ICOAC_CRITIC_N_THETA_DOT;
+                value += (pab * gth[c]) * ((u[0] * gthd[0] + u[1] * gthd[1]) + u[2] * gthd[2]);
+            }
+        }
+    }
     return value;
 }
 
 void icoac_critic_update(const icoac_config_t *cfg, icoac_real_t v[ICOAC_CRITIC_UNITS],
                          const icoac_real_t factors[ICOAC_CRITIC_FACTORS], icoac_real_t step)
 {
-    ICOAC_FOR_EACH_UNIT(factors, cfg->critic_threshold, v[unit_k] += step * unit_b);
+    const icoac_real_t *gx = factors;
+    const icoac_real_t *gxd = gx + ICOAC_CRITIC_N_X;
+    const icoac_real_t *gth = gxd + ICOAC_CRITIC_N_X_DOT;
+    const icoac_real_t *gthd = gth + ICOAC_CRITIC_N_THETA;
+    int a;
+    int b;
+    int c;
+    if (cfg->critic_threshold > ICOAC_R(0.0)) {
+        ICOAC_FOR_EACH_UNIT(factors, cfg->critic_threshold, v[unit_k] += step * unit_b);
+        return;
+    }
+    for (a = 0; a < ICOAC_CRITIC_N_X; ++a) {
+        for (b = 0; b < ICOAC_CRITIC_N_X_DOT; ++b) {
+            const icoac_real_t pab = step * gx[a] * gxd[b];
+            for (c = 0; c < ICOAC_CRITIC_N_THETA; ++c) {
+                const icoac_real_t pabc = pab * gth[c];
+                icoac_real_t *u = v + ((a * ICOAC_CRITIC_N_X_DOT + b) * ICOAC_CRITIC_N_THETA + c) *
+                                          ICOAC_CRITIC_N_THETA_DOT;
+                u[0] += pabc * gthd[0];
+                u[1] += pabc * gthd[1];
+                u[2] += pabc * gthd[2];
+            }
+        }
+    }
 }
