@@ -244,7 +244,12 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     try:
         args = build_parser().parse_args(argv)
-        from ._binding import ConfigError, IcoacError, LibraryError
+        try:
+            from ._binding import ConfigError, IcoacError, LibraryError
+        except Exception as exc:  # missing or mismatched shared library: one line, status 2
+            if type(exc).__name__ == "LibraryError":
+                raise UsageError(str(exc))
+            raise
         try:
             return args.func(args)
         except (ConfigError, LibraryError) as exc:

@@ -86,3 +86,17 @@ def test_sigint_then_resume(tmp_path):
     ref = grid.make_cells(0, range(590, 641))
     grid.run_grid(build_config({"max_trials": 20000, "success_steps": 5000}), ref, progress=False)
     assert np.array_equal(ref, final)
+
+
+def test_missing_library_is_one_line(tmp_path):
+    env = dict(os.environ, ICOAC_SIM_LIBRARY=str(tmp_path / "libnone.so"))
+    res = subprocess.run([sys.executable, "-m", "harness", "grid", "--out", str(tmp_path / "x")], cwd=REPO,
+                         capture_output=True, text=True, env=env, timeout=60)
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "make build" in lines[0] and lines[0].startswith("icoac-harness: error: ")
+
+
+def test_help_exits_zero():
+    res = run("grid", "--help")
+    assert res.returncode == 0 and "--set" in res.stdout and "--resume" in res.stdout
