@@ -2,13 +2,18 @@
 #ifndef SIM_INTERNAL_H
 #define SIM_INTERNAL_H
 
+#include <math.h>
+
 #include "icoac_sim/icoac_sim.h"
 
-/* Failure test of spec 3 with strict limits; written so that NaN counts as failure. */
+/* Failure test of spec 3 with strict limits; written so that NaN counts as failure.
+ * Non-finite velocities fail too (icoac_sim_failed contract: "or not finite"); otherwise the
+ * next tick hands them to the controller, which rejects the observation and the cell ends
+ * as ICOAC_SIM_ERROR instead of a failed trial. */
 static inline int32_t sim_failed(const icoac_sim_plant_t *plant, const double s[ICOAC_N_INPUTS])
 {
     return !(s[0] >= -plant->x_limit && s[0] <= plant->x_limit && s[2] >= -plant->theta_limit &&
-             s[2] <= plant->theta_limit);
+             s[2] <= plant->theta_limit && isfinite(s[1]) && isfinite(s[3]));
 }
 
 /* Check the controller configuration, plant and (if not NULL) run parameters. */

@@ -1,2 +1,308 @@
+/* Cart-pole plant against an independent evaluation of spec section 3; failure test;
+ * parameter checks; the paper grid. */
 #include "test_common.h"
-int main(void){return 0;}
+
+#include <stdlib.h>
+
+#include "icoac_sim/icoac_sim.h"
+
+/* Spec 3 rearranged: multiply the theta equation through by (m_c + m_p), then
+ * x_acc = (F + m_p l (thd^2 sin - th_acc cos)) / (m_c + m_p). Long double. */
+static void ref_deriv(const long double s[4], long double force, long double ds[4])
+{
+    const long double g = 9.8L, mc = 1.0L, mp = 0.1L, l = 0.5L;
+    const long double m = mc + mp;
+    const long double sn = sinl(s[2]), cs = cosl(s[2]);
+    const long double th_acc =
+        (m * g * sn - cs * (force + mp * l * s[3] * s[3] * sn)) / (l * (4.0L / 3.0L * m - mp * cs * cs));
+    const long double x_acc = (force + mp * l * (s[3] * s[3] * sn - th_acc * cs)) / m;
+    ds[0] = s[1];
+    ds[1] = x_acc;
+    ds[2] = s[3];
+    ds[3] = th_acc;
+}
+
+static void ref_euler(long double s[4], long double force, long double dt)
+{
+    long double ds[4];
+    int i;
+    ref_deriv(s, force, ds);
+    for (i = 0; i < 4; ++i) {
+        s[i] += dt * ds[i];
+    }
+}
+
+static void ref_rk4(long double s[4], long double force, long double dt)
+{
+    long double k[4][4], t[4];
+    int i, stage;
+    static const long double frac[4] = {0.0L, 0.5L, 0.5L, 1.0L};
+    for (stage = 0; stage < 4; ++stage) {
+        for (i = 0; i < 4; ++i) {
+            t[i] = s[i] + (stage ? frac[stage] * dt * k[stage - 1][i] : 0.0L);
+        }
+        ref_deriv(t, force, k[stage]);
+    }
+    for (i = 0; i < 4; ++i) {
+        s[i] += dt / 6.0L * (k[0][i] + 2.0L * k[1][i] + 2.0L * k[2][i] + k[3][i]);
+    }
+}
+
+static const double states[][4] = {
+    {0.0, 0.0, 0.0, 0.0},          {0.5, -0.3, 0.1, 0.4},   {-2.0, 1.5, -0.2, -1.7},
+    {1.2, 0.0, 0.2094, 3.0},       {0.0, 0.0, 1.3, -5.0},   {-0.7, 2.2, -0.05, 0.0},
+};
+static const double forces[] = {0.0, 1.0, -10.0, 37.5, -0.25};
+
+static void check_integrator(int integrator)
+{
+    icoac_sim_plant_t plant;
+    size_t a, f;
+    int i;
+    icoac_sim_plant_default(&plant);
+    plant.integrator = integrator;
+    assert_int_equal(icoac_sim_plant_check(&plant), ICOAC_SIM_OK);
+    for (a = 0; a < sizeof states / sizeof states[0]; ++a) {
+        for (f = 0; f < sizeof forces / sizeof forces[0]; ++f) {
+            double s[4];
+            long double r[4];
+            for (i = 0; i < 4; ++i) {
+                s[i] = states[a][i];
+                r[i] = states[a][i];
+            }
+            assert_int_equal(icoac_sim_plant_step(&plant, s, forces[f]), ICOAC_SIM_OK);
+            if (integrator == ICOAC_SIM_RK4) {
+                ref_rk4(r, forces[f], 0.01L);
+            } else {
+                ref_euler(r, forces[f], 0.01L);
+            }
+            for (i = 0; i < 4; ++i) {
+                assert_close(s[i], (double)r[i], 1e-12);
+            }
+        }
+    }
+}
+
+static void test_euler_step(void **unused)
+{
+    (void)unused;
+    check_integrator(ICOAC_SIM_EULER);
+}
+
+static void test_rk4_step(void **unused)
+{
+    (void)unused;
+    check_integrator(ICOAC_SIM_RK4);
+}
+
+/* Sanity of the reference itself: hand values at the upright and the sign convention. */
+static void test_reference_sanity(void **unused)
+{
+    icoac_sim_plant_t plant;
+    double s[4] = {0, 0, 0, 0};
+    long double ds[4], r[4] = {0, 0, 0, 0};
+    (void)unused;
+    /* upright, F = 1 N: theta_acc = -1/1.1 / (0.5 (4/3 - 0.1/1.1)), x_acc = 1/1.1 - 0.1 * 0.5 * theta_acc / 1.1 */
+    ref_deriv(r, 1.0L, ds);
+    {
+        const double th = -(1.0 / 1.1) / (0.5 * (4.0 / 3.0 - 0.1 / 1.1));
+        assert_close((double)ds[3], th, 1e-15);
+        assert_close((double)ds[1], 1.0 / 1.1 - 0.05 * th / 1.1, 1e-15);
+    }
+    /* pushing +x tips the pole toward -x; a pole leaning +x falls further +x */
+    icoac_sim_plant_default(&plant);
+    assert_int_equal(icoac_sim_plant_step(&plant, s, 10.0), ICOAC_SIM_OK);
+    assert_true(s[1] > 0 && s[3] < 0 && s[0] == 0.0 && s[2] == 0.0); /* Euler: positions use old velocities */
+    s[0] = s[1] = s[3] = 0;
+    s[2] = 0.1;
+    assert_int_equal(icoac_sim_plant_step(&plant, s, 0.0), ICOAC_SIM_OK);
+    assert_true(s[3] > 0);
+    /* RK4 and Euler differ (the switch is effective) */
+    {
+        double e[4] = {0.1, 0.2, 0.1, 0.3}, k[4] = {0.1, 0.2, 0.1, 0.3};
+        assert_int_equal(icoac_sim_plant_step(&plant, e, 3.0), ICOAC_SIM_OK);
+        plant.integrator = ICOAC_SIM_RK4;
+        assert_int_equal(icoac_sim_plant_step(&plant, k, 3.0), ICOAC_SIM_OK);
+        assert_true(fabs(e[0] - k[0]) > 1e-6);
+    }
+    assert_int_equal(icoac_sim_plant_step(NULL, s, 0.0), ICOAC_SIM_ERR_BAD_ARGUMENT);
+    assert_int_equal(icoac_sim_plant_step(&plant, NULL, 0.0), ICOAC_SIM_ERR_BAD_ARGUMENT);
+}
+
+static void test_failure_strict(void **unused)
+{
+    icoac_sim_plant_t plant;
+    const double lim = 12.0 * TEST_PI / 180.0;
+    double s[4];
+    int c;
+    (void)unused;
+    icoac_sim_plant_default(&plant);
+    assert_close(plant.theta_limit, lim, 1e-16);
+    assert_close(plant.x_limit, 2.4, 0.0);
+#define FAILED(x, th) (s[0] = (x), s[1] = 0.3, s[2] = (th), s[3] = -0.2, icoac_sim_failed(&plant, s))
+    assert_int_equal(FAILED(0.0, 0.0), 0);
+    assert_int_equal(FAILED(2.4, 0.0), 0);
+    assert_int_equal(FAILED(-2.4, 0.0), 0);
+    assert_int_equal(FAILED(2.4 + 1e-12, 0.0), 1);
+    assert_int_equal(FAILED(-2.4 - 1e-12, 0.0), 1);
+    assert_int_equal(FAILED(0.0, lim), 0);
+    assert_int_equal(FAILED(0.0, -lim), 0);
+    assert_int_equal(FAILED(2.4, -lim), 0);
+    assert_int_equal(FAILED(0.0, nextafter(lim, 1.0)), 1);
+    assert_int_equal(FAILED(0.0, -nextafter(lim, 1.0)), 1);
+    assert_int_equal(FAILED(0.0, lim + 1e-12), 1);
+    assert_int_equal(FAILED((double)NAN, 0.0), 1);
+    assert_int_equal(FAILED(0.0, (double)NAN), 1);
+    assert_int_equal(FAILED((double)INFINITY, 0.0), 1);
+    assert_int_equal(FAILED(0.0, -(double)INFINITY), 1);
+#undef FAILED
+    /* non-finite velocities: the state is not finite (header contract) */
+    for (c = 1; c <= 3; c += 2) {
+        s[0] = 0.0;
+        s[1] = 0.0;
+        s[2] = 0.0;
+        s[3] = 0.0;
+        s[c] = (double)NAN;
+        assert_int_equal(icoac_sim_failed(&plant, s), 1);
+        s[c] = (double)INFINITY;
+        assert_int_equal(icoac_sim_failed(&plant, s), 1);
+    }
+}
+
+typedef void (*plant_mut)(icoac_sim_plant_t *p);
+#define PMUT(name, body) \
+    static void name(icoac_sim_plant_t *p) { body; }
+PMUT(p_g0, p->gravity = 0)
+PMUT(p_gnan, p->gravity = (double)NAN)
+PMUT(p_mc, p->cart_mass = -1)
+PMUT(p_mp, p->pole_mass = 0)
+PMUT(p_l, p->half_length = (double)INFINITY)
+PMUT(p_dt0, p->dt = 0)
+PMUT(p_dtbig, p->dt = 1.5)
+PMUT(p_xl, p->x_limit = 0)
+PMUT(p_tl, p->theta_limit = (double)NAN)
+PMUT(p_int, p->integrator = 2)
+PMUT(p_intneg, p->integrator = -1)
+
+static void test_plant_and_run_checks(void **unused)
+{
+    static const plant_mut muts[] = {p_g0, p_gnan, p_mc, p_mp, p_l, p_dt0, p_dtbig, p_xl, p_tl, p_int, p_intneg};
+    icoac_sim_plant_t plant;
+    icoac_sim_run_t run;
+    size_t i;
+    (void)unused;
+    icoac_sim_plant_default(&plant);
+    assert_close(plant.gravity, 9.8, 0);
+    assert_close(plant.cart_mass, 1.0, 0);
+    assert_close(plant.pole_mass, 0.1, 0);
+    assert_close(plant.half_length, 0.5, 0);
+    assert_close(plant.dt, 0.01, 0);
+    assert_int_equal(plant.integrator, ICOAC_SIM_EULER);
+    for (i = 0; i < sizeof muts / sizeof muts[0]; ++i) {
+        icoac_sim_plant_default(&plant);
+        muts[i](&plant);
+        assert_int_equal(icoac_sim_plant_check(&plant), ICOAC_SIM_ERR_BAD_PLANT);
+    }
+    assert_int_equal(icoac_sim_plant_check(NULL), ICOAC_SIM_ERR_BAD_ARGUMENT);
+    icoac_sim_run_default(&run);
+    assert_true(run.max_trials == 100000 && run.success_steps == 100000);
+    assert_close(run.init_velocity_noise, 1e-4, 0);
+    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_OK);
+    run.max_trials = 0;
+    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    icoac_sim_run_default(&run);
+    run.success_steps = -1;
+    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    icoac_sim_run_default(&run);
+    run.init_velocity_noise = -1e-4;
+    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    run.init_velocity_noise = (double)NAN;
+    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    run.init_velocity_noise = 0.0;
+    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_OK);
+    assert_int_equal(icoac_sim_run_check(NULL), ICOAC_SIM_ERR_BAD_ARGUMENT);
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : (x > y);
+}
+
+static void test_paper_grid(void **unused)
+{
+    static icoac_sim_cell_t cells[ICOAC_SIM_GRID_CELLS];
+    static icoac_sim_cell_t other[ICOAC_SIM_GRID_CELLS];
+    static uint64_t seeds[ICOAC_SIM_GRID_CELLS];
+    int row, col, i, differ = 0;
+    (void)unused;
+    assert_int_equal(ICOAC_SIM_GRID_CELLS, 1225);
+    assert_int_equal(ICOAC_SIM_GRID_THETAS, 25);
+    assert_int_equal(ICOAC_SIM_GRID_XS, 49);
+    memset(cells, 0x33, sizeof cells);
+    assert_int_equal(icoac_sim_paper_grid(cells, 1225, 42u), ICOAC_SIM_OK);
+    for (row = 0; row < 25; ++row) {
+        for (col = 0; col < 49; ++col) {
+            const icoac_sim_cell_t *c = &cells[row * 49 + col];
+            assert_close(c->theta0, (double)(-12 + row) / 180.0 * TEST_PI, 1e-15);
+            assert_close(c->x0, -2.4 + 0.1 * col, 1e-12);
+            assert_int_equal(c->outcome, ICOAC_SIM_PENDING);
+            assert_int_equal(c->trials, 0);
+            assert_int_equal(c->total_steps, 0);
+        }
+    }
+    /* the corners and centre exactly on the documented values */
+    assert_true(cells[0].x0 == -2.4 && cells[0].theta0 == -12.0 * TEST_PI / 180.0);
+    assert_close(cells[1224].x0, 2.4, 1e-12);
+    assert_close(cells[1224].theta0, 12.0 * TEST_PI / 180.0, 1e-15);
+    assert_close(cells[12 * 49 + 24].x0, 0.0, 1e-12);
+    assert_true(cells[12 * 49 + 24].theta0 == 0.0);
+    for (i = 0; i < 1225; ++i) {
+        seeds[i] = cells[i].seed;
+    }
+    qsort(seeds, 1225, sizeof seeds[0], cmp_u64);
+    for (i = 1; i < 1225; ++i) {
+        assert_true(seeds[i] != seeds[i - 1]);
+    }
+    /* the grid seed drives the cell seeds, and reproducibly */
+    assert_int_equal(icoac_sim_paper_grid(other, 1225, 42u), ICOAC_SIM_OK);
+    assert_memory_equal(other, cells, sizeof cells);
+    assert_int_equal(icoac_sim_paper_grid(other, 1225, 43u), ICOAC_SIM_OK);
+    for (i = 0; i < 1225; ++i) {
+        differ += other[i].seed != cells[i].seed;
+    }
+    assert_int_equal(differ, 1225);
+    assert_int_equal(icoac_sim_paper_grid(cells, 1224, 42u), ICOAC_SIM_ERR_BAD_ARGUMENT);
+    assert_int_equal(icoac_sim_paper_grid(NULL, 1225, 42u), ICOAC_SIM_ERR_BAD_ARGUMENT);
+}
+
+static void test_sim_sizes_and_strings(void **unused)
+{
+    static const int32_t statuses[] = {ICOAC_SIM_OK, ICOAC_SIM_ERR_BAD_PLANT, ICOAC_SIM_ERR_BAD_RUN,
+                                       ICOAC_SIM_ERR_BAD_ARGUMENT, ICOAC_SIM_ERR_THREAD, ICOAC_SIM_CANCELLED,
+                                       ICOAC_ERR_BAD_PRIOR, 12345};
+    size_t i;
+    (void)unused;
+    assert_int_equal(icoac_sim_abi_version(), ICOAC_SIM_ABI_VERSION);
+    assert_int_equal(icoac_sim_sizeof_plant(), sizeof(icoac_sim_plant_t));
+    assert_int_equal(icoac_sim_sizeof_run(), sizeof(icoac_sim_run_t));
+    assert_int_equal(icoac_sim_sizeof_cell(), sizeof(icoac_sim_cell_t));
+    for (i = 0; i < sizeof statuses / sizeof statuses[0]; ++i) {
+        assert_non_null(icoac_sim_status_str(statuses[i]));
+    }
+    assert_string_equal(icoac_sim_status_str(ICOAC_ERR_BAD_PRIOR), icoac_status_str(ICOAC_ERR_BAD_PRIOR));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_euler_step),
+        cmocka_unit_test(test_rk4_step),
+        cmocka_unit_test(test_reference_sanity),
+        cmocka_unit_test(test_failure_strict),
+        cmocka_unit_test(test_plant_and_run_checks),
+        cmocka_unit_test(test_paper_grid),
+        cmocka_unit_test(test_sim_sizes_and_strings),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
