@@ -117,13 +117,19 @@ def success_title(label: str, summary: Mapping) -> str:
 
 def plot_success_map(cells: np.ndarray, path: str | Path, *, label: str = "ICO",
                      frame: tuple[float, float] | None = None, outline: np.ndarray | None = None,
-                     vmax: float | None = None) -> Path:
-    """Fig. 1b style: colour = trials to success (log scale), failed cells white."""
+                     vmin: float | None = None, vmax: float | None = None) -> Path:
+    """Fig. 1b style: colour = trials to success (log scale, whole decades around the data unless
+    vmin/vmax are given, e.g. to compare conditions), failed cells white."""
     trials = metrics.trials_to_success(cells)
     grid = metrics.to_grid(cells, trials)
     finite = grid[np.isfinite(grid)]
-    hi = vmax if vmax is not None else (max(10.0, float(finite.max())) if finite.size else 10.0)
-    norm = colors.LogNorm(vmin=1.0, vmax=hi)
+    lo_data = float(finite.min()) if finite.size else 1.0
+    hi_data = float(finite.max()) if finite.size else 10.0
+    lo = vmin if vmin is not None else 10.0 ** math.floor(math.log10(max(lo_data, 1.0)))
+    hi = vmax if vmax is not None else 10.0 ** math.ceil(math.log10(max(hi_data, 1.0)))
+    if hi <= lo:
+        hi = lo * 10.0
+    norm = colors.LogNorm(vmin=lo, vmax=hi)
     with plt.rc_context(STYLE):
         fig, ax = plt.subplots(figsize=(6.4, 3.6))
         plot_map(ax, grid, cmap="viridis", norm=norm, title=success_title(label, metrics.summary(cells)),
