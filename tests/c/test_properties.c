@@ -132,7 +132,8 @@ static void warm_up(const icoac_config_t *cfg, icoac_state_t *state)
     icoac_input_t in;
     int k;
     for (k = 0; k < 30; ++k) {
-        in = (k % 7 == 3) ? zone_input(&rng) : calm_input(&rng);
+        /* ends inside the zone so that penalty_prev = -1 (ICO) and x_prev is non-zero */
+        in = (k % 7 == 3 || k >= 28) ? zone_input(&rng) : calm_input(&rng);
         assert_int_equal(icoac_step(cfg, state, &in, &out), ICOAC_OK);
     }
 }
@@ -162,6 +163,9 @@ static void test_nonfinite_inputs(void **unused)
                     icoac_prior_t p = test_prior(0.1, 0.05, 0.3, 0.1, 0.5);
                     assert_int_equal(icoac_init(&cfg, &state, &p, 9u), ICOAC_OK);
                     warm_up(&cfg, &state);
+                    if (cfg.mode == ICOAC_MODE_ICO) {
+                        assert_true(state.penalty_prev == -1);
+                    }
                     twin = state;
                     snapshot = state;
                     in.s[comp] = (icoac_real_t)bad[b];
