@@ -315,6 +315,67 @@ static void test_step_wiring(void **unused)
                  REAL_IS_FLOAT ? 1e-5 : 1e-12);
 }
 
+
+/* act_with_sample: at each reset the acting weights are mu + L n, L L^T = Sigma, n ~ N(0, I)
+ * drawn from the controller's generator (spec 7 "act with a posterior sample"). */
+static void test_posterior_sample_per_trial(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_state_t state;
+    icoac_prior_t p = test_prior(0.1, -0.2, 0.3, 0.05, 0.0);
+    double cov[N][N], lower[N][N];
+    int i, j, k, trial;
+    (void)unused;
+    cfg.mode = ICOAC_MODE_RL;
+    cfg.act_with_sample = 1;
+    /* a full SPD covariance */
+    {
+        const double m[N][N] = {{0.5, 0.1, 0.0, 0.05}, {0.1, 0.4, 0.02, 0.0},
+                                {0.0, 0.02, 0.3, 0.01}, {0.05, 0.0, 0.01, 0.2}};
+        for (i = 0; i < N; ++i) {
+            for (j = 0; j < N; ++j) {
+                p.cov[i][j] = (icoac_real_t)m[i][j];
+                cov[i][j] = (double)p.cov[i][j];
+            }
+        }
+    }
+    /* Cholesky-Banachiewicz in double, independent of icoac_cholesky4 */
+    memset(lower, 0, sizeof lower);
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j <= i; ++j) {
+            double sum = cov[i][j];
+            for (k = 0; k < j; ++k) {
+                sum -= lower[i][k] * lower[j][k];
+            }
+            lower[i][j] = i == j ? sqrt(sum) : sum / lower[j][j];
+        }
+    }
+    assert_int_equal(icoac_init(&cfg, &state, &p, 31u), ICOAC_OK);
+    /* the sample drawn by icoac_init is reproducible from the seed */
+    {
+        icoac_state_t fresh;
+        assert_int_equal(icoac_init(&cfg, &fresh, &p, 31u), ICOAC_OK);
+        assert_memory_equal(fresh.w_act, state.w_act, sizeof fresh.w_act);
+    }
+    /* direct check: draw the normals from a copy of the generator, then reset */
+    for (trial = 0; trial < 5; ++trial) {
+        icoac_rng_t copy = state.rng;
+        double n[N];
+        for (i = 0; i < N; ++i) {
+            n[i] = (double)icoac_rng_normal(&copy);
+        }
+        assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+        for (i = 0; i < N; ++i) {
+            double expect = (double)state.w[i];
+            for (j = 0; j <= i; ++j) {
+                expect += lower[i][j] * n[j];
+            }
+            assert_close(state.w_act[i], expect, REAL_IS_FLOAT ? 1e-6 : 1e-13);
+        }
+        assert_true(memcmp(state.w_act, state.w, sizeof state.w) != 0);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -324,6 +385,7 @@ int main(void)
         cmocka_unit_test(test_long_run_symmetric_pd),
         cmocka_unit_test(test_long_run_with_forgetting),
         cmocka_unit_test(test_step_wiring),
+        cmocka_unit_test(test_posterior_sample_per_trial),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
