@@ -6,7 +6,7 @@
 /* Normalized 1-D Gaussian factors of one coordinate. With centres c_j = -R + (2j+1)R/n and
  * width sigma = R/n, (s - c_j)/sigma = s*n/R + n - 1 - 2j. The smallest squared distance is
  * subtracted before exp, so far-away states never underflow to 0/0. */
-static void dimension_factors(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
+static inline void dimension_factors(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
 {
     const icoac_real_t offset = value * ((icoac_real_t)n / range) + (icoac_real_t)(n - 1);
     icoac_real_t dist[ICOAC_CRITIC_N_THETA];
