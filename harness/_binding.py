@@ -150,6 +150,61 @@ class Prior(ctypes.Structure):
     _fields_ = [("mean", _R4), ("cov", _R44)]
 
 
+class Rng(ctypes.Structure):
+    """icoac_rng_t."""
+    _fields_ = [("state", ctypes.c_uint64), ("increment", ctypes.c_uint64),
+                ("spare_normal", c_real), ("has_spare", ctypes.c_int32)]
+
+
+CRITIC_UNITS = 3 * 3 * 6 * 3
+CRITIC_FACTORS = 3 + 3 + 6 + 3
+INPUT_TERMINAL = 1
+
+
+class State(ctypes.Structure):
+    """icoac_state_t (opaque to callers; mirrored for size checks and direct controller tests)."""
+    _fields_ = [
+        ("magic", ctypes.c_uint32),
+        ("has_prev", ctypes.c_int32),
+        ("inv_range", _R4),
+        ("w", _R4),
+        ("weight_norm", c_real),
+        ("cov", _R44),
+        ("w_act", _R4),
+        ("v", c_real * CRITIC_UNITS),
+        ("factor_prev", c_real * CRITIC_FACTORS),
+        ("x_prev", _R4),
+        ("penalty_prev", c_real),
+        ("value_prev", c_real),
+        ("noise_prev", c_real),
+        ("rng", Rng),
+        ("ticks", ctypes.c_uint32),
+        ("nonfinite_count", ctypes.c_uint32),
+    ]
+
+
+class Input(ctypes.Structure):
+    """icoac_input_t."""
+    _fields_ = [("s", _R4), ("flags", ctypes.c_uint32)]
+
+
+class Output(ctypes.Structure):
+    """icoac_output_t."""
+    _fields_ = [
+        ("force", c_real),
+        ("z", c_real),
+        ("reflex", c_real),
+        ("penalty", c_real),
+        ("q", c_real),
+        ("weight_norm", c_real),
+        ("value", c_real),
+        ("td_error", c_real),
+        ("noise", c_real),
+        ("cov_trace", c_real),
+        ("status", ctypes.c_int32),
+    ]
+
+
 class Plant(ctypes.Structure):
     """icoac_sim_plant_t."""
     _fields_ = [
@@ -212,6 +267,10 @@ _PROTOTYPES = {
     "icoac_status_str": ([ctypes.c_int], ctypes.c_char_p),
     "icoac_config_default": ([_P(Config)], None),
     "icoac_config_check": ([_P(Config)], ctypes.c_int),
+    "icoac_init": ([_P(Config), _P(State), _P(Prior), ctypes.c_uint64], ctypes.c_int),
+    "icoac_reset": ([_P(Config), _P(State)], ctypes.c_int),
+    "icoac_step": ([_P(Config), _P(State), _P(Input), _P(Output)], ctypes.c_int),
+    "icoac_get_posterior": ([_P(State), _P(Prior)], ctypes.c_int),
     "icoac_mix_seed": ([ctypes.c_uint64, ctypes.c_uint64], ctypes.c_uint64),
     "icoac_sim_status_str": ([ctypes.c_int32], ctypes.c_char_p),
     "icoac_sim_plant_default": ([_P(Plant)], None),
@@ -264,6 +323,9 @@ def layout_report() -> dict:
         "sim_abi_version": (SIM_ABI_VERSION, lib.icoac_sim_abi_version()),
         "config": (ctypes.sizeof(Config), lib.icoac_sizeof_config()),
         "prior": (ctypes.sizeof(Prior), lib.icoac_sizeof_prior()),
+        "state": (ctypes.sizeof(State), lib.icoac_sizeof_state()),
+        "input": (ctypes.sizeof(Input), lib.icoac_sizeof_input()),
+        "output": (ctypes.sizeof(Output), lib.icoac_sizeof_output()),
         "plant": (ctypes.sizeof(Plant), lib.icoac_sim_sizeof_plant()),
         "run": (ctypes.sizeof(Run), lib.icoac_sim_sizeof_run()),
         "cell": (CELL_DTYPE.itemsize, lib.icoac_sim_sizeof_cell()),

@@ -30,7 +30,8 @@ ALL_FIELDS = CONTROLLER_FIELDS + PLANT_FIELDS + RUN_FIELDS
 # Named learning conditions: overrides applied on top of the defaults.
 CONDITIONS: dict[str, dict[str, Any]] = {
     "ico": {"mode": "ico"},
-    "rl": {"mode": "rl"},
+    "rl": {"mode": "rl"},       # prior mean 0 (spec A16)
+    "ico-rl": {"mode": "rl"},   # prior from an ICO grid (spec 7)
 }
 
 

@@ -227,3 +227,67 @@ def make_figures(cells: np.ndarray, record: Mapping, out: str | Path, *, label: 
                  f"(cell {state})")
         written.append(plot_trajectory(traj, out / f"{prefix}g_trajectory.png", title=title, cfg=cfg))
     return written
+
+
+def plot_fig3a(path: str | Path, labels: Sequence[str], all_stats: Sequence[Mapping],
+               interior_stats: Sequence[Mapping], paper: Sequence[float | None]) -> Path:
+    """Fig. 3a: mean success rate per condition (+- sd over seeds), all cells and interior cells,
+    with the paper's values (e.g. ~68 % ICO, ~84 % ICO->RL) marked."""
+    def mv(stats):
+        m = [np.nan if s is None or s.get("mean") is None else 100 * s["mean"] for s in stats]
+        e = [0.0 if s is None or s.get("sd") is None else 100 * s["sd"] for s in stats]
+        return np.array(m), np.array(e)
+
+    m_all, e_all = mv(all_stats)
+    m_in, e_in = mv(interior_stats)
+    with plt.rc_context(STYLE):
+        fig, ax = plt.subplots(figsize=(5.0, 3.4))
+        pos = np.arange(len(labels))
+        width = 0.36
+        ax.bar(pos - width / 2, np.nan_to_num(m_all), width, yerr=e_all, capsize=3, color="tab:blue",
+               label="all cells")
+        ax.bar(pos + width / 2, np.nan_to_num(m_in), width, yerr=e_in, capsize=3, color="tab:orange",
+               label="interior cells")
+        first = True
+        for p, value in zip(pos, paper):
+            if value is None:
+                continue
+            ax.hlines(100 * value, p - 0.45, p + 0.45, colors="black", linestyles="--", linewidth=1.2,
+                      label="paper" if first else None)
+            ax.annotate(f"paper ~{100 * value:.0f} %", (p, 100 * value), textcoords="offset points",
+                        xytext=(0, 3), ha="center", fontsize=7)
+            first = False
+        ax.set_xticks(pos)
+        ax.set_xticklabels(labels)
+        ax.set_ylim(0, 105)
+        ax.set_ylabel("success rate (%)")
+        ax.set_title("(a) success rate, mean ± sd over seeds")
+        ax.legend(loc="upper left", frameon=False, fontsize=7)
+        fig.tight_layout()
+        return save_figure(fig, path)
+
+
+def plot_fig3b(path: str | Path, labels: Sequence[str], stats: Sequence[Mapping]) -> Path:
+    """Fig. 3b: mean elapsed simulated time of successful cells per condition (mean +- sd over seeds), log axis."""
+    m = np.array([np.nan if s is None or s.get("mean") is None else s["mean"] for s in stats], dtype=float)
+    e = np.array([0.0 if s is None or s.get("sd") is None else s["sd"] for s in stats], dtype=float)
+    with plt.rc_context(STYLE):
+        fig, ax = plt.subplots(figsize=(4.4, 3.4))
+        pos = np.arange(len(labels))
+        ok = np.isfinite(m) & (m > 0)
+        # Asymmetric error bars clipped above zero so the log axis can show them.
+        lower = np.where(ok, np.minimum(e, m * 0.999), 0.0)
+        ax.bar(pos[ok], m[ok], 0.6, yerr=np.vstack([lower[ok], e[ok]]), capsize=3, color="tab:green")
+        for p in pos[~ok]:
+            ax.annotate("n/a", (p, 1.0), ha="center", fontsize=8)
+        ax.set_yscale("log")
+        if ok.any():
+            lo = 10.0 ** math.floor(math.log10(max(np.min(m[ok] - lower[ok]), 1e-3)))
+            hi = 10.0 ** math.ceil(math.log10(np.max(m[ok] + e[ok]) * 1.01))
+            ax.set_ylim(lo, hi)
+        ax.set_xticks(pos)
+        ax.set_xticklabels(labels)
+        ax.set_ylabel("elapsed simulated time (s)")
+        ax.set_title("(b) time to success, mean ± sd over seeds")
+        fig.tight_layout()
+        return save_figure(fig, path)

@@ -1,0 +1,159 @@
+"""Priors of the RL conditions (spec 7, A15/A16/A17) from the final weights of an ICO grid.
+
+ICO->RL: mean and 4x4 sample covariance (ddof 1) of the final ICO weights of the ICO-successful cells
+inside a frame (default |x0| <= 1.2 m, |theta0| <= 6 deg; or every successful cell), plus ridge * I.
+RL alone: mean 0 and the same covariance (A16), or 1*I (``rl_cov="identity"``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from . import _binding as B
+from . import metrics
+
+DEFAULT_FRAME = (1.2, 6.0)  # |x0| <= 1.2 m, |theta0| <= 6 deg
+DEFAULT_RIDGE = 1e-6
+FRAME_NAMES = ("central", "all")
+_TOL = 1e-9
+
+
+class PriorError(B.ConfigError):
+    """No (or too few) ICO-successful cells to build a prior from, or a bad prior option."""
+
+
+@dataclass
+class PriorInfo:
+    """The prior actually used and where it came from (stored in run.json as ``prior_info``)."""
+    mean: np.ndarray
+    cov: np.ndarray
+    frame: tuple[float, float] | None      # None: every ICO-successful cell
+    n_cells: int
+    ridge: float
+    kind: str = "ico-rl"                   # "ico-rl", "rl" (mean 0) or "rl-identity"
+    source: str | None = None
+    source_commit: str | None = None
+    source_seed: int | None = None
+    ico_phase_simulated_time: float | None = None  # A17: total simulated time of the ICO grid (s)
+    extra: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        out = {
+            "kind": self.kind,
+            "mean": [float(v) for v in self.mean],
+            "cov": [[float(v) for v in row] for row in self.cov],
+            "frame": "all" if self.frame is None else {"x0_abs_max": self.frame[0],
+                                                        "theta0_abs_max_deg": self.frame[1]},
+            "n_cells": int(self.n_cells),
+            "ridge": float(self.ridge),
+            "source": self.source,
+            "source_commit": self.source_commit,
+            "source_seed": self.source_seed,
+            "ico_phase_simulated_time": self.ico_phase_simulated_time,
+        }
+        out.update(self.extra)
+        return out
+
+    def prior(self) -> B.Prior:
+        from .config import make_prior
+        return make_prior(self.mean, self.cov)
+
+
+def frame_mask(cells: np.ndarray, frame: tuple[float, float] | None) -> np.ndarray:
+    """Cells with |x0| <= frame[0] m and |theta0| <= frame[1] deg (every cell when frame is None)."""
+    if frame is None:
+        return np.ones(cells.size, dtype=bool)
+    half_x, half_th = frame
+    return ((np.abs(cells["x0"]) <= half_x + _TOL)
+            & (np.abs(np.degrees(cells["theta0"])) <= half_th + _TOL))
+
+
+def parse_frame(text: str | None, x_max: float | None = None, theta_max_deg: float | None = None
+                ) -> tuple[float, float] | None:
+    """'central' (default, bounds overridable) or 'all' -> frame tuple or None."""
+    name = (text or "central").strip().lower()
+    if name not in FRAME_NAMES:
+        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, f"bad prior frame {text!r}; valid: {', '.join(FRAME_NAMES)}")
+    if name == "all":
+        return None
+    x = DEFAULT_FRAME[0] if x_max is None else float(x_max)
+    th = DEFAULT_FRAME[1] if theta_max_deg is None else float(theta_max_deg)
+    if not (math.isfinite(x) and math.isfinite(th) and x > 0 and th > 0):
+        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, f"prior frame bounds must be > 0, got x {x}, theta {th}")
+    return (x, th)
+
+
+def compute(cells: np.ndarray, frame: tuple[float, float] | None = DEFAULT_FRAME,
+            ridge: float = DEFAULT_RIDGE) -> PriorInfo:
+    """ICO->RL prior from an ICO cell array: successful cells inside frame, mean and sample cov + ridge*I."""
+    if not (math.isfinite(ridge) and ridge >= 0):
+        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, f"prior ridge must be finite and >= 0, got {ridge}")
+    sel = metrics.success_mask(cells) & frame_mask(cells, frame)
+    n = int(np.count_nonzero(sel))
+    where = "any cell" if frame is None else f"|x0| <= {frame[0]:g} m, |theta0| <= {frame[1]:g} deg"
+    if n == 0:
+        raise PriorError(B.SIM_ERR_BAD_ARGUMENT,
+                         f"no ICO-successful cell in the prior frame ({where}); "
+                         "widen the frame or use --prior-frame all")
+    if n < 2:
+        raise PriorError(B.SIM_ERR_BAD_ARGUMENT,
+                         f"only {n} ICO-successful cell in the prior frame ({where}); "
+                         "a sample covariance needs at least 2")
+    w = cells["weights"][sel].astype(np.float64)
+    mean = w.mean(axis=0)
+    cov = np.cov(w, rowvar=False, ddof=1) + ridge * np.eye(B.N_INPUTS)
+    cov = 0.5 * (cov + cov.T)
+    return PriorInfo(mean=mean, cov=cov, frame=frame, n_cells=n, ridge=float(ridge))
+
+
+def rl_prior(ico_rl: PriorInfo | None, rl_cov: str = "ico") -> PriorInfo:
+    """RL-alone prior: mean 0, covariance of the ICO->RL prior (A16) or identity."""
+    if rl_cov == "identity":
+        base = ico_rl
+        return PriorInfo(mean=np.zeros(B.N_INPUTS), cov=np.eye(B.N_INPUTS),
+                         frame=base.frame if base else None, n_cells=base.n_cells if base else 0,
+                         ridge=0.0, kind="rl-identity",
+                         source=base.source if base else None,
+                         source_commit=base.source_commit if base else None,
+                         source_seed=base.source_seed if base else None)
+    if rl_cov != "ico":
+        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, f"bad --rl-cov {rl_cov!r}; valid: ico, identity")
+    if ico_rl is None:
+        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, "condition rl needs --prior-from (or --rl-cov identity)")
+    return PriorInfo(mean=np.zeros(B.N_INPUTS), cov=ico_rl.cov.copy(), frame=ico_rl.frame,
+                     n_cells=ico_rl.n_cells, ridge=ico_rl.ridge, kind="rl", source=ico_rl.source,
+                     source_commit=ico_rl.source_commit, source_seed=ico_rl.source_seed)
+
+
+def from_results(path: str | Path, frame: tuple[float, float] | None = DEFAULT_FRAME,
+                 ridge: float = DEFAULT_RIDGE) -> PriorInfo:
+    """ICO->RL prior from an ICO results directory, with its provenance and ICO-phase simulated time."""
+    from . import results
+
+    path = Path(path)
+    if not path.is_dir():
+        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, f"--prior-from: directory {str(path)!r} does not exist")
+    cells, record = results.load(path)
+    if record.get("condition") != "ico":
+        raise PriorError(B.SIM_ERR_BAD_ARGUMENT,
+                         f"--prior-from: {str(path)!r} holds condition {record.get('condition')!r}, not ico")
+    if not record.get("complete", False):
+        raise PriorError(B.SIM_ERR_BAD_ARGUMENT,
+                         f"--prior-from: {str(path)!r} is incomplete (PENDING cells); finish it with --resume")
+    info = compute(cells, frame, ridge)
+    info.source = str(path.resolve())
+    info.source_commit = (record.get("git") or {}).get("commit")
+    info.source_seed = record.get("seed")
+    info.ico_phase_simulated_time = float(np.sum(cells["elapsed_time"]))
+    info.extra = {"source_cells": int(cells.size), "source_success_rate": record.get("summary", {}).get("success_rate")}
+    return info
+
+
+def load_ico_cells(path: str | Path) -> np.ndarray:
+    from . import results
+    cells, _ = results.load(path)
+    return cells
