@@ -15,6 +15,9 @@ def test_struct_sizes_match_c():
     assert ctypes.sizeof(B.Run) == B.lib.icoac_sim_sizeof_run()
     assert B.CELL_DTYPE.itemsize == B.lib.icoac_sim_sizeof_cell()
     assert ctypes.sizeof(B.c_real) == B.lib.icoac_sizeof_real()
+    assert ctypes.sizeof(B.State) == B.lib.icoac_sizeof_state()
+    assert ctypes.sizeof(B.Input) == B.lib.icoac_sizeof_input()
+    assert ctypes.sizeof(B.Output) == B.lib.icoac_sizeof_output()
     for name, (py, c) in B.layout_report().items():
         assert py == c, name
 

@@ -1,0 +1,283 @@
+"""RL / ICO->RL: priors, RL grids, the Bayesian actor step against numpy, sweep and bench CLI."""
+import csv
+import ctypes
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from harness import _binding as B
+from harness import grid, results
+from harness import prior as P
+from harness.config import build_config, make_prior
+
+REPO = Path(__file__).resolve().parents[2]
+PNG = b"\x89PNG\r\n\x1a\n"
+TINY_RL = {"max_trials": 30, "success_steps": 500}
+
+
+def run_cli(*args, timeout=60):
+    return subprocess.run([sys.executable, "-m", "harness", *args], cwd=REPO, capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def one_line_error(res, words):
+    assert res.returncode == 2, res.stderr
+    assert "Traceback" not in res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("icoac-harness: error: "), res.stderr
+    assert words in lines[0], lines[0]
+
+
+# -- prior computation -----------------------------------------------------------------------------
+def hand_cells():
+    """Six cells: four successful inside the central frame, one successful outside, one failed inside."""
+    cells = np.zeros(6, dtype=B.CELL_DTYPE)
+    xs = [0.0, 1.2, -1.2, 0.5, 2.0, 0.1]
+    th = [0.0, 6.0, -6.0, 3.0, 0.0, 1.0]
+    cells["x0"] = xs
+    cells["theta0"] = np.radians(th)
+    cells["outcome"] = [B.SUCCESS] * 5 + [B.FAILED]
+    rng = np.random.default_rng(3)
+    cells["weights"] = rng.normal(size=(6, 4))
+    return cells
+
+
+def test_prior_exact_mean_cov_and_frame():
+    cells = hand_cells()
+    info = P.compute(cells, P.DEFAULT_FRAME, ridge=1e-3)
+    w = cells["weights"][:4]  # frame bounds are inclusive: x0 = +-1.2 m, theta0 = +-6 deg are in
+    assert info.n_cells == 4
+    np.testing.assert_allclose(info.mean, w.mean(axis=0), rtol=0, atol=1e-15)
+    d = w - w.mean(axis=0)
+    np.testing.assert_allclose(info.cov, d.T @ d / 3 + 1e-3 * np.eye(4), rtol=1e-13, atol=1e-15)
+    assert np.array_equal(info.cov, info.cov.T)
+    # all successful cells
+    every = P.compute(cells, None, ridge=0.0)
+    assert every.n_cells == 5
+    np.testing.assert_allclose(every.cov, np.cov(cells["weights"][:5], rowvar=False))
+    # narrower frame, ridge default
+    narrow = P.compute(cells, (0.6, 3.0))
+    assert narrow.n_cells == 2 and narrow.ridge == P.DEFAULT_RIDGE
+    d = narrow.to_dict()
+    assert d["frame"] == {"x0_abs_max": 0.6, "theta0_abs_max_deg": 3.0} and d["n_cells"] == 2
+    rl = P.rl_prior(info)
+    assert np.all(rl.mean == 0) and np.array_equal(rl.cov, info.cov)
+    assert np.array_equal(P.rl_prior(info, "identity").cov, np.eye(4))
+
+
+def test_prior_errors():
+    cells = hand_cells()
+    failed = cells.copy()
+    failed["outcome"][:4] = B.FAILED  # only the cell at x0 = 2 m (outside the frame) succeeded
+    with pytest.raises(P.PriorError, match="no ICO-successful cell"):
+        P.compute(failed, P.DEFAULT_FRAME)
+    assert P.compute(cells, None).n_cells == 5
+    with pytest.raises(P.PriorError, match="at least 2"):
+        P.compute(cells, (0.05, 0.5))
+    with pytest.raises(P.PriorError):
+        P.compute(cells, ridge=-1.0)
+    with pytest.raises(P.PriorError):
+        P.parse_frame("corner")
+
+
+# -- an ICO results directory shared by the CLI tests ----------------------------------------------
+ICO_CELLS = [0, 610, 611, 612, 613, 1224]
+
+
+@pytest.fixture(scope="module")
+def ico_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ico")
+    cfg = build_config({"max_trials": 6000, "success_steps": 2000})
+    cells = grid.make_cells(0, ICO_CELLS)
+    grid.run_grid(cfg, cells, threads=2, progress=False)
+    results.save(out, cells, cfg, condition="ico", seed=0, wall_time=0.0, threads=2, cell_indices=ICO_CELLS)
+    return out
+
+
+def test_prior_from_results_records_provenance(ico_dir):
+    info = P.from_results(ico_dir)
+    cells, record = results.load(ico_dir)
+    ok = (cells["outcome"] == B.SUCCESS) & (np.abs(cells["x0"]) <= 1.2)
+    assert info.n_cells == int(ok.sum()) >= 2
+    np.testing.assert_allclose(info.mean, cells["weights"][ok].mean(axis=0))
+    assert info.source_commit == record["git"]["commit"]
+    assert info.ico_phase_simulated_time == pytest.approx(float(cells["elapsed_time"].sum()))
+
+
+# -- RL grids ------------------------------------------------------------------------------------------
+def test_rl_grid_deterministic_records_posterior(ico_dir):
+    info = P.from_results(ico_dir)
+    cfg = build_config(TINY_RL, condition="ico-rl", prior=info.prior())
+    assert cfg.controller.mode == 1
+    a = grid.make_cells(5, [300, 611, 900])
+    b = grid.make_cells(5, [300, 611, 900])
+    grid.run_grid(cfg, a, threads=2, progress=False)
+    grid.run_grid(cfg, b, threads=1, progress=False)
+    for f in B.CELL_DTYPE.names:
+        assert np.array_equal(a[f], b[f]), f
+    assert np.all(a["outcome"] != B.PENDING) and np.all(a["status"] == 0)
+    assert not np.array_equal(a["weights"][0], info.mean)  # mu_w learned
+    for cov in a["cov"]:
+        assert np.array_equal(cov, cov.T)
+        assert np.all(np.linalg.eigvalsh(cov) > 0)
+        assert np.trace(cov) < np.trace(info.cov)  # no forgetting: Sigma_w shrinks
+    rl = build_config(TINY_RL, condition="rl", prior=P.rl_prior(info).prior())
+    c = grid.make_cells(5, [611])
+    grid.run_grid(rl, c, progress=False)
+    assert c["outcome"][0] != B.PENDING
+
+
+# -- the Bayesian actor step against the closed-form posterior -----------------------------------------
+def controller(cfg, mean, cov, seed=1):
+    state = B.State()
+    B.check_status(B.lib.icoac_init(ctypes.byref(cfg.controller), ctypes.byref(state),
+                                    ctypes.byref(make_prior(mean, cov)), seed))
+    return state
+
+
+def tick(cfg, state, s, terminal=False):
+    inp = B.Input()
+    for i in range(4):
+        inp.s[i] = s[i]
+    inp.flags = B.INPUT_TERMINAL if terminal else 0
+    out = B.Output()
+    B.check_status(B.lib.icoac_step(ctypes.byref(cfg.controller), ctypes.byref(state), ctypes.byref(inp),
+                                    ctypes.byref(out)))
+    return out
+
+
+def posterior(state):
+    post = B.Prior()
+    B.check_status(B.lib.icoac_get_posterior(ctypes.byref(state), ctypes.byref(post)))
+    return np.array(post.mean, dtype=float), np.array([list(r) for r in post.cov], dtype=float)
+
+
+MU = np.array([0.08, 0.05, 0.3, 0.09])
+A = np.array([[1.0, 0.2, 0.0, 0.1], [0.0, 0.7, 0.3, 0.0], [0.2, 0.0, 0.9, 0.2], [0.0, 0.1, 0.0, 0.5]])
+SIGMA = 0.05 * A @ A.T + 0.01 * np.eye(4)
+S_T = np.array([0.3, -0.4, 0.05, 0.6])  # inside the limits and outside the reflex zone
+S_T1 = np.array([0.31, -0.38, 0.052, 0.58])
+
+
+def closed_form(cfg, mu, sigma, s_t, delta, eps):
+    c = cfg.controller
+    rng = np.array(c.input_range, dtype=float)
+    h = c.gain * np.clip(s_t / rng, -1.0, 1.0)
+    y = h @ mu + c.actor_scale * delta * eps  # u_ob = mu_u + alpha * delta * eps
+    S = h @ sigma @ h + c.noise_std ** 2
+    return mu + sigma @ h * (y - h @ mu) / S, sigma - np.outer(sigma @ h, sigma @ h) / S
+
+
+@pytest.mark.parametrize("noise_std, actor_scale", [(1.0, 0.5), (2.0, 1.0)])
+def test_bayes_step_terminal_matches_closed_form(noise_std, actor_scale):
+    cfg = build_config({"noise_std": noise_std, "actor_scale": actor_scale}, condition="rl")
+    state = controller(cfg, MU, SIGMA, seed=11)
+    out1 = tick(cfg, state, S_T)
+    assert out1.status == 0 and out1.value == 0.0 and out1.noise != 0.0
+    mu0, sig0 = posterior(state)
+    np.testing.assert_allclose(mu0, MU, rtol=1e-6)  # no update on the first tick
+    out2 = tick(cfg, state, S_T1, terminal=True)
+    delta = float(out2.td_error)
+    assert delta == pytest.approx(-1.0)  # r = -1, V(terminal) = 0, V(s_t) = 0
+    mu_ref, cov_ref = closed_form(cfg, mu0, sig0, S_T, delta, float(out1.noise))
+    mu, cov = posterior(state)
+    np.testing.assert_allclose(mu, mu_ref, rtol=2e-5, atol=1e-6)
+    np.testing.assert_allclose(cov, cov_ref, rtol=2e-4, atol=2e-6)
+    assert not np.allclose(mu, MU, rtol=1e-4)
+
+
+def test_bayes_step_zero_td_error_keeps_mean():
+    cfg = build_config({"discount": 0.95}, condition="rl")
+    state = controller(cfg, MU, SIGMA, seed=5)
+    mu0, sig0 = posterior(state)
+    out1 = tick(cfg, state, S_T)
+    out2 = tick(cfg, state, S_T1)  # non-terminal: r = 0, V = 0 (untrained critic) -> delta = 0
+    assert out1.value == 0.0 and out2.value == 0.0 and out2.td_error == 0.0
+    mu, cov = posterior(state)
+    assert np.array_equal(mu, mu0)
+    _, cov_ref = closed_form(cfg, mu0, sig0, S_T, 0.0, float(out1.noise))
+    np.testing.assert_allclose(cov, cov_ref, rtol=2e-4, atol=2e-6)
+
+
+# -- CLI: grid, sweep, bench -------------------------------------------------------------------------
+def test_cli_grid_ico_rl_records_prior(ico_dir, tmp_path):
+    out = tmp_path / "icorl"
+    res = run_cli("grid", "--condition", "ico-rl", "--prior-from", str(ico_dir), "--out", str(out),
+                  "--cells", "611,612", "--max-trials", "30", "--success-steps", "500", "--quiet")
+    assert res.returncode == 0, res.stderr
+    record = json.loads((out / "run.json").read_text())
+    pi = record["prior_info"]
+    assert record["condition"] == "ico-rl" and record["config"]["controller"]["mode"] == "rl"
+    assert pi["source"] == str(ico_dir.resolve()) and pi["n_cells"] >= 2 and pi["ico_phase_simulated_time"] > 0
+    assert pi["frame"] == {"x0_abs_max": 1.2, "theta0_abs_max_deg": 6.0} and len(pi["cov"]) == 4
+    res = run_cli("grid", "--out", str(out), "--resume", "--quiet")
+    assert res.returncode == 0, res.stderr
+    assert json.loads((out / "run.json").read_text())["prior_info"] == pi
+
+
+@pytest.mark.parametrize("args, words", [
+    (["grid", "--condition", "ico-rl", "--prior-from", "{tmp}/none", "--out", "{tmp}/a"], "does not exist"),
+    (["grid", "--condition", "ico-rl", "--out", "{tmp}/a"], "--prior-from"),
+    (["grid", "--condition", "ico-rl", "--prior-from", "{ico}", "--prior-x", "0.01", "--prior-theta", "0.1",
+      "--out", "{tmp}/a"], "ICO-successful cell in the prior frame"),
+    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "noise_std"], "--param"),
+    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "nosie_std=1,2"], "unknown parameter"),
+    (["sweep", "--prior-from", "{tmp}/none", "--out", "{tmp}/w", "--param", "noise_std=1"], "does not exist"),
+])
+def test_cli_rl_errors(ico_dir, tmp_path, args, words):
+    res = run_cli(*[a.format(tmp=tmp_path, ico=ico_dir) for a in args])
+    one_line_error(res, words)
+
+
+def test_sweep_two_settings_resumable(ico_dir, tmp_path):
+    out = tmp_path / "sweep"
+    args = ["sweep", "--prior-from", str(ico_dir), "--out", str(out), "--param", "noise_std=0.5,2",
+            "--cells", "0,611", "--max-trials", "20", "--success-steps", "500", "--quiet"]
+    res = run_cli(*args)
+    assert res.returncode == 0, res.stderr
+    with open(out / "sweep.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 2 and [r["noise_std"] for r in rows] == ["0.5", "2"]
+    assert rows[0]["n_ico_failed"] == "1" and rows[0]["n_cells"] == "2"
+    assert (out / "sweep.md").read_text().count("\n| ") >= 3
+    res = run_cli(*args)  # resumed: nothing rerun, still two rows
+    assert res.returncode == 0 and res.stderr.count("skipped") == 2
+    with open(out / "sweep.csv", newline="") as fh:
+        assert len(list(csv.DictReader(fh))) == 2
+
+
+def test_bench_quick_writes_comparison(tmp_path):
+    out, fig = tmp_path / "b", tmp_path / "fig"
+    res = run_cli("bench", "--profile", "quick", "--out", str(out), "--figures", str(fig), "--quiet",
+                  "--rl-max-trials", "100", timeout=120)
+    assert res.returncode == 0, res.stderr
+    for name in ("fig2b_icorl_success_map.png", "fig3a_success_rate.png", "fig3b_elapsed_time.png",
+                 "fig1b_success_map.png"):
+        data = (fig / name).read_bytes()
+        assert data[:8] == PNG and len(data) > 5000
+    for cond in ("ico", "ico-rl", "rl"):
+        for seed in (0, 1):
+            assert results.exists(out / cond / f"seed-{seed}")
+    summary = json.loads((out / "summary.json").read_text())
+    assert set(summary) == {"ico", "ico-rl", "rl"} and summary["ico"]["paper"]["success_rate"] == 0.68
+    assert "ICO->RL" in (out / "summary.md").read_text()
+    bench = json.loads((out / "bench.json").read_text())
+    assert bench["complete"] and len(bench["stages"]) == 10
+    icorl = json.loads((out / "ico-rl" / "seed-0" / "run.json").read_text())
+    assert icorl["prior_info"]["source"] == str((out / "ico" / "seed-0").resolve())
+    assert icorl["config"]["run"]["max_trials"] == 100
+    # resume: every grid is complete, nothing reruns, figures are byte-identical
+    before = (fig / "fig3a_success_rate.png").read_bytes()
+    cells_before, _ = results.load(out / "rl" / "seed-1")
+    res = run_cli("bench", "--profile", "quick", "--out", str(out), "--figures", str(fig), "--quiet",
+                  "--rl-max-trials", "100", "--resume", timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert (fig / "fig3a_success_rate.png").read_bytes() == before
+    cells_after, record = results.load(out / "rl" / "seed-1")
+    assert np.array_equal(cells_before, cells_after) and record["complete"]
+    assert json.loads((out / "bench.json").read_text())["meta"]["resume"] is True
