@@ -279,7 +279,7 @@ def plot_fig3b(path: str | Path, labels: Sequence[str], stats: Sequence[Mapping]
         lower = np.where(ok, np.minimum(e, m * 0.999), 0.0)
         ax.bar(pos[ok], m[ok], 0.6, yerr=np.vstack([lower[ok], e[ok]]), capsize=3, color="tab:green")
         for p in pos[~ok]:
-            ax.annotate("n/a", (p, 1.0), ha="center", fontsize=8)
+            ax.annotate("no success", (p, 0.03), xycoords=("data", "axes fraction"), ha="center", fontsize=8)
         ax.set_yscale("log")
         if ok.any():
             lo = 10.0 ** math.floor(math.log10(max(np.min(m[ok] - lower[ok]), 1e-3)))

@@ -176,6 +176,11 @@ def run_sweep(args) -> int:
         info = priors[k]
         return info if args.condition == "ico-rl" else P.rl_prior(info, args.rl_cov)
 
+    for setting in todo:  # every setting valid before the first grid runs
+        over = dict(fixed)
+        over.update({k: v for k, v in setting.items() if k not in PRIOR_PARAMS})
+        build_config(over, condition=args.condition, prior=prior_for(setting).prior())
+
     t_all = time.monotonic()
     for i, setting in enumerate(todo, 1):
         key = key_of(setting)

@@ -227,6 +227,8 @@ def test_cli_grid_ico_rl_records_prior(ico_dir, tmp_path):
       "--out", "{tmp}/a"], "ICO-successful cell in the prior frame"),
     (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "noise_std"], "--param"),
     (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "nosie_std=1,2"], "unknown parameter"),
+    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "noise_std=1,-2"], "actor"),
+    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "prior_frame=wide"], "prior_frame"),
     (["sweep", "--prior-from", "{tmp}/none", "--out", "{tmp}/w", "--param", "noise_std=1"], "does not exist"),
 ])
 def test_cli_rl_errors(ico_dir, tmp_path, args, words):
