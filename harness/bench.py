@@ -34,8 +34,9 @@ QUICK_CELLS = sorted(r * B.GRID_XS + c for r in QUICK_ROWS for c in QUICK_COLS)
 
 PROFILES: dict[str, dict[str, Any]] = {
     # ICO at the paper's caps (1e5 trials, 1e5 steps), RL conditions with a reduced trial cap.
-    # Measured on 2 shared cores: ICO full grid 2-3.2 min per seed, ICO->RL (2000 trials) ~2 min
-    # (4.6 s on 49 cells), RL alone (2000) well under a minute (its trials are short): 3 seeds ~ 17 min.
+    # Measured on 2 shared cores (bench --seeds 1): ICO full grid 111 s (193 s under load), ICO->RL
+    # (2000 trials) 72 s, RL alone (2000) 14 s (its trials are short): ~200 s per seed, so 3 seeds take
+    # ~10 min (~16 min under load); 5 seeds would risk the 30 min budget under load.
     "default": {"seeds": 3, "ico": {}, "rl": {"max_trials": 2000}, "cells": None},
     "paper": {"seeds": 5, "ico": {}, "rl": {}, "cells": None},
     "quick": {"seeds": 2, "ico": {"max_trials": 6000, "success_steps": 2000},
