@@ -34,10 +34,10 @@ QUICK_CELLS = sorted(r * B.GRID_XS + c for r in QUICK_ROWS for c in QUICK_COLS)
 
 PROFILES: dict[str, dict[str, Any]] = {
     # ICO at the paper's caps (1e5 trials, 1e5 steps), RL conditions with a reduced trial cap.
-    # Measured on 2 shared cores (bench --seeds 1): ICO full grid 111 s (193 s under load), ICO->RL
-    # (2000 trials) 72 s, RL alone (2000) 14 s (its trials are short): ~200 s per seed, so 3 seeds take
-    # ~10 min (~16 min under load); 5 seeds would risk the 30 min budget under load.
-    "default": {"seeds": 3, "ico": {}, "rl": {"max_trials": 2000}, "cells": None},
+    # Measured on 2 cores (bench --seeds 1): ICO full grid ~111 s, ICO->RL ~72 s at a 2000-trial
+    # cap (most of it in cells that never succeed; successes need a median of ~12 trials), RL alone
+    # ~14 s. With a 1000-trial RL cap, 5 seeds take ~14 min, inside the 30 min budget.
+    "default": {"seeds": 5, "ico": {}, "rl": {"max_trials": 1000}, "cells": None},
     "paper": {"seeds": 5, "ico": {}, "rl": {}, "cells": None},
     "quick": {"seeds": 2, "ico": {"max_trials": 6000, "success_steps": 2000},
               "rl": {"max_trials": 600, "success_steps": 2000}, "cells": QUICK_CELLS},
