@@ -5,12 +5,13 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 VPY := $(VENV)/bin/python
-APT_PACKAGES := cmake ninja-build gcc libc6-dev libcmocka-dev python3 python3-venv git
+APT_PACKAGES := cmake ninja-build gcc libc6-dev libcmocka-dev python3 python3-venv git \
+  gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm binutils-arm-none-eabi
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 BENCH_PROFILE ?= default
 BENCH_OUT ?= results/bench
 
-.PHONY: all deps venv build build-asan test test-c test-asan test-python bench bench-speed clean
+.PHONY: all deps venv build build-asan test test-c test-asan test-python bench bench-speed clean target-report
 
 all: build
 
@@ -54,6 +55,10 @@ bench-speed: build
 
 bench: build venv bench-speed
 	$(VPY) -m harness bench --profile $(BENCH_PROFILE) --out $(BENCH_OUT) --figures docs/figures
+
+# Microcontroller resource report: cross builds, QEMU runs, table in docs/porting.md.
+target-report: deps
+	$(PYTHON) firmware/port/report.py --update docs/porting.md
 
 clean:
 	rm -rf build

@@ -1,0 +1,25 @@
+# Generic bare-metal arm-none-eabi layer. Include it from a per-core file that sets
+# ICOAC_CPU_FLAGS first (cortex-m4f.cmake, cortex-m0plus.cmake).
+set(CMAKE_SYSTEM_NAME Generic)
+set(CMAKE_SYSTEM_PROCESSOR arm)
+
+find_program(ICOAC_ARM_GCC arm-none-eabi-gcc REQUIRED)
+find_program(ICOAC_ARM_AR arm-none-eabi-ar REQUIRED)
+find_program(ICOAC_ARM_OBJCOPY arm-none-eabi-objcopy REQUIRED)
+find_program(ICOAC_ARM_SIZE arm-none-eabi-size REQUIRED)
+find_program(ICOAC_ARM_NM arm-none-eabi-nm REQUIRED)
+set(CMAKE_C_COMPILER ${ICOAC_ARM_GCC})
+set(CMAKE_ASM_COMPILER ${ICOAC_ARM_GCC})
+set(CMAKE_AR ${ICOAC_ARM_AR})
+
+# No host executables can run: try_compile builds a static library instead.
+set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
+
+set(CMAKE_C_FLAGS_INIT "${ICOAC_CPU_FLAGS} -ffunction-sections -fdata-sections")
+set(CMAKE_ASM_FLAGS_INIT "${ICOAC_CPU_FLAGS}")
+set(CMAKE_EXE_LINKER_FLAGS_INIT "${ICOAC_CPU_FLAGS} -Wl,--gc-sections")
+
+set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
+set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
+set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
+set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)

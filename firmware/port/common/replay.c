@@ -1,0 +1,168 @@
+/* Replay of recorded closed-loop sequences; see replay.h. */
+#include "replay.h"
+
+#include <string.h>
+
+#include "recorded_inputs.h"
+
+ICOAC_STATIC_ASSERT(sizeof(icoac_real_t) == sizeof(float), replay_needs_float_build);
+
+char *replay_fmt_u32(char *p, uint32_t v)
+{
+    char tmp[10];
+    int n = 0;
+    do {
+        tmp[n++] = (char)('0' + (v % 10u));
+        v /= 10u;
+    } while (v != 0u);
+    while (n > 0) {
+        *p++ = tmp[--n];
+    }
+    *p = '\0';
+    return p;
+}
+
+char *replay_fmt_hex32(char *p, uint32_t v)
+{
+    static const char digits[] = "0123456789abcdef";
+    int i;
+    for (i = 7; i >= 0; --i) {
+        *p++ = digits[(v >> (4 * i)) & 0xfu];
+    }
+    *p = '\0';
+    return p;
+}
+
+char *replay_fmt_real(char *p, float v)
+{
+    uint32_t bits;
+    double d = (double)v;
+    double ip;
+    uint32_t hi, lo;
+    memcpy(&bits, &v, sizeof bits);
+    p = replay_fmt_hex32(p, bits);
+    *p++ = ':';
+    if (d != d) {
+        memcpy(p, "nan", 4);
+        return p + 3;
+    }
+    if (d < 0.0) {
+        *p++ = '-';
+        d = -d;
+    }
+    if (d >= 4e9) {
+        memcpy(p, "big", 4);
+        return p + 3;
+    }
+    d = d * 1e6 + 0.5; /* 6 decimals, rounded half up */
+    ip = d / 1e6;
+    hi = (uint32_t)ip;
+    lo = (uint32_t)(d - (double)hi * 1e6);
+    if (lo >= 1000000u) {
+        lo -= 1000000u;
+        hi += 1u;
+    }
+    p = replay_fmt_u32(p, hi);
+    *p++ = '.';
+    {
+        char frac[12];
+        char *e = replay_fmt_u32(frac, lo);
+        size_t n = (size_t)(e - frac);
+        while (n < 6u) {
+            *p++ = '0';
+            ++n;
+        }
+        memcpy(p, frac, (size_t)(e - frac) + 1u);
+        p += e - frac;
+    }
+    return p;
+}
+
+static void print_tick(uint32_t i, const icoac_output_t *out)
+{
+    char line[256];
+    char *p = line;
+    const float f[10] = {out->force, out->z, out->reflex, out->penalty, out->q,
+                         out->weight_norm, out->value, out->td_error, out->noise, out->cov_trace};
+    int k;
+    *p++ = 'T';
+    *p++ = ' ';
+    p = replay_fmt_u32(p, i);
+    *p++ = ' ';
+    p = replay_fmt_u32(p, (uint32_t)out->status);
+    for (k = 0; k < 10; ++k) {
+        *p++ = ' ';
+        p = replay_fmt_real(p, f[k]);
+    }
+    *p++ = '\n';
+    *p = '\0';
+    port_puts(line);
+}
+
+static void print_posterior(const icoac_state_t *state)
+{
+    icoac_prior_t post;
+    char line[128];
+    int i, j;
+    (void)icoac_get_posterior(state, &post);
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        char *p = line;
+        *p++ = 'P';
+        *p++ = ' ';
+        p = replay_fmt_real(p, post.mean[i]);
+        for (j = i; j < ICOAC_N_INPUTS; ++j) {
+            *p++ = ' ';
+            p = replay_fmt_real(p, post.cov[i][j]);
+        }
+        *p++ = '\n';
+        *p = '\0';
+        port_puts(line);
+    }
+}
+
+/* Kept in .bss, not on the stack, so the measured stack is the tick's own. */
+static icoac_config_t replay_cfg;
+static icoac_state_t replay_state;
+
+uint32_t replay_run(int32_t mode, replay_step_fn step, int verbose)
+{
+    const replay_tick_t *seq = mode == ICOAC_MODE_RL ? replay_rl : replay_ico;
+    uint32_t n = mode == ICOAC_MODE_RL ? REPLAY_RL_N : REPLAY_ICO_N;
+    uint64_t seed = mode == ICOAC_MODE_RL ? REPLAY_RL_SEED : REPLAY_ICO_SEED;
+    icoac_input_t in;
+    icoac_output_t out;
+    uint32_t i;
+    uintptr_t sp;
+
+    icoac_config_default(&replay_cfg);
+    replay_cfg.mode = mode;
+    if (icoac_config_check(&replay_cfg) != ICOAC_OK ||
+        icoac_init(&replay_cfg, &replay_state, NULL, seed) != ICOAC_OK) {
+        port_puts("E init\n");
+        return 0u;
+    }
+    if (verbose) {
+        port_puts(mode == ICOAC_MODE_RL ? "S rl\n" : "S ico\n");
+    }
+    sp = port_read_sp();
+    if (!verbose) {
+        port_ticks_begin(sp);
+    }
+    for (i = 0u; i < n; ++i) {
+        if ((seq[i].flags & REPLAY_FLAG_RESET) != 0u) {
+            (void)icoac_reset(&replay_cfg, &replay_state);
+        }
+        memcpy(in.s, seq[i].s, sizeof in.s);
+        in.flags = (seq[i].flags & REPLAY_FLAG_TERMINAL) != 0u ? ICOAC_INPUT_TERMINAL : 0u;
+        (void)step(&replay_cfg, &replay_state, &in, &out);
+        if (verbose) {
+            print_tick(i, &out);
+        }
+    }
+    if (!verbose) {
+        port_ticks_end(sp);
+    } else {
+        print_posterior(&replay_state);
+    }
+    return n;
+}

@@ -1,0 +1,41 @@
+/* Replay of recorded closed-loop observation sequences through icoac_step.
+ *
+ * Shared by the target example (main_target.c) and the host reference build
+ * (tests/target/host_main.c), so both run the same code on the same inputs.
+ */
+#ifndef ICOAC_PORT_REPLAY_H
+#define ICOAC_PORT_REPLAY_H
+
+#include <stdint.h>
+
+#include "icoac/icoac.h"
+
+#define REPLAY_FLAG_TERMINAL 1u /* pass ICOAC_INPUT_TERMINAL */
+#define REPLAY_FLAG_RESET 2u    /* call icoac_reset before this tick (new trial) */
+
+typedef struct {
+    float s[ICOAC_N_INPUTS]; /* observation as the host controller saw it */
+    uint8_t flags;           /* REPLAY_FLAG_* */
+} replay_tick_t;
+
+typedef icoac_status_t (*replay_step_fn)(const icoac_config_t *cfg, icoac_state_t *state,
+                                         const icoac_input_t *in, icoac_output_t *out);
+
+/* Provided by the platform (target: semihosting; host: stdout). */
+void port_puts(const char *s);
+/* Called right before and after the tick loop with the stack pointer of the loop's frame
+ * (0 on the host). The target paints the stack and reads its timer here. */
+void port_ticks_begin(uintptr_t sp);
+void port_ticks_end(uintptr_t sp);
+uintptr_t port_read_sp(void);
+
+/* Run sequence mode (ICOAC_MODE_ICO / ICOAC_MODE_RL) with step; print each tick when verbose.
+ * Returns the number of ticks, or 0 on an init error. */
+uint32_t replay_run(int32_t mode, replay_step_fn step, int verbose);
+
+/* Formatting helpers (no printf: newlib's float printf allocates). */
+char *replay_fmt_u32(char *p, uint32_t v);
+char *replay_fmt_hex32(char *p, uint32_t v);
+char *replay_fmt_real(char *p, float v); /* hex bits, ':', decimal with 6 digits */
+
+#endif

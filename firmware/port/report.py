@@ -1,0 +1,95 @@
+#!/usr/bin/env python3
+"""Resource report of the microcontroller targets.
+
+Builds the cortex-m4f and cortex-m0plus presets, runs the port example under QEMU with
+-icount shift=0 (1 instruction = 1 ns of virtual time) and tabulates flash/RAM
+(arm-none-eabi-size), struct sizes, peak stack and instructions per tick.
+
+  python3 firmware/port/report.py                      # print the table
+  python3 firmware/port/report.py --update docs/porting.md   # rewrite the table between markers
+(`make target-report` runs the second form.)
+"""
+import os
+import re
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "tests", "target"))
+import target_check  # noqa: E402
+
+BEGIN, END = "<!-- target-report:begin -->", "<!-- target-report:end -->"
+GOALS = {"cortex-m4f": 3000, "cortex-m0plus": 100000}
+
+
+def size_of(path):
+    """(text, data, bss) summed over every object / the ELF."""
+    out = subprocess.run(["arm-none-eabi-size", "-t", path], check=True, stdout=subprocess.PIPE,
+                         text=True).stdout.splitlines()
+    line = out[-1] if path.endswith(".a") else out[1]
+    text, data, bss = (int(v) for v in line.split()[:3])
+    return text, data, bss
+
+
+def measure(preset):
+    target_check.cmd_build(preset)
+    out = target_check.run_qemu(preset)
+    z = dict(kv.split("=") for kv in re.search(r"^Z (.*)$", out, re.M).group(1).split())
+    cal = dict(kv.split("=") for kv in re.search(r"^C (.*)$", out, re.M).group(1).split())
+    insn_per_count = int(cal["insns"]) / int(cal["systick"])
+    ticks = {}
+    for m in re.finditer(r"^M (\w+) (.*)$", out, re.M):
+        kv = dict(x.split("=") for x in m.group(2).split())
+        n = int(kv["ticks"])
+        net = (int(kv["systick_total"]) - int(kv["systick_base"])) * insn_per_count / n
+        ticks[m.group(1)] = (net, int(kv["stack"]))
+    return {
+        "lib": size_of(target_check.lib(preset)),
+        "elf": size_of(target_check.elf(preset)),
+        "config": int(z["config"]), "state": int(z["state"]),
+        "ico": ticks["ico"], "rl": ticks["rl"], "board": target_check.BOARDS[preset],
+        "insn_per_count": insn_per_count,
+    }
+
+
+def table(results):
+    p = list(results)
+    rows = [("", "goal") + tuple("%s (QEMU `%s`)" % (k, results[k]["board"]) for k in p)]
+    rows.append(("---",) * (len(p) + 2))
+
+    def row(name, goal, fn):
+        rows.append((name, goal) + tuple(fn(results[k], k) for k in p))
+
+    row("library flash: text + data (whole `libicoac.a`)", "", lambda r, k: "%d B" % (r["lib"][0] + r["lib"][1]))
+    row("library RAM: data + bss", "", lambda r, k: "%d B" % (r["lib"][1] + r["lib"][2]))
+    row("example flash: text + data (incl. %s recorded ticks)" % "800", "",
+        lambda r, k: "%d B" % (r["elf"][0] + r["elf"][1]))
+    row("example RAM: data + bss (excl. stack)", "", lambda r, k: "%d B" % (r["elf"][1] + r["elf"][2]))
+    row("`sizeof(icoac_config_t)`", "", lambda r, k: "%d B" % r["config"])
+    row("`sizeof(icoac_state_t)`", "", lambda r, k: "%d B" % r["state"])
+    row("state + config", "<= 4096 B", lambda r, k: "%d B %s" % (r["config"] + r["state"],
+        "ok" if r["config"] + r["state"] <= 4096 else "**over**"))
+    row("peak stack of a tick, ICO (painted)", "<= 512 B",
+        lambda r, k: "%d B %s" % (r["ico"][1], "ok" if r["ico"][1] <= 512 else "**over**"))
+    row("peak stack of a tick, RL (painted)", "<= 512 B",
+        lambda r, k: "%d B %s" % (r["rl"][1], "ok" if r["rl"][1] <= 512 else "**over**"))
+    row("instructions per ICO tick (mean of 400)", "", lambda r, k: "%.0f" % r["ico"][0])
+    row("instructions per RL tick (mean of 400)", "M4F <= 3,000; M0+ <= 100,000",
+        lambda r, k: "%.0f %s" % (r["rl"][0], "ok" if r["rl"][0] <= GOALS[k] else "**over goal**"))
+    return "\n".join("| " + " | ".join(r) + " |" for r in rows) + "\n"
+
+
+def main(argv):
+    results = {p: measure(p) for p in ("cortex-m4f", "cortex-m0plus")}
+    text = table(results)
+    if len(argv) > 2 and argv[1] == "--update":
+        path = argv[2]
+        doc = open(path).read()
+        a, b = doc.index(BEGIN) + len(BEGIN), doc.index(END)
+        open(path, "w").write(doc[:a] + "\n" + text + doc[b:])
+        print("updated", path)
+    print(text)
+
+
+if __name__ == "__main__":
+    main(sys.argv)
