@@ -31,6 +31,47 @@ def size_of(path):
     return text, data, bss
 
 
+def linked_sizes(map_path):
+    """Flash bytes of the example's input sections from libicoac.a and from the C runtime
+    libraries (libm, libc, libgcc), after --gc-sections, read from the linker map."""
+    sums = {"icoac": 0, "runtime": 0}
+    pending = None
+    in_memory_map = False
+    for line in open(map_path):
+        if line.startswith("Linker script and memory map"):
+            in_memory_map = True
+            continue
+        if not in_memory_map or line.startswith("/DISCARD/"):
+            continue
+        m = re.match(r"^ (\.\S+)\s*$", line)
+        if m:
+            pending = m.group(1)
+            continue
+        m = re.match(r"^ (\.\S+)?\s+0x[0-9a-f]+\s+0x([0-9a-f]+)\s+(\S+)\s*$", line)
+        if m:
+            sect = m.group(1) or pending
+            pending = None
+            if not sect or not sect.startswith((".text", ".rodata", ".data")):
+                continue
+            size, obj = int(m.group(2), 16), m.group(3)
+            if "libicoac.a(" in obj:
+                sums["icoac"] += size
+            elif re.search(r"lib(m|c|c_nano|gcc)\.a\(", obj):
+                sums["runtime"] += size
+        else:
+            pending = None
+    return sums
+
+
+def step_frame(preset):
+    """Own frame of icoac_step from the library's -fstack-usage output."""
+    su_dir = os.path.join(target_check.build_dir(preset), "firmware", "CMakeFiles", "icoac.dir", "src")
+    for line in open(os.path.join(su_dir, "icoac_step.c.su")):
+        if ":icoac_step\t" in line:
+            return int(line.split("\t")[1])
+    return -1
+
+
 def measure(preset):
     target_check.cmd_build(preset)
     out = target_check.run_qemu(preset)
@@ -42,10 +83,13 @@ def measure(preset):
         kv = dict(x.split("=") for x in m.group(2).split())
         n = int(kv["ticks"])
         net = (int(kv["systick_total"]) - int(kv["systick_base"])) * insn_per_count / n
-        ticks[m.group(1)] = (net, int(kv["stack"]))
+        worst = (int(kv["systick_max"]) - int(kv["systick_base_max"])) * insn_per_count
+        ticks[m.group(1)] = (net, int(kv["stack"]), worst)
     return {
         "lib": size_of(target_check.lib(preset)),
+        "linked": linked_sizes(target_check.elf(preset)[:-4] + ".map"),
         "elf": size_of(target_check.elf(preset)),
+        "frame": step_frame(preset),
         "config": int(z["config"]), "state": int(z["state"]),
         "ico": ticks["ico"], "rl": ticks["rl"], "board": target_check.BOARDS[preset],
         "insn_per_count": insn_per_count,
@@ -61,6 +105,10 @@ def table(results):
         rows.append((name, goal) + tuple(fn(results[k], k) for k in p))
 
     row("library flash: text + data (whole `libicoac.a`)", "", lambda r, k: "%d B" % (r["lib"][0] + r["lib"][1]))
+    row("library flash linked into the example (after --gc-sections)", "",
+        lambda r, k: "%d B" % r["linked"]["icoac"])
+    row("libm/libc/libgcc flash in the example (float math for the library, memcpy)", "",
+        lambda r, k: "%d B" % r["linked"]["runtime"])
     row("library RAM: data + bss", "", lambda r, k: "%d B" % (r["lib"][1] + r["lib"][2]))
     row("example flash: text + data (incl. %s recorded ticks)" % "800", "",
         lambda r, k: "%d B" % (r["elf"][0] + r["elf"][1]))
@@ -73,9 +121,15 @@ def table(results):
         lambda r, k: "%d B %s" % (r["ico"][1], "ok" if r["ico"][1] <= 512 else "**over**"))
     row("peak stack of a tick, RL (painted)", "<= 512 B",
         lambda r, k: "%d B %s" % (r["rl"][1], "ok" if r["rl"][1] <= 512 else "**over**"))
+    row("`icoac_step` own frame (`-fstack-usage`)", "",
+        lambda r, k: "%d B" % r["frame"])
     row("instructions per ICO tick (mean of 400)", "", lambda r, k: "%.0f" % r["ico"][0])
     row("instructions per RL tick (mean of 400)", "M4F <= 3,000; M0+ <= 100,000",
         lambda r, k: "%.0f %s" % (r["rl"][0], "ok" if r["rl"][0] <= GOALS[k] else "**over goal**"))
+    row("slowest ICO tick (instructions, approx.)", "",
+        lambda r, k: "%.0f +- %.0f" % (r["ico"][2], 2 * r["insn_per_count"]))
+    row("slowest RL tick (instructions, approx.)", "",
+        lambda r, k: "%.0f +- %.0f" % (r["rl"][2], 2 * r["insn_per_count"]))
     return "\n".join("| " + " | ".join(r) + " |" for r in rows) + "\n"
 
 

@@ -6,6 +6,7 @@
 void port_puts(const char *s) { fputs(s, stdout); }
 void port_ticks_begin(uintptr_t sp) { (void)sp; }
 void port_ticks_end(uintptr_t sp) { (void)sp; }
+void port_tick_done(void) {}
 uintptr_t port_read_sp(void) { return 0u; }
 
 int main(void)

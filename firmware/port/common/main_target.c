@@ -22,7 +22,7 @@
 
 extern uint32_t __stack_bottom[];
 
-static uint32_t t_begin, t_end;
+static uint32_t t_begin, t_end, t_last, t_max;
 static uintptr_t stack_low, loop_sp;
 
 void port_puts(const char *s)
@@ -54,7 +54,19 @@ void port_ticks_begin(uintptr_t sp)
     while (p < end) {
         *p++ = STACK_PAINT;
     }
+    t_max = 0u;
     t_begin = timer_now();
+    t_last = t_begin;
+}
+
+void port_tick_done(void)
+{
+    uint32_t now = timer_now();
+    uint32_t d = timer_elapsed(t_last, now);
+    if (d > t_max) {
+        t_max = d;
+    }
+    t_last = now;
 }
 
 void port_ticks_end(uintptr_t sp)
@@ -80,7 +92,7 @@ static icoac_status_t step_stub(const icoac_config_t *cfg, icoac_state_t *state,
 
 static void put_kv(const char *key, uint32_t v)
 {
-    char buf[24];
+    char buf[48];
     char *p = buf;
     *p++ = ' ';
     p = (char *)memcpy(p, key, strlen(key)) + strlen(key);
@@ -101,9 +113,10 @@ static uint32_t calibrate(uint32_t iterations)
 
 static int measure(int32_t mode, const char *name)
 {
-    uint32_t n, base, total, stack;
+    uint32_t n, base, base_max, total, stack;
     n = replay_run(mode, step_stub, 0);
     base = timer_elapsed(t_begin, t_end);
+    base_max = t_max;
     n = replay_run(mode, icoac_step, 0);
     total = timer_elapsed(t_begin, t_end);
     stack = (uint32_t)(loop_sp - stack_low); /* bytes below the tick loop's frame */
@@ -112,6 +125,8 @@ static int measure(int32_t mode, const char *name)
     put_kv("ticks", n);
     put_kv("systick_total", total);
     put_kv("systick_base", base);
+    put_kv("systick_max", t_max);
+    put_kv("systick_base_max", base_max);
     put_kv("stack", stack);
     port_puts("\n");
     return n == 0u;

@@ -157,6 +157,8 @@ uint32_t replay_run(int32_t mode, replay_step_fn step, int verbose)
         (void)step(&replay_cfg, &replay_state, &in, &out);
         if (verbose) {
             print_tick(i, &out);
+        } else {
+            port_tick_done();
         }
     }
     if (!verbose) {

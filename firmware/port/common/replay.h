@@ -27,6 +27,8 @@ void port_puts(const char *s);
  * (0 on the host). The target paints the stack and reads its timer here. */
 void port_ticks_begin(uintptr_t sp);
 void port_ticks_end(uintptr_t sp);
+/* Called after every tick of a non-verbose run (timing of the slowest tick). */
+void port_tick_done(void);
 uintptr_t port_read_sp(void);
 
 /* Run sequence mode (ICOAC_MODE_ICO / ICOAC_MODE_RL) with step; print each tick when verbose.
