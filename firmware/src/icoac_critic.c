@@ -23,7 +23,7 @@ static inline void dimension_factors(icoac_real_t value, icoac_real_t range, int
         nearest = dist[j] < nearest ? dist[j] : nearest;
     }
     for (j = 0; j < n; ++j) {
-        g[j] = ICOAC_EXP(ICOAC_R(-0.5) * (dist[j] - nearest));
+        g[j] = icoac_exp(ICOAC_R(-0.5) * (dist[j] - nearest));
         total += g[j];
     }
     inv_total = ICOAC_R(1.0) / total;

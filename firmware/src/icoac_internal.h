@@ -17,6 +17,46 @@ typedef struct {
     icoac_real_t penalty;
 } icoac_zone_t;
 
+/* exp(a) for the critic. Default: the C library's expf/exp. With ICOAC_FAST_EXP=1 (float
+ * builds; the microcontroller presets turn it on): Cody-Waite reduction a = n ln2 + r,
+ * |r| <= ln2/2, a degree-6 Taylor polynomial for e^r and 2^n from the exponent bits.
+ * Relative error < 1e-6 on [-87, 88] (tests/c/test_fast_exp.c); 0 below -87. */
+#if defined(ICOAC_FAST_EXP) && ICOAC_FAST_EXP && !(defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE)
+static inline float icoac_exp(float a)
+{
+    const float ln2_hi = 0.693145751953125f;
+    const float ln2_lo = 1.42860676533018704e-06f;
+    const float inv_ln2 = 1.44269504088896341f;
+    union {
+        float f;
+        uint32_t u;
+    } scale;
+    float n_real;
+    float r;
+    float p;
+    int32_t n;
+    if (a < -87.0f) {
+        return 0.0f;
+    }
+    if (a > 88.0f) {
+        a = 88.0f;
+    }
+    n_real = a * inv_ln2;
+    n = (int32_t)(n_real < 0.0f ? n_real - 0.5f : n_real + 0.5f);
+    n_real = (float)n;
+    r = (a - n_real * ln2_hi) - n_real * ln2_lo;
+    p = 1.0f + r * (1.0f + r * (0.5f + r * (1.0f / 6.0f + r * (1.0f / 24.0f +
+                                       r * (1.0f / 120.0f + r * (1.0f / 720.0f))))));
+    scale.u = (uint32_t)(n + 127) << 23;
+    return p * scale.f;
+}
+#else
+static inline icoac_real_t icoac_exp(icoac_real_t a)
+{
+    return ICOAC_EXP(a);
+}
+#endif
+
 /* Hot-path helpers: static inline so every tick is one straight-line function. */
 static inline icoac_real_t icoac_clip_unit(icoac_real_t a)
 {
