@@ -271,6 +271,7 @@ _PROTOTYPES = {
     "icoac_reset": ([_P(Config), _P(State)], ctypes.c_int),
     "icoac_step": ([_P(Config), _P(State), _P(Input), _P(Output)], ctypes.c_int),
     "icoac_get_posterior": ([_P(State), _P(Prior)], ctypes.c_int),
+    "icoac_prior_check": ([_P(Prior)], ctypes.c_int),
     "icoac_mix_seed": ([ctypes.c_uint64, ctypes.c_uint64], ctypes.c_uint64),
     "icoac_sim_status_str": ([ctypes.c_int32], ctypes.c_char_p),
     "icoac_sim_plant_default": ([_P(Plant)], None),

@@ -155,7 +155,7 @@ class RunConfig:
         B.check_status(B.lib.icoac_sim_plant_check(ctypes.byref(self.plant)), "plant config")
         B.check_status(B.lib.icoac_sim_run_check(ctypes.byref(self.run)), "run config")
         if self.prior is not None:
-            check_prior(self.controller, self.plant, self.prior)
+            check_prior(self.prior)
         return self
 
 
@@ -182,15 +182,9 @@ def prior_from_dict(data: Mapping[str, Any] | None) -> B.Prior | None:
     return make_prior(data["mean"], data["cov"])
 
 
-def check_prior(controller: B.Config, plant: B.Plant, prior: B.Prior) -> None:
-    """The C library exports no prior check; icoac_init (reached through a one-tick trajectory)
-    is the one implementation of prior validation."""
-    states = np.zeros(2 * B.N_INPUTS)
-    forces = np.zeros(1)
-    n = ctypes.c_int64(0)
-    status = B.lib.icoac_sim_trajectory(ctypes.byref(controller), ctypes.byref(plant), ctypes.byref(prior),
-                                        0.0, 0.0, 0.0, 0, 1, states, forces, ctypes.byref(n))
-    B.check_status(status, "prior")
+def check_prior(prior: B.Prior) -> None:
+    """Prior validation is the C library's (icoac_prior_check, also run by icoac_init)."""
+    B.check_status(B.lib.icoac_prior_check(ctypes.byref(prior)), "prior")
 
 
 def _resolve(name: str) -> str:

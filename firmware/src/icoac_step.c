@@ -4,11 +4,14 @@
 #include <math.h>
 #include <string.h>
 
-static icoac_status_t check_prior(const icoac_prior_t *prior)
+icoac_status_t icoac_prior_check(const icoac_prior_t *prior)
 {
     icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
     int i;
     int j;
+    if (prior == 0) {
+        return ICOAC_ERR_NULL;
+    }
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
         if (!isfinite(prior->mean[i])) {
             return ICOAC_ERR_BAD_PRIOR;
@@ -41,7 +44,7 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state,
     }
     status = icoac_config_check(cfg);
     if (status == ICOAC_OK && prior != 0) {
-        status = check_prior(prior);
+        status = icoac_prior_check(prior);
     }
     if (status != ICOAC_OK) {
         return status;

@@ -220,6 +220,7 @@ static void expect_bad_prior(const icoac_prior_t *prior, const char *name)
     icoac_state_t sentinel;
     icoac_status_t got;
     int mode;
+    assert_int_equal(icoac_prior_check(prior), ICOAC_ERR_BAD_PRIOR);
     for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
         cfg.mode = mode;
         memset(&state, 0x5A, sizeof state);
@@ -276,6 +277,7 @@ static void test_init_prior_copied(void **unused)
     int i, j;
     (void)unused;
     p.cov[0][3] = p.cov[3][0] = (icoac_real_t)0.5;
+    assert_int_equal(icoac_prior_check(&p), ICOAC_OK);
     assert_int_equal(icoac_init(&cfg, &state, &p, 3u), ICOAC_OK);
     assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_OK);
     assert_memory_equal(post.mean, p.mean, sizeof p.mean);
@@ -304,6 +306,7 @@ static void test_null_pointers(void **unused)
     icoac_prior_t post;
     (void)unused;
     assert_int_equal(icoac_config_check(NULL), ICOAC_ERR_NULL);
+    assert_int_equal(icoac_prior_check(NULL), ICOAC_ERR_NULL);
     assert_int_equal(icoac_init(NULL, &state, NULL, 0u), ICOAC_ERR_NULL);
     assert_int_equal(icoac_init(&cfg, NULL, NULL, 0u), ICOAC_ERR_NULL);
     assert_int_equal(icoac_init(&cfg, &state, NULL, 0u), ICOAC_OK);

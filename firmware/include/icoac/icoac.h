@@ -114,6 +114,9 @@ void icoac_config_default(icoac_config_t *cfg);
 /* Validate every field; ICOAC_OK or the status naming the first bad group. */
 icoac_status_t icoac_config_check(const icoac_config_t *cfg);
 
+/* Validate a prior: finite mean, exactly symmetric positive definite covariance. */
+icoac_status_t icoac_prior_check(const icoac_prior_t *prior);
+
 /* Check cfg and prior, then clear state. prior NULL: mean 0, covariance I.
  * In ICO mode the prior mean is the initial w. seed drives exploration noise. */
 icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state,
