@@ -11,7 +11,9 @@ uintptr_t port_read_sp(void) { return 0u; }
 
 int main(void)
 {
-    if (replay_run(ICOAC_MODE_ICO, icoac_step, 1) == 0u || replay_run(ICOAC_MODE_RL, icoac_step, 1) == 0u) {
+    replay_controller_t ctrl;
+    if (replay_run(&ctrl, ICOAC_MODE_ICO, icoac_step, 1) == 0u ||
+        replay_run(&ctrl, ICOAC_MODE_RL, icoac_step, 1) == 0u) {
         return 1;
     }
     port_puts("END\n");

@@ -120,11 +120,7 @@ static void print_posterior(const icoac_state_t *state)
     }
 }
 
-/* Kept in .bss, not on the stack, so the measured stack is the tick's own. */
-static icoac_config_t replay_cfg;
-static icoac_state_t replay_state;
-
-uint32_t replay_run(int32_t mode, replay_step_fn step, int verbose)
+uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step, int verbose)
 {
     const replay_tick_t *seq = mode == ICOAC_MODE_RL ? replay_rl : replay_ico;
     uint32_t n = mode == ICOAC_MODE_RL ? REPLAY_RL_N : REPLAY_ICO_N;
@@ -134,10 +130,10 @@ uint32_t replay_run(int32_t mode, replay_step_fn step, int verbose)
     uint32_t i;
     uintptr_t sp;
 
-    icoac_config_default(&replay_cfg);
-    replay_cfg.mode = mode;
-    if (icoac_config_check(&replay_cfg) != ICOAC_OK ||
-        icoac_init(&replay_cfg, &replay_state, NULL, seed) != ICOAC_OK) {
+    icoac_config_default(&ctrl->cfg);
+    ctrl->cfg.mode = mode;
+    if (icoac_config_check(&ctrl->cfg) != ICOAC_OK ||
+        icoac_init(&ctrl->cfg, &ctrl->state, NULL, seed) != ICOAC_OK) {
         port_puts("E init\n");
         return 0u;
     }
@@ -150,11 +146,11 @@ uint32_t replay_run(int32_t mode, replay_step_fn step, int verbose)
     }
     for (i = 0u; i < n; ++i) {
         if ((seq[i].flags & REPLAY_FLAG_RESET) != 0u) {
-            (void)icoac_reset(&replay_cfg, &replay_state);
+            (void)icoac_reset(&ctrl->cfg, &ctrl->state);
         }
         memcpy(in.s, seq[i].s, sizeof in.s);
         in.flags = (seq[i].flags & REPLAY_FLAG_TERMINAL) != 0u ? ICOAC_INPUT_TERMINAL : 0u;
-        (void)step(&replay_cfg, &replay_state, &in, &out);
+        (void)step(&ctrl->cfg, &ctrl->state, &in, &out);
         if (verbose) {
             print_tick(i, &out);
         } else {
@@ -164,7 +160,7 @@ uint32_t replay_run(int32_t mode, replay_step_fn step, int verbose)
     if (!verbose) {
         port_ticks_end(sp);
     } else {
-        print_posterior(&replay_state);
+        print_posterior(&ctrl->state);
     }
     return n;
 }

@@ -31,9 +31,15 @@ void port_ticks_end(uintptr_t sp);
 void port_tick_done(void);
 uintptr_t port_read_sp(void);
 
-/* Run sequence mode (ICOAC_MODE_ICO / ICOAC_MODE_RL) with step; print each tick when verbose.
- * Returns the number of ticks, or 0 on an init error. */
-uint32_t replay_run(int32_t mode, replay_step_fn step, int verbose);
+/* One controller instance, owned by the caller (the library keeps no state of its own). */
+typedef struct {
+    icoac_config_t cfg;
+    icoac_state_t state;
+} replay_controller_t;
+
+/* Run sequence mode (ICOAC_MODE_ICO / ICOAC_MODE_RL) with step on ctrl (re-initialised);
+ * print each tick when verbose. Returns the number of ticks, or 0 on an init error. */
+uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step, int verbose);
 
 /* Formatting helpers (no printf: newlib's float printf allocates). */
 char *replay_fmt_u32(char *p, uint32_t v);
