@@ -16,7 +16,7 @@ REPO_ROOT = Path(__file__).resolve().parent.parent
 LIBRARY_ENV = "ICOAC_SIM_LIBRARY"
 DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.so"
 
-ABI_VERSION = 1
+ABI_VERSION = 2
 SIM_ABI_VERSION = 1
 N_INPUTS = 4
 GRID_THETAS = 25
@@ -157,8 +157,22 @@ class Rng(ctypes.Structure):
 
 
 CRITIC_UNITS = 3 * 3 * 6 * 3
-CRITIC_FACTORS = 3 + 3 + 6 + 3
+CRITIC_PAIRS = 3 * 3
+CRITIC_CELLS = 6 * 3
 INPUT_TERMINAL = 1
+
+
+class CriticActive(ctypes.Structure):
+    """icoac_critic_active_t: critic units kept at one state."""
+    _fields_ = [
+        ("pair_product", c_real * CRITIC_PAIRS),
+        ("cell_product", c_real * (CRITIC_CELLS + 1)),
+        ("pair", ctypes.c_uint8 * CRITIC_PAIRS),
+        ("pair_cells", ctypes.c_uint8 * CRITIC_PAIRS),
+        ("cell", ctypes.c_uint8 * CRITIC_CELLS),
+        ("pairs", ctypes.c_uint8),
+        ("cells", ctypes.c_uint8),
+    ]
 
 
 class State(ctypes.Structure):
@@ -172,7 +186,8 @@ class State(ctypes.Structure):
         ("cov", _R44),
         ("w_act", _R4),
         ("v", c_real * CRITIC_UNITS),
-        ("factor_prev", c_real * CRITIC_FACTORS),
+        ("active", CriticActive * 2),
+        ("active_slot", ctypes.c_int32),
         ("x_prev", _R4),
         ("penalty_prev", c_real),
         ("value_prev", c_real),

@@ -76,7 +76,7 @@ void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,
     icoac_real_t gain[N];
     icoac_real_t a_cov[N][N];
     icoac_real_t a_cov_h[N];
-    icoac_real_t innovation_var;
+    icoac_real_t inv_innovation_var;
     int i;
     int j;
 
@@ -91,9 +91,9 @@ void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,
     for (i = 0; i < N; ++i) {
         cov_h[i] = icoac_dot4(cov[i], h);
     }
-    innovation_var = icoac_dot4(h, cov_h) + noise_var;
+    inv_innovation_var = ICOAC_R(1.0) / (icoac_dot4(h, cov_h) + noise_var);
     for (i = 0; i < N; ++i) {
-        gain[i] = cov_h[i] / innovation_var;
+        gain[i] = cov_h[i] * inv_innovation_var;
         state->w[i] += gain[i] * innovation;
     }
     for (i = 0; i < N; ++i) {

@@ -66,7 +66,7 @@ void icoac_config_default(icoac_config_t *cfg)
     cfg->critic_range[ICOAC_IDX_X_DOT] = ICOAC_R(3.5);
     cfg->critic_range[ICOAC_IDX_THETA] = ICOAC_R(0.2094384);
     cfg->critic_range[ICOAC_IDX_THETA_DOT] = ICOAC_R(2.0);
-    cfg->critic_threshold = ICOAC_R(0.0);
+    cfg->critic_threshold = ICOAC_R(0.001);
     cfg->noise_std = ICOAC_R(1.0);
     cfg->actor_scale = ICOAC_R(0.5);
     cfg->forgetting = ICOAC_R(1.0);

@@ -1,29 +1,68 @@
 /* Normalized Gaussian critic on the 3x3x6x3 grid (spec 6), evaluated separably:
  * a_k = prod_i f_i(k_i) and sum_k a_k = prod_i sum_j f_i(j), so the normalized
- * activation is b_k = prod_i g_i(k_i) with per-dimension normalized factors g. */
+ * activation is b_k = prod_i g_i(k_i) with per-dimension normalized factors g.
+ * Units with b_k below cfg->critic_threshold count as 0 (spec 6); the value pass lists the
+ * units it kept, and the TD update of the next tick walks that list.
+ * Layout: k = pair * 18 + cell with pair = a*3 + b over (x, x_dot) and cell = c*3 + d over
+ * (theta, theta_dot); b_k is evaluated as (g_x[a] g_xd[b]) * (g_th[c] g_thd[d]).
+ * All factors are <= 1, so a pair or cell product below the threshold rules out every unit it
+ * belongs to. The surviving cells are sorted by product, largest first; the kept units of a
+ * pair are then a leading run of that order, and V sums over them in that order. */
 #include "icoac_internal.h"
 
+#include <float.h>
+
 /* Normalized 1-D Gaussian factors of one coordinate. With centres c_j = -R + (2j+1)R/n and
- * width sigma = R/n, (s - c_j)/sigma = s*n/R + n - 1 - 2j. The smallest squared distance is
- * subtracted before exp, so far-away states never underflow to 0/0. */
+ * width sigma = R/n, (s - c_j)/sigma = d_j = o - 2j with o = s*n/R + n - 1. Relative to the
+ * nearest centre j* (distance d), a_{j*+1}/a_{j*} = exp(2d - 2) =: up, a_{j*-1}/a_{j*} =
+ * exp(-2d - 2) = e^-4 / up, and each further step out multiplies the ratio by e^-4: one
+ * exponential per dimension instead of n. a_{j*} = 1, so far-away states never give 0/0. */
 static inline void dimension_factors(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
 {
+    const icoac_real_t exp_minus_4 = ICOAC_R(0.018315638888734180294);
     const icoac_real_t offset = value * ((icoac_real_t)n / range) + (icoac_real_t)(n - 1);
-    icoac_real_t dist[ICOAC_CRITIC_N_THETA];
-    icoac_real_t nearest;
+    icoac_real_t up = ICOAC_R(0.0);
+    icoac_real_t down = ICOAC_R(0.0);
+    icoac_real_t ratio;
+    icoac_real_t distance;
     icoac_real_t total = ICOAC_R(0.0);
     icoac_real_t inv_total;
+    int nearest;
     int j;
-    for (j = 0; j < n; ++j) {
-        const icoac_real_t d = offset - (icoac_real_t)(2 * j);
-        dist[j] = d * d;
+    if (!(offset > ICOAC_R(0.0))) {
+        nearest = 0;
+    } else if (offset >= (icoac_real_t)(2 * (n - 1))) {
+        nearest = n - 1;
+    } else {
+        nearest = (int)(offset * ICOAC_R(0.5) + ICOAC_R(0.5));
     }
-    nearest = dist[0];
+    distance = offset - (icoac_real_t)(2 * nearest);
+    if (nearest < n - 1) {
+        up = icoac_exp(ICOAC_R(2.0) * distance - ICOAC_R(2.0));
+    }
+    if (nearest > 0) {
+        /* inside the grid |distance| <= 1, so up >= e^-4 and down = e^-4 / up <= 1 */
+        down = nearest < n - 1 ? exp_minus_4 / up : icoac_exp(ICOAC_R(-2.0) * distance - ICOAC_R(2.0));
+    }
+    /* Both chains run over the whole array and select, so no branch depends on nearest. */
+    for (j = 0; j < n; ++j) {
+        g[j] = ICOAC_R(1.0);
+    }
+    ratio = up;
     for (j = 1; j < n; ++j) {
-        nearest = dist[j] < nearest ? dist[j] : nearest;
+        const int above = j > nearest;
+        const icoac_real_t next = g[j - 1] * ratio;
+        g[j] = above ? next : g[j];
+        ratio = above ? ratio * exp_minus_4 : ratio;
+    }
+    ratio = down;
+    for (j = n - 2; j >= 0; --j) {
+        const int below = j < nearest;
+        const icoac_real_t next = g[j + 1] * ratio;
+        g[j] = below ? next : g[j];
+        ratio = below ? ratio * exp_minus_4 : ratio;
     }
     for (j = 0; j < n; ++j) {
-        g[j] = icoac_exp(ICOAC_R(-0.5) * (dist[j] - nearest));
         total += g[j];
     }
     inv_total = ICOAC_R(1.0) / total;
@@ -45,87 +84,122 @@ void icoac_critic_factors(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_
                       ICOAC_CRITIC_N_THETA_DOT, factors);
 }
 
-/* Slow path with the activity threshold: visits every unit with b_k >= threshold. */
-#define ICOAC_FOR_EACH_UNIT(factors, threshold, BODY)                                            \
-    do {                                                                                         \
-        const icoac_real_t *gx_ = (factors);                                                     \
-        const icoac_real_t *gxd_ = gx_ + ICOAC_CRITIC_N_X;                                       \
-        const icoac_real_t *gth_ = gxd_ + ICOAC_CRITIC_N_X_DOT;                                  \
-        const icoac_real_t *gthd_ = gth_ + ICOAC_CRITIC_N_THETA;                                 \
-        int a_, b_, c_, d_, k_ = 0;                                                              \
-        for (a_ = 0; a_ < ICOAC_CRITIC_N_X; ++a_) {                                              \
-            for (b_ = 0; b_ < ICOAC_CRITIC_N_X_DOT; ++b_) {                                      \
-                for (c_ = 0; c_ < ICOAC_CRITIC_N_THETA; ++c_) {                                  \
-                    for (d_ = 0; d_ < ICOAC_CRITIC_N_THETA_DOT; ++d_, ++k_) {                    \
-                        const icoac_real_t unit_b = gx_[a_] * gxd_[b_] * gth_[c_] * gthd_[d_];   \
-                        const int unit_k = k_;                                                   \
-                        if (unit_b >= (threshold)) {                                             \
-                            BODY;                                                                \
-                        }                                                                        \
-                    }                                                                            \
-                }                                                                                \
-            }                                                                                    \
-        }                                                                                        \
-    } while (0)
+#define ICOAC_CELLS ICOAC_CRITIC_CELLS
 
-/* Units are stored with theta_dot fastest: k = ((a*3 + b)*6 + c)*3 + d. The fast paths
- * walk the 54 (a, b, c) prefixes and handle the 3 theta_dot units of each inline. */
-#define ICOAC_PREFIXES (ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT * ICOAC_CRITIC_N_THETA)
-ICOAC_STATIC_ASSERT(ICOAC_CRITIC_N_THETA_DOT == 3, fast_path_expects_three_theta_dot_units);
+/* Units are kept when b_k >= this floor: the threshold, or with threshold 0 the smallest
+ * normal number (b_k below it is 0 under flush-to-zero and adds nothing to V either way). */
+static inline icoac_real_t kept_floor(const icoac_config_t *cfg)
+{
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+    const icoac_real_t smallest_normal = DBL_MIN;
+#else
+    const icoac_real_t smallest_normal = FLT_MIN;
+#endif
+    return cfg->critic_threshold > smallest_normal ? cfg->critic_threshold : smallest_normal;
+}
+
+/* First and one-past-last index of the factors >= threshold (factors are unimodal). */
+static inline void kept_range(const icoac_real_t *g, int n, icoac_real_t threshold, int *begin, int *end)
+{
+    int j = 0;
+    while (j < n && !icoac_nonneg_at_least(g[j], threshold)) {
+        ++j;
+    }
+    *begin = j;
+    while (j < n && icoac_nonneg_at_least(g[j], threshold)) {
+        ++j;
+    }
+    *end = j;
+}
+
+/* Cells with g_th g_thd >= threshold, sorted by product (largest first, ties in cell order). */
+static int sorted_cells(const icoac_real_t *gth, const icoac_real_t *gthd, icoac_real_t threshold,
+                        icoac_critic_active_t *active)
+{
+    int cells = 0;
+    int c_begin, c_end, d_begin, d_end;
+    int c;
+    int d;
+    kept_range(gth, ICOAC_CRITIC_N_THETA, threshold, &c_begin, &c_end);
+    kept_range(gthd, ICOAC_CRITIC_N_THETA_DOT, threshold, &d_begin, &d_end);
+    for (c = c_begin; c < c_end; ++c) {
+        for (d = d_begin; d < d_end; ++d) {
+            const icoac_real_t product = gth[c] * gthd[d];
+            int i = cells;
+            if (!icoac_nonneg_at_least(product, threshold)) {
+                continue;
+            }
+            while (i > 0 && !icoac_nonneg_at_least(active->cell_product[i - 1], product)) {
+                active->cell_product[i] = active->cell_product[i - 1];
+                active->cell[i] = active->cell[i - 1];
+                --i;
+            }
+            active->cell_product[i] = product;
+            active->cell[i] = (uint8_t)(c * ICOAC_CRITIC_N_THETA_DOT + d);
+            ++cells;
+        }
+    }
+    active->cell_product[cells] = ICOAC_R(0.0); /* sentinel: ends every scan of the list */
+    return cells;
+}
 
 icoac_real_t icoac_critic_value(const icoac_config_t *cfg, const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                                const icoac_real_t factors[ICOAC_CRITIC_FACTORS])
+                                const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+                                icoac_critic_active_t *active)
 {
+    const icoac_real_t threshold = kept_floor(cfg);
     const icoac_real_t *gx = factors;
     const icoac_real_t *gxd = gx + ICOAC_CRITIC_N_X;
     const icoac_real_t *gth = gxd + ICOAC_CRITIC_N_X_DOT;
     const icoac_real_t *gthd = gth + ICOAC_CRITIC_N_THETA;
+    const int cells = sorted_cells(gth, gthd, threshold, active);
     icoac_real_t value = ICOAC_R(0.0);
+    int pairs = 0;
     int a;
     int b;
-    int c;
-    if (cfg->critic_threshold > ICOAC_R(0.0)) {
-        ICOAC_FOR_EACH_UNIT(factors, cfg->critic_threshold, value += v[unit_k] * unit_b);
-        return value;
-    }
     for (a = 0; a < ICOAC_CRITIC_N_X; ++a) {
         for (b = 0; b < ICOAC_CRITIC_N_X_DOT; ++b) {
-            const icoac_real_t pab = gx[a] * gxd[b];
-            for (c = 0; c < ICOAC_CRITIC_N_THETA; ++c) {
-                const icoac_real_t *u = v + ((a * ICOAC_CRITIC_N_X_DOT + b) * ICOAC_CRITIC_N_THETA + c) *
-                                                ICOAC_CRITIC_N_THETA_DOT;
-                value += (pab * gth[c]) * ((u[0] * gthd[0] + u[1] * gthd[1]) + u[2] * gthd[2]);
+            const icoac_real_t pair_product = gx[a] * gxd[b];
+            const int pair = a * ICOAC_CRITIC_N_X_DOT + b;
+            const icoac_real_t *u = v + pair * ICOAC_CELLS;
+            const icoac_real_t *product = active->cell_product;
+            const uint8_t *cell = active->cell;
+            icoac_real_t unit_b;
+            int kept;
+            if (!icoac_nonneg_at_least(pair_product, threshold)) {
+                continue;
+            }
+            unit_b = pair_product * *product;
+            while (icoac_nonneg_at_least(unit_b, threshold)) {
+                value += u[*cell++] * unit_b;
+                unit_b = pair_product * *++product;
+            }
+            kept = (int)(cell - active->cell);
+            if (kept > 0) {
+                active->pair_product[pairs] = pair_product;
+                active->pair[pairs] = (uint8_t)pair;
+                active->pair_cells[pairs] = (uint8_t)kept;
+                ++pairs;
             }
         }
     }
+    active->cells = (uint8_t)cells;
+    active->pairs = (uint8_t)pairs;
     return value;
 }
 
-void icoac_critic_update(const icoac_config_t *cfg, icoac_real_t v[ICOAC_CRITIC_UNITS],
-                         const icoac_real_t factors[ICOAC_CRITIC_FACTORS], icoac_real_t step)
+/* v_k += step * b_k over the units listed by icoac_critic_value. */
+void icoac_critic_update(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_critic_active_t *active,
+                         icoac_real_t step)
 {
-    const icoac_real_t *gx = factors;
-    const icoac_real_t *gxd = gx + ICOAC_CRITIC_N_X;
-    const icoac_real_t *gth = gxd + ICOAC_CRITIC_N_X_DOT;
-    const icoac_real_t *gthd = gth + ICOAC_CRITIC_N_THETA;
-    int a;
-    int b;
-    int c;
-    if (cfg->critic_threshold > ICOAC_R(0.0)) {
-        ICOAC_FOR_EACH_UNIT(factors, cfg->critic_threshold, v[unit_k] += step * unit_b);
-        return;
-    }
-    for (a = 0; a < ICOAC_CRITIC_N_X; ++a) {
-        for (b = 0; b < ICOAC_CRITIC_N_X_DOT; ++b) {
-            const icoac_real_t pab = step * gx[a] * gxd[b];
-            for (c = 0; c < ICOAC_CRITIC_N_THETA; ++c) {
-                const icoac_real_t pabc = pab * gth[c];
-                icoac_real_t *u = v + ((a * ICOAC_CRITIC_N_X_DOT + b) * ICOAC_CRITIC_N_THETA + c) *
-                                          ICOAC_CRITIC_N_THETA_DOT;
-                u[0] += pabc * gthd[0];
-                u[1] += pabc * gthd[1];
-                u[2] += pabc * gthd[2];
-            }
+    int p;
+    int i;
+    for (p = 0; p < (int)active->pairs; ++p) {
+        const icoac_real_t pair_step = step * active->pair_product[p];
+        const int kept = active->pair_cells[p];
+        icoac_real_t *u = v + (int)active->pair[p] * ICOAC_CELLS;
+        for (i = 0; i < kept; ++i) {
+            u[active->cell[i]] += pair_step * active->cell_product[i];
         }
     }
 }

@@ -3,6 +3,7 @@
 #define ICOAC_INTERNAL_H
 
 #include <math.h>
+#include <string.h>
 
 #include "icoac/icoac.h"
 
@@ -99,6 +100,32 @@ static inline icoac_real_t icoac_reflex_force(const icoac_config_t *cfg, icoac_r
     return cfg->reflex_mode == ICOAC_REFLEX_GAIN ? cfg->gain * reflex : cfg->reflex_force * reflex;
 }
 
+/* a >= b for non-negative, non-NaN a and b. Such IEEE-754 values order like their bit
+ * patterns, so this is an integer compare: a soft-float compare costs ~40 instructions on a
+ * Cortex-M0+, and the sparse critic makes hundreds per tick. */
+static inline int icoac_nonneg_at_least(icoac_real_t a, icoac_real_t b)
+{
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+    uint64_t bits_a;
+    uint64_t bits_b;
+#else
+    uint32_t bits_a;
+    uint32_t bits_b;
+#endif
+    memcpy(&bits_a, &a, sizeof bits_a);
+    memcpy(&bits_b, &b, sizeof bits_b);
+    return bits_a >= bits_b;
+}
+
+/* dst = src for 4-vectors; inline, as newlib-nano's memcpy copies byte by byte. */
+static inline void icoac_copy4(icoac_real_t dst[ICOAC_N_INPUTS], const icoac_real_t src[ICOAC_N_INPUTS])
+{
+    dst[0] = src[0];
+    dst[1] = src[1];
+    dst[2] = src[2];
+    dst[3] = src[3];
+}
+
 /* Fixed pairwise order: the same result on every target. */
 static inline icoac_real_t icoac_dot4(const icoac_real_t a[ICOAC_N_INPUTS],
                                       const icoac_real_t b[ICOAC_N_INPUTS])
@@ -110,9 +137,10 @@ static inline icoac_real_t icoac_dot4(const icoac_real_t a[ICOAC_N_INPUTS],
 void icoac_critic_factors(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_N_INPUTS],
                           icoac_real_t factors[ICOAC_CRITIC_FACTORS]);
 icoac_real_t icoac_critic_value(const icoac_config_t *cfg, const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                                const icoac_real_t factors[ICOAC_CRITIC_FACTORS]);
-void icoac_critic_update(const icoac_config_t *cfg, icoac_real_t v[ICOAC_CRITIC_UNITS],
-                         const icoac_real_t factors[ICOAC_CRITIC_FACTORS], icoac_real_t step);
+                                const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+                                icoac_critic_active_t *active);
+void icoac_critic_update(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_critic_active_t *active,
+                         icoac_real_t step);
 
 /* Actor (icoac_actor.c). */
 void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,

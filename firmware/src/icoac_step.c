@@ -31,7 +31,8 @@ static void clear_trial(icoac_state_t *state)
     state->value_prev = ICOAC_R(0.0);
     state->noise_prev = ICOAC_R(0.0);
     memset(state->x_prev, 0, sizeof state->x_prev);
-    memset(state->factor_prev, 0, sizeof state->factor_prev);
+    state->active[0].pairs = 0u;
+    state->active[1].pairs = 0u;
 }
 
 icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state,
@@ -79,7 +80,7 @@ icoac_status_t icoac_reset(const icoac_config_t *cfg, icoac_state_t *state)
     if (cfg->mode == ICOAC_MODE_RL && cfg->act_with_sample) {
         icoac_actor_sample(state);
     } else {
-        memcpy(state->w_act, state->w, sizeof state->w_act);
+        icoac_copy4(state->w_act, state->w);
     }
     return ICOAC_OK;
 }
@@ -121,7 +122,7 @@ static void ico_literal_timing(const icoac_config_t *cfg, icoac_state_t *state,
         }
     }
     state->penalty_prev = penalty;
-    memcpy(state->x_prev, scaled, sizeof state->x_prev);
+    icoac_copy4(state->x_prev, scaled);
     state->has_prev = 1;
     out->z = icoac_dot4(state->w, scaled);
 }
@@ -146,10 +147,11 @@ static void rl_tick(const icoac_config_t *cfg, icoac_state_t *state, const icoac
 {
     icoac_real_t factors[ICOAC_CRITIC_FACTORS];
     icoac_real_t value = ICOAC_R(0.0);
+    const int slot_prev = state->active_slot;
     int i;
     if (!terminal) {
         icoac_critic_factors(cfg, s, factors);
-        value = icoac_critic_value(cfg, state->v, factors);
+        value = icoac_critic_value(cfg, state->v, factors, &state->active[slot_prev ^ 1]);
     }
     if (state->has_prev) {
         const icoac_real_t reward = terminal ? ICOAC_R(-1.0) : ICOAC_R(0.0);
@@ -161,7 +163,7 @@ static void rl_tick(const icoac_config_t *cfg, icoac_state_t *state, const icoac
         } else if (delta < -cfg->td_clip) {
             delta = -cfg->td_clip;
         }
-        icoac_critic_update(cfg, state->v, state->factor_prev, cfg->critic_rate * delta);
+        icoac_critic_update(state->v, &state->active[slot_prev], cfg->critic_rate * delta);
         for (i = 0; i < ICOAC_N_INPUTS; ++i) {
             h[i] = cfg->gain * state->x_prev[i];
         }
@@ -171,7 +173,7 @@ static void rl_tick(const icoac_config_t *cfg, icoac_state_t *state, const icoac
         icoac_actor_update(cfg, state, h, innovation);
         state->weight_norm = ICOAC_SQRT(icoac_dot4(state->w, state->w));
         if (!cfg->act_with_sample) {
-            memcpy(state->w_act, state->w, sizeof state->w_act);
+            icoac_copy4(state->w_act, state->w);
         }
         out->td_error = delta;
     }
@@ -187,11 +189,27 @@ static void rl_tick(const icoac_config_t *cfg, icoac_state_t *state, const icoac
     if (cfg->rl_reflex) {
         out->force += icoac_reflex_force(cfg, out->reflex);
     }
-    memcpy(state->factor_prev, factors, sizeof state->factor_prev);
-    memcpy(state->x_prev, scaled, sizeof state->x_prev);
+    state->active_slot = slot_prev ^ 1;
+    icoac_copy4(state->x_prev, scaled);
     state->value_prev = value;
     state->noise_prev = out->noise;
     state->has_prev = 1;
+}
+
+/* Field by field: newlib-nano's memset goes byte by byte. */
+static void clear_output(icoac_output_t *out)
+{
+    out->force = ICOAC_R(0.0);
+    out->z = ICOAC_R(0.0);
+    out->reflex = ICOAC_R(0.0);
+    out->penalty = ICOAC_R(0.0);
+    out->q = ICOAC_R(0.0);
+    out->weight_norm = ICOAC_R(0.0);
+    out->value = ICOAC_R(0.0);
+    out->td_error = ICOAC_R(0.0);
+    out->noise = ICOAC_R(0.0);
+    out->cov_trace = ICOAC_R(0.0);
+    out->status = ICOAC_OK;
 }
 
 icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
@@ -203,7 +221,7 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
     icoac_zone_t zone;
     int terminal;
     if (out != 0) {
-        memset(out, 0, sizeof *out);
+        clear_output(out);
     }
     if (cfg == 0 || state == 0 || in == 0 || out == 0) {
         if (out != 0) {

@@ -1,5 +1,5 @@
-/* NGnet critic (spec 6): separable evaluation against the direct 4-D formula, and the
- * TD(0) update through icoac_step in RL mode. */
+/* NGnet critic (spec 6): separable evaluation against the direct 4-D formula, the activity
+ * threshold and the kept-unit list, and the TD(0) update through icoac_step in RL mode. */
 #include "test_common.h"
 
 #include "icoac_internal.h"
@@ -44,15 +44,34 @@ static void direct_b(const icoac_real_t s_in[4], double b[K])
     }
 }
 
-/* b_k(s) from the library: a critic update with step 1 on v = 0 writes b into v. */
+/* The same with the activity threshold of spec 6: b_k < threshold counts as 0. */
+static void direct_b_kept(const icoac_real_t s_in[4], double threshold, double b[K])
+{
+    int k;
+    direct_b(s_in, b);
+    for (k = 0; k < K; ++k) {
+        b[k] = b[k] < threshold ? 0.0 : b[k];
+    }
+}
+
+/* Too close to the threshold to call, given float rounding of b_k. */
+static int near_threshold(double b, double threshold)
+{
+    return threshold > 0 && fabs(b - threshold) < 1e-5 * threshold;
+}
+
+/* b_k(s) from the library: the value pass lists the kept units, and an update with step 1 on
+ * v = 0 writes their b_k into v. */
 static void library_b(const icoac_config_t *cfg, const icoac_real_t s[4], double b[K])
 {
     icoac_real_t factors[ICOAC_CRITIC_FACTORS];
     icoac_real_t v[K];
+    icoac_critic_active_t active;
     int k;
     memset(v, 0, sizeof v);
     icoac_critic_factors(cfg, s, factors);
-    icoac_critic_update(cfg, v, factors, (icoac_real_t)1.0);
+    assert_true(icoac_critic_value(cfg, v, factors, &active) == 0);
+    icoac_critic_update(v, &active, (icoac_real_t)1.0);
     for (k = 0; k < K; ++k) {
         b[k] = (double)v[k];
     }
@@ -69,6 +88,28 @@ static void random_state(test_rng_t *rng, int far, icoac_real_t s[4])
     for (i = 0; i < 4; ++i) {
         const double scale = far ? (i == 2 ? 20.0 : 15.0) : 1.3;
         s[i] = (icoac_real_t)test_uniform(rng, -scale * ranges[i], scale * ranges[i]);
+    }
+}
+
+/* The integer comparison behind the threshold agrees with >= on non-negative reals. */
+static void test_nonneg_at_least(void **unused)
+{
+    const icoac_real_t special[] = {(icoac_real_t)0.0, (icoac_real_t)1e-45, (icoac_real_t)1e-40,
+                                    (icoac_real_t)1e-38, (icoac_real_t)0.001, (icoac_real_t)0.5,
+                                    (icoac_real_t)1.0, (icoac_real_t)3e38, (icoac_real_t)INFINITY};
+    const int n_special = (int)(sizeof special / sizeof special[0]);
+    test_rng_t rng = {77u};
+    int i, j;
+    (void)unused;
+    for (i = 0; i < n_special; ++i) {
+        for (j = 0; j < n_special; ++j) {
+            assert_int_equal(icoac_nonneg_at_least(special[i], special[j]), special[i] >= special[j]);
+        }
+    }
+    for (i = 0; i < 100000; ++i) {
+        const icoac_real_t a = (icoac_real_t)pow(10.0, test_uniform(&rng, -40, 3));
+        const icoac_real_t b = i % 3 == 0 ? a : (icoac_real_t)pow(10.0, test_uniform(&rng, -40, 3));
+        assert_int_equal(icoac_nonneg_at_least(a, b), a >= b);
     }
 }
 
@@ -89,11 +130,12 @@ static void test_centres_of_spec(void **unused)
 
 static void test_separable_equals_direct(void **unused)
 {
-    const icoac_config_t cfg = test_default_config();
+    icoac_config_t cfg = test_default_config();
     test_rng_t rng = {0xC0FFEEu};
     double bl[K], bd[K];
     int n, k;
     (void)unused;
+    cfg.critic_threshold = 0; /* every unit */
     for (n = 0; n < 400; ++n) {
         icoac_real_t s[4];
         double sum = 0;
@@ -121,27 +163,39 @@ static void test_separable_equals_direct(void **unused)
     }
 }
 
-static void test_value_is_weighted_sum(void **unused)
+static void check_value(icoac_config_t cfg, unsigned seed)
 {
-    const icoac_config_t cfg = test_default_config();
-    test_rng_t rng = {31u};
+    test_rng_t rng = {seed};
     icoac_real_t v[K], factors[ICOAC_CRITIC_FACTORS], s[4];
+    icoac_critic_active_t active;
     double bd[K];
     int n, k;
-    (void)unused;
-    for (n = 0; n < 50; ++n) {
-        double expected = 0;
+    for (n = 0; n < 200; ++n) {
+        double expected = 0, slack = 0;
         for (k = 0; k < K; ++k) {
             v[k] = (icoac_real_t)test_uniform(&rng, -1, 1);
         }
         random_state(&rng, n & 1, s);
         icoac_critic_factors(&cfg, s, factors);
-        direct_b(s, bd);
+        direct_b_kept(s, (double)cfg.critic_threshold, bd);
         for (k = 0; k < K; ++k) {
             expected += (double)v[k] * bd[k];
+            slack += near_threshold(bd[k], (double)cfg.critic_threshold) ? fabs((double)v[k]) * bd[k] : 0;
         }
-        assert_close(icoac_critic_value(&cfg, v, factors), expected, REAL_IS_FLOAT ? 1e-5 : 1e-12);
+        assert_close(icoac_critic_value(&cfg, v, factors, &active), expected,
+                     slack + (REAL_IS_FLOAT ? 1e-5 : 1e-12));
     }
+}
+
+static void test_value_is_weighted_sum(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    (void)unused;
+    check_value(cfg, 31u); /* default threshold 0.001 */
+    cfg.critic_threshold = 0;
+    check_value(cfg, 32u);
+    cfg.critic_threshold = (icoac_real_t)0.05;
+    check_value(cfg, 33u);
 }
 
 static void test_threshold_drops_small_activations(void **unused)
@@ -149,27 +203,85 @@ static void test_threshold_drops_small_activations(void **unused)
     icoac_config_t cfg = test_default_config();
     test_rng_t rng = {8u};
     double bl[K], bd[K];
-    int n, k, dropped = 0;
+    int n, k, dropped = 0, kept = 0;
     (void)unused;
-    cfg.critic_threshold = (icoac_real_t)0.001;
-    for (n = 0; n < 50; ++n) {
+    assert_true(cfg.critic_threshold == (icoac_real_t)0.001); /* the authors' cut-off is the default */
+    for (n = 0; n < 200; ++n) {
         icoac_real_t s[4];
-        random_state(&rng, 0, s);
+        random_state(&rng, n >= 150, s);
         library_b(&cfg, s, bl);
         direct_b(s, bd);
         for (k = 0; k < K; ++k) {
-            if (fabs(bd[k] - 0.001) < 1e-5) {
-                continue; /* too close to the threshold to call */
+            if (near_threshold(bd[k], 0.001)) {
+                continue;
             }
             if (bd[k] < 0.001) {
                 assert_true(bl[k] == 0.0);
                 ++dropped;
             } else {
                 assert_close(bl[k], bd[k], b_tol());
+                ++kept;
             }
         }
     }
-    assert_true(dropped > 0);
+    assert_true(dropped > 0 && kept > 0);
+}
+
+/* The kept-unit list: pairs in order with their leading cells, cells sorted by product with a
+ * zero sentinel, and exactly the units with b_k >= threshold. */
+static void test_kept_unit_list(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    test_rng_t rng = {12u};
+    icoac_real_t factors[ICOAC_CRITIC_FACTORS], v[K], s[4];
+    icoac_critic_active_t active;
+    int n, i, p, total_kept = 0;
+    (void)unused;
+    memset(v, 0, sizeof v);
+    for (n = 0; n < 300; ++n) {
+        double bd[K];
+        int listed[K];
+        random_state(&rng, n % 3 == 2, s);
+        icoac_critic_factors(&cfg, s, factors);
+        (void)icoac_critic_value(&cfg, v, factors, &active);
+        direct_b(s, bd);
+        assert_true(active.cells <= ICOAC_CRITIC_CELLS && active.pairs <= ICOAC_CRITIC_PAIRS);
+        assert_true(active.cell_product[active.cells] == 0);
+        for (i = 1; i < active.cells; ++i) {
+            assert_true(active.cell_product[i - 1] >= active.cell_product[i]);
+        }
+        memset(listed, 0, sizeof listed);
+        for (p = 0; p < active.pairs; ++p) {
+            assert_true(p == 0 || active.pair[p - 1] < active.pair[p]);
+            assert_true(active.pair_cells[p] >= 1 && active.pair_cells[p] <= active.cells);
+            for (i = 0; i < active.pair_cells[p]; ++i) {
+                const int k = active.pair[p] * ICOAC_CRITIC_CELLS + active.cell[i];
+                assert_true(listed[k] == 0);
+                listed[k] = 1;
+            }
+        }
+        for (i = 0; i < K; ++i) {
+            if (!near_threshold(bd[i], 0.001)) {
+                assert_int_equal(listed[i], bd[i] >= 0.001);
+            }
+            total_kept += listed[i];
+        }
+    }
+    assert_true(total_kept > 0 && total_kept < 300 * K / 2); /* the threshold does prune */
+
+    /* threshold 0: a state inside the grid keeps all 162 units */
+    cfg.critic_threshold = 0;
+    s[0] = (icoac_real_t)0.3;
+    s[1] = (icoac_real_t)-0.2;
+    s[2] = (icoac_real_t)0.01;
+    s[3] = (icoac_real_t)0.1;
+    icoac_critic_factors(&cfg, s, factors);
+    (void)icoac_critic_value(&cfg, v, factors, &active);
+    assert_int_equal(active.pairs, ICOAC_CRITIC_PAIRS);
+    assert_int_equal(active.cells, ICOAC_CRITIC_CELLS);
+    for (p = 0; p < active.pairs; ++p) {
+        assert_int_equal(active.pair_cells[p], ICOAC_CRITIC_CELLS);
+    }
 }
 
 static void step_ok(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
@@ -203,7 +315,7 @@ static void test_td_update_through_step(void **unused)
     step_ok(&cfg, &state, &fail_in, &out);
     assert_close(out.td_error, -1.0, 0.0);
     assert_true(out.force == 0);
-    direct_b(st.s, b_t);
+    direct_b_kept(st.s, 0.001, b_t);
     for (k = 0; k < K; ++k) {
         assert_close(state.v[k], -0.6 * b_t[k], b_tol());
         v1[k] = (double)state.v[k];
@@ -211,8 +323,8 @@ static void test_td_update_through_step(void **unused)
 
     /* a non-terminal transition s_a -> s_b: delta = gamma V(s_b) - V(s_a) */
     assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
-    direct_b(sa.s, b_a);
-    direct_b(sb.s, b_b);
+    direct_b_kept(sa.s, 0.001, b_a);
+    direct_b_kept(sb.s, 0.001, b_b);
     for (k = 0; k < K; ++k) {
         va += v1[k] * b_a[k];
         vb += v1[k] * b_b[k];
@@ -247,7 +359,7 @@ static void test_td_clip(void **unused)
     step_ok(&cfg, &state, &st, &out);
     step_ok(&cfg, &state, &fail_in, &out);
     assert_close(out.td_error, -0.25, 0.0);
-    direct_b(st.s, b_t);
+    direct_b_kept(st.s, 0.001, b_t);
     for (k = 0; k < K; ++k) {
         assert_close(state.v[k], -0.5 * 0.25 * b_t[k], b_tol());
     }
@@ -256,10 +368,12 @@ static void test_td_clip(void **unused)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_nonneg_at_least),
         cmocka_unit_test(test_centres_of_spec),
         cmocka_unit_test(test_separable_equals_direct),
         cmocka_unit_test(test_value_is_weighted_sum),
         cmocka_unit_test(test_threshold_drops_small_activations),
+        cmocka_unit_test(test_kept_unit_list),
         cmocka_unit_test(test_td_update_through_step),
         cmocka_unit_test(test_td_clip),
     };

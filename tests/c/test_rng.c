@@ -1,4 +1,4 @@
-/* PCG32 known answers, uniform range, Box-Muller statistics, SplitMix64 seed mixing. */
+/* PCG32 known answers, uniform range, polar-method normals, SplitMix64 seed mixing. */
 #include "test_common.h"
 
 #include "icoac/icoac_rng.h"
@@ -148,26 +148,38 @@ static void test_normal_statistics(void **unused)
     }
 }
 
-/* Box-Muller pairs: z1 = r cos(2 pi u2), z2 = r sin(2 pi u2), r = sqrt(-2 ln(1 - u1)). */
-static void test_normal_box_muller_pairs(void **unused)
+/* Polar-method pairs: from uniforms (u1, u2), u = 2 u1 - 1, v = 2 u2 - 1, points with
+ * s = u^2 + v^2 outside (0, 1) are rejected; an accepted point gives u f and v f with
+ * f = sqrt(-2 ln s / s). The twin generator replays the uniforms. */
+static void test_normal_polar_pairs(void **unused)
 {
     icoac_rng_t rng, twin;
-    int i;
+    int i, rejected = 0;
     (void)unused;
     icoac_rng_seed(&rng, 5u, 6u);
     icoac_rng_seed(&twin, 5u, 6u);
-    for (i = 0; i < 1000; ++i) {
+    for (i = 0; i < 2000; ++i) {
         const double z1 = (double)icoac_rng_normal(&rng);
         const double z2 = (double)icoac_rng_normal(&rng);
-        const double u1 = 1.0 - (double)icoac_rng_uniform(&twin);
-        const double u2 = (double)icoac_rng_uniform(&twin);
-        const double r = sqrt(-2.0 * log(u1));
-        const double tol = REAL_IS_FLOAT ? 2e-5 * (1.0 + r) : 1e-12 * (1.0 + r);
-        assert_close(z1, r * cos(2.0 * TEST_PI * u2), tol);
-        assert_close(z2, r * sin(2.0 * TEST_PI * u2), tol);
-        /* both draws of a pair used exactly two uniforms */
+        double u, v, s, f, tol;
+        for (;;) {
+            u = 2.0 * (double)icoac_rng_uniform(&twin) - 1.0;
+            v = 2.0 * (double)icoac_rng_uniform(&twin) - 1.0;
+            s = u * u + v * v;
+            if (s < 1.0 && s > 0.0) {
+                break;
+            }
+            ++rejected;
+        }
+        f = sqrt(-2.0 * log(s) / s);
+        tol = REAL_IS_FLOAT ? 2e-5 * (1.0 + f) : 1e-12 * (1.0 + f);
+        assert_close(z1, u * f, tol);
+        assert_close(z2, v * f, tol);
+        /* the pair consumed exactly the twin's uniforms, rejections included */
         assert_true(rng.state == twin.state);
     }
+    /* acceptance pi/4: about 0.27 rejections per pair */
+    assert_true(rejected > 400 && rejected < 700);
 }
 
 /* SplitMix64 (Steele, Lea, Flood 2014): the i-th output of a generator seeded with `seed`. */
@@ -206,7 +218,7 @@ int main(void)
         cmocka_unit_test(test_pcg32_matches_reference),
         cmocka_unit_test(test_uniform_range),
         cmocka_unit_test(test_normal_statistics),
-        cmocka_unit_test(test_normal_box_muller_pairs),
+        cmocka_unit_test(test_normal_polar_pairs),
         cmocka_unit_test(test_mix_seed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

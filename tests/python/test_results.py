@@ -22,7 +22,7 @@ def test_save_load_round_trip(tmp_path, small_cfg, small_run):
     assert record["config"]["run"]["max_trials"] == SMALL["max_trials"]
     assert record["config"]["controller"]["gain"] == 10.0
     assert set(record["git"]) == {"commit", "dirty"}
-    assert record["abi"]["abi_version"] == 1 and record["complete"] is True
+    assert record["abi"]["abi_version"] == B.ABI_VERSION and record["complete"] is True
     assert record["summary"]["n_success"] == int((small_run["outcome"] == B.SUCCESS).sum())
     cfg = results.load_config(record)
     assert cfg.to_dict() == small_cfg.to_dict()

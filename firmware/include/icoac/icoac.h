@@ -50,7 +50,7 @@ typedef struct {
     icoac_real_t discount;                      /* gamma per tick, [0, 1]. 0.95 */
     icoac_real_t td_clip;                       /* |delta| limit, > 0. 1 */
     icoac_real_t critic_range[ICOAC_N_INPUTS];  /* critic grid half-widths (SI), > 0. 2.4, 3.5, 0.2094, 2.0 */
-    icoac_real_t critic_threshold;              /* drop normalized activations below this, [0, 1). 0 (off) */
+    icoac_real_t critic_threshold;              /* drop normalized activations below this, [0, 1). 0.001 (code); 0 = dense */
     icoac_real_t noise_std;                     /* sigma_u (N), > 0. 1 */
     icoac_real_t actor_scale;                   /* alpha, >= 0. 0.5 */
     icoac_real_t forgetting;                    /* lambda_f, (0, 1]. 1 (none) */
@@ -64,6 +64,19 @@ typedef struct {
     icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
 } icoac_prior_t;
 
+/* Critic units kept (b_k >= critic_threshold) at one state: the eligibility of the next TD
+ * update. Pair p keeps the units of its first pair_cells[p] cells, in the listed cell order.
+ * Part of the state. */
+typedef struct {
+    icoac_real_t pair_product[ICOAC_CRITIC_PAIRS]; /* g_x * g_xdot of each listed pair */
+    icoac_real_t cell_product[ICOAC_CRITIC_CELLS + 1]; /* g_theta * g_thetadot, largest first; 0 */
+    uint8_t pair[ICOAC_CRITIC_PAIRS];              /* a*3 + b */
+    uint8_t pair_cells[ICOAC_CRITIC_PAIRS];        /* leading cells kept by each pair */
+    uint8_t cell[ICOAC_CRITIC_CELLS];              /* c*3 + d */
+    uint8_t pairs;                                 /* pairs listed */
+    uint8_t cells;                                 /* cells listed */
+} icoac_critic_active_t;
+
 /* Everything the controller owns. Treat as opaque; read it through the output struct. */
 typedef struct {
     uint32_t magic;                                 /* set by icoac_init */
@@ -74,7 +87,8 @@ typedef struct {
     icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* actor covariance Sigma_w */
     icoac_real_t w_act[ICOAC_N_INPUTS];             /* weights used to act (mu_w or a sample) */
     icoac_real_t v[ICOAC_CRITIC_UNITS];             /* critic weights */
-    icoac_real_t factor_prev[ICOAC_CRITIC_FACTORS]; /* normalized 1-D critic factors of s_t */
+    icoac_critic_active_t active[2];                /* kept critic units of s_t and of s */
+    int32_t active_slot;                            /* index of s_t's entry in active */
     icoac_real_t x_prev[ICOAC_N_INPUTS];            /* scaled observation of the previous tick */
     icoac_real_t penalty_prev;                      /* r of the previous ICO observation */
     icoac_real_t value_prev;                        /* V(s_t) */

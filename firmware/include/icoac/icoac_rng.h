@@ -12,7 +12,7 @@ extern "C" {
 typedef struct {
     uint64_t state;             /* LCG state */
     uint64_t increment;         /* stream selector, always odd */
-    icoac_real_t spare_normal;  /* second Box-Muller value */
+    icoac_real_t spare_normal;  /* second value of the last polar-method pair */
     int32_t has_spare;          /* 1 when spare_normal is valid */
 } icoac_rng_t;
 
@@ -25,7 +25,7 @@ uint32_t icoac_rng_next_u32(icoac_rng_t *rng);
 /* Uniform real in [0, 1) (24 bits for float, 32 bits for double). */
 icoac_real_t icoac_rng_uniform(icoac_rng_t *rng);
 
-/* Standard normal N(0, 1) by the Box-Muller transform; constant time per call. */
+/* Standard normal N(0, 1) by the Marsaglia polar method (pairs; one cached). */
 icoac_real_t icoac_rng_normal(icoac_rng_t *rng);
 
 /* SplitMix64 finaliser: decorrelates derived seeds (e.g. seed per grid cell). */

@@ -9,7 +9,7 @@ extern "C" {
 #endif
 
 /* Bump when a public struct layout or an enum value changes. */
-#define ICOAC_ABI_VERSION 1
+#define ICOAC_ABI_VERSION 2
 
 /* Real-number type: float by default; define ICOAC_REAL_DOUBLE=1 for double. */
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
@@ -46,6 +46,9 @@ typedef float icoac_real_t;
     (ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT * ICOAC_CRITIC_N_THETA * ICOAC_CRITIC_N_THETA_DOT)
 #define ICOAC_CRITIC_FACTORS \
     (ICOAC_CRITIC_N_X + ICOAC_CRITIC_N_X_DOT + ICOAC_CRITIC_N_THETA + ICOAC_CRITIC_N_THETA_DOT)
+/* Unit k = pair * CELLS + cell: pair over (x, x_dot), cell over (theta, theta_dot). */
+#define ICOAC_CRITIC_PAIRS (ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT)
+#define ICOAC_CRITIC_CELLS (ICOAC_CRITIC_N_THETA * ICOAC_CRITIC_N_THETA_DOT)
 
 /* Compile-time assertion usable in C99 and C11. */
 #if defined(__STDC_VERSION__) && __STDC_VERSION__ >= 201112L
