@@ -18,7 +18,6 @@ typedef double icoac_real_t;
 #define ICOAC_EXP exp
 #define ICOAC_SQRT sqrt
 #define ICOAC_LOG log
-#define ICOAC_COS cos
 #define ICOAC_FABS fabs
 #else
 typedef float icoac_real_t;
@@ -26,7 +25,6 @@ typedef float icoac_real_t;
 #define ICOAC_EXP expf
 #define ICOAC_SQRT sqrtf
 #define ICOAC_LOG logf
-#define ICOAC_COS cosf
 #define ICOAC_FABS fabsf
 #endif
 
