@@ -214,6 +214,29 @@ static void test_output_status_and_counters(void **unused)
     assert_int_equal(state.nonfinite_count, 0u);
 }
 
+/* Every output field is cleared on entry, so an error leaves no stale value: fill the struct,
+ * call with an uninitialised state, and check every real before status (fields added later
+ * are covered as well). */
+static void test_output_cleared_on_error(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_state_t state;
+    icoac_output_t out;
+    icoac_input_t in = test_input(0.1, 0.0, 0.02, 0.0, 0);
+    const icoac_real_t *reals = (const icoac_real_t *)(const void *)&out;
+    const size_t n_reals = offsetof(icoac_output_t, status) / sizeof(icoac_real_t);
+    size_t i;
+    (void)unused;
+    memset(&state, 0, sizeof state);
+    memset(&out, 0x7F, sizeof out);
+    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_ERR_NOT_INITIALISED);
+    assert_int_equal(out.status, ICOAC_ERR_NOT_INITIALISED);
+    assert_true(n_reals >= 10u);
+    for (i = 0; i < n_reals; ++i) {
+        assert_true(reals[i] == 0);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -222,6 +245,7 @@ int main(void)
         cmocka_unit_test(test_no_penalty_change_no_learning),
         cmocka_unit_test(test_nonfinite_inputs),
         cmocka_unit_test(test_output_status_and_counters),
+        cmocka_unit_test(test_output_cleared_on_error),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
