@@ -16,7 +16,7 @@ REPO_ROOT = Path(__file__).resolve().parent.parent
 LIBRARY_ENV = "ICOAC_SIM_LIBRARY"
 DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.so"
 
-ABI_VERSION = 2
+ABI_VERSION = 3
 SIM_ABI_VERSION = 1
 N_INPUTS = 4
 GRID_THETAS = 25
@@ -29,6 +29,7 @@ OK = 0
 ERR_NULL = 1
 ERR_NOT_INITIALISED = 2
 ERR_NONFINITE_INPUT = 3
+ERR_NUMERIC = 4
 ERR_BAD_MODE = 10
 ERR_BAD_SCALE = 11
 ERR_BAD_GAIN = 12
@@ -195,6 +196,7 @@ class State(ctypes.Structure):
         ("rng", Rng),
         ("ticks", ctypes.c_uint32),
         ("nonfinite_count", ctypes.c_uint32),
+        ("numeric_fault_count", ctypes.c_uint32),
     ]
 
 

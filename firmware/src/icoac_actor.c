@@ -50,9 +50,7 @@ void icoac_actor_sample(icoac_state_t *state)
         normal[i] = icoac_rng_normal(&state->rng);
     }
     if (!icoac_cholesky4(ICOAC_CONST_MAT4(state->cov), lower)) {
-        for (i = 0; i < N; ++i) {
-            state->w_act[i] = state->w[i];
-        }
+        icoac_copy4(state->w_act, state->w);
         return;
     }
     for (i = 0; i < N; ++i) {
@@ -67,11 +65,12 @@ void icoac_actor_sample(icoac_state_t *state)
 /* Sigma' = A Sigma A^T + sigma_u^2 k k^T with A = I - k h^T (Joseph form), evaluated as
  * A Sigma = Sigma - k (Sigma h)^T and (A Sigma) A^T = A Sigma - (A Sigma h) k^T; the upper
  * triangle is mirrored, so Sigma stays exactly symmetric. */
-void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,
-                        const icoac_real_t h[N], icoac_real_t innovation)
+void icoac_actor_update(const icoac_config_t *cfg, const icoac_state_t *state,
+                        const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
+                        icoac_real_t cov[N][N])
 {
     const icoac_real_t noise_var = cfg->noise_std * cfg->noise_std;
-    icoac_real_t (*cov)[N] = state->cov;
+    const icoac_real_t (*prior)[N] = ICOAC_CONST_MAT4(state->cov);
     icoac_real_t cov_h[N];
     icoac_real_t gain[N];
     icoac_real_t a_cov[N][N];
@@ -84,26 +83,28 @@ void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,
         const icoac_real_t inflate = ICOAC_R(1.0) / cfg->forgetting;
         for (i = 0; i < N; ++i) {
             for (j = 0; j < N; ++j) {
-                cov[i][j] *= inflate;
+                cov[i][j] = state->cov[i][j] * inflate;
             }
         }
+        prior = ICOAC_CONST_MAT4(cov);
     }
     for (i = 0; i < N; ++i) {
-        cov_h[i] = icoac_dot4(cov[i], h);
+        cov_h[i] = icoac_dot4(prior[i], h);
     }
     inv_innovation_var = ICOAC_R(1.0) / (icoac_dot4(h, cov_h) + noise_var);
     for (i = 0; i < N; ++i) {
         gain[i] = cov_h[i] * inv_innovation_var;
-        state->w[i] += gain[i] * innovation;
+        w[i] = state->w[i] + gain[i] * innovation;
     }
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
-            a_cov[i][j] = cov[i][j] - gain[i] * cov_h[j];
+            a_cov[i][j] = prior[i][j] - gain[i] * cov_h[j];
         }
     }
     for (i = 0; i < N; ++i) {
         a_cov_h[i] = icoac_dot4(a_cov[i], h);
     }
+    /* written last: cov may be the prior it was computed from */
     for (i = 0; i < N; ++i) {
         for (j = i; j < N; ++j) {
             const icoac_real_t value = a_cov[i][j] - a_cov_h[i] * gain[j] + noise_var * gain[i] * gain[j];

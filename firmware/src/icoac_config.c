@@ -1,20 +1,15 @@
 #include "icoac/icoac.h"
 
-#include <math.h>
-
-static int is_finite(icoac_real_t v)
+/* lo <= v <= hi; false for NaN. */
+static int within(icoac_real_t v, icoac_real_t lo, icoac_real_t hi)
 {
-    return isfinite(v) ? 1 : 0;
+    return v >= lo && v <= hi;
 }
 
-static int positive(icoac_real_t v)
+/* lo < v <= hi; false for NaN. */
+static int above_within(icoac_real_t v, icoac_real_t lo, icoac_real_t hi)
 {
-    return is_finite(v) && v > ICOAC_R(0.0);
-}
-
-static int non_negative(icoac_real_t v)
-{
-    return is_finite(v) && v >= ICOAC_R(0.0);
+    return v > lo && v <= hi;
 }
 
 static int is_flag(int32_t v)
@@ -29,13 +24,14 @@ const char *icoac_status_str(icoac_status_t status)
     case ICOAC_ERR_NULL: return "null pointer";
     case ICOAC_ERR_NOT_INITIALISED: return "state not initialised (call icoac_init)";
     case ICOAC_ERR_NONFINITE_INPUT: return "non-finite observation (ignored, no learning)";
+    case ICOAC_ERR_NUMERIC: return "numeric failure: a value derived in this tick was not finite (force 0, nothing learned)";
     case ICOAC_ERR_BAD_MODE: return "invalid switch (mode, reflex_mode, ico_timing or a 0/1 flag)";
-    case ICOAC_ERR_BAD_SCALE: return "invalid input_range (must be finite and > 0)";
-    case ICOAC_ERR_BAD_GAIN: return "invalid gain or reflex_force (must be finite and >= 0)";
-    case ICOAC_ERR_BAD_ZONE: return "invalid zone_theta or zone_x (must be finite and > 0)";
-    case ICOAC_ERR_BAD_ICO_RATE: return "invalid ico_rate (must be finite and >= 0)";
-    case ICOAC_ERR_BAD_CRITIC: return "invalid critic parameter (rate, discount, td_clip, range, threshold)";
-    case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std > 0, actor_scale >= 0, forgetting in (0, 1])";
+    case ICOAC_ERR_BAD_SCALE: return "invalid input_range (must be in [1e-6, 1e6])";
+    case ICOAC_ERR_BAD_GAIN: return "invalid gain or reflex_force (must be in [0, 1e4])";
+    case ICOAC_ERR_BAD_ZONE: return "invalid zone_theta or zone_x (must be in (0, pi] rad and (0, 1e6] m)";
+    case ICOAC_ERR_BAD_ICO_RATE: return "invalid ico_rate (must be in [0, 1])";
+    case ICOAC_ERR_BAD_CRITIC: return "invalid critic parameter (critic_rate [0, 10], discount [0, 1], td_clip [1e-6, 1e3], critic_range [1e-6, 1e6], critic_threshold [0, 1))";
+    case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std [1e-3, 1e3], actor_scale [0, 1e3], forgetting [0.5, 1])";
     case ICOAC_ERR_BAD_PRIOR: return "invalid prior (mean not finite or covariance not symmetric positive definite)";
     default: return "unknown status";
     }
@@ -87,31 +83,35 @@ icoac_status_t icoac_config_check(const icoac_config_t *cfg)
         return ICOAC_ERR_BAD_MODE;
     }
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-        if (!positive(cfg->input_range[i])) {
+        if (!within(cfg->input_range[i], ICOAC_RANGE_MIN, ICOAC_RANGE_MAX)) {
             return ICOAC_ERR_BAD_SCALE;
         }
     }
-    if (!non_negative(cfg->gain) || !non_negative(cfg->reflex_force)) {
+    if (!within(cfg->gain, ICOAC_R(0.0), ICOAC_GAIN_MAX) ||
+        !within(cfg->reflex_force, ICOAC_R(0.0), ICOAC_FORCE_MAX)) {
         return ICOAC_ERR_BAD_GAIN;
     }
-    if (!positive(cfg->zone_theta) || !positive(cfg->zone_x)) {
+    if (!above_within(cfg->zone_theta, ICOAC_R(0.0), ICOAC_ZONE_THETA_MAX) ||
+        !above_within(cfg->zone_x, ICOAC_R(0.0), ICOAC_ZONE_X_MAX)) {
         return ICOAC_ERR_BAD_ZONE;
     }
-    if (!non_negative(cfg->ico_rate)) {
+    if (!within(cfg->ico_rate, ICOAC_R(0.0), ICOAC_ICO_RATE_MAX)) {
         return ICOAC_ERR_BAD_ICO_RATE;
     }
-    if (!non_negative(cfg->critic_rate) || cfg->critic_rate > ICOAC_R(10.0) ||
-        !non_negative(cfg->discount) || cfg->discount > ICOAC_R(1.0) || !positive(cfg->td_clip) ||
-        !non_negative(cfg->critic_threshold) || cfg->critic_threshold >= ICOAC_R(1.0)) {
+    if (!within(cfg->critic_rate, ICOAC_R(0.0), ICOAC_CRITIC_RATE_MAX) ||
+        !within(cfg->discount, ICOAC_R(0.0), ICOAC_R(1.0)) ||
+        !within(cfg->td_clip, ICOAC_TD_CLIP_MIN, ICOAC_TD_CLIP_MAX) ||
+        !(cfg->critic_threshold >= ICOAC_R(0.0) && cfg->critic_threshold < ICOAC_R(1.0))) {
         return ICOAC_ERR_BAD_CRITIC;
     }
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-        if (!positive(cfg->critic_range[i])) {
+        if (!within(cfg->critic_range[i], ICOAC_RANGE_MIN, ICOAC_RANGE_MAX)) {
             return ICOAC_ERR_BAD_CRITIC;
         }
     }
-    if (!positive(cfg->noise_std) || !non_negative(cfg->actor_scale) || !positive(cfg->forgetting) ||
-        cfg->forgetting > ICOAC_R(1.0)) {
+    if (!within(cfg->noise_std, ICOAC_NOISE_STD_MIN, ICOAC_NOISE_STD_MAX) ||
+        !within(cfg->actor_scale, ICOAC_R(0.0), ICOAC_ACTOR_SCALE_MAX) ||
+        !within(cfg->forgetting, ICOAC_FORGETTING_MIN, ICOAC_R(1.0))) {
         return ICOAC_ERR_BAD_ACTOR;
     }
     return ICOAC_OK;

@@ -139,7 +139,9 @@ static int sorted_cells(const icoac_real_t *gth, const icoac_real_t *gthd, icoac
             ++cells;
         }
     }
-    active->cell_product[cells] = ICOAC_R(0.0); /* sentinel: ends every scan of the list */
+    /* sentinel: at most 6 x 3 cells pass, so it always fits; with a pair product in
+     * [threshold, 1] it ends every scan of the list (threshold >= the smallest normal) */
+    active->cell_product[cells] = ICOAC_R(0.0);
     return cells;
 }
 
@@ -166,7 +168,10 @@ icoac_real_t icoac_critic_value(const icoac_config_t *cfg, const icoac_real_t v[
             const uint8_t *cell = active->cell;
             icoac_real_t unit_b;
             int kept;
-            if (!icoac_nonneg_at_least(pair_product, threshold)) {
+            /* threshold <= pair_product <= 1 as bit patterns: false for NaN, Inf and negative
+             * values, so pair_product * 0 = 0 and the sentinel ends the scan below */
+            if (!icoac_nonneg_at_least(pair_product, threshold) ||
+                !icoac_nonneg_at_least(ICOAC_R(1.0), pair_product)) {
                 continue;
             }
             unit_b = pair_product * *product;

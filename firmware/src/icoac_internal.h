@@ -21,7 +21,7 @@ typedef struct {
 /* exp(a) for the critic. Default: the C library's expf/exp. With ICOAC_FAST_EXP=1 (float
  * builds; the microcontroller presets turn it on): Cody-Waite reduction a = n ln2 + r,
  * |r| <= ln2/2, a degree-6 Taylor polynomial for e^r and 2^n from the exponent bits.
- * Relative error < 1e-6 on [-87, 88] (tests/c/test_fast_exp.c); 0 below -87. */
+ * Relative error < 1e-6 on [-87, 88] (tests/c/test_fast_exp.c); 0 below -87, NaN for NaN. */
 #if defined(ICOAC_FAST_EXP) && ICOAC_FAST_EXP && !(defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE)
 static inline float icoac_exp(float a)
 {
@@ -36,8 +36,8 @@ static inline float icoac_exp(float a)
     float r;
     float p;
     int32_t n;
-    if (a < -87.0f) {
-        return 0.0f;
+    if (!(a >= -87.0f)) {
+        return a != a ? a : 0.0f; /* NaN stays NaN (the tick's finiteness check reports it) */
     }
     if (a > 88.0f) {
         a = 88.0f;
@@ -117,6 +117,26 @@ static inline int icoac_nonneg_at_least(icoac_real_t a, icoac_real_t b)
     return bits_a >= bits_b;
 }
 
+/* 1 when every one of the n values is finite. An IEEE-754 value is NaN or Inf exactly when its
+ * exponent bits are all ones: integer operations only, no branch per value, cheap in soft float. */
+static inline int icoac_all_finite(const icoac_real_t *values, int n)
+{
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+    const uint64_t exponent = 0x7FF0000000000000ull;
+    uint64_t bits;
+#else
+    const uint32_t exponent = 0x7F800000u;
+    uint32_t bits;
+#endif
+    int bad = 0;
+    int i;
+    for (i = 0; i < n; ++i) {
+        memcpy(&bits, &values[i], sizeof bits);
+        bad |= (bits & exponent) == exponent;
+    }
+    return !bad;
+}
+
 /* dst = src for 4-vectors; inline, as newlib-nano's memcpy copies byte by byte. */
 static inline void icoac_copy4(icoac_real_t dst[ICOAC_N_INPUTS], const icoac_real_t src[ICOAC_N_INPUTS])
 {
@@ -142,9 +162,14 @@ icoac_real_t icoac_critic_value(const icoac_config_t *cfg, const icoac_real_t v[
 void icoac_critic_update(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_critic_active_t *active,
                          icoac_real_t step);
 
-/* Actor (icoac_actor.c). */
-void icoac_actor_update(const icoac_config_t *cfg, icoac_state_t *state,
-                        const icoac_real_t h[ICOAC_N_INPUTS], icoac_real_t innovation);
+/* Actor (icoac_actor.c). The update reads mu_w, Sigma_w from state and writes the candidate
+ * posterior to w, cov (which may be state's own w, cov); the caller commits it after its
+ * finiteness check. */
+void icoac_actor_update(const icoac_config_t *cfg, const icoac_state_t *state,
+                        const icoac_real_t h[ICOAC_N_INPUTS], icoac_real_t innovation,
+                        icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+/* w_act = mu_w + L n (L L^T = Sigma_w), or mu_w when Sigma_w is not positive definite. Always
+ * finite: |L_ij| <= sqrt(Sigma_ii) <= sqrt(REAL_MAX) and the polar normals are below 1e8. */
 void icoac_actor_sample(icoac_state_t *state);
 icoac_real_t icoac_trace4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
 int icoac_cholesky4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS],

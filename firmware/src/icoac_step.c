@@ -85,115 +85,170 @@ icoac_status_t icoac_reset(const icoac_config_t *cfg, icoac_state_t *state)
     return ICOAC_OK;
 }
 
-/* ICO rule, code timing: act with w_t, then learn from the penalty onset at s_t. */
-static void ico_code_timing(const icoac_config_t *cfg, icoac_state_t *state,
-                            const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty,
-                            icoac_output_t *out)
+/* The per-tick caches both tick kinds stage and commit together. */
+static void commit_trial_cache(icoac_state_t *state, const icoac_real_t scaled[ICOAC_N_INPUTS])
 {
-    const icoac_real_t drop = state->penalty_prev - penalty;
-    int i;
-    out->z = icoac_dot4(state->w, scaled);
-    if (drop > ICOAC_R(0.0)) {
-        const icoac_real_t step = cfg->ico_rate * drop;
-        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-            state->w[i] += step * ICOAC_FABS(scaled[i]);
-        }
-        state->weight_norm = ICOAC_SQRT(icoac_dot4(state->w, state->w));
-        out->q = drop;
-    }
-    state->penalty_prev = penalty;
-}
-
-/* ICO rule, literal timing: learn from r(t+1) - r(t) with x~(t), then act with w_{t+1}. */
-static void ico_literal_timing(const icoac_config_t *cfg, icoac_state_t *state,
-                               const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty,
-                               icoac_output_t *out)
-{
-    int i;
-    if (state->has_prev) {
-        const icoac_real_t drop = state->penalty_prev - penalty;
-        if (drop > ICOAC_R(0.0)) {
-            const icoac_real_t step = cfg->ico_rate * drop;
-            for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-                state->w[i] += step * ICOAC_FABS(state->x_prev[i]);
-            }
-            state->weight_norm = ICOAC_SQRT(icoac_dot4(state->w, state->w));
-            out->q = drop;
-        }
-    }
-    state->penalty_prev = penalty;
     icoac_copy4(state->x_prev, scaled);
     state->has_prev = 1;
-    out->z = icoac_dot4(state->w, scaled);
 }
 
-static void ico_tick(const icoac_config_t *cfg, icoac_state_t *state,
-                     const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
-                     icoac_output_t *out)
+/* ICO tick (Eq. 2-3) in either timing (spec A4). The new weights, their norm and the force
+ * are staged and committed only when finite; returns 0, with the state untouched, otherwise.
+ *   code timing: act with w_t, then learn from the penalty onset at s_t (failure states
+ *     are not seen);
+ *   literal timing: learn from r(t+1) - r(t) with x~(t), then act with w_{t+1}.
+ * Checked: |w| (finite only if every w_i is) and the force (G z + reflex, finite only if z
+ * is), or z itself on a terminal tick, which outputs no force. */
+static int ico_tick(const icoac_config_t *cfg, icoac_state_t *state,
+                    const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
+                    icoac_output_t *out)
 {
-    if (cfg->ico_timing == ICOAC_ICO_TIMING_LITERAL) {
-        ico_literal_timing(cfg, state, scaled, penalty, out);
-    } else if (!terminal) {
-        ico_code_timing(cfg, state, scaled, penalty, out);
+    const int literal = cfg->ico_timing == ICOAC_ICO_TIMING_LITERAL;
+    const icoac_real_t *trace = literal ? state->x_prev : scaled;
+    const int sees_penalty = literal ? state->has_prev : !terminal;
+    const icoac_real_t drop = state->penalty_prev - penalty;
+    icoac_real_t w[ICOAC_N_INPUTS];
+    icoac_real_t checked[2]; /* |w|, force (or z when terminal) */
+    icoac_real_t z;
+    icoac_real_t force = ICOAC_R(0.0);
+    int learned = 0;
+    int i;
+    if (!literal && terminal) {
+        return 1; /* code timing ignores failure states */
+    }
+    icoac_copy4(w, state->w);
+    checked[0] = state->weight_norm;
+    z = icoac_dot4(w, scaled); /* code timing acts with w_t */
+    if (sees_penalty && drop > ICOAC_R(0.0)) {
+        const icoac_real_t step = cfg->ico_rate * drop;
+        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+            w[i] += step * ICOAC_FABS(trace[i]);
+        }
+        checked[0] = ICOAC_SQRT(icoac_dot4(w, w));
+        learned = 1;
+    }
+    if (literal) {
+        z = icoac_dot4(w, scaled); /* literal timing acts with w_{t+1} */
     }
     if (!terminal) {
-        out->force = cfg->gain * out->z + icoac_reflex_force(cfg, out->reflex);
+        force = cfg->gain * z + icoac_reflex_force(cfg, out->reflex);
     }
+    checked[1] = terminal ? z : force;
+    if (!icoac_all_finite(checked, 2)) {
+        return 0;
+    }
+    icoac_copy4(state->w, w);
+    state->weight_norm = checked[0];
+    state->penalty_prev = penalty;
+    if (literal) {
+        commit_trial_cache(state, scaled);
+    }
+    out->q = learned ? drop : ICOAC_R(0.0);
+    out->z = z;
+    out->force = force;
+    return 1;
 }
 
-/* Actor-critic: learn from the transition s_t -> s (spec 8b steps 5-8), then act on s. */
-static void rl_tick(const icoac_config_t *cfg, icoac_state_t *state, const icoac_real_t s[ICOAC_N_INPUTS],
-                    const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out)
+/* delta clipped to +-td_clip. */
+static icoac_real_t clip_td(icoac_real_t delta, icoac_real_t td_clip)
+{
+    return delta > td_clip ? td_clip : (delta < -td_clip ? -td_clip : delta);
+}
+
+/* Off-diagonal entries of a symmetric 4x4 matrix finite (its trace covers the diagonal). */
+static int off_diagonal_finite(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS])
+{
+    return icoac_all_finite(&m[0][1], 3) && icoac_all_finite(&m[1][2], 2) && icoac_all_finite(&m[2][3], 1);
+}
+
+/* Actor-critic tick: learn from the transition s_t -> s (spec 8b steps 5-8), then act on s.
+ * V(s), delta, the actor's candidate posterior and the force are staged; the critic and the
+ * actor are updated, and the caches advanced, only when they are finite. Returns 0, with the
+ * state untouched, otherwise. Checked: V(s), delta, |w| (covers every w_i), the trace of
+ * Sigma_w (covers its diagonal) and its off-diagonal, and G z (+ reflex). Not checked, as
+ * finite by the configuration's bounds: the noise (|eps| < 1e8 sigma_u), hence the force
+ * G z + eps + reflex; and the critic weights, which move by at most critic_rate * td_clip
+ * <= 1e4 per tick. */
+static int rl_tick(const icoac_config_t *cfg, icoac_state_t *state, const icoac_real_t s[ICOAC_N_INPUTS],
+                   const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out)
 {
     icoac_real_t factors[ICOAC_CRITIC_FACTORS];
-    icoac_real_t value = ICOAC_R(0.0);
+    icoac_real_t w[ICOAC_N_INPUTS];
+    icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
+    icoac_real_t checked[5]; /* V(s), delta, |w|, trace of Sigma_w, G z (+ reflex) */
     const int slot_prev = state->active_slot;
+    const int learn = state->has_prev;
+    const icoac_real_t *w_act = cfg->act_with_sample ? state->w_act : (learn ? w : state->w);
+    icoac_real_t z = ICOAC_R(0.0);
+    icoac_real_t noise;
     int i;
+    checked[0] = ICOAC_R(0.0);
+    checked[4] = ICOAC_R(0.0);
     if (!terminal) {
         icoac_critic_factors(cfg, s, factors);
-        value = icoac_critic_value(cfg, state->v, factors, &state->active[slot_prev ^ 1]);
+        /* fills the spare slot: the current one stays the eligibility of this update */
+        checked[0] = icoac_critic_value(cfg, state->v, factors, &state->active[slot_prev ^ 1]);
     }
-    if (state->has_prev) {
+    if (learn) {
         const icoac_real_t reward = terminal ? ICOAC_R(-1.0) : ICOAC_R(0.0);
-        icoac_real_t delta = reward + cfg->discount * value - state->value_prev;
         icoac_real_t h[ICOAC_N_INPUTS];
         icoac_real_t innovation;
-        if (delta > cfg->td_clip) {
-            delta = cfg->td_clip;
-        } else if (delta < -cfg->td_clip) {
-            delta = -cfg->td_clip;
-        }
-        icoac_critic_update(state->v, &state->active[slot_prev], cfg->critic_rate * delta);
+        checked[1] = clip_td(reward + cfg->discount * checked[0] - state->value_prev, cfg->td_clip);
         for (i = 0; i < ICOAC_N_INPUTS; ++i) {
             h[i] = cfg->gain * state->x_prev[i];
         }
         /* u_ob - h^T mu_w, with u_ob = h^T w_act + alpha * delta * eps (Eq. 7-8). */
         innovation = icoac_dot4(h, state->w_act) - icoac_dot4(h, state->w) +
-                     cfg->actor_scale * delta * state->noise_prev;
-        icoac_actor_update(cfg, state, h, innovation);
-        state->weight_norm = ICOAC_SQRT(icoac_dot4(state->w, state->w));
-        if (!cfg->act_with_sample) {
-            icoac_copy4(state->w_act, state->w);
+                     cfg->actor_scale * checked[1] * state->noise_prev;
+        icoac_actor_update(cfg, state, h, innovation, w, cov);
+        checked[2] = ICOAC_SQRT(icoac_dot4(w, w));
+        checked[3] = icoac_trace4(ICOAC_CONST_MAT4(cov));
+        if (!off_diagonal_finite(ICOAC_CONST_MAT4(cov))) {
+            return 0;
         }
-        out->td_error = delta;
+    } else {
+        checked[1] = ICOAC_R(0.0);
+        checked[2] = state->weight_norm;
+        checked[3] = icoac_trace4(ICOAC_CONST_MAT4(state->cov));
     }
-    out->value = value;
-    out->cov_trace = icoac_trace4(ICOAC_CONST_MAT4(state->cov));
+    if (!terminal) {
+        z = icoac_dot4(w_act, scaled);
+        checked[4] = cfg->gain * z;
+    }
+    if (!icoac_all_finite(checked, 5)) {
+        return 0;
+    }
+    /* commit */
+    if (learn) {
+        icoac_critic_update(state->v, &state->active[slot_prev], cfg->critic_rate * checked[1]);
+        icoac_copy4(state->w, w);
+        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+            icoac_copy4(state->cov[i], cov[i]);
+        }
+        state->weight_norm = checked[2];
+        if (!cfg->act_with_sample) {
+            icoac_copy4(state->w_act, w);
+        }
+        out->td_error = checked[1];
+    }
+    out->value = checked[0];
+    out->cov_trace = checked[3];
     if (terminal) {
         state->has_prev = 0;
-        return;
+        return 1;
     }
-    out->z = icoac_dot4(state->w_act, scaled);
-    out->noise = cfg->noise_std * icoac_rng_normal(&state->rng);
-    out->force = cfg->gain * out->z + out->noise;
+    noise = cfg->noise_std * icoac_rng_normal(&state->rng);
+    out->z = z;
+    out->noise = noise;
+    out->force = checked[4] + noise;
     if (cfg->rl_reflex) {
         out->force += icoac_reflex_force(cfg, out->reflex);
     }
     state->active_slot = slot_prev ^ 1;
-    icoac_copy4(state->x_prev, scaled);
-    state->value_prev = value;
-    state->noise_prev = out->noise;
-    state->has_prev = 1;
+    state->value_prev = checked[0];
+    state->noise_prev = noise;
+    commit_trial_cache(state, scaled);
+    return 1;
 }
 
 /* Field by field: newlib-nano's memset goes byte by byte. */
@@ -220,6 +275,7 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
     icoac_real_t scaled[ICOAC_N_INPUTS];
     icoac_zone_t zone;
     int terminal;
+    int ok;
     if (out != 0) {
         clear_output(out);
     }
@@ -246,10 +302,14 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
     zone = icoac_zone(cfg, in->s);
     out->reflex = zone.reflex;
     out->penalty = zone.penalty;
-    if (cfg->mode == ICOAC_MODE_RL) {
-        rl_tick(cfg, state, in->s, scaled, terminal, out);
-    } else {
-        ico_tick(cfg, state, scaled, zone.penalty, terminal, out);
+    ok = cfg->mode == ICOAC_MODE_RL ? rl_tick(cfg, state, in->s, scaled, terminal, out)
+                                    : ico_tick(cfg, state, scaled, zone.penalty, terminal, out);
+    if (!ok) {
+        state->numeric_fault_count++;
+        clear_output(out);
+        out->weight_norm = state->weight_norm;
+        out->status = ICOAC_ERR_NUMERIC;
+        return ICOAC_ERR_NUMERIC;
     }
     out->weight_norm = state->weight_norm;
     out->status = ICOAC_OK;

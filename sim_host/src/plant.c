@@ -22,9 +22,10 @@ void icoac_sim_plant_default(icoac_sim_plant_t *plant)
     plant->reserved = 0;
 }
 
-static int positive(double v)
+/* lo <= v <= hi; false for NaN. */
+static int within(double v, double lo, double hi)
 {
-    return isfinite(v) && v > 0.0;
+    return v >= lo && v <= hi;
 }
 
 int32_t icoac_sim_plant_check(const icoac_sim_plant_t *plant)
@@ -32,9 +33,13 @@ int32_t icoac_sim_plant_check(const icoac_sim_plant_t *plant)
     if (plant == 0) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
-    if (!positive(plant->gravity) || !positive(plant->cart_mass) || !positive(plant->pole_mass) ||
-        !positive(plant->half_length) || !positive(plant->dt) || plant->dt > 1.0 ||
-        !positive(plant->x_limit) || !positive(plant->theta_limit) ||
+    if (!within(plant->gravity, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX) ||
+        !within(plant->cart_mass, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX) ||
+        !within(plant->pole_mass, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX) ||
+        !within(plant->half_length, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX) ||
+        !within(plant->dt, ICOAC_SIM_DT_MIN, ICOAC_SIM_DT_MAX) ||
+        !within(plant->x_limit, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX) ||
+        !within(plant->theta_limit, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX) ||
         (plant->integrator != ICOAC_SIM_EULER && plant->integrator != ICOAC_SIM_RK4)) {
         return ICOAC_SIM_ERR_BAD_PLANT;
     }

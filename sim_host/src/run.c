@@ -1,4 +1,5 @@
 /* The benchmark trial loop of one cell (spec 8-9) and the Fig. 1g trajectory recorder. */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -6,6 +7,12 @@
 #include "sim_internal.h"
 
 #define SIM_PI 3.14159265358979323846
+
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+#define SIM_REAL_MAX DBL_MAX
+#else
+#define SIM_REAL_MAX ((double)FLT_MAX)
+#endif
 
 void icoac_sim_run_default(icoac_sim_run_t *run)
 {
@@ -17,13 +24,18 @@ void icoac_sim_run_default(icoac_sim_run_t *run)
     run->init_velocity_noise = 1.0e-4;
 }
 
+/* 0, or a normal value in [ICOAC_SIM_NOISE_MIN, ICOAC_SIM_NOISE_MAX]. */
+static int velocity_noise_valid(double a)
+{
+    return a == 0.0 || (a >= ICOAC_SIM_NOISE_MIN && a <= ICOAC_SIM_NOISE_MAX);
+}
+
 int32_t icoac_sim_run_check(const icoac_sim_run_t *run)
 {
     if (run == 0) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
-    if (run->max_trials < 1 || run->success_steps < 1 || !isfinite(run->init_velocity_noise) ||
-        run->init_velocity_noise < 0.0) {
+    if (run->max_trials < 1 || run->success_steps < 1 || !velocity_noise_valid(run->init_velocity_noise)) {
         return ICOAC_SIM_ERR_BAD_RUN;
     }
     return ICOAC_SIM_OK;
@@ -79,11 +91,13 @@ static void start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t 
     s[3] = uniform_symmetric(rng, noise);
 }
 
+/* The plant state as the controller's reals. A value outside the real type's range would be
+ * an undefined conversion: it is passed as NaN, which the controller rejects. */
 static void to_input(const double s[4], uint32_t flags, icoac_input_t *in)
 {
     int i;
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-        in->s[i] = (icoac_real_t)s[i];
+        in->s[i] = fabs(s[i]) <= SIM_REAL_MAX ? (icoac_real_t)s[i] : (icoac_real_t)NAN;
     }
     in->flags = flags;
 }
@@ -121,9 +135,13 @@ static int64_t run_trial(const icoac_config_t *cfg, const icoac_sim_plant_t *pla
         icoac_sim_plant_step(plant, s, (double)out.force);
         ++steps;
         if (sim_failed(plant, s)) {
-            /* Let the controller learn from the failure state (it ignores NaN plant states). */
+            /* Let the controller learn from the failure state; it rejects NaN plant states,
+             * which end the trial like any failure, but a numeric fault is an error. */
             to_input(s, ICOAC_INPUT_TERMINAL, &in);
-            (void)icoac_step(cfg, ctrl, &in, &out);
+            if (icoac_step(cfg, ctrl, &in, &out) == ICOAC_ERR_NUMERIC) {
+                *status = ICOAC_ERR_NUMERIC;
+                return -1;
+            }
             return steps;
         }
     }
@@ -227,7 +245,7 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t 
         return status;
     }
     if (states == 0 || forces == 0 || n_steps == 0 || max_steps < 1 || !isfinite(x0) ||
-        !isfinite(theta0) || !isfinite(init_velocity_noise) || init_velocity_noise < 0.0) {
+        !isfinite(theta0) || !velocity_noise_valid(init_velocity_noise)) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
     status = (int32_t)icoac_init(cfg, &ctrl, prior, icoac_mix_seed(seed, 1u));

@@ -6,6 +6,13 @@
 
 #define N ICOAC_N_INPUTS
 
+/* The update writes its candidate posterior over the state's own (mu_w, Sigma_w). */
+static void actor_update_in_place(const icoac_config_t *cfg, icoac_state_t *state, const icoac_real_t h[N],
+                                  icoac_real_t innovation)
+{
+    icoac_actor_update(cfg, state, h, innovation, state->w, state->cov);
+}
+
 typedef struct {
     double mean[N];
     double cov[N][N];
@@ -106,7 +113,7 @@ static void compare_with_closed_form(const icoac_config_t *cfg, test_rng_t *rng,
     innovation = (double)(icoac_real_t)test_uniform(rng, -3, 3);
     r = (double)cfg->noise_std * (double)cfg->noise_std;
     closed_form(&prior, hd, innovation, r, &post);
-    icoac_actor_update(cfg, &state, h, (icoac_real_t)innovation);
+    actor_update_in_place(cfg, &state, h, (icoac_real_t)innovation);
     /* float: a few hundred ulps of the largest prior entry (the update subtracts nearly equal terms) */
     tol = (REAL_IS_FLOAT ? 2e-5 : 1e-12) * (1.0 + max_abs(prior.cov));
     for (i = 0; i < N; ++i) {
@@ -145,7 +152,7 @@ static void test_zero_innovation_keeps_mean(void **unused)
     load_state(&state, &prior);
     memcpy(mean_before, state.w, sizeof mean_before);
     trace_before = (double)icoac_trace4(ICOAC_CONST_MAT4(state.cov));
-    icoac_actor_update(&cfg, &state, h, (icoac_real_t)0.0);
+    actor_update_in_place(&cfg, &state, h, (icoac_real_t)0.0);
     assert_memory_equal(state.w, mean_before, sizeof mean_before);
     /* the covariance still shrinks */
     assert_true((double)icoac_trace4(ICOAC_CONST_MAT4(state.cov)) < trace_before);
@@ -176,7 +183,7 @@ static void test_forgetting_inflates_first(void **unused)
         }
     }
     closed_form(&inflated, hd, 0.7, 1.0, &post);
-    icoac_actor_update(&cfg, &state, h, (icoac_real_t)0.7);
+    actor_update_in_place(&cfg, &state, h, (icoac_real_t)0.7);
     for (i = 0; i < N; ++i) {
         assert_close(state.w[i], post.mean[i], REAL_IS_FLOAT ? 1e-4 : 1e-12);
         for (j = 0; j < N; ++j) {
@@ -186,7 +193,7 @@ static void test_forgetting_inflates_first(void **unused)
     /* with h = 0 (no information) the step is pure inflation: Sigma / lambda */
     load_state(&state, &prior);
     memset(h, 0, sizeof h);
-    icoac_actor_update(&cfg, &state, h, (icoac_real_t)0.3);
+    actor_update_in_place(&cfg, &state, h, (icoac_real_t)0.3);
     for (i = 0; i < N; ++i) {
         assert_true(state.w[i] == (icoac_real_t)prior.mean[i]);
         for (j = 0; j < N; ++j) {
@@ -217,7 +224,7 @@ static void run_long(double forgetting, int n_updates)
         for (i = 0; i < N; ++i) {
             h[i] = (icoac_real_t)(10.0 * test_uniform(&rng, -1, 1)); /* G x~, |x~| <= 1 */
         }
-        icoac_actor_update(&cfg, &state, h, (icoac_real_t)test_uniform(&rng, -3, 3));
+        actor_update_in_place(&cfg, &state, h, (icoac_real_t)test_uniform(&rng, -3, 3));
         for (i = 0; i < N; ++i) {
             for (j = 0; j < N; ++j) {
                 if (state.cov[i][j] != state.cov[j][i]) {

@@ -97,7 +97,31 @@ MUT(m_scale_nan, c->actor_scale = NAN_R)
 MUT(m_forget_zero, c->forgetting = 0)
 MUT(m_forget_big, c->forgetting = 1.001f)
 MUT(m_forget_nan, c->forgetting = NAN_R)
+/* Issue 8: accepted before, then NaN/Inf (or a critic overrun) in the tick. Both ends bounded. */
+MUT(m_range0_subnormal, c->input_range[0] = (icoac_real_t)1e-39)
+MUT(m_range1_tiny, c->input_range[1] = (icoac_real_t)9e-7)
+MUT(m_range2_huge, c->input_range[2] = (icoac_real_t)1.1e6)
+MUT(m_gain_huge, c->gain = (icoac_real_t)1e30)
+MUT(m_reflex_force_huge, c->reflex_force = (icoac_real_t)1e38)
+MUT(m_zone_theta_big, c->zone_theta = (icoac_real_t)3.2)
+MUT(m_zone_x_huge, c->zone_x = (icoac_real_t)1e30)
+MUT(m_ico_rate_huge, c->ico_rate = (icoac_real_t)1e30)
+MUT(m_td_clip_subnormal, c->td_clip = (icoac_real_t)1e-39)
+MUT(m_td_clip_huge, c->td_clip = (icoac_real_t)1e30)
+MUT(m_critic_range0_subnormal, { c->mode = ICOAC_MODE_RL; c->critic_range[0] = (icoac_real_t)1e-39; })
+MUT(m_critic_range1_huge, c->critic_range[1] = (icoac_real_t)1e30)
+MUT(m_noise_tiny, { c->mode = ICOAC_MODE_RL; c->noise_std = (icoac_real_t)1e-20; })
+MUT(m_noise_huge, c->noise_std = (icoac_real_t)1e30)
+MUT(m_scale_huge, c->actor_scale = (icoac_real_t)1e30)
+MUT(m_forget_tiny, c->forgetting = (icoac_real_t)1e-30)
+MUT(m_forget_below_half, c->forgetting = (icoac_real_t)0.49)
 /* Boundary values that are valid. */
+MUT(ok_range_bounds, { c->input_range[0] = (icoac_real_t)1e-6; c->input_range[1] = (icoac_real_t)1e6;
+                       c->critic_range[2] = (icoac_real_t)1e-6; c->critic_range[3] = (icoac_real_t)1e6; })
+MUT(ok_upper_bounds, { c->gain = (icoac_real_t)1e4; c->reflex_force = (icoac_real_t)1e4;
+                       c->ico_rate = 1; c->td_clip = (icoac_real_t)1e3; c->noise_std = (icoac_real_t)1e3;
+                       c->actor_scale = (icoac_real_t)1e3; })
+MUT(ok_lower_bounds, { c->td_clip = (icoac_real_t)1e-6; c->noise_std = (icoac_real_t)1e-3; })
 MUT(ok_gain_zero, c->gain = 0)
 MUT(ok_reflex_force_zero, c->reflex_force = 0)
 MUT(ok_ico_rate_zero, c->ico_rate = 0)
@@ -159,6 +183,26 @@ static const config_case_t config_cases[] = {
     {"forgetting=0", m_forget_zero, ICOAC_ERR_BAD_ACTOR},
     {"forgetting>1", m_forget_big, ICOAC_ERR_BAD_ACTOR},
     {"forgetting=NaN", m_forget_nan, ICOAC_ERR_BAD_ACTOR},
+    {"input_range[0]=1e-39", m_range0_subnormal, ICOAC_ERR_BAD_SCALE},
+    {"input_range[1]=9e-7", m_range1_tiny, ICOAC_ERR_BAD_SCALE},
+    {"input_range[2]=1.1e6", m_range2_huge, ICOAC_ERR_BAD_SCALE},
+    {"gain=1e30", m_gain_huge, ICOAC_ERR_BAD_GAIN},
+    {"reflex_force=1e38", m_reflex_force_huge, ICOAC_ERR_BAD_GAIN},
+    {"zone_theta=3.2", m_zone_theta_big, ICOAC_ERR_BAD_ZONE},
+    {"zone_x=1e30", m_zone_x_huge, ICOAC_ERR_BAD_ZONE},
+    {"ico_rate=1e30", m_ico_rate_huge, ICOAC_ERR_BAD_ICO_RATE},
+    {"td_clip=1e-39", m_td_clip_subnormal, ICOAC_ERR_BAD_CRITIC},
+    {"td_clip=1e30", m_td_clip_huge, ICOAC_ERR_BAD_CRITIC},
+    {"RL, critic_range[0]=1e-39", m_critic_range0_subnormal, ICOAC_ERR_BAD_CRITIC},
+    {"critic_range[1]=1e30", m_critic_range1_huge, ICOAC_ERR_BAD_CRITIC},
+    {"RL, noise_std=1e-20", m_noise_tiny, ICOAC_ERR_BAD_ACTOR},
+    {"noise_std=1e30", m_noise_huge, ICOAC_ERR_BAD_ACTOR},
+    {"actor_scale=1e30", m_scale_huge, ICOAC_ERR_BAD_ACTOR},
+    {"forgetting=1e-30", m_forget_tiny, ICOAC_ERR_BAD_ACTOR},
+    {"forgetting=0.49", m_forget_below_half, ICOAC_ERR_BAD_ACTOR},
+    {"ranges at their bounds", ok_range_bounds, ICOAC_OK},
+    {"upper bounds", ok_upper_bounds, ICOAC_OK},
+    {"lower bounds", ok_lower_bounds, ICOAC_OK},
     {"gain=0", ok_gain_zero, ICOAC_OK},
     {"reflex_force=0", ok_reflex_force_zero, ICOAC_OK},
     {"ico_rate=0", ok_ico_rate_zero, ICOAC_OK},
@@ -357,7 +401,7 @@ static void test_not_initialised(void **unused)
 static void test_status_strings(void **unused)
 {
     static const icoac_status_t all[] = {
-        ICOAC_OK, ICOAC_ERR_NULL, ICOAC_ERR_NOT_INITIALISED, ICOAC_ERR_NONFINITE_INPUT,
+        ICOAC_OK, ICOAC_ERR_NULL, ICOAC_ERR_NOT_INITIALISED, ICOAC_ERR_NONFINITE_INPUT, ICOAC_ERR_NUMERIC,
         ICOAC_ERR_BAD_MODE, ICOAC_ERR_BAD_SCALE, ICOAC_ERR_BAD_GAIN, ICOAC_ERR_BAD_ZONE,
         ICOAC_ERR_BAD_ICO_RATE, ICOAC_ERR_BAD_CRITIC, ICOAC_ERR_BAD_ACTOR, ICOAC_ERR_BAD_PRIOR};
     const size_t n = sizeof all / sizeof all[0];

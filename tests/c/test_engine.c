@@ -97,6 +97,35 @@ static void test_run_cell_outcomes(void **unused)
     assert_true(c.weights[2] > 0.0);
 }
 
+/* A controller that faults numerically mid-run (an accepted prior covariance near the float
+ * limit, inflated by forgetting) ends its cell as ERROR with ICOAC_ERR_NUMERIC and finite
+ * recorded weights; such cells used to end SUCCESS or FAILED with NaN weights. */
+static void test_numeric_fault_marks_cell_error(void **unused)
+{
+    const icoac_sim_plant_t plant = default_plant();
+    icoac_config_t cfg = test_default_config();
+    icoac_sim_run_t run = small_run(3, 5000);
+    icoac_sim_cell_t cells[2];
+    const icoac_prior_t prior = test_prior(0.1, 0.1, 0.5, 0.1, 1e38);
+    int i, j, k;
+    (void)unused;
+    cfg.mode = ICOAC_MODE_RL;
+    cfg.forgetting = ICOAC_FORGETTING_MIN;
+    cells[0] = make_cell(0.0, 0.0, 1u);
+    cells[1] = make_cell(0.5, DEG(1.0), 2u);
+    assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, &prior, cells, 2, 1, NULL, NULL), ICOAC_SIM_OK);
+    for (k = 0; k < 2; ++k) {
+        assert_int_equal(cells[k].outcome, ICOAC_SIM_ERROR);
+        assert_int_equal(cells[k].status, ICOAC_ERR_NUMERIC);
+        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+            assert_true(isfinite(cells[k].weights[i]));
+            for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+                assert_true(isfinite(cells[k].cov[i][j]));
+            }
+        }
+    }
+}
+
 static void run_grid_ok(const icoac_config_t *cfg, icoac_sim_cell_t *cells, int64_t n, int32_t threads,
                         int64_t progress[ICOAC_SIM_PROGRESS_LEN])
 {
@@ -216,6 +245,9 @@ static void test_bad_parameters(void **unused)
     run.max_trials = 0;
     assert_int_equal(icoac_sim_run_cell(&cfg, &plant, &run, NULL, &cells[0], NULL, NULL), ICOAC_SIM_ERR_BAD_RUN);
     assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL), ICOAC_SIM_ERR_BAD_RUN);
+    plant.dt = 1e-310; /* subnormal: flushed to 0 by the workers, the plant would never move */
+    assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL), ICOAC_SIM_ERR_BAD_PLANT);
+    plant = good_plant;
     run = good_run;
     run.init_velocity_noise = -1.0;
     assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL), ICOAC_SIM_ERR_BAD_RUN);
@@ -348,6 +380,7 @@ int main(void)
         cmocka_unit_test(test_grid_thread_independent),
         cmocka_unit_test(test_cancel_and_resume),
         cmocka_unit_test(test_bad_parameters),
+        cmocka_unit_test(test_numeric_fault_marks_cell_error),
         cmocka_unit_test(test_trajectory_recorder),
         cmocka_unit_test(test_trajectory_falls),
         cmocka_unit_test(test_fpu_mode_restored),

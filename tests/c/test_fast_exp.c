@@ -60,6 +60,9 @@ static void test_exact_points_and_limits(void **state)
     assert_true(icoac_exp(-1000.0f) == 0.0f);
     assert_true(isfinite(icoac_exp(1000.0f)));
     assert_true(icoac_exp(-1.0f) < icoac_exp(-0.999f));
+    /* NaN stays NaN and never reaches the float -> int32 conversion (UB under UBSan) */
+    assert_true(isnan(icoac_exp(NAN)));
+    assert_true(icoac_exp(-INFINITY) == 0.0f);
 }
 
 int main(void)

@@ -183,10 +183,22 @@ PMUT(p_xl, p->x_limit = 0)
 PMUT(p_tl, p->theta_limit = (double)NAN)
 PMUT(p_int, p->integrator = 2)
 PMUT(p_intneg, p->integrator = -1)
+/* Issue 8: subnormal or absurd values the workers would flush to zero or overflow on. */
+PMUT(p_dt_subnormal, p->dt = 1e-310)
+PMUT(p_dt_tiny, p->dt = 9e-7)
+PMUT(p_g_subnormal, p->gravity = 1e-310)
+PMUT(p_g_huge, p->gravity = 1e300)
+PMUT(p_mc_subnormal, p->cart_mass = 4.9e-324)
+PMUT(p_mp_huge, p->pole_mass = 1e7)
+PMUT(p_l_tiny, p->half_length = 1e-9)
+PMUT(p_xl_huge, p->x_limit = 1e300)
+PMUT(p_tl_big, p->theta_limit = 4.0)
 
 static void test_plant_and_run_checks(void **unused)
 {
-    static const plant_mut muts[] = {p_g0, p_gnan, p_mc, p_mp, p_l, p_dt0, p_dtbig, p_xl, p_tl, p_int, p_intneg};
+    static const plant_mut muts[] = {p_g0, p_gnan, p_mc, p_mp, p_l, p_dt0, p_dtbig, p_xl, p_tl, p_int, p_intneg,
+                                     p_dt_subnormal, p_dt_tiny, p_g_subnormal, p_g_huge, p_mc_subnormal,
+                                     p_mp_huge, p_l_tiny, p_xl_huge, p_tl_big};
     icoac_sim_plant_t plant;
     icoac_sim_run_t run;
     size_t i;
@@ -218,9 +230,19 @@ static void test_plant_and_run_checks(void **unused)
     assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
     run.init_velocity_noise = (double)NAN;
     assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    run.init_velocity_noise = 1e-310; /* subnormal */
+    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    run.init_velocity_noise = 1e4;
+    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
     run.init_velocity_noise = 0.0;
     assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_OK);
     assert_int_equal(icoac_sim_run_check(NULL), ICOAC_SIM_ERR_BAD_ARGUMENT);
+    /* the bounds themselves are valid */
+    icoac_sim_plant_default(&plant);
+    plant.dt = ICOAC_SIM_DT_MIN;
+    plant.gravity = ICOAC_SIM_PHYS_MAX;
+    plant.theta_limit = ICOAC_SIM_THETA_LIMIT_MAX;
+    assert_int_equal(icoac_sim_plant_check(&plant), ICOAC_SIM_OK);
 }
 
 static int cmp_u64(const void *a, const void *b)

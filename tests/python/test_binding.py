@@ -23,7 +23,7 @@ def test_struct_sizes_match_c():
 
 
 def test_abi_versions():
-    assert B.lib.icoac_abi_version() == B.ABI_VERSION == 2
+    assert B.lib.icoac_abi_version() == B.ABI_VERSION == 3
     assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == 1
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)

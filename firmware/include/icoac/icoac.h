@@ -33,27 +33,46 @@ typedef enum {
     ICOAC_ICO_TIMING_LITERAL = 1 /* r(t+1) from the post-step state incl. failure, update with x~(t) */
 } icoac_ico_timing_t;
 
-/* Configuration. Integer switches are int32_t so the layout is the same on every ABI. */
+/* Valid ranges of the configuration, closed at both ends unless said otherwise. Each bound
+ * keeps a derived quantity representable in float: 1/range and s*n/range (critic) stay finite
+ * and normal, sigma_u^2 stays normal, 1/forgetting stays small. */
+#define ICOAC_RANGE_MIN ICOAC_R(1.0e-6)       /* input_range, critic_range (m, m/s, rad, rad/s) */
+#define ICOAC_RANGE_MAX ICOAC_R(1.0e6)
+#define ICOAC_GAIN_MAX ICOAC_R(1.0e4)         /* gain (N per unit feature), >= 0 */
+#define ICOAC_FORCE_MAX ICOAC_R(1.0e4)        /* reflex_force (N), >= 0 */
+#define ICOAC_ZONE_THETA_MAX ICOAC_R(3.14159265358979) /* zone_theta (rad), > 0 */
+#define ICOAC_ZONE_X_MAX ICOAC_R(1.0e6)       /* zone_x (m), > 0 */
+#define ICOAC_ICO_RATE_MAX ICOAC_R(1.0)       /* ico_rate, >= 0 */
+#define ICOAC_CRITIC_RATE_MAX ICOAC_R(10.0)   /* critic_rate, >= 0 */
+#define ICOAC_TD_CLIP_MIN ICOAC_R(1.0e-6)     /* td_clip */
+#define ICOAC_TD_CLIP_MAX ICOAC_R(1.0e3)
+#define ICOAC_NOISE_STD_MIN ICOAC_R(1.0e-3)   /* noise_std (N) */
+#define ICOAC_NOISE_STD_MAX ICOAC_R(1.0e3)
+#define ICOAC_ACTOR_SCALE_MAX ICOAC_R(1.0e3)  /* actor_scale, >= 0 */
+#define ICOAC_FORGETTING_MIN ICOAC_R(0.5)     /* forgetting, <= 1 */
+
+/* Configuration. Integer switches are int32_t so the layout is the same on every ABI.
+ * Ranges: the ICOAC_*_MIN / _MAX bounds above. */
 typedef struct {
     int32_t mode;                               /* icoac_mode_t */
     int32_t reflex_mode;                        /* icoac_reflex_mode_t */
     int32_t ico_timing;                         /* icoac_ico_timing_t */
     int32_t clip_inputs;                        /* 1: clip scaled inputs to [-1, 1]; 0: no clip */
-    icoac_real_t input_range[ICOAC_N_INPUTS];   /* (m, m/s, rad, rad/s) maps to +-1; > 0. 2.4, 3.5, 0.2094384, 2.0 */
-    icoac_real_t gain;                          /* G (N per unit feature), >= 0. 10 */
-    icoac_real_t reflex_force;                  /* N per unit U in ICOAC_REFLEX_UNIT, >= 0. 1 */
-    icoac_real_t zone_theta;                    /* reflex/penalty angle (rad), > 0. 11.5 deg = 0.20071286 */
-    icoac_real_t zone_x;                        /* reflex/penalty cart position (m), > 0. 2.35 */
-    icoac_real_t ico_rate;                      /* mu, >= 0. 1e-4 */
+    icoac_real_t input_range[ICOAC_N_INPUTS];   /* (m, m/s, rad, rad/s) maps to +-1; [1e-6, 1e6]. 2.4, 3.5, 0.2094384, 2.0 */
+    icoac_real_t gain;                          /* G (N per unit feature), [0, 1e4]. 10 */
+    icoac_real_t reflex_force;                  /* N per unit U in ICOAC_REFLEX_UNIT, [0, 1e4]. 1 */
+    icoac_real_t zone_theta;                    /* reflex/penalty angle (rad), (0, pi]. 11.5 deg = 0.20071286 */
+    icoac_real_t zone_x;                        /* reflex/penalty cart position (m), (0, 1e6]. 2.35 */
+    icoac_real_t ico_rate;                      /* mu, [0, 1]. 1e-4 */
     /* RL (ICOAC_MODE_RL) */
     icoac_real_t critic_rate;                   /* eta_c, [0, 10]. 0.6 */
     icoac_real_t discount;                      /* gamma per tick, [0, 1]. 0.95 */
-    icoac_real_t td_clip;                       /* |delta| limit, > 0. 1 */
-    icoac_real_t critic_range[ICOAC_N_INPUTS];  /* critic grid half-widths (SI), > 0. 2.4, 3.5, 0.2094, 2.0 */
+    icoac_real_t td_clip;                       /* |delta| limit, [1e-6, 1e3]. 1 */
+    icoac_real_t critic_range[ICOAC_N_INPUTS];  /* critic grid half-widths (SI), [1e-6, 1e6]. 2.4, 3.5, 0.2094, 2.0 */
     icoac_real_t critic_threshold;              /* drop normalized activations below this, [0, 1). 0.001 (code); 0 = dense */
-    icoac_real_t noise_std;                     /* sigma_u (N), > 0. 1 */
-    icoac_real_t actor_scale;                   /* alpha, >= 0. 0.5 */
-    icoac_real_t forgetting;                    /* lambda_f, (0, 1]. 1 (none) */
+    icoac_real_t noise_std;                     /* sigma_u (N), [1e-3, 1e3]. 1 */
+    icoac_real_t actor_scale;                   /* alpha, [0, 1e3]. 0.5 */
+    icoac_real_t forgetting;                    /* lambda_f, [0.5, 1]. 1 (none) */
     int32_t rl_reflex;                          /* 1: reflex added to the executed force in RL; 0: off */
     int32_t act_with_sample;                    /* 1: act with a posterior sample of w per trial; 0: with mu_w */
 } icoac_config_t;
@@ -96,6 +115,7 @@ typedef struct {
     icoac_rng_t rng;                                /* exploration noise */
     uint32_t ticks;                                 /* icoac_step calls since init (wraps) */
     uint32_t nonfinite_count;                       /* rejected observations since init */
+    uint32_t numeric_fault_count;                   /* ticks rejected with ICOAC_ERR_NUMERIC since init */
 } icoac_state_t;
 
 /* Flags of icoac_input_t. */
@@ -139,7 +159,12 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state,
 /* Start a new trial: forget the previous tick, keep everything learned. */
 icoac_status_t icoac_reset(const icoac_config_t *cfg, icoac_state_t *state);
 
-/* One tick: learn from the transition into in->s, then act on it. */
+/* One tick: learn from the transition into in->s, then act on it. The return value and
+ * out->status are the same. Contract: with a configuration icoac_config_check accepts and a
+ * finite in->s, either ICOAC_OK with a finite output and a finite learned state (w, Sigma_w,
+ * v), or an error status with force 0 and the state unchanged but for its tick counters:
+ * ICOAC_ERR_NONFINITE_INPUT for a NaN/Inf observation, ICOAC_ERR_NUMERIC when a value the tick
+ * derived (force, new weights, covariance or its trace, critic value or TD error) was not finite. */
 icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
                           const icoac_input_t *in, icoac_output_t *out);
 

@@ -9,7 +9,7 @@ extern "C" {
 #endif
 
 /* Bump when a public struct layout or an enum value changes. */
-#define ICOAC_ABI_VERSION 2
+#define ICOAC_ABI_VERSION 3
 
 /* Real-number type: float by default; define ICOAC_REAL_DOUBLE=1 for double. */
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
@@ -61,6 +61,7 @@ typedef enum {
     ICOAC_ERR_NULL = 1,             /* a required pointer was NULL */
     ICOAC_ERR_NOT_INITIALISED = 2,  /* state not set up by icoac_init */
     ICOAC_ERR_NONFINITE_INPUT = 3,  /* observation had NaN/Inf: safe output, no learning */
+    ICOAC_ERR_NUMERIC = 4,          /* a value derived in this tick was not finite: force 0, nothing learned */
     ICOAC_ERR_BAD_MODE = 10,        /* mode, reflex_mode, ico_timing or another switch out of range */
     ICOAC_ERR_BAD_SCALE = 11,       /* input_range not finite and > 0 */
     ICOAC_ERR_BAD_GAIN = 12,        /* gain or reflex_force not finite and >= 0 */

@@ -28,15 +28,25 @@ typedef enum {
     ICOAC_SIM_RK4 = 1    /* classical Runge-Kutta, same dt */
 } icoac_sim_integrator_t;
 
+/* Valid plant and run ranges (closed): no subnormal or absurd value reaches the integrator,
+ * whose worker threads flush subnormals to zero. */
+#define ICOAC_SIM_PHYS_MIN 1.0e-6   /* gravity (m/s^2), masses (kg), half_length, x_limit (m) */
+#define ICOAC_SIM_PHYS_MAX 1.0e6
+#define ICOAC_SIM_DT_MIN 1.0e-6     /* dt (s) */
+#define ICOAC_SIM_DT_MAX 1.0
+#define ICOAC_SIM_THETA_LIMIT_MAX 3.14159265358979323846 /* theta_limit (rad), >= 1e-6 */
+#define ICOAC_SIM_NOISE_MIN 1.0e-12 /* init_velocity_noise: 0 or in [1e-12, 1e3] (m/s, rad/s) */
+#define ICOAC_SIM_NOISE_MAX 1.0e3
+
 /* Frictionless cart-pole (Barto, Sutton & Anderson 1983 without friction). */
 typedef struct {
-    double gravity;     /* m/s^2, > 0. 9.8 */
-    double cart_mass;   /* kg, > 0. 1.0 */
-    double pole_mass;   /* kg, > 0. 0.1 */
-    double half_length; /* m, > 0. 0.5 */
-    double dt;          /* s, (0, 1]. 0.01 */
-    double x_limit;     /* m, > 0: failure when |x| > x_limit. 2.4 */
-    double theta_limit; /* rad, > 0: failure when |theta| > theta_limit. 12 deg */
+    double gravity;     /* m/s^2, [1e-6, 1e6]. 9.8 */
+    double cart_mass;   /* kg, [1e-6, 1e6]. 1.0 */
+    double pole_mass;   /* kg, [1e-6, 1e6]. 0.1 */
+    double half_length; /* m, [1e-6, 1e6]. 0.5 */
+    double dt;          /* s, [1e-6, 1]. 0.01 */
+    double x_limit;     /* m, [1e-6, 1e6]: failure when |x| > x_limit. 2.4 */
+    double theta_limit; /* rad, [1e-6, pi]: failure when |theta| > theta_limit. 12 deg */
     int32_t integrator; /* icoac_sim_integrator_t */
     int32_t reserved;   /* 0 */
 } icoac_sim_plant_t;
@@ -45,14 +55,14 @@ typedef struct {
 typedef struct {
     int64_t max_trials;          /* trials before a cell counts as failed, >= 1. 1e5 */
     int64_t success_steps;       /* steps of one trial that make a success, >= 1. 1e5 (1000 s) */
-    double init_velocity_noise;  /* initial x_dot, theta_dot ~ U(-a, a), a >= 0. 1e-4 */
+    double init_velocity_noise;  /* initial x_dot, theta_dot ~ U(-a, a), a = 0 or [1e-12, 1e3]. 1e-4 */
 } icoac_sim_run_t;
 
 typedef enum {
     ICOAC_SIM_PENDING = 0, /* not run yet (or cancelled mid-run) */
     ICOAC_SIM_SUCCESS = 1, /* a trial lasted success_steps */
     ICOAC_SIM_FAILED = 2,  /* max_trials trials, none successful */
-    ICOAC_SIM_ERROR = 3    /* the controller reported an error; see status */
+    ICOAC_SIM_ERROR = 3    /* the controller reported an error (e.g. ICOAC_ERR_NUMERIC); see status */
 } icoac_sim_outcome_t;
 
 /* One cell: the caller fills x0, theta0, seed; the run fills the rest. */

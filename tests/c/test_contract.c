@@ -1,0 +1,291 @@
+/* The tick contract (issue 8): with an accepted configuration and a finite observation,
+ * icoac_step returns ICOAC_OK with a finite output and learned state, or an error status with
+ * force 0 and the state unchanged but for its counters. Regression tests of the reproducers
+ * an outside tester found: the critic scan that ran off its arrays, and OK ticks with a NaN or
+ * infinite force. */
+#include "test_common.h"
+
+#include <float.h>
+
+#include "icoac_internal.h"
+
+static int finite_real(icoac_real_t v)
+{
+    return isfinite((double)v) ? 1 : 0;
+}
+
+static int state_finite(const icoac_state_t *s)
+{
+    int i, j;
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        if (!finite_real(s->w[i]) || !finite_real(s->w_act[i])) {
+            return 0;
+        }
+        for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+            if (!finite_real(s->cov[i][j])) {
+                return 0;
+            }
+        }
+    }
+    for (i = 0; i < ICOAC_CRITIC_UNITS; ++i) {
+        if (!finite_real(s->v[i])) {
+            return 0;
+        }
+    }
+    return finite_real(s->weight_norm);
+}
+
+static int output_finite(const icoac_output_t *o)
+{
+    return finite_real(o->force) && finite_real(o->z) && finite_real(o->reflex) && finite_real(o->penalty) &&
+           finite_real(o->q) && finite_real(o->weight_norm) && finite_real(o->value) &&
+           finite_real(o->td_error) && finite_real(o->noise) && finite_real(o->cov_trace);
+}
+
+/* One tick under the contract; returns the status. A rejected tick must leave every byte of
+ * the state as it was, except the counters and the critic's spare kept-unit slot. */
+static icoac_status_t checked_step(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in)
+{
+    icoac_state_t before = *state;
+    icoac_output_t out;
+    icoac_status_t status = icoac_step(cfg, state, in, &out);
+    assert_int_equal(status, out.status);
+    if (status == ICOAC_OK) {
+        assert_true(output_finite(&out));
+        assert_true(state_finite(state));
+        return status;
+    }
+    assert_int_equal(status, ICOAC_ERR_NUMERIC);
+    assert_true(out.force == 0);
+    assert_int_equal(state->numeric_fault_count, before.numeric_fault_count + 1u);
+    before.ticks = state->ticks;
+    before.numeric_fault_count = state->numeric_fault_count;
+    before.active[before.active_slot ^ 1] = state->active[state->active_slot ^ 1];
+    assert_memory_equal(state, &before, sizeof before);
+    return status;
+}
+
+/* Reproducer 1, first half: NaN critic factors (what a subnormal critic_range produced) must
+ * not run the kept-unit scans off their arrays. Before the fix they read past the end of
+ * cell_product (ASan: stack-buffer-overflow) and wrote through the indices they found. Here
+ * NaN in every factor, then only in the (theta, theta_dot) factors: the value is then NaN,
+ * which the tick rejects. */
+static void check_scan(const icoac_config_t *cfg, const icoac_real_t v[ICOAC_CRITIC_UNITS],
+                       const icoac_real_t factors[ICOAC_CRITIC_FACTORS], int expect_nan)
+{
+    icoac_critic_active_t active[2]; /* a neighbour to overrun into, as in the state */
+    icoac_real_t value;
+    int i;
+    memset(active, 0, sizeof active);
+    value = icoac_critic_value(cfg, v, factors, &active[0]);
+    assert_int_equal(isnan((double)value) ? 1 : 0, expect_nan);
+    assert_true(active[0].cells <= ICOAC_CRITIC_CELLS);
+    assert_true(active[0].pairs <= ICOAC_CRITIC_PAIRS);
+    for (i = 0; i < active[0].pairs; ++i) {
+        assert_true(active[0].pair_cells[i] <= active[0].cells);
+        assert_true(active[0].pair[i] < ICOAC_CRITIC_PAIRS);
+    }
+    for (i = 0; i < active[0].cells; ++i) {
+        assert_true(active[0].cell[i] < ICOAC_CRITIC_CELLS);
+    }
+    assert_true(active[1].pairs == 0 && active[1].cells == 0);
+}
+
+static void test_critic_scan_bounded_for_nan(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_real_t v[ICOAC_CRITIC_UNITS];
+    icoac_real_t factors[ICOAC_CRITIC_FACTORS];
+    const icoac_real_t s[ICOAC_N_INPUTS] = {ICOAC_R(0.3), ICOAC_R(-0.2), ICOAC_R(0.05), ICOAC_R(0.1)};
+    int i;
+    (void)unused;
+    for (i = 0; i < ICOAC_CRITIC_UNITS; ++i) {
+        v[i] = (icoac_real_t)0.5;
+    }
+    for (i = 0; i < ICOAC_CRITIC_FACTORS; ++i) {
+        factors[i] = (icoac_real_t)NAN;
+    }
+    check_scan(&cfg, v, factors, 0); /* no pair passes: nothing kept */
+    icoac_critic_factors(&cfg, s, factors);
+    for (i = ICOAC_CRITIC_N_X + ICOAC_CRITIC_N_X_DOT; i < ICOAC_CRITIC_FACTORS; ++i) {
+        factors[i] = (icoac_real_t)(i % 2 ? NAN : -NAN);
+    }
+    check_scan(&cfg, v, factors, 1);
+    cfg.critic_threshold = 0; /* the smallest-normal floor */
+    check_scan(&cfg, v, factors, 1);
+}
+
+/* Reproducer 1, second half: the configuration is now rejected, and an RL tick at s = 0 from
+ * the nearest accepted range is finite. */
+static void test_subnormal_critic_range(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_state_t state;
+    icoac_input_t in = test_input(0, 0, 0, 0, 0);
+    (void)unused;
+    cfg.mode = ICOAC_MODE_RL;
+    cfg.critic_range[0] = (icoac_real_t)1e-39;
+    assert_int_equal(icoac_config_check(&cfg), ICOAC_ERR_BAD_CRITIC);
+    assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_ERR_BAD_CRITIC);
+    cfg.critic_range[0] = ICOAC_RANGE_MIN;
+    assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
+    assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_OK);
+    in.s[0] = (icoac_real_t)1e30; /* far outside the narrow grid: s * n / range overflows */
+    assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_OK);
+    in.s[0] = -FLT_MAX;
+    assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_OK);
+}
+
+/* Reproducer 2: unclipped inputs with a huge finite x gave an OK tick with an infinite force
+ * (ICO) or NaN weights (RL). Now: a numeric fault, nothing learned, and the controller goes
+ * on from the same state when the input is sane again. */
+static void test_unclipped_huge_input(void **unused)
+{
+    int mode;
+    (void)unused;
+    for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
+        icoac_config_t cfg = test_default_config();
+        icoac_state_t state;
+        icoac_state_t twin;
+        icoac_input_t calm = test_input(0.1, 0, 0.01, 0, 0);
+        /* finite, but x / input_range overflows; in the penalty zone, so ICO learns from it */
+        icoac_input_t huge = test_input(REAL_IS_FLOAT ? 3e38 : 1e303, 0, 0.3, 0, 0);
+        cfg.mode = mode;
+        cfg.clip_inputs = 0;
+        cfg.input_range[0] = ICOAC_RANGE_MIN;
+        assert_int_equal(icoac_init(&cfg, &state, NULL, 3u), ICOAC_OK);
+        assert_int_equal(checked_step(&cfg, &state, &calm), ICOAC_OK);
+        twin = state;
+        assert_int_equal(checked_step(&cfg, &state, &huge), ICOAC_ERR_NUMERIC);
+        assert_int_equal(checked_step(&cfg, &state, &calm), ICOAC_OK);
+        assert_int_equal(checked_step(&cfg, &twin, &calm), ICOAC_OK);
+        assert_memory_equal(state.w, twin.w, sizeof state.w);
+        assert_memory_equal(state.v, twin.v, sizeof state.v);
+    }
+}
+
+/* Reproducer 3: a prior the check accepts but whose covariance overflows in the actor. */
+static void test_huge_prior_covariance(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_state_t state;
+    /* the trace (4 * max / 8) is still finite at the first tick */
+    icoac_prior_t prior = test_prior(0.1, 0.1, 0.5, 0.1, (REAL_IS_FLOAT ? (double)FLT_MAX : DBL_MAX) / 8.0);
+    icoac_input_t in = test_input(1.0, 0.5, 0.1, 0.2, 0);
+    int k;
+    (void)unused;
+    cfg.mode = ICOAC_MODE_RL;
+    cfg.forgetting = ICOAC_FORGETTING_MIN; /* the first inflation overflows */
+    assert_int_equal(icoac_prior_check(&prior), ICOAC_OK);
+    assert_int_equal(icoac_init(&cfg, &state, &prior, 5u), ICOAC_OK);
+    assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_OK); /* nothing to learn from yet */
+    for (k = 0; k < 20; ++k) {
+        assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_ERR_NUMERIC);
+    }
+    assert_int_equal(state.numeric_fault_count, 20u);
+}
+
+/* Forgetting inflates Sigma_w by 1/lambda per tick; at s = 0 no observation informs it, so it
+ * overflows after ~128 ticks at lambda = 0.5. Every tick is OK and finite until then, every
+ * later one a numeric fault. */
+static void test_forgetting_overflow_is_a_fault(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_state_t state;
+    icoac_input_t in = test_input(0, 0, 0, 0, 0);
+    int k;
+    int first_fault = -1;
+    (void)unused;
+    cfg.mode = ICOAC_MODE_RL;
+    cfg.forgetting = ICOAC_FORGETTING_MIN;
+    assert_int_equal(icoac_init(&cfg, &state, NULL, 11u), ICOAC_OK);
+    for (k = 0; k < (REAL_IS_FLOAT ? 400 : 2200); ++k) {
+        const icoac_status_t status = checked_step(&cfg, &state, &in);
+        if (status != ICOAC_OK && first_fault < 0) {
+            first_fault = k;
+        }
+        if (first_fault >= 0) {
+            assert_int_equal(status, ICOAC_ERR_NUMERIC);
+        }
+    }
+    assert_true(first_fault > 100);
+    assert_int_equal(state.numeric_fault_count, (uint32_t)((REAL_IS_FLOAT ? 400 : 2200) - first_fault));
+}
+
+/* Random walks over accepted extreme configurations and extreme finite inputs: every tick
+ * keeps the contract (checked_step asserts it). */
+static void test_contract_random_extremes(void **unused)
+{
+    static const double extremes[] = {0.0, -0.0, 1e-39, -1e-39, 1e-6, 0.5, -1.0, 3.0, 1e6, -1e12, 1e30, -3e38};
+    const int n_extremes = (int)(sizeof extremes / sizeof extremes[0]);
+    test_rng_t rng = {0xC0FFEEu};
+    int run;
+    (void)unused;
+    for (run = 0; run < 200; ++run) {
+        icoac_config_t cfg = test_default_config();
+        icoac_state_t state;
+        int k;
+        cfg.mode = run % 2;
+        cfg.clip_inputs = (run / 2) % 2;
+        cfg.act_with_sample = (run / 4) % 2;
+        cfg.ico_timing = (run / 8) % 2;
+        cfg.gain = ICOAC_GAIN_MAX;
+        cfg.ico_rate = ICOAC_ICO_RATE_MAX;
+        cfg.noise_std = run % 3 ? ICOAC_NOISE_STD_MIN : ICOAC_NOISE_STD_MAX;
+        cfg.actor_scale = ICOAC_ACTOR_SCALE_MAX;
+        cfg.td_clip = ICOAC_TD_CLIP_MAX;
+        cfg.critic_rate = ICOAC_CRITIC_RATE_MAX;
+        cfg.forgetting = run % 5 ? ICOAC_R(1.0) : ICOAC_FORGETTING_MIN;
+        cfg.input_range[run % 4] = ICOAC_RANGE_MIN;
+        cfg.critic_range[(run + 1) % 4] = ICOAC_RANGE_MIN;
+        cfg.critic_threshold = run % 7 ? cfg.critic_threshold : ICOAC_R(0.0);
+        assert_int_equal(icoac_init(&cfg, &state, NULL, (uint64_t)run), ICOAC_OK);
+        for (k = 0; k < 300; ++k) {
+            icoac_input_t in;
+            int i;
+            for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+                const int pick = (int)(test_rng_u64(&rng) % (uint64_t)(n_extremes + 4));
+                in.s[i] = (icoac_real_t)(pick < n_extremes ? extremes[pick] : test_uniform(&rng, -3, 3));
+            }
+            in.flags = test_rng_u64(&rng) % 20u == 0u ? ICOAC_INPUT_TERMINAL : 0u;
+            (void)checked_step(&cfg, &state, &in);
+            if (test_rng_u64(&rng) % 50u == 0u) {
+                assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+                assert_true(state_finite(&state));
+            }
+        }
+    }
+}
+
+/* The finiteness check itself, on every class of value. */
+static void test_all_finite(void **unused)
+{
+    icoac_real_t values[4] = {ICOAC_R(0.0), ICOAC_R(-0.0), ICOAC_R(1.0), ICOAC_R(-3.0e38)};
+    (void)unused;
+    assert_true(icoac_all_finite(values, 4));
+    values[2] = (icoac_real_t)1e-39; /* subnormal (float) is finite */
+    assert_true(icoac_all_finite(values, 4));
+    values[1] = (icoac_real_t)INFINITY;
+    assert_false(icoac_all_finite(values, 4));
+    values[1] = (icoac_real_t)-INFINITY;
+    assert_false(icoac_all_finite(values, 4));
+    values[1] = (icoac_real_t)NAN;
+    assert_false(icoac_all_finite(values, 4));
+    values[1] = -(icoac_real_t)NAN;
+    assert_false(icoac_all_finite(values, 4));
+    assert_true(icoac_all_finite(values, 1));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_critic_scan_bounded_for_nan),
+        cmocka_unit_test(test_subnormal_critic_range),
+        cmocka_unit_test(test_unclipped_huge_input),
+        cmocka_unit_test(test_huge_prior_covariance),
+        cmocka_unit_test(test_forgetting_overflow_is_a_fault),
+        cmocka_unit_test(test_contract_random_extremes),
+        cmocka_unit_test(test_all_finite),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
