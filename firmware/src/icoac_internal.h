@@ -117,9 +117,9 @@ static inline int icoac_nonneg_at_least(icoac_real_t a, icoac_real_t b)
     return bits_a >= bits_b;
 }
 
-/* 1 when every one of the n values is finite. An IEEE-754 value is NaN or Inf exactly when its
- * exponent bits are all ones: integer operations only, no branch per value, cheap in soft float. */
-static inline int icoac_all_finite(const icoac_real_t *values, int n)
+/* 1 when v is finite. An IEEE-754 value is NaN or Inf exactly when its exponent bits are all
+ * ones: an integer test, no float compare (costly in soft float). */
+static inline int icoac_finite(icoac_real_t v)
 {
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
     const uint64_t exponent = 0x7FF0000000000000ull;
@@ -128,13 +128,19 @@ static inline int icoac_all_finite(const icoac_real_t *values, int n)
     const uint32_t exponent = 0x7F800000u;
     uint32_t bits;
 #endif
-    int bad = 0;
+    memcpy(&bits, &v, sizeof bits);
+    return (bits & exponent) != exponent;
+}
+
+/* 1 when every one of the n values is finite; no branch per value. */
+static inline int icoac_all_finite(const icoac_real_t *values, int n)
+{
+    int finite = 1;
     int i;
     for (i = 0; i < n; ++i) {
-        memcpy(&bits, &values[i], sizeof bits);
-        bad |= (bits & exponent) == exponent;
+        finite &= icoac_finite(values[i]);
     }
-    return !bad;
+    return finite;
 }
 
 /* dst = src for 4-vectors; inline, as newlib-nano's memcpy copies byte by byte. */

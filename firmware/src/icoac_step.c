@@ -92,58 +92,87 @@ static void commit_trial_cache(icoac_state_t *state, const icoac_real_t scaled[I
     state->has_prev = 1;
 }
 
-/* ICO tick (Eq. 2-3) in either timing (spec A4). The new weights, their norm and the force
- * are staged and committed only when finite; returns 0, with the state untouched, otherwise.
- *   code timing: act with w_t, then learn from the penalty onset at s_t (failure states
- *     are not seen);
- *   literal timing: learn from r(t+1) - r(t) with x~(t), then act with w_{t+1}.
- * Checked: |w| (finite only if every w_i is) and the force (G z + reflex, finite only if z
- * is), or z itself on a terminal tick, which outputs no force. */
-static int ico_tick(const icoac_config_t *cfg, icoac_state_t *state,
-                    const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
-                    icoac_output_t *out)
+/* ICO weights after a penalty onset of size drop > 0 (Eq. 2-3), and their norm. */
+static icoac_real_t ico_learn(const icoac_config_t *cfg, const icoac_state_t *state,
+                              const icoac_real_t trace[ICOAC_N_INPUTS], icoac_real_t drop,
+                              icoac_real_t w[ICOAC_N_INPUTS])
 {
-    const int literal = cfg->ico_timing == ICOAC_ICO_TIMING_LITERAL;
-    const icoac_real_t *trace = literal ? state->x_prev : scaled;
-    const int sees_penalty = literal ? state->has_prev : !terminal;
+    const icoac_real_t step = cfg->ico_rate * drop;
+    int i;
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        w[i] = state->w[i] + step * ICOAC_FABS(trace[i]);
+    }
+    return ICOAC_SQRT(icoac_dot4(w, w));
+}
+
+static void ico_commit(icoac_state_t *state, const icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t norm)
+{
+    icoac_copy4(state->w, w);
+    state->weight_norm = norm;
+}
+
+/* ICO rule, code timing: act with w_t, then learn from the penalty onset at s_t. Failure
+ * states are not seen. The force and the new weights' norm (finite only if every w_i is) are
+ * checked before anything is stored; returns 0, with the state untouched, when one is not. */
+static int ico_code_timing(const icoac_config_t *cfg, icoac_state_t *state,
+                           const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
+                           icoac_output_t *out)
+{
     const icoac_real_t drop = state->penalty_prev - penalty;
     icoac_real_t w[ICOAC_N_INPUTS];
-    icoac_real_t checked[2]; /* |w|, force (or z when terminal) */
+    icoac_real_t norm = ICOAC_R(0.0);
+    icoac_real_t z;
+    icoac_real_t force;
+    if (terminal) {
+        return 1;
+    }
+    z = icoac_dot4(state->w, scaled);
+    force = cfg->gain * z + icoac_reflex_force(cfg, out->reflex);
+    if (drop > ICOAC_R(0.0)) {
+        norm = ico_learn(cfg, state, scaled, drop, w);
+    }
+    if (!icoac_finite(force) || !icoac_finite(norm)) {
+        return 0;
+    }
+    if (drop > ICOAC_R(0.0)) {
+        ico_commit(state, w, norm);
+        out->q = drop;
+    }
+    state->penalty_prev = penalty;
+    out->z = z;
+    out->force = force;
+    return 1;
+}
+
+/* ICO rule, literal timing: learn from r(t+1) - r(t) with x~(t), then act with w_{t+1}; a
+ * terminal tick learns and outputs no force. Checked like the code timing (z stands for the
+ * force on a terminal tick). */
+static int ico_literal_timing(const icoac_config_t *cfg, icoac_state_t *state,
+                              const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty,
+                              int terminal, icoac_output_t *out)
+{
+    const icoac_real_t drop = state->penalty_prev - penalty;
+    const int learn = state->has_prev && drop > ICOAC_R(0.0);
+    icoac_real_t w[ICOAC_N_INPUTS];
+    icoac_real_t norm = ICOAC_R(0.0);
     icoac_real_t z;
     icoac_real_t force = ICOAC_R(0.0);
-    int learned = 0;
-    int i;
-    if (!literal && terminal) {
-        return 1; /* code timing ignores failure states */
+    if (learn) {
+        norm = ico_learn(cfg, state, state->x_prev, drop, w);
     }
-    icoac_copy4(w, state->w);
-    checked[0] = state->weight_norm;
-    z = icoac_dot4(w, scaled); /* code timing acts with w_t */
-    if (sees_penalty && drop > ICOAC_R(0.0)) {
-        const icoac_real_t step = cfg->ico_rate * drop;
-        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-            w[i] += step * ICOAC_FABS(trace[i]);
-        }
-        checked[0] = ICOAC_SQRT(icoac_dot4(w, w));
-        learned = 1;
-    }
-    if (literal) {
-        z = icoac_dot4(w, scaled); /* literal timing acts with w_{t+1} */
-    }
+    z = icoac_dot4(learn ? w : state->w, scaled);
     if (!terminal) {
         force = cfg->gain * z + icoac_reflex_force(cfg, out->reflex);
     }
-    checked[1] = terminal ? z : force;
-    if (!icoac_all_finite(checked, 2)) {
+    if (!icoac_finite(terminal ? z : force) || !icoac_finite(norm)) {
         return 0;
     }
-    icoac_copy4(state->w, w);
-    state->weight_norm = checked[0];
-    state->penalty_prev = penalty;
-    if (literal) {
-        commit_trial_cache(state, scaled);
+    if (learn) {
+        ico_commit(state, w, norm);
+        out->q = drop;
     }
-    out->q = learned ? drop : ICOAC_R(0.0);
+    state->penalty_prev = penalty;
+    commit_trial_cache(state, scaled);
     out->z = z;
     out->force = force;
     return 1;
@@ -302,8 +331,13 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
     zone = icoac_zone(cfg, in->s);
     out->reflex = zone.reflex;
     out->penalty = zone.penalty;
-    ok = cfg->mode == ICOAC_MODE_RL ? rl_tick(cfg, state, in->s, scaled, terminal, out)
-                                    : ico_tick(cfg, state, scaled, zone.penalty, terminal, out);
+    if (cfg->mode == ICOAC_MODE_RL) {
+        ok = rl_tick(cfg, state, in->s, scaled, terminal, out);
+    } else if (cfg->ico_timing == ICOAC_ICO_TIMING_LITERAL) {
+        ok = ico_literal_timing(cfg, state, scaled, zone.penalty, terminal, out);
+    } else {
+        ok = ico_code_timing(cfg, state, scaled, zone.penalty, terminal, out);
+    }
     if (!ok) {
         state->numeric_fault_count++;
         clear_output(out);
