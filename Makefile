@@ -6,12 +6,19 @@ PYTHON ?= python3
 VENV := .venv
 VPY := $(VENV)/bin/python
 APT_PACKAGES := cmake ninja-build gcc libc6-dev libcmocka-dev python3 python3-venv git \
-  gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm binutils-arm-none-eabi
+  gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm binutils-arm-none-eabi \
+  clang libclang-rt-14-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 BENCH_PROFILE ?= default
 BENCH_OUT ?= results/bench
+# `make fuzz`: seconds per target, targets run at once, extra libFuzzer options.
+FUZZ_TIME ?= 600
+FUZZ_JOBS ?= 2
+FUZZ_FLAGS ?=
+FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_sim
 
-.PHONY: all deps venv build build-asan test test-c test-asan test-python bench bench-speed clean target-report
+.PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz bench \
+  bench-speed clean target-report
 
 all: build
 
@@ -48,7 +55,21 @@ test-c: build
 test-python: build venv
 	$(VPY) -m pytest -q tests/python
 
-test: test-asan test-c test-python
+build-fuzz: deps
+	cmake --preset fuzz >/dev/null
+	cmake --build --preset fuzz
+
+# Each fuzz target over its committed corpus, then a short fuzzing run (tests/fuzz).
+test-fuzz: build-fuzz
+	ctest --preset fuzz
+
+test: test-asan test-c test-python test-fuzz
+
+# Long fuzzing: FUZZ_TIME s per target, FUZZ_JOBS at a time, from tests/fuzz/corpus/<target>;
+# new inputs, logs and crash reproducers go to build/fuzz/work/<target>/.
+fuzz: build-fuzz
+	@printf '%s\n' $(FUZZ_TARGETS) | xargs -P $(FUZZ_JOBS) -I '{}' sh tests/fuzz/run_fuzzer.sh fuzz $(FUZZ_TIME) \
+	  build/fuzz/tests/fuzz/'{}' tests/fuzz/corpus/'{}' build/fuzz/work/'{}' $(FUZZ_FLAGS)
 
 bench-speed: build
 	./build/release/sim_host/icoac_bench

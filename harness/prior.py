@@ -107,6 +107,9 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | None = DEFAULT_FRAME
     mean = w.mean(axis=0)
     cov = np.cov(w, rowvar=False, ddof=1) + ridge * np.eye(B.N_INPUTS)
     cov = 0.5 * (cov + cov.T)
+    # entries that would be subnormal in the controller's reals are 0 to it on a host that
+    # flushes subnormals, so the C prior check rejects them: store them as 0
+    cov[np.abs(cov) < np.finfo(B.real_dtype).tiny] = 0.0
     return PriorInfo(mean=mean, cov=cov, frame=frame, n_cells=n, ridge=float(ridge))
 
 

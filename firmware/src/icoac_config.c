@@ -1,15 +1,9 @@
-#include "icoac/icoac.h"
+#include "icoac_internal.h"
 
-/* lo <= v <= hi; false for NaN. */
+/* lo <= v <= hi and v not subnormal; false for NaN. */
 static int within(icoac_real_t v, icoac_real_t lo, icoac_real_t hi)
 {
-    return v >= lo && v <= hi;
-}
-
-/* lo < v <= hi; false for NaN. */
-static int above_within(icoac_real_t v, icoac_real_t lo, icoac_real_t hi)
-{
-    return v > lo && v <= hi;
+    return v >= lo && v <= hi && icoac_zero_or_normal(v);
 }
 
 static int is_flag(int32_t v)
@@ -28,11 +22,11 @@ const char *icoac_status_str(icoac_status_t status)
     case ICOAC_ERR_BAD_MODE: return "invalid switch (mode, reflex_mode, ico_timing or a 0/1 flag)";
     case ICOAC_ERR_BAD_SCALE: return "invalid input_range (must be in [1e-6, 1e6])";
     case ICOAC_ERR_BAD_GAIN: return "invalid gain or reflex_force (must be in [0, 1e4])";
-    case ICOAC_ERR_BAD_ZONE: return "invalid zone_theta or zone_x (must be in (0, pi] rad and (0, 1e6] m)";
+    case ICOAC_ERR_BAD_ZONE: return "invalid zone_theta or zone_x (must be in [1e-6, pi] rad and [1e-6, 1e6] m)";
     case ICOAC_ERR_BAD_ICO_RATE: return "invalid ico_rate (must be in [0, 1])";
     case ICOAC_ERR_BAD_CRITIC: return "invalid critic parameter (critic_rate [0, 10], discount [0, 1], td_clip [1e-6, 1e3], critic_range [1e-6, 1e6], critic_threshold [0, 1))";
     case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std [1e-3, 1e3], actor_scale [0, 1e3], forgetting [0.5, 1])";
-    case ICOAC_ERR_BAD_PRIOR: return "invalid prior (mean not finite or covariance not symmetric positive definite)";
+    case ICOAC_ERR_BAD_PRIOR: return "invalid prior (|mean| <= 1e6, covariance entries |c| <= 1e12, zero or normal, symmetric positive definite)";
     default: return "unknown status";
     }
 }
@@ -91,8 +85,8 @@ icoac_status_t icoac_config_check(const icoac_config_t *cfg)
         !within(cfg->reflex_force, ICOAC_R(0.0), ICOAC_FORCE_MAX)) {
         return ICOAC_ERR_BAD_GAIN;
     }
-    if (!above_within(cfg->zone_theta, ICOAC_R(0.0), ICOAC_ZONE_THETA_MAX) ||
-        !above_within(cfg->zone_x, ICOAC_R(0.0), ICOAC_ZONE_X_MAX)) {
+    if (!within(cfg->zone_theta, ICOAC_ZONE_MIN, ICOAC_ZONE_THETA_MAX) ||
+        !within(cfg->zone_x, ICOAC_ZONE_MIN, ICOAC_ZONE_X_MAX)) {
         return ICOAC_ERR_BAD_ZONE;
     }
     if (!within(cfg->ico_rate, ICOAC_R(0.0), ICOAC_ICO_RATE_MAX)) {
@@ -101,7 +95,7 @@ icoac_status_t icoac_config_check(const icoac_config_t *cfg)
     if (!within(cfg->critic_rate, ICOAC_R(0.0), ICOAC_CRITIC_RATE_MAX) ||
         !within(cfg->discount, ICOAC_R(0.0), ICOAC_R(1.0)) ||
         !within(cfg->td_clip, ICOAC_TD_CLIP_MIN, ICOAC_TD_CLIP_MAX) ||
-        !(cfg->critic_threshold >= ICOAC_R(0.0) && cfg->critic_threshold < ICOAC_R(1.0))) {
+        !(within(cfg->critic_threshold, ICOAC_R(0.0), ICOAC_R(1.0)) && cfg->critic_threshold < ICOAC_R(1.0))) {
         return ICOAC_ERR_BAD_CRITIC;
     }
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {

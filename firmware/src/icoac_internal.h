@@ -132,6 +132,23 @@ static inline int icoac_finite(icoac_real_t v)
     return (bits & exponent) != exponent;
 }
 
+/* 1 when v is +-0 or a normal number (or Inf/NaN): not subnormal. Configuration and prior
+ * values must be, since hosts that flush subnormals to zero would read them as 0. */
+static inline int icoac_zero_or_normal(icoac_real_t v)
+{
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+    const uint64_t exponent = 0x7FF0000000000000ull;
+    const uint64_t magnitude = 0x7FFFFFFFFFFFFFFFull;
+    uint64_t bits;
+#else
+    const uint32_t exponent = 0x7F800000u;
+    const uint32_t magnitude = 0x7FFFFFFFu;
+    uint32_t bits;
+#endif
+    memcpy(&bits, &v, sizeof bits);
+    return (bits & exponent) != 0u || (bits & magnitude) == 0u;
+}
+
 /* 1 when every one of the n values is finite; no branch per value. */
 static inline int icoac_all_finite(const icoac_real_t *values, int n)
 {

@@ -13,11 +13,13 @@ icoac_status_t icoac_prior_check(const icoac_prior_t *prior)
         return ICOAC_ERR_NULL;
     }
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-        if (!isfinite(prior->mean[i])) {
+        const icoac_real_t m = prior->mean[i];
+        if (!(ICOAC_FABS(m) <= ICOAC_PRIOR_MEAN_MAX) || !icoac_zero_or_normal(m)) {
             return ICOAC_ERR_BAD_PRIOR;
         }
         for (j = 0; j < ICOAC_N_INPUTS; ++j) {
-            if (!isfinite(prior->cov[i][j]) || prior->cov[i][j] != prior->cov[j][i]) {
+            const icoac_real_t c = prior->cov[i][j];
+            if (!(ICOAC_FABS(c) <= ICOAC_PRIOR_COV_MAX) || !icoac_zero_or_normal(c) || c != prior->cov[j][i]) {
                 return ICOAC_ERR_BAD_PRIOR;
             }
         }

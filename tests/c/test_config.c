@@ -115,6 +115,10 @@ MUT(m_noise_huge, c->noise_std = (icoac_real_t)1e30)
 MUT(m_scale_huge, c->actor_scale = (icoac_real_t)1e30)
 MUT(m_forget_tiny, c->forgetting = (icoac_real_t)1e-30)
 MUT(m_forget_below_half, c->forgetting = (icoac_real_t)0.49)
+MUT(m_zone_theta_subnormal, c->zone_theta = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
+MUT(m_zone_x_tiny, c->zone_x = (icoac_real_t)9e-7)
+MUT(m_gain_subnormal, c->gain = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
+MUT(m_threshold_subnormal, c->critic_threshold = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
 /* Boundary values that are valid. */
 MUT(ok_range_bounds, { c->input_range[0] = (icoac_real_t)1e-6; c->input_range[1] = (icoac_real_t)1e6;
                        c->critic_range[2] = (icoac_real_t)1e-6; c->critic_range[3] = (icoac_real_t)1e6; })
@@ -200,6 +204,10 @@ static const config_case_t config_cases[] = {
     {"actor_scale=1e30", m_scale_huge, ICOAC_ERR_BAD_ACTOR},
     {"forgetting=1e-30", m_forget_tiny, ICOAC_ERR_BAD_ACTOR},
     {"forgetting=0.49", m_forget_below_half, ICOAC_ERR_BAD_ACTOR},
+    {"zone_theta subnormal", m_zone_theta_subnormal, ICOAC_ERR_BAD_ZONE},
+    {"zone_x=9e-7", m_zone_x_tiny, ICOAC_ERR_BAD_ZONE},
+    {"gain subnormal", m_gain_subnormal, ICOAC_ERR_BAD_GAIN},
+    {"critic_threshold subnormal", m_threshold_subnormal, ICOAC_ERR_BAD_CRITIC},
     {"ranges at their bounds", ok_range_bounds, ICOAC_OK},
     {"upper bounds", ok_upper_bounds, ICOAC_OK},
     {"lower bounds", ok_lower_bounds, ICOAC_OK},

@@ -164,25 +164,41 @@ static void test_unclipped_huge_input(void **unused)
     }
 }
 
-/* Reproducer 3: a prior the check accepts but whose covariance overflows in the actor. */
-static void test_huge_prior_covariance(void **unused)
+/* Reproducer 3: priors the check accepted but whose derived values overflowed (|w|^2 of a mean
+ * of 1e30: OK ticks with an infinite |w|), or which a host that flushes subnormals reads
+ * differently (a subnormal diagonal becomes 0, a subnormal asymmetry disappears). Now rejected;
+ * the largest accepted covariance, inflated by forgetting, gives numeric faults. */
+static void test_prior_bounds(void **unused)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
-    /* the trace (4 * max / 8) is still finite at the first tick */
-    icoac_prior_t prior = test_prior(0.1, 0.1, 0.5, 0.1, (REAL_IS_FLOAT ? (double)FLT_MAX : DBL_MAX) / 8.0);
+    icoac_prior_t prior = test_prior(1e30, 0.1, 0.5, 0.1, 1.0);
     icoac_input_t in = test_input(1.0, 0.5, 0.1, 0.2, 0);
     int k;
+    int faults = 0;
     (void)unused;
+    assert_int_equal(icoac_prior_check(&prior), ICOAC_ERR_BAD_PRIOR);
+    prior = test_prior(0, 0, 0, 0, 1.0);
+    prior.cov[1][1] = (icoac_real_t)1e-39; /* subnormal in float, tiny in double: below 1e-12 of the rest */
+    assert_int_equal(icoac_prior_check(&prior), REAL_IS_FLOAT ? ICOAC_ERR_BAD_PRIOR : ICOAC_OK);
+    prior = test_prior(0, 0, 0, 0, 1.0);
+    prior.cov[3][0] = (icoac_real_t)(REAL_IS_FLOAT ? -1e-39 : -1e-310);
+    assert_int_equal(icoac_prior_check(&prior), ICOAC_ERR_BAD_PRIOR);
+    prior.cov[0][3] = prior.cov[3][0]; /* symmetric now, but still subnormal */
+    assert_int_equal(icoac_prior_check(&prior), ICOAC_ERR_BAD_PRIOR);
+    prior = test_prior(ICOAC_PRIOR_MEAN_MAX, 0, 0, 0, 1.1 * (double)ICOAC_PRIOR_COV_MAX);
+    assert_int_equal(icoac_prior_check(&prior), ICOAC_ERR_BAD_PRIOR);
+
+    prior = test_prior(ICOAC_PRIOR_MEAN_MAX, 0.1, 0.5, 0.1, (double)ICOAC_PRIOR_COV_MAX);
     cfg.mode = ICOAC_MODE_RL;
-    cfg.forgetting = ICOAC_FORGETTING_MIN; /* the first inflation overflows */
+    cfg.forgetting = ICOAC_FORGETTING_MIN;
     assert_int_equal(icoac_prior_check(&prior), ICOAC_OK);
     assert_int_equal(icoac_init(&cfg, &state, &prior, 5u), ICOAC_OK);
-    assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_OK); /* nothing to learn from yet */
-    for (k = 0; k < 20; ++k) {
-        assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_ERR_NUMERIC);
+    for (k = 0; k < (REAL_IS_FLOAT ? 200 : 1200); ++k) {
+        faults += checked_step(&cfg, &state, &in) == ICOAC_ERR_NUMERIC;
     }
-    assert_int_equal(state.numeric_fault_count, 20u);
+    assert_true(faults > 0);
+    assert_int_equal(state.numeric_fault_count, (uint32_t)faults);
 }
 
 /* Forgetting inflates Sigma_w by 1/lambda per tick; at s = 0 no observation informs it, so it
@@ -282,7 +298,7 @@ int main(void)
         cmocka_unit_test(test_critic_scan_bounded_for_nan),
         cmocka_unit_test(test_subnormal_critic_range),
         cmocka_unit_test(test_unclipped_huge_input),
-        cmocka_unit_test(test_huge_prior_covariance),
+        cmocka_unit_test(test_prior_bounds),
         cmocka_unit_test(test_forgetting_overflow_is_a_fault),
         cmocka_unit_test(test_contract_random_extremes),
         cmocka_unit_test(test_all_finite),

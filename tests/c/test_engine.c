@@ -97,16 +97,17 @@ static void test_run_cell_outcomes(void **unused)
     assert_true(c.weights[2] > 0.0);
 }
 
-/* A controller that faults numerically mid-run (an accepted prior covariance near the float
- * limit, inflated by forgetting) ends its cell as ERROR with ICOAC_ERR_NUMERIC and finite
- * recorded weights; such cells used to end SUCCESS or FAILED with NaN weights. */
+/* A controller that faults numerically mid-run (the largest accepted prior covariance,
+ * inflated by forgetting in the directions the observations inform least) ends its cell as
+ * ERROR with ICOAC_ERR_NUMERIC and finite recorded weights; such cells used to end SUCCESS or
+ * FAILED with NaN weights. */
 static void test_numeric_fault_marks_cell_error(void **unused)
 {
     const icoac_sim_plant_t plant = default_plant();
     icoac_config_t cfg = test_default_config();
-    icoac_sim_run_t run = small_run(3, 5000);
+    icoac_sim_run_t run = small_run(50, 5000);
     icoac_sim_cell_t cells[2];
-    const icoac_prior_t prior = test_prior(0.1, 0.1, 0.5, 0.1, 1e38);
+    const icoac_prior_t prior = test_prior(0.1, 0.1, 0.5, 0.1, (double)ICOAC_PRIOR_COV_MAX);
     int i, j, k;
     (void)unused;
     cfg.mode = ICOAC_MODE_RL;

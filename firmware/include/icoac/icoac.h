@@ -33,15 +33,17 @@ typedef enum {
     ICOAC_ICO_TIMING_LITERAL = 1 /* r(t+1) from the post-step state incl. failure, update with x~(t) */
 } icoac_ico_timing_t;
 
-/* Valid ranges of the configuration, closed at both ends unless said otherwise. Each bound
+/* Valid ranges of the configuration, closed at both ends unless said otherwise; subnormal
+ * values are rejected everywhere (a host that flushes them to zero would read 0). Each bound
  * keeps a derived quantity representable in float: 1/range and s*n/range (critic) stay finite
  * and normal, sigma_u^2 stays normal, 1/forgetting stays small. */
 #define ICOAC_RANGE_MIN ICOAC_R(1.0e-6)       /* input_range, critic_range (m, m/s, rad, rad/s) */
 #define ICOAC_RANGE_MAX ICOAC_R(1.0e6)
 #define ICOAC_GAIN_MAX ICOAC_R(1.0e4)         /* gain (N per unit feature), >= 0 */
 #define ICOAC_FORCE_MAX ICOAC_R(1.0e4)        /* reflex_force (N), >= 0 */
-#define ICOAC_ZONE_THETA_MAX ICOAC_R(3.14159265358979) /* zone_theta (rad), > 0 */
-#define ICOAC_ZONE_X_MAX ICOAC_R(1.0e6)       /* zone_x (m), > 0 */
+#define ICOAC_ZONE_MIN ICOAC_R(1.0e-6)        /* zone_theta (rad), zone_x (m) */
+#define ICOAC_ZONE_THETA_MAX ICOAC_R(3.14159265358979)
+#define ICOAC_ZONE_X_MAX ICOAC_R(1.0e6)
 #define ICOAC_ICO_RATE_MAX ICOAC_R(1.0)       /* ico_rate, >= 0 */
 #define ICOAC_CRITIC_RATE_MAX ICOAC_R(10.0)   /* critic_rate, >= 0 */
 #define ICOAC_TD_CLIP_MIN ICOAC_R(1.0e-6)     /* td_clip */
@@ -61,8 +63,8 @@ typedef struct {
     icoac_real_t input_range[ICOAC_N_INPUTS];   /* (m, m/s, rad, rad/s) maps to +-1; [1e-6, 1e6]. 2.4, 3.5, 0.2094384, 2.0 */
     icoac_real_t gain;                          /* G (N per unit feature), [0, 1e4]. 10 */
     icoac_real_t reflex_force;                  /* N per unit U in ICOAC_REFLEX_UNIT, [0, 1e4]. 1 */
-    icoac_real_t zone_theta;                    /* reflex/penalty angle (rad), (0, pi]. 11.5 deg = 0.20071286 */
-    icoac_real_t zone_x;                        /* reflex/penalty cart position (m), (0, 1e6]. 2.35 */
+    icoac_real_t zone_theta;                    /* reflex/penalty angle (rad), [1e-6, pi]. 11.5 deg = 0.20071286 */
+    icoac_real_t zone_x;                        /* reflex/penalty cart position (m), [1e-6, 1e6]. 2.35 */
     icoac_real_t ico_rate;                      /* mu, [0, 1]. 1e-4 */
     /* RL (ICOAC_MODE_RL) */
     icoac_real_t critic_rate;                   /* eta_c, [0, 10]. 0.6 */
@@ -77,7 +79,11 @@ typedef struct {
     int32_t act_with_sample;                    /* 1: act with a posterior sample of w per trial; 0: with mu_w */
 } icoac_config_t;
 
-/* Gaussian prior / posterior of the feature weights, (w_x, w_xdot, w_theta, w_thetadot). */
+/* Gaussian prior / posterior of the feature weights, (w_x, w_xdot, w_theta, w_thetadot).
+ * A prior must have |mean_i| <= ICOAC_PRIOR_MEAN_MAX, |cov_ij| <= ICOAC_PRIOR_COV_MAX, no
+ * subnormal entry, and an exactly symmetric positive definite covariance. */
+#define ICOAC_PRIOR_MEAN_MAX ICOAC_R(1.0e6)
+#define ICOAC_PRIOR_COV_MAX ICOAC_R(1.0e12)
 typedef struct {
     icoac_real_t mean[ICOAC_N_INPUTS];
     icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
@@ -148,7 +154,7 @@ void icoac_config_default(icoac_config_t *cfg);
 /* Validate every field; ICOAC_OK or the status naming the first bad group. */
 icoac_status_t icoac_config_check(const icoac_config_t *cfg);
 
-/* Validate a prior: finite mean, exactly symmetric positive definite covariance. */
+/* Validate a prior (the bounds at icoac_prior_t). */
 icoac_status_t icoac_prior_check(const icoac_prior_t *prior);
 
 /* Check cfg and prior, then clear state. prior NULL: mean 0, covariance I.

@@ -1,0 +1,226 @@
+/* Byte reader, special-value tables and the config / prior sections of the fuzz inputs.
+ * tests/fuzz/gen_corpus.py writes inputs in this format: keep the tables in step with it. */
+#include "fuzz_input.h"
+
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+#define FZ_REAL_MIN DBL_MIN
+#define FZ_REAL_MAX DBL_MAX
+#define FZ_REAL_TRUE_MIN DBL_TRUE_MIN
+#else
+#define FZ_REAL_MIN FLT_MIN
+#define FZ_REAL_MAX FLT_MAX
+#define FZ_REAL_TRUE_MIN FLT_TRUE_MIN
+#endif
+
+/* Special values of icoac_real_t; 1e-39 and 1e-45 are float subnormals. */
+static const icoac_real_t real_table[FZ_VALUE_TABLE] = {
+    ICOAC_R(0.0), ICOAC_R(-0.0), ICOAC_R(1e-39), ICOAC_R(1e-45), FZ_REAL_MIN, FZ_REAL_MAX,
+    ICOAC_R(1e30), ICOAC_R(1e-20), (icoac_real_t)NAN, (icoac_real_t)INFINITY,
+    -(icoac_real_t)INFINITY, ICOAC_R(-1.0), ICOAC_R(1.0), ICOAC_R(0.5), ICOAC_R(-1e30),
+    ICOAC_R(1e38), -FZ_REAL_MAX, ICOAC_R(2.0), ICOAC_R(0.25), ICOAC_R(2.4), ICOAC_R(-2.4),
+    ICOAC_R(10.0), ICOAC_R(1e-5), ICOAC_R(-0.25), FZ_REAL_TRUE_MIN, ICOAC_R(0.999),
+    ICOAC_R(1e10), ICOAC_R(-1e-39)};
+
+/* Special doubles; 1e-310 is a double subnormal. */
+static const double double_table[FZ_VALUE_TABLE] = {
+    0.0, -0.0, 1e-310, DBL_TRUE_MIN, DBL_MIN, DBL_MAX, 1e300, 1e30, (double)NAN, (double)INFINITY,
+    -(double)INFINITY, -1.0, 1.0, 0.5, -1e30, 1e-20, -DBL_MAX, 2.0, 0.25, 2.4, -2.4, 9.8, 0.01, 1e-6,
+    1e6, 0.1, 1e-39, 3.2};
+
+static const double bounded_scale[FZ_VALUE_BOUNDED] = {1e-3, 1e-2, 0.1, 1.0, 3.0, 10.0, 100.0, 1e4};
+
+static const int64_t i64_table[11] = {0, 1, 2, 3, -1, 300, 1000, 100000, INT64_MAX, INT64_MIN, 10};
+
+void fz_reader_init(fz_reader_t *r, const uint8_t *data, size_t size)
+{
+    r->data = data;
+    r->size = size;
+    r->pos = 0;
+}
+
+int fz_done(const fz_reader_t *r)
+{
+    return r->pos >= r->size;
+}
+
+uint8_t fz_u8(fz_reader_t *r)
+{
+    return r->pos < r->size ? r->data[r->pos++] : 0u;
+}
+
+/* n <= 8 bytes, little endian. */
+static uint64_t read_le(fz_reader_t *r, int n)
+{
+    uint64_t v = 0;
+    int i;
+    for (i = 0; i < n; ++i) {
+        v |= (uint64_t)fz_u8(r) << (8 * i);
+    }
+    return v;
+}
+
+uint64_t fz_u64(fz_reader_t *r)
+{
+    return read_le(r, 8);
+}
+
+void fz_overlay(fz_reader_t *r, void *dst, size_t n)
+{
+    const size_t left = r->size - r->pos;
+    const size_t take = n < left ? n : left;
+    if (take > 0) {
+        memcpy(dst, r->data + r->pos, take);
+        r->pos += take;
+    }
+}
+
+/* int16 / 32768 * scale for a bounded selector k. */
+static double bounded(fz_reader_t *r, int k)
+{
+    const int16_t q = (int16_t)(uint16_t)read_le(r, 2);
+    return (double)q / 32768.0 * bounded_scale[k - FZ_VALUE_TABLE];
+}
+
+icoac_real_t fz_real(fz_reader_t *r)
+{
+    const int k = fz_u8(r) % FZ_VALUE_KINDS;
+    icoac_real_t v;
+    if (k < FZ_VALUE_TABLE) {
+        return real_table[k];
+    }
+    if (k < FZ_VALUE_TABLE + FZ_VALUE_BOUNDED) {
+        return (icoac_real_t)bounded(r, k);
+    }
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+    {
+        const uint64_t bits = read_le(r, 8);
+        memcpy(&v, &bits, sizeof v);
+    }
+#else
+    {
+        const uint32_t bits = (uint32_t)read_le(r, 4);
+        memcpy(&v, &bits, sizeof v);
+    }
+#endif
+    return v;
+}
+
+double fz_double(fz_reader_t *r)
+{
+    const int k = fz_u8(r) % FZ_VALUE_KINDS;
+    double v;
+    uint64_t bits;
+    if (k < FZ_VALUE_TABLE) {
+        return double_table[k];
+    }
+    if (k < FZ_VALUE_TABLE + FZ_VALUE_BOUNDED) {
+        return bounded(r, k);
+    }
+    bits = read_le(r, 8);
+    memcpy(&v, &bits, sizeof v);
+    return v;
+}
+
+int32_t fz_i32(fz_reader_t *r)
+{
+    static const int32_t table[7] = {0, 1, 2, -1, INT32_MAX, INT32_MIN, 3};
+    const int k = fz_u8(r) % 8;
+    return k < 7 ? table[k] : (int32_t)(uint32_t)read_le(r, 4);
+}
+
+int64_t fz_i64(fz_reader_t *r)
+{
+    const int k = fz_u8(r) % 12;
+    return k < 11 ? i64_table[k] : (int64_t)read_le(r, 8);
+}
+
+/* Config field index -> its int32 or real member (exactly one is set). Indices:
+ * 0 mode, 1 reflex_mode, 2 ico_timing, 3 clip_inputs, 4-7 input_range, 8 gain,
+ * 9 reflex_force, 10 zone_theta, 11 zone_x, 12 ico_rate, 13 critic_rate, 14 discount,
+ * 15 td_clip, 16-19 critic_range, 20 critic_threshold, 21 noise_std, 22 actor_scale,
+ * 23 forgetting, 24 rl_reflex, 25 act_with_sample. */
+static void config_field(icoac_config_t *cfg, int index, int32_t **int_field, icoac_real_t **real_field)
+{
+    *int_field = 0;
+    *real_field = 0;
+    switch (index) {
+    case 0: *int_field = &cfg->mode; break;
+    case 1: *int_field = &cfg->reflex_mode; break;
+    case 2: *int_field = &cfg->ico_timing; break;
+    case 3: *int_field = &cfg->clip_inputs; break;
+    case 4: case 5: case 6: case 7: *real_field = &cfg->input_range[index - 4]; break;
+    case 8: *real_field = &cfg->gain; break;
+    case 9: *real_field = &cfg->reflex_force; break;
+    case 10: *real_field = &cfg->zone_theta; break;
+    case 11: *real_field = &cfg->zone_x; break;
+    case 12: *real_field = &cfg->ico_rate; break;
+    case 13: *real_field = &cfg->critic_rate; break;
+    case 14: *real_field = &cfg->discount; break;
+    case 15: *real_field = &cfg->td_clip; break;
+    case 16: case 17: case 18: case 19: *real_field = &cfg->critic_range[index - 16]; break;
+    case 20: *real_field = &cfg->critic_threshold; break;
+    case 21: *real_field = &cfg->noise_std; break;
+    case 22: *real_field = &cfg->actor_scale; break;
+    case 23: *real_field = &cfg->forgetting; break;
+    case 24: *int_field = &cfg->rl_reflex; break;
+    default: *int_field = &cfg->act_with_sample; break;
+    }
+}
+
+void fz_config(fz_reader_t *r, icoac_config_t *cfg)
+{
+    const uint8_t c = fz_u8(r);
+    int n;
+    icoac_config_default(cfg);
+    if (c & 1u) {
+        fz_overlay(r, cfg, sizeof *cfg);
+        return;
+    }
+    for (n = (c >> 1) % 8; n > 0; --n) {
+        int32_t *int_field;
+        icoac_real_t *real_field;
+        config_field(cfg, fz_u8(r) % FZ_CONFIG_FIELDS, &int_field, &real_field);
+        if (int_field != 0) {
+            *int_field = fz_i32(r);
+        } else {
+            *real_field = fz_real(r);
+        }
+    }
+}
+
+const icoac_prior_t *fz_prior(fz_reader_t *r, icoac_prior_t *prior)
+{
+    const uint8_t p = fz_u8(r);
+    int i;
+    int n;
+    if (p % 3 == 0) {
+        return 0;
+    }
+    memset(prior, 0, sizeof *prior);
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        prior->cov[i][i] = ICOAC_R(1.0);
+    }
+    if (p % 3 == 1) {
+        return prior;
+    }
+    for (n = (p / 3) % 8; n > 0; --n) {
+        const uint8_t b = fz_u8(r);
+        const int field = (b & 0x7f) % FZ_PRIOR_FIELDS;
+        const icoac_real_t v = fz_real(r);
+        if (field < ICOAC_N_INPUTS) {
+            prior->mean[field] = v;
+        } else {
+            const int row = (field - ICOAC_N_INPUTS) / ICOAC_N_INPUTS;
+            const int col = (field - ICOAC_N_INPUTS) % ICOAC_N_INPUTS;
+            prior->cov[row][col] = v;
+            if (b & 0x80) {
+                prior->cov[col][row] = v;
+            }
+        }
+    }
+    return prior;
+}

@@ -1,0 +1,46 @@
+/* Decoding of fuzz input bytes, shared by the fuzz targets (format: fuzz_controller.c).
+ * The reader yields zero bytes once the input is used up, so every input decodes. */
+#ifndef ICOAC_FUZZ_INPUT_H
+#define ICOAC_FUZZ_INPUT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "icoac/icoac.h"
+
+typedef struct {
+    const uint8_t *data;
+    size_t size;
+    size_t pos;
+} fz_reader_t;
+
+/* Selector ranges of one value: table index, bounded value or raw bits (fuzz_input.c). */
+#define FZ_VALUE_TABLE 28   /* selectors 0..27: the special-value table */
+#define FZ_VALUE_BOUNDED 8  /* 28..35: int16 / 32768 * scale, scale 1e-3 .. 1e4 */
+#define FZ_VALUE_RAW 4      /* 36..39: raw bits of the value, little endian */
+#define FZ_VALUE_KINDS (FZ_VALUE_TABLE + FZ_VALUE_BOUNDED + FZ_VALUE_RAW)
+
+#define FZ_CONFIG_FIELDS 26 /* config mutation field indices 0..25, see fuzz_input.c */
+#define FZ_PRIOR_FIELDS 20  /* 0..3 mean, 4 + 4i + j cov[i][j] */
+
+void fz_reader_init(fz_reader_t *r, const uint8_t *data, size_t size);
+int fz_done(const fz_reader_t *r);
+uint8_t fz_u8(fz_reader_t *r);
+uint64_t fz_u64(fz_reader_t *r);
+/* Copy the next n bytes over dst; fewer when the input ends (the rest of dst is kept). */
+void fz_overlay(fz_reader_t *r, void *dst, size_t n);
+
+icoac_real_t fz_real(fz_reader_t *r); /* selector byte (mod FZ_VALUE_KINDS), then its bytes */
+double fz_double(fz_reader_t *r);     /* same, with the double table */
+int32_t fz_i32(fz_reader_t *r);       /* selector (mod 8): 0, 1, 2, -1, INT32_MAX, INT32_MIN, 3, raw */
+int64_t fz_i64(fz_reader_t *r);       /* selector (mod 12): see fuzz_input.c, 11 = raw */
+
+/* Config section: a mode byte c; c odd: the raw bytes of icoac_config_t over the default;
+ * c even: the default with (c >> 1) % 8 mutations (field byte % 26, value). */
+void fz_config(fz_reader_t *r, icoac_config_t *cfg);
+
+/* Prior section: a byte p; p % 3 == 0: NULL, 1: mean 0 and cov I, 2: that with (p / 3) % 8
+ * mutations (field byte b: (b & 127) % 20, b & 128 also sets cov[j][i]; value). */
+const icoac_prior_t *fz_prior(fz_reader_t *r, icoac_prior_t *prior);
+
+#endif /* ICOAC_FUZZ_INPUT_H */

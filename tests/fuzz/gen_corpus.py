@@ -1,0 +1,298 @@
+#!/usr/bin/env python3
+"""Write the committed seed corpus of the fuzz targets, tests/fuzz/corpus/<target>/.
+
+Inputs follow the formats documented at the top of fuzz_controller.c and fuzz_sim.c; the
+value tables below mirror fuzz_input.c. Files named repro-* are known reproducers.
+
+    python3 tests/fuzz/gen_corpus.py          # (re)write the corpus
+    python3 tests/fuzz/gen_corpus.py --check  # exit 1 unless the committed corpus is current
+"""
+import argparse
+import struct
+import sys
+from pathlib import Path
+
+CORPUS = Path(__file__).resolve().parent / "corpus"
+
+# Special-value tables of fuzz_input.c, by selector.
+REAL_TABLE = ["0", "-0", "1e-39", "1e-45", "min", "max", "1e30", "1e-20", "nan", "inf", "-inf",
+              "-1", "1", "0.5", "-1e30", "1e38", "-max", "2", "0.25", "2.4", "-2.4", "10", "1e-5",
+              "-0.25", "true_min", "0.999", "1e10", "-1e-39"]
+DOUBLE_TABLE = ["0", "-0", "1e-310", "true_min", "min", "max", "1e300", "1e30", "nan", "inf",
+                "-inf", "-1", "1", "0.5", "-1e30", "1e-20", "-max", "2", "0.25", "2.4", "-2.4",
+                "9.8", "0.01", "1e-6", "1e6", "0.1", "1e-39", "3.2"]
+BOUNDED_SCALES = [1e-3, 1e-2, 0.1, 1.0, 3.0, 10.0, 100.0, 1e4]
+INT32_TABLE = [0, 1, 2, -1, 2**31 - 1, -2**31, 3]
+INT64_TABLE = [0, 1, 2, 3, -1, 300, 1000, 100000, 2**63 - 1, -2**63, 10]
+
+CONFIG_FIELDS = (["mode", "reflex_mode", "ico_timing", "clip_inputs"]
+                 + [f"input_range{i}" for i in range(4)]
+                 + ["gain", "reflex_force", "zone_theta", "zone_x", "ico_rate", "critic_rate",
+                    "discount", "td_clip"]
+                 + [f"critic_range{i}" for i in range(4)]
+                 + ["critic_threshold", "noise_std", "actor_scale", "forgetting", "rl_reflex",
+                    "act_with_sample"])
+CONFIG_INTS = {"mode", "reflex_mode", "ico_timing", "clip_inputs", "rl_reflex", "act_with_sample"}
+CONFIG_DEFAULT = {"mode": 0, "reflex_mode": 0, "ico_timing": 0, "clip_inputs": 1,
+                  "input_range0": 2.4, "input_range1": 3.5, "input_range2": 0.2094384,
+                  "input_range3": 2.0, "gain": 10.0, "reflex_force": 1.0,
+                  "zone_theta": 0.20071286397934788, "zone_x": 2.35, "ico_rate": 1.0e-4,
+                  "critic_rate": 0.6, "discount": 0.95, "td_clip": 1.0, "critic_range0": 2.4,
+                  "critic_range1": 3.5, "critic_range2": 0.2094384, "critic_range3": 2.0,
+                  "critic_threshold": 0.001, "noise_std": 1.0, "actor_scale": 0.5,
+                  "forgetting": 1.0, "rl_reflex": 1, "act_with_sample": 0}
+PLANT_FIELDS = ["gravity", "cart_mass", "pole_mass", "half_length", "dt", "x_limit",
+                "theta_limit", "integrator", "reserved"]
+RUN_FIELDS = ["max_trials", "success_steps", "init_velocity_noise"]
+
+
+def value(v, table):
+    """A real or double: a table name (str) or an ordinary number as a bounded int16."""
+    if isinstance(v, str):
+        return bytes([table.index(v)])
+    for k, scale in enumerate(BOUNDED_SCALES):
+        q = round(v / scale * 32768)
+        if -32768 <= q <= 32767:
+            return bytes([len(REAL_TABLE) + k]) + struct.pack("<h", q)
+    raise ValueError(f"{v} is outside the bounded range; use a table name")
+
+
+def real(v):
+    return value(v, REAL_TABLE)
+
+
+def double(v):
+    return value(v, DOUBLE_TABLE)
+
+
+def int32(v):
+    return bytes([INT32_TABLE.index(v)])
+
+
+def int64(v):
+    return bytes([INT64_TABLE.index(v)])
+
+
+def config(**fields):
+    """icoac_config_default with mutations (at most 7, applied in order)."""
+    assert len(fields) <= 7
+    out = bytes([len(fields) << 1])
+    for name, v in fields.items():
+        out += bytes([CONFIG_FIELDS.index(name)]) + (int32(v) if name in CONFIG_INTS else real(v))
+    return out
+
+
+def config_raw(fmt, **fields):
+    """Raw icoac_config_t bytes (fmt 'f' float, 'd' double) over the default."""
+    cfg = dict(CONFIG_DEFAULT, **fields)
+    ints = [cfg[n] for n in CONFIG_FIELDS[:4]]
+    reals = [cfg[n] for n in CONFIG_FIELDS[4:24]]
+    return b"\x01" + struct.pack(f"<4i20{fmt}2i", *ints, *reals, cfg["rl_reflex"],
+                                 cfg["act_with_sample"])
+
+
+def prior(*mutations):
+    """None: NULL; (): mean 0, cov I; else (field, value[, mirror]) mutations of that."""
+    if mutations == (None,):
+        return b"\x00"
+    if not mutations:
+        return b"\x01"
+    assert len(mutations) <= 7
+    out = bytes([3 * len(mutations) + 2])
+    for m in mutations:
+        field, v = m[0], m[1]
+        mirror = len(m) > 2 and m[2]
+        index = int(field[4:]) if isinstance(field, str) else 4 + 4 * field[0] + field[1]
+        out += bytes([index | (0x80 if mirror else 0)]) + real(v)
+    return out
+
+
+NO_PRIOR = prior(None)
+
+
+def seed(n):
+    return struct.pack("<Q", n)
+
+
+def step(s=None, repeat=1, terminal=False):
+    """repeat (1..8) controller steps on s (4 values), or on the previous s when None."""
+    assert 1 <= repeat <= 8
+    op = (2 if terminal else 0) | ((repeat - 1) << 2) | (0x20 if s is None else 0)
+    return bytes([op]) + (b"".join(real(x) for x in s) if s is not None else b"")
+
+
+def steps(s, n, terminal=False):
+    """n steps on s, in ops of up to 8."""
+    out = step(s, min(n, 8), terminal)
+    n -= min(n, 8)
+    while n > 0:
+        out += step(None, min(n, 8), terminal)
+        n -= min(n, 8)
+    return out
+
+
+RESET = b"\x03"
+ZERO = ("0", "0", "0", "0")
+
+# A trial through the middle, the reflex / penalty zones, a failure and a new trial.
+EXERCISE = (steps(ZERO, 2) + steps((0.5, 0.3, 0.05, 0.2), 4) + steps((2.5, 1.0, "0.25", 1.0), 2)
+            + steps(("-2.4", -1.0, "-0.25", -1.0), 2) + step((2.5, 1.0, "0.25", 1.0), terminal=True)
+            + RESET + steps((0.1, 0.0, 0.01, 0.0), 8) + steps((-0.3, 0.2, -0.1, 0.5), 8))
+
+
+def controller_seeds(fmt):
+    """Seeds of the controller targets; fmt is the real type's struct code."""
+    rl = {"mode": 1}
+    s = {
+        "default-ico": config() + NO_PRIOR + seed(1) + EXERCISE,
+        "default-rl": config(**rl) + NO_PRIOR + seed(2) + EXERCISE + EXERCISE,
+        "rl-sample": config(act_with_sample=1, **rl) + NO_PRIOR + seed(3) + EXERCISE + RESET + EXERCISE,
+        "rl-dense-forgetting": config(critic_threshold="0", forgetting=0.9, **rl) + NO_PRIOR + seed(4) + EXERCISE,
+        "rl-no-reflex": config(rl_reflex=0, discount="1", **rl) + NO_PRIOR + seed(5) + EXERCISE,
+        "ico-literal": config(ico_timing=1) + NO_PRIOR + seed(6) + EXERCISE,
+        "ico-reflex-gain": config(reflex_mode=1) + NO_PRIOR + seed(7) + EXERCISE,
+        "ico-prior": config() + prior(("mean0", 1.0), ("mean2", 10.0), ((1, 1), 2.0)) + seed(8) + EXERCISE,
+        "rl-prior-correlated": config(**rl) + prior(("mean2", 5.0), ((0, 1), 0.5, True)) + seed(9) + EXERCISE,
+        "prior-asymmetric": config(**rl) + prior(((0, 1), 0.5)) + seed(10) + EXERCISE,
+        "prior-mean-nan": config() + prior(("mean1", "nan")) + seed(11) + EXERCISE,
+        "config-bad-mode": config(mode=2) + NO_PRIOR + seed(12) + EXERCISE,
+        "config-bad-range": config(input_range1="-1") + NO_PRIOR + seed(13) + EXERCISE,
+        "config-raw-default": config_raw(fmt) + NO_PRIOR + seed(14) + EXERCISE,
+        "config-raw-rl": config_raw(fmt, mode=1, noise_std=0.5) + prior() + seed(15) + EXERCISE,
+        "nonfinite-input": (config(**rl) + NO_PRIOR + seed(16) + steps(ZERO, 2)
+                            + step(("nan", "0", "0", "0")) + step(("0", "inf", "0", "0"))
+                            + step(("0", "0", "-inf", "0"), terminal=True) + steps(ZERO, 2)),
+        # Known reproducers (issue 8).
+        "repro-rl-critic-range0-1e-39": config(critic_range0="1e-39", **rl) + NO_PRIOR + seed(1) + step(ZERO),
+        "repro-rl-noise-std-1e-20": config(noise_std="1e-20", **rl) + NO_PRIOR + seed(1) + steps(ZERO, 3) + EXERCISE,
+        "repro-input-range0-1e-39": config(input_range0="1e-39") + NO_PRIOR + seed(1) + step(ZERO) + EXERCISE,
+        "repro-noclip-x-1e30": config(clip_inputs=0) + NO_PRIOR + seed(1) + steps(("1e30", "0", "0", "0"), 3),
+        # Found by fuzzing the fixed firmware: a finite prior mean whose |w| overflows.
+        "repro-prior-mean-1e30": config() + prior(("mean0", "1e30")) + seed(1) + EXERCISE,
+    }
+    for field, v in (("gain", "1e30"), ("reflex_force", "1e38"), ("ico_rate", "1e30"), ("noise_std", "1e30")):
+        name = field.replace("_", "-")
+        s[f"repro-ico-{name}-{v}"] = config(**{field: v}) + NO_PRIOR + seed(1) + EXERCISE
+        s[f"repro-rl-{name}-{v}"] = config(**{field: v}, **rl) + NO_PRIOR + seed(1) + EXERCISE
+    return s
+
+
+def plant(**fields):
+    assert len(fields) <= 7
+    out = bytes([len(fields) << 1])
+    for name, v in fields.items():
+        out += bytes([PLANT_FIELDS.index(name)]) + (int32(v) if name in ("integrator", "reserved") else double(v))
+    return out
+
+
+def run(**fields):
+    assert len(fields) <= 3
+    out = bytes([len(fields) << 1])
+    for name, v in fields.items():
+        out += bytes([RUN_FIELDS.index(name)]) + (double(v) if name == "init_velocity_noise" else int64(v))
+    return out
+
+
+def op_plant(s, force):
+    return b"\x00" + b"".join(double(x) for x in s) + double(force)
+
+
+def op_cell(x0, theta0, cell_seed):
+    return b"\x01" + double(x0) + double(theta0) + bytes([cell_seed])
+
+
+def op_grid(cells, threads=1):
+    """cells: (x0, theta0, seed, finished) tuples, 0 to 4 of them."""
+    count = len(cells) - 1 if cells else 31
+    out = b"\x02" + bytes([count, {1: 0, 2: 13, -1: 15}[threads]])
+    for x0, theta0, cell_seed, finished in cells:
+        out += double(x0) + double(theta0) + bytes([cell_seed, 3 if finished else 0])
+    return out
+
+
+def op_trajectory(x0, theta0, noise, traj_seed, max_steps):
+    return b"\x03" + double(x0) + double(theta0) + double(noise) + bytes([traj_seed, max_steps + 1])
+
+
+PAPER_SIZES = [0, -1, 1, 1224, 1226, 2**63 - 1, -2**63, 1225]
+
+
+def op_paper(n, null=False):
+    return b"\x04" + bytes([PAPER_SIZES.index(n) | (0x80 if null else 0)])
+
+
+SIM_OPS = (op_cell(0.5, 0.05, 1) + op_grid([(0.0, 0.02, 2, False), (-1.0, -0.1, 3, False)])
+           + op_trajectory(0.5, 0.1, "0", 4, 64) + op_plant((0.0, 0.1, 0.05, -0.2), 10.0))
+
+
+def sim_seeds():
+    rl = config(mode=1)
+    return {
+        "default-ico": plant() + run() + config() + NO_PRIOR + SIM_OPS,
+        "default-rl": plant() + run() + rl + NO_PRIOR + SIM_OPS,
+        "rl-prior": plant() + run() + rl + prior(("mean2", 5.0), ("mean3", 1.0)) + SIM_OPS,
+        "rk4-noise": plant(integrator=1) + run(init_velocity_noise=0.1) + config() + NO_PRIOR + SIM_OPS,
+        "grid-threads": (plant() + run() + rl + NO_PRIOR
+                         + op_grid([(0.0, 0.0, 1, False), (1.0, 0.1, 2, True), (-1.0, -0.1, 3, False),
+                                    (2.0, 0.2, 4, False)], threads=2)
+                         + op_grid([(0.0, 0.0, 1, False)], threads=-1) + op_grid([])
+                         + op_grid([("nan", 0.0, 1, False)])),
+        "paper-grid": plant() + run() + config() + NO_PRIOR + op_paper(1225) + op_paper(1224) + op_paper(0, True),
+        "bad-plant": plant(gravity="nan") + run() + config() + NO_PRIOR + SIM_OPS,
+        "bad-run": plant() + run(max_trials=0, init_velocity_noise="-1") + config() + NO_PRIOR + SIM_OPS,
+        "bad-config-prior": plant() + run() + config(mode=2) + prior(((2, 2), "-1")) + SIM_OPS,
+        "bad-arguments": (plant() + run() + config() + NO_PRIOR + op_cell("inf", 0.0, 1)
+                          + op_trajectory(0.0, 0.0, "nan", 1, 0) + op_trajectory(0.0, "nan", "0", 1, 10)),
+        "plant-extremes": (plant() + run() + config() + NO_PRIOR + op_plant(("1e300", "-1e30", "2.4", "nan"), "max")
+                           + op_plant(("0", "0", "3.2", "1e300"), "-max")),
+        "trajectory-fall": plant() + run() + config(gain="0") + NO_PRIOR + op_trajectory(0.0, 0.2, "0.01", 9, 64),
+        # Known reproducer (issue 8): a subnormal dt passes the plant check.
+        "repro-plant-dt-1e-310": plant(dt="1e-310") + run() + config() + NO_PRIOR + SIM_OPS,
+        # Found by fuzzing the fixed engine: float subnormals in the configuration or prior are
+        # checked as given, then flushed to 0 in the run (FTZ/DAZ), so the verdicts differ.
+        "repro-config-zone-theta-1e-39": plant() + run() + config(zone_theta="1e-39") + NO_PRIOR + SIM_OPS,
+        "repro-prior-cov-diag-1e-39": plant() + run() + config() + prior(((0, 0), "1e-39")) + SIM_OPS,
+        "repro-prior-cov-asymmetric-1e-39": plant() + run() + config() + prior(((3, 0), "-1e-39")) + SIM_OPS,
+    }
+
+
+def corpus():
+    """{target: {file name: bytes}}."""
+    float_seeds = controller_seeds("f")
+    return {
+        "fuzz_controller": float_seeds,
+        "fuzz_controller_fast_exp": float_seeds,
+        "fuzz_controller_double": controller_seeds("d"),
+        "fuzz_sim": sim_seeds(),
+    }
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--check", action="store_true", help="compare instead of writing")
+    args = parser.parse_args()
+    stale = []
+    for target, files in corpus().items():
+        directory = CORPUS / target
+        if not args.check:
+            directory.mkdir(parents=True, exist_ok=True)
+            for old in directory.iterdir():
+                if old.name not in files:
+                    old.unlink()
+        for name, data in files.items():
+            path = directory / name
+            if args.check:
+                if not path.is_file() or path.read_bytes() != data:
+                    stale.append(str(path))
+            else:
+                path.write_bytes(data)
+        if args.check and directory.is_dir():
+            stale += [str(p) for p in directory.iterdir() if p.name not in files]
+    if stale:
+        print("corpus out of date (run tests/fuzz/gen_corpus.py):", *stale, sep="\n  ")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

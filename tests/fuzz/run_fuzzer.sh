@@ -1,0 +1,68 @@
+#!/bin/sh
+# Run one libFuzzer target with the project's options (used by ctest and `make fuzz`).
+#   run_fuzzer.sh replay EXE CORPUS WORK
+#       run EXE once on every file in CORPUS.
+#   run_fuzzer.sh fuzz SECONDS EXE CORPUS WORK [--fresh] [libFuzzer options...]
+#       fuzz for SECONDS from CORPUS, which is only read: new inputs go to WORK/corpus
+#       (--fresh empties it first), the log to WORK/fuzz.log.
+# Crash and contract-violation reproducers go to WORK/artifacts/. The exit status is non-zero
+# on a crash, a sanitizer report, a contract violation, a timeout or an out-of-memory.
+set -eu
+
+: "${ASAN_OPTIONS:=detect_leaks=1}"
+: "${UBSAN_OPTIONS:=print_stacktrace=1:halt_on_error=1}"
+export ASAN_OPTIONS UBSAN_OPTIONS
+
+usage() {
+    echo "usage: $0 replay EXE CORPUS WORK | fuzz SECONDS EXE CORPUS WORK [--fresh] [options]" >&2
+    exit 2
+}
+
+[ $# -ge 4 ] || usage
+mode=$1
+shift
+if [ "$mode" = fuzz ]; then
+    [ $# -ge 4 ] || usage
+    seconds=$1
+    shift
+fi
+exe=$1
+corpus=$2
+work=$3
+shift 3
+name=$(basename "$exe")
+mkdir -p "$work/artifacts"
+limits="-timeout=10 -rss_limit_mb=2048 -artifact_prefix=$work/artifacts/"
+
+case $mode in
+replay)
+    # shellcheck disable=SC2086
+    exec "$exe" $limits "$corpus"/*
+    ;;
+fuzz)
+    if [ "${1:-}" = --fresh ]; then
+        rm -rf "$work/corpus"
+        shift
+    fi
+    mkdir -p "$work/corpus"
+    log=$work/fuzz.log
+    status=0
+    echo "$name: fuzzing for ${seconds} s, log $log"
+    # shellcheck disable=SC2086
+    "$exe" $limits -max_total_time="$seconds" -print_final_stats=1 "$@" "$work/corpus" "$corpus" \
+        >"$log" 2>&1 || status=$?
+    if [ "$status" -eq 0 ]; then
+        echo "$name: no failure in ${seconds} s (log $log)"
+        grep -E '^#[0-9]+ +DONE|^stat::' "$log" || true
+    else
+        echo "$name: FAILED, exit status $status (log $log); last lines:"
+        tail -n 60 "$log"
+        echo "$name: reproducers in $work/artifacts/:"
+        ls -l "$work/artifacts/"
+    fi
+    exit "$status"
+    ;;
+*)
+    usage
+    ;;
+esac
