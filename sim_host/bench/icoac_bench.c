@@ -40,7 +40,7 @@ static double ns_per_tick(int mode, int64_t steps, int64_t *ticks_out)
     run.max_trials = 1000;
     memset(&cell, 0, sizeof cell);
     cell.x0 = -0.5;
-    cell.theta0 = -4.0 * 3.14159265358979323846 / 180.0;
+    cell.theta0 = -4.0 * ICOAC_SIM_PI / 180.0;
     cell.seed = 7u;
     t0 = now_seconds();
     if (icoac_sim_run_cell(&cfg, &plant, &run, &balanced_prior, &cell, 0, progress) != ICOAC_SIM_OK) {

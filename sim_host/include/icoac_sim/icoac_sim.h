@@ -28,13 +28,15 @@ typedef enum {
     ICOAC_SIM_RK4 = 1    /* classical Runge-Kutta, same dt */
 } icoac_sim_integrator_t;
 
+#define ICOAC_SIM_PI 3.14159265358979323846
+
 /* Valid plant and run ranges (closed): no subnormal or absurd value reaches the integrator,
  * whose worker threads flush subnormals to zero. */
 #define ICOAC_SIM_PHYS_MIN 1.0e-6   /* gravity (m/s^2), masses (kg), half_length, x_limit (m) */
 #define ICOAC_SIM_PHYS_MAX 1.0e6
 #define ICOAC_SIM_DT_MIN 1.0e-6     /* dt (s) */
 #define ICOAC_SIM_DT_MAX 1.0
-#define ICOAC_SIM_THETA_LIMIT_MAX 3.14159265358979323846 /* theta_limit (rad), >= 1e-6 */
+#define ICOAC_SIM_THETA_LIMIT_MAX ICOAC_SIM_PI /* theta_limit (rad), >= 1e-6 */
 #define ICOAC_SIM_NOISE_MIN 1.0e-12 /* init_velocity_noise: 0 or in [1e-12, 1e3] (m/s, rad/s) */
 #define ICOAC_SIM_NOISE_MAX 1.0e3
 

@@ -1,4 +1,5 @@
-/* The benchmark trial loop of one cell (spec 8-9) and the Fig. 1g trajectory recorder. */
+/* The benchmark trial loop of one cell (spec 8-9): trials from a fresh controller until one
+ * lasts success_steps or max_trials have failed. */
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -6,75 +7,11 @@
 #include "icoac_sim/icoac_sim.h"
 #include "sim_internal.h"
 
-#define SIM_PI 3.14159265358979323846
-
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
 #define SIM_REAL_MAX DBL_MAX
 #else
 #define SIM_REAL_MAX ((double)FLT_MAX)
 #endif
-
-void icoac_sim_run_default(icoac_sim_run_t *run)
-{
-    if (run == 0) {
-        return;
-    }
-    run->max_trials = 100000;
-    run->success_steps = 100000;
-    run->init_velocity_noise = 1.0e-4;
-}
-
-/* 0, or a normal value in [ICOAC_SIM_NOISE_MIN, ICOAC_SIM_NOISE_MAX]. */
-static int velocity_noise_valid(double a)
-{
-    return a == 0.0 || (a >= ICOAC_SIM_NOISE_MIN && a <= ICOAC_SIM_NOISE_MAX);
-}
-
-int32_t icoac_sim_run_check(const icoac_sim_run_t *run)
-{
-    if (run == 0) {
-        return ICOAC_SIM_ERR_BAD_ARGUMENT;
-    }
-    if (run->max_trials < 1 || run->success_steps < 1 || !velocity_noise_valid(run->init_velocity_noise)) {
-        return ICOAC_SIM_ERR_BAD_RUN;
-    }
-    return ICOAC_SIM_OK;
-}
-
-int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                      const icoac_sim_run_t *run)
-{
-    int32_t status;
-    if (cfg == 0 || plant == 0) {
-        return ICOAC_SIM_ERR_BAD_ARGUMENT;
-    }
-    status = (int32_t)icoac_config_check(cfg);
-    if (status == ICOAC_SIM_OK) {
-        status = icoac_sim_plant_check(plant);
-    }
-    if (status == ICOAC_SIM_OK && run != 0) {
-        status = icoac_sim_run_check(run);
-    }
-    return status;
-}
-
-int32_t icoac_sim_paper_grid(icoac_sim_cell_t *cells, int64_t n_cells, uint64_t seed)
-{
-    int64_t i;
-    if (cells == 0 || n_cells != ICOAC_SIM_GRID_CELLS) {
-        return ICOAC_SIM_ERR_BAD_ARGUMENT;
-    }
-    memset(cells, 0, (size_t)n_cells * sizeof *cells);
-    for (i = 0; i < n_cells; ++i) {
-        const int64_t row = i / ICOAC_SIM_GRID_XS;
-        const int64_t col = i % ICOAC_SIM_GRID_XS;
-        cells[i].theta0 = (double)(-12 + row) * SIM_PI / 180.0;
-        cells[i].x0 = -2.4 + 0.1 * (double)col;
-        cells[i].seed = icoac_mix_seed(seed, (uint64_t)i);
-        cells[i].outcome = ICOAC_SIM_PENDING;
-    }
-    return ICOAC_SIM_OK;
-}
 
 /* Uniform in (-a, a) from the plant's own generator, in double. */
 static double uniform_symmetric(icoac_rng_t *rng, double a)
@@ -83,7 +20,7 @@ static double uniform_symmetric(icoac_rng_t *rng, double a)
     return a * (2.0 * u - 1.0);
 }
 
-static void start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t *rng, double s[4])
+void sim_start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t *rng, double s[4])
 {
     s[0] = cell->x0;
     s[1] = uniform_symmetric(rng, noise);
@@ -93,7 +30,7 @@ static void start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t 
 
 /* The plant state as the controller's reals. A value outside the real type's range would be
  * an undefined conversion: it is passed as NaN, which the controller rejects. */
-static void to_input(const double s[4], uint32_t flags, icoac_input_t *in)
+void sim_to_input(const double s[4], uint32_t flags, icoac_input_t *in)
 {
     int i;
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
@@ -124,10 +61,10 @@ static int64_t run_trial(const icoac_config_t *cfg, const icoac_sim_plant_t *pla
     icoac_input_t in;
     icoac_output_t out;
     int64_t steps = 0;
-    start_trial(cell, run->init_velocity_noise, rng, s);
+    sim_start_trial(cell, run->init_velocity_noise, rng, s);
     *status = (int32_t)icoac_reset(cfg, ctrl);
     while (*status == ICOAC_SIM_OK && steps < run->success_steps) {
-        to_input(s, 0u, &in);
+        sim_to_input(s, 0u, &in);
         *status = (int32_t)icoac_step(cfg, ctrl, &in, &out);
         if (*status != ICOAC_SIM_OK) {
             break;
@@ -137,7 +74,7 @@ static int64_t run_trial(const icoac_config_t *cfg, const icoac_sim_plant_t *pla
         if (sim_failed(plant, s)) {
             /* Let the controller learn from the failure state; it rejects NaN plant states,
              * which end the trial like any failure, but a numeric fault is an error. */
-            to_input(s, ICOAC_INPUT_TERMINAL, &in);
+            sim_to_input(s, ICOAC_INPUT_TERMINAL, &in);
             if (icoac_step(cfg, ctrl, &in, &out) == ICOAC_ERR_NUMERIC) {
                 *status = ICOAC_ERR_NUMERIC;
                 return -1;
@@ -223,57 +160,6 @@ int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *p
     }
     fpu_mode = sim_fpu_flush_subnormals();
     status = sim_run_cell_checked(cfg, plant, run, prior, cell, cancel, progress);
-    sim_fpu_restore(fpu_mode);
-    return status;
-}
-
-int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                             const icoac_prior_t *prior, double x0, double theta0,
-                             double init_velocity_noise, uint64_t seed, int64_t max_steps,
-                             double *states, double *forces, int64_t *n_steps)
-{
-    icoac_state_t ctrl;
-    icoac_rng_t rng;
-    icoac_sim_cell_t cell;
-    icoac_input_t in;
-    icoac_output_t out;
-    double s[4];
-    int64_t k;
-    uint32_t fpu_mode;
-    int32_t status = sim_check_all(cfg, plant, 0);
-    if (status != ICOAC_SIM_OK) {
-        return status;
-    }
-    if (states == 0 || forces == 0 || n_steps == 0 || max_steps < 1 || !isfinite(x0) ||
-        !isfinite(theta0) || !velocity_noise_valid(init_velocity_noise)) {
-        return ICOAC_SIM_ERR_BAD_ARGUMENT;
-    }
-    status = (int32_t)icoac_init(cfg, &ctrl, prior, icoac_mix_seed(seed, 1u));
-    if (status != ICOAC_SIM_OK) {
-        return status;
-    }
-    fpu_mode = sim_fpu_flush_subnormals();
-    memset(&cell, 0, sizeof cell);
-    cell.x0 = x0;
-    cell.theta0 = theta0;
-    icoac_rng_seed(&rng, seed, 2u);
-    start_trial(&cell, init_velocity_noise, &rng, s);
-    memcpy(states, s, sizeof s);
-    *n_steps = 0;
-    for (k = 0; k < max_steps; ++k) {
-        to_input(s, 0u, &in);
-        status = (int32_t)icoac_step(cfg, &ctrl, &in, &out);
-        if (status != ICOAC_SIM_OK) {
-            break;
-        }
-        forces[k] = (double)out.force;
-        icoac_sim_plant_step(plant, s, forces[k]);
-        memcpy(states + 4 * (k + 1), s, sizeof s);
-        *n_steps = k + 1;
-        if (sim_failed(plant, s)) {
-            break;
-        }
-    }
     sim_fpu_restore(fpu_mode);
     return status;
 }
