@@ -1,16 +1,16 @@
 /* Bayesian actor (spec 7): rank-1 Gaussian posterior step on (mu_w, Sigma_w),
  * covariance in Joseph form so it stays symmetric positive definite. */
-#include "icoac_internal.h"
+#include "icoac_priv.h"
 
 #define N ICOAC_N_INPUTS
 
-icoac_real_t icoac_trace4(const icoac_real_t m[N][N])
+icoac_real_t icoac_priv_trace4(const icoac_real_t m[N][N])
 {
     return (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
 }
 
 /* m = L L^T; returns 0 when m is not positive definite. */
-int icoac_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
+int icoac_priv_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
 {
     int i;
     int j;
@@ -28,7 +28,7 @@ int icoac_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
         if (!(diag > ICOAC_R(0.0))) {
             return 0;
         }
-        lower[j][j] = ICOAC_SQRT(diag);
+        lower[j][j] = ICOAC_PRIV_SQRT(diag);
         for (i = j + 1; i < N; ++i) {
             icoac_real_t sum = m[i][j];
             for (k = 0; k < j; ++k) {
@@ -40,37 +40,37 @@ int icoac_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
     return 1;
 }
 
-void icoac_actor_sample(icoac_state_t *state)
+void icoac_priv_actor_sample(icoac_priv_state_t *st)
 {
     icoac_real_t lower[N][N];
     icoac_real_t normal[N];
     int i;
     int j;
     for (i = 0; i < N; ++i) {
-        normal[i] = icoac_rng_normal(&state->rng);
+        normal[i] = icoac_rng_normal(&st->rng);
     }
-    if (!icoac_cholesky4(ICOAC_CONST_MAT4(state->cov), lower)) {
-        icoac_copy4(state->w_act, state->w);
+    if (!icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(st->cov), lower)) {
+        icoac_priv_copy4(st->w_act, st->w);
         return;
     }
     for (i = 0; i < N; ++i) {
-        icoac_real_t sum = state->w[i];
+        icoac_real_t sum = st->w[i];
         for (j = 0; j <= i; ++j) {
             sum += lower[i][j] * normal[j];
         }
-        state->w_act[i] = sum;
+        st->w_act[i] = sum;
     }
 }
 
 /* Sigma' = A Sigma A^T + sigma_u^2 k k^T with A = I - k h^T (Joseph form), evaluated as
  * A Sigma = Sigma - k (Sigma h)^T and (A Sigma) A^T = A Sigma - (A Sigma h) k^T; the upper
  * triangle is mirrored, so Sigma stays exactly symmetric. */
-void icoac_actor_update(const icoac_config_t *cfg, const icoac_state_t *state,
+void icoac_priv_actor_update(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
                         const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
                         icoac_real_t cov[N][N])
 {
-    const icoac_real_t noise_var = cfg->noise_std * cfg->noise_std;
-    const icoac_real_t (*prior)[N] = ICOAC_CONST_MAT4(state->cov);
+    const icoac_real_t noise_var = actor->noise_std * actor->noise_std;
+    const icoac_real_t (*prior)[N] = ICOAC_PRIV_CONST_MAT4(st->cov);
     icoac_real_t cov_h[N];
     icoac_real_t gain[N];
     icoac_real_t a_cov[N][N];
@@ -79,22 +79,22 @@ void icoac_actor_update(const icoac_config_t *cfg, const icoac_state_t *state,
     int i;
     int j;
 
-    if (cfg->forgetting < ICOAC_R(1.0)) {
-        const icoac_real_t inflate = ICOAC_R(1.0) / cfg->forgetting;
+    if (actor->forgetting < ICOAC_R(1.0)) {
+        const icoac_real_t inflate = ICOAC_R(1.0) / actor->forgetting;
         for (i = 0; i < N; ++i) {
             for (j = 0; j < N; ++j) {
-                cov[i][j] = state->cov[i][j] * inflate;
+                cov[i][j] = st->cov[i][j] * inflate;
             }
         }
-        prior = ICOAC_CONST_MAT4(cov);
+        prior = ICOAC_PRIV_CONST_MAT4(cov);
     }
     for (i = 0; i < N; ++i) {
-        cov_h[i] = icoac_dot4(prior[i], h);
+        cov_h[i] = icoac_priv_dot4(prior[i], h);
     }
-    inv_innovation_var = ICOAC_R(1.0) / (icoac_dot4(h, cov_h) + noise_var);
+    inv_innovation_var = ICOAC_R(1.0) / (icoac_priv_dot4(h, cov_h) + noise_var);
     for (i = 0; i < N; ++i) {
         gain[i] = cov_h[i] * inv_innovation_var;
-        w[i] = state->w[i] + gain[i] * innovation;
+        w[i] = st->w[i] + gain[i] * innovation;
     }
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
@@ -102,7 +102,7 @@ void icoac_actor_update(const icoac_config_t *cfg, const icoac_state_t *state,
         }
     }
     for (i = 0; i < N; ++i) {
-        a_cov_h[i] = icoac_dot4(a_cov[i], h);
+        a_cov_h[i] = icoac_priv_dot4(a_cov[i], h);
     }
     /* written last: cov may be the prior it was computed from */
     for (i = 0; i < N; ++i) {

@@ -1,15 +1,5 @@
-#include "icoac_internal.h"
-
-/* lo <= v <= hi and v not subnormal; false for NaN. */
-static int within(icoac_real_t v, icoac_real_t lo, icoac_real_t hi)
-{
-    return v >= lo && v <= hi && icoac_zero_or_normal(v);
-}
-
-static int is_flag(int32_t v)
-{
-    return v == 0 || v == 1;
-}
+/* Configuration: defaults and checks of every group, the prior check, status names. */
+#include "icoac_priv.h"
 
 const char *icoac_status_str(icoac_status_t status)
 {
@@ -19,16 +9,69 @@ const char *icoac_status_str(icoac_status_t status)
     case ICOAC_ERR_NOT_INITIALISED: return "state not initialised (call icoac_init)";
     case ICOAC_ERR_NONFINITE_INPUT: return "non-finite observation (ignored, no learning)";
     case ICOAC_ERR_NUMERIC: return "numeric failure: a value derived in this tick was not finite (force 0, nothing learned)";
-    case ICOAC_ERR_BAD_MODE: return "invalid switch (mode, reflex_mode, ico_timing or a 0/1 flag)";
-    case ICOAC_ERR_BAD_SCALE: return "invalid input_range (must be in [1e-6, 1e6])";
-    case ICOAC_ERR_BAD_GAIN: return "invalid gain or reflex_force (must be in [0, 1e4])";
-    case ICOAC_ERR_BAD_ZONE: return "invalid zone_theta or zone_x (must be in [1e-6, pi] rad and [1e-6, 1e6] m)";
-    case ICOAC_ERR_BAD_ICO_RATE: return "invalid ico_rate (must be in [0, 1])";
-    case ICOAC_ERR_BAD_CRITIC: return "invalid critic parameter (critic_rate [0, 10], discount [0, 1], td_clip [1e-6, 1e3], critic_range [1e-6, 1e6], critic_threshold [0, 1))";
-    case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std [1e-3, 1e3], actor_scale [0, 1e3], forgetting [0.5, 1])";
+    case ICOAC_ERR_BAD_MODE: return "invalid switch (mode, policy.reflex_mode, ico.timing or a 0/1 flag)";
+    case ICOAC_ERR_BAD_SCALE: return "invalid policy.input_range (must be in [1e-6, 1e6])";
+    case ICOAC_ERR_BAD_GAIN: return "invalid policy.gain or policy.reflex_force (must be in [0, 1e4])";
+    case ICOAC_ERR_BAD_ZONE: return "invalid policy.zone_theta or policy.zone_x (must be in [1e-6, pi] rad and [1e-6, 1e6] m)";
+    case ICOAC_ERR_BAD_ICO_RATE: return "invalid ico.rate (must be in [0, 1])";
+    case ICOAC_ERR_BAD_CRITIC: return "invalid critic parameter (rate [0, 10], discount [0, 1], td_clip [1e-6, 1e3], range [1e-6, 1e6], threshold [0, 1))";
+    case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std [1e-3, 1e3], scale [0, 1e3], forgetting [0.5, 1])";
     case ICOAC_ERR_BAD_PRIOR: return "invalid prior (|mean| <= 1e6, covariance entries |c| <= 1e12, zero or normal, symmetric positive definite)";
     default: return "unknown status";
     }
+}
+
+void icoac_policy_config_default(icoac_policy_config_t *policy)
+{
+    if (policy == 0) {
+        return;
+    }
+    policy->input_range[ICOAC_IDX_X] = ICOAC_R(2.4);
+    policy->input_range[ICOAC_IDX_X_DOT] = ICOAC_R(3.5);
+    policy->input_range[ICOAC_IDX_THETA] = ICOAC_R(0.2094384);
+    policy->input_range[ICOAC_IDX_THETA_DOT] = ICOAC_R(2.0);
+    policy->clip_inputs = 1;
+    policy->gain = ICOAC_R(10.0);
+    policy->reflex_mode = ICOAC_REFLEX_UNIT;
+    policy->reflex_force = ICOAC_R(1.0);
+    policy->zone_theta = ICOAC_R(0.20071286397934788); /* 11.5 deg */
+    policy->zone_x = ICOAC_R(2.35);
+}
+
+void icoac_ico_config_default(icoac_ico_config_t *ico)
+{
+    if (ico == 0) {
+        return;
+    }
+    ico->rate = ICOAC_R(1.0e-4);
+    ico->timing = ICOAC_ICO_TIMING_CODE;
+}
+
+void icoac_critic_config_default(icoac_critic_config_t *critic)
+{
+    if (critic == 0) {
+        return;
+    }
+    critic->rate = ICOAC_R(0.6);
+    critic->discount = ICOAC_R(0.95);
+    critic->td_clip = ICOAC_R(1.0);
+    critic->range[ICOAC_IDX_X] = ICOAC_R(2.4);
+    critic->range[ICOAC_IDX_X_DOT] = ICOAC_R(3.5);
+    critic->range[ICOAC_IDX_THETA] = ICOAC_R(0.2094384);
+    critic->range[ICOAC_IDX_THETA_DOT] = ICOAC_R(2.0);
+    critic->threshold = ICOAC_R(0.001);
+}
+
+void icoac_actor_config_default(icoac_actor_config_t *actor)
+{
+    if (actor == 0) {
+        return;
+    }
+    actor->noise_std = ICOAC_R(1.0);
+    actor->scale = ICOAC_R(0.5);
+    actor->forgetting = ICOAC_R(1.0);
+    actor->reflex = 1;
+    actor->act_with_sample = 0;
 }
 
 void icoac_config_default(icoac_config_t *cfg)
@@ -37,76 +80,181 @@ void icoac_config_default(icoac_config_t *cfg)
         return;
     }
     cfg->mode = ICOAC_MODE_ICO;
-    cfg->reflex_mode = ICOAC_REFLEX_UNIT;
-    cfg->ico_timing = ICOAC_ICO_TIMING_CODE;
-    cfg->clip_inputs = 1;
-    cfg->input_range[ICOAC_IDX_X] = ICOAC_R(2.4);
-    cfg->input_range[ICOAC_IDX_X_DOT] = ICOAC_R(3.5);
-    cfg->input_range[ICOAC_IDX_THETA] = ICOAC_R(0.2094384);
-    cfg->input_range[ICOAC_IDX_THETA_DOT] = ICOAC_R(2.0);
-    cfg->gain = ICOAC_R(10.0);
-    cfg->reflex_force = ICOAC_R(1.0);
-    cfg->zone_theta = ICOAC_R(0.20071286397934788); /* 11.5 deg */
-    cfg->zone_x = ICOAC_R(2.35);
-    cfg->ico_rate = ICOAC_R(1.0e-4);
-    cfg->critic_rate = ICOAC_R(0.6);
-    cfg->discount = ICOAC_R(0.95);
-    cfg->td_clip = ICOAC_R(1.0);
-    cfg->critic_range[ICOAC_IDX_X] = ICOAC_R(2.4);
-    cfg->critic_range[ICOAC_IDX_X_DOT] = ICOAC_R(3.5);
-    cfg->critic_range[ICOAC_IDX_THETA] = ICOAC_R(0.2094384);
-    cfg->critic_range[ICOAC_IDX_THETA_DOT] = ICOAC_R(2.0);
-    cfg->critic_threshold = ICOAC_R(0.001);
-    cfg->noise_std = ICOAC_R(1.0);
-    cfg->actor_scale = ICOAC_R(0.5);
-    cfg->forgetting = ICOAC_R(1.0);
-    cfg->rl_reflex = 1;
-    cfg->act_with_sample = 0;
+    icoac_policy_config_default(&cfg->policy);
+    icoac_ico_config_default(&cfg->ico);
+    icoac_critic_config_default(&cfg->critic);
+    icoac_actor_config_default(&cfg->actor);
+}
+
+/* lo <= v <= hi and v not subnormal; false for NaN. */
+static int within(icoac_real_t v, icoac_real_t lo, icoac_real_t hi)
+{
+    return v >= lo && v <= hi && icoac_priv_zero_or_normal(v);
+}
+
+static int is_flag(int32_t v)
+{
+    return v == 0 || v == 1;
+}
+
+/* The first bad field of a check: its name and its group's status. */
+typedef struct {
+    const char *field;
+    icoac_status_t status;
+} bad_field_t;
+
+#define ICOAC_PRIV_FAIL(name, code) \
+    do {                            \
+        bad->field = (name);        \
+        bad->status = (code);       \
+        return 0;                   \
+    } while (0)
+
+static const char *const input_range_names[ICOAC_N_INPUTS] = {
+    "policy.input_range[0]", "policy.input_range[1]", "policy.input_range[2]", "policy.input_range[3]"};
+static const char *const critic_range_names[ICOAC_N_INPUTS] = {
+    "critic.range[0]", "critic.range[1]", "critic.range[2]", "critic.range[3]"};
+
+static int policy_ok(const icoac_policy_config_t *p, bad_field_t *bad)
+{
+    int i;
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        if (!within(p->input_range[i], ICOAC_RANGE_MIN, ICOAC_RANGE_MAX)) {
+            ICOAC_PRIV_FAIL(input_range_names[i], ICOAC_ERR_BAD_SCALE);
+        }
+    }
+    if (!is_flag(p->clip_inputs)) {
+        ICOAC_PRIV_FAIL("policy.clip_inputs", ICOAC_ERR_BAD_MODE);
+    }
+    if (!within(p->gain, ICOAC_R(0.0), ICOAC_GAIN_MAX)) {
+        ICOAC_PRIV_FAIL("policy.gain", ICOAC_ERR_BAD_GAIN);
+    }
+    if (p->reflex_mode != ICOAC_REFLEX_UNIT && p->reflex_mode != ICOAC_REFLEX_GAIN) {
+        ICOAC_PRIV_FAIL("policy.reflex_mode", ICOAC_ERR_BAD_MODE);
+    }
+    if (!within(p->reflex_force, ICOAC_R(0.0), ICOAC_FORCE_MAX)) {
+        ICOAC_PRIV_FAIL("policy.reflex_force", ICOAC_ERR_BAD_GAIN);
+    }
+    if (!within(p->zone_theta, ICOAC_ZONE_MIN, ICOAC_ZONE_THETA_MAX)) {
+        ICOAC_PRIV_FAIL("policy.zone_theta", ICOAC_ERR_BAD_ZONE);
+    }
+    if (!within(p->zone_x, ICOAC_ZONE_MIN, ICOAC_ZONE_X_MAX)) {
+        ICOAC_PRIV_FAIL("policy.zone_x", ICOAC_ERR_BAD_ZONE);
+    }
+    return 1;
+}
+
+static int ico_ok(const icoac_ico_config_t *ico, bad_field_t *bad)
+{
+    if (!within(ico->rate, ICOAC_R(0.0), ICOAC_ICO_RATE_MAX)) {
+        ICOAC_PRIV_FAIL("ico.rate", ICOAC_ERR_BAD_ICO_RATE);
+    }
+    if (ico->timing != ICOAC_ICO_TIMING_CODE && ico->timing != ICOAC_ICO_TIMING_LITERAL) {
+        ICOAC_PRIV_FAIL("ico.timing", ICOAC_ERR_BAD_MODE);
+    }
+    return 1;
+}
+
+static int critic_ok(const icoac_critic_config_t *c, bad_field_t *bad)
+{
+    int i;
+    if (!within(c->rate, ICOAC_R(0.0), ICOAC_CRITIC_RATE_MAX)) {
+        ICOAC_PRIV_FAIL("critic.rate", ICOAC_ERR_BAD_CRITIC);
+    }
+    if (!within(c->discount, ICOAC_R(0.0), ICOAC_R(1.0))) {
+        ICOAC_PRIV_FAIL("critic.discount", ICOAC_ERR_BAD_CRITIC);
+    }
+    if (!within(c->td_clip, ICOAC_TD_CLIP_MIN, ICOAC_TD_CLIP_MAX)) {
+        ICOAC_PRIV_FAIL("critic.td_clip", ICOAC_ERR_BAD_CRITIC);
+    }
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        if (!within(c->range[i], ICOAC_RANGE_MIN, ICOAC_RANGE_MAX)) {
+            ICOAC_PRIV_FAIL(critic_range_names[i], ICOAC_ERR_BAD_CRITIC);
+        }
+    }
+    if (!within(c->threshold, ICOAC_R(0.0), ICOAC_R(1.0)) || !(c->threshold < ICOAC_R(1.0))) {
+        ICOAC_PRIV_FAIL("critic.threshold", ICOAC_ERR_BAD_CRITIC);
+    }
+    return 1;
+}
+
+static int actor_ok(const icoac_actor_config_t *a, bad_field_t *bad)
+{
+    if (!within(a->noise_std, ICOAC_NOISE_STD_MIN, ICOAC_NOISE_STD_MAX)) {
+        ICOAC_PRIV_FAIL("actor.noise_std", ICOAC_ERR_BAD_ACTOR);
+    }
+    if (!within(a->scale, ICOAC_R(0.0), ICOAC_ACTOR_SCALE_MAX)) {
+        ICOAC_PRIV_FAIL("actor.scale", ICOAC_ERR_BAD_ACTOR);
+    }
+    if (!within(a->forgetting, ICOAC_FORGETTING_MIN, ICOAC_R(1.0))) {
+        ICOAC_PRIV_FAIL("actor.forgetting", ICOAC_ERR_BAD_ACTOR);
+    }
+    if (!is_flag(a->reflex)) {
+        ICOAC_PRIV_FAIL("actor.reflex", ICOAC_ERR_BAD_MODE);
+    }
+    if (!is_flag(a->act_with_sample)) {
+        ICOAC_PRIV_FAIL("actor.act_with_sample", ICOAC_ERR_BAD_MODE);
+    }
+    return 1;
+}
+
+/* The mode, then the groups it uses, in struct order. */
+static int config_ok(const icoac_config_t *cfg, bad_field_t *bad)
+{
+    if (cfg->mode != ICOAC_MODE_ICO && cfg->mode != ICOAC_MODE_RL) {
+        ICOAC_PRIV_FAIL("mode", ICOAC_ERR_BAD_MODE);
+    }
+    if (!policy_ok(&cfg->policy, bad)) {
+        return 0;
+    }
+    if (cfg->mode == ICOAC_MODE_ICO) {
+        return ico_ok(&cfg->ico, bad);
+    }
+    return critic_ok(&cfg->critic, bad) && actor_ok(&cfg->actor, bad);
+}
+
+icoac_status_t icoac_config_check_field(const icoac_config_t *cfg, const char **field)
+{
+    bad_field_t bad = {0, ICOAC_OK};
+    if (field != 0) {
+        *field = 0;
+    }
+    if (cfg == 0) {
+        return ICOAC_ERR_NULL;
+    }
+    if (config_ok(cfg, &bad)) {
+        return ICOAC_OK;
+    }
+    if (field != 0) {
+        *field = bad.field;
+    }
+    return bad.status;
 }
 
 icoac_status_t icoac_config_check(const icoac_config_t *cfg)
 {
+    return icoac_config_check_field(cfg, 0);
+}
+
+icoac_status_t icoac_prior_check(const icoac_prior_t *prior)
+{
+    icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
     int i;
-    if (cfg == 0) {
+    int j;
+    if (prior == 0) {
         return ICOAC_ERR_NULL;
     }
-    if ((cfg->mode != ICOAC_MODE_ICO && cfg->mode != ICOAC_MODE_RL) ||
-        (cfg->reflex_mode != ICOAC_REFLEX_UNIT && cfg->reflex_mode != ICOAC_REFLEX_GAIN) ||
-        (cfg->ico_timing != ICOAC_ICO_TIMING_CODE && cfg->ico_timing != ICOAC_ICO_TIMING_LITERAL) ||
-        !is_flag(cfg->clip_inputs) || !is_flag(cfg->rl_reflex) || !is_flag(cfg->act_with_sample)) {
-        return ICOAC_ERR_BAD_MODE;
-    }
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-        if (!within(cfg->input_range[i], ICOAC_RANGE_MIN, ICOAC_RANGE_MAX)) {
-            return ICOAC_ERR_BAD_SCALE;
+        const icoac_real_t m = prior->mean[i];
+        if (!(ICOAC_PRIV_FABS(m) <= ICOAC_PRIOR_MEAN_MAX) || !icoac_priv_zero_or_normal(m)) {
+            return ICOAC_ERR_BAD_PRIOR;
+        }
+        for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+            const icoac_real_t c = prior->cov[i][j];
+            if (!(ICOAC_PRIV_FABS(c) <= ICOAC_PRIOR_COV_MAX) || !icoac_priv_zero_or_normal(c) || c != prior->cov[j][i]) {
+                return ICOAC_ERR_BAD_PRIOR;
+            }
         }
     }
-    if (!within(cfg->gain, ICOAC_R(0.0), ICOAC_GAIN_MAX) ||
-        !within(cfg->reflex_force, ICOAC_R(0.0), ICOAC_FORCE_MAX)) {
-        return ICOAC_ERR_BAD_GAIN;
-    }
-    if (!within(cfg->zone_theta, ICOAC_ZONE_MIN, ICOAC_ZONE_THETA_MAX) ||
-        !within(cfg->zone_x, ICOAC_ZONE_MIN, ICOAC_ZONE_X_MAX)) {
-        return ICOAC_ERR_BAD_ZONE;
-    }
-    if (!within(cfg->ico_rate, ICOAC_R(0.0), ICOAC_ICO_RATE_MAX)) {
-        return ICOAC_ERR_BAD_ICO_RATE;
-    }
-    if (!within(cfg->critic_rate, ICOAC_R(0.0), ICOAC_CRITIC_RATE_MAX) ||
-        !within(cfg->discount, ICOAC_R(0.0), ICOAC_R(1.0)) ||
-        !within(cfg->td_clip, ICOAC_TD_CLIP_MIN, ICOAC_TD_CLIP_MAX) ||
-        !(within(cfg->critic_threshold, ICOAC_R(0.0), ICOAC_R(1.0)) && cfg->critic_threshold < ICOAC_R(1.0))) {
-        return ICOAC_ERR_BAD_CRITIC;
-    }
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-        if (!within(cfg->critic_range[i], ICOAC_RANGE_MIN, ICOAC_RANGE_MAX)) {
-            return ICOAC_ERR_BAD_CRITIC;
-        }
-    }
-    if (!within(cfg->noise_std, ICOAC_NOISE_STD_MIN, ICOAC_NOISE_STD_MAX) ||
-        !within(cfg->actor_scale, ICOAC_R(0.0), ICOAC_ACTOR_SCALE_MAX) ||
-        !within(cfg->forgetting, ICOAC_FORGETTING_MIN, ICOAC_R(1.0))) {
-        return ICOAC_ERR_BAD_ACTOR;
-    }
-    return ICOAC_OK;
+    return icoac_priv_cholesky4(prior->cov, lower) ? ICOAC_OK : ICOAC_ERR_BAD_PRIOR;
 }

@@ -1,14 +1,14 @@
 /* Normalized Gaussian critic on the 3x3x6x3 grid (spec 6), evaluated separably:
  * a_k = prod_i f_i(k_i) and sum_k a_k = prod_i sum_j f_i(j), so the normalized
  * activation is b_k = prod_i g_i(k_i) with per-dimension normalized factors g.
- * Units with b_k below cfg->critic_threshold count as 0 (spec 6); the value pass lists the
+ * Units with b_k below critic->threshold count as 0 (spec 6); the value pass lists the
  * units it kept, and the TD update of the next tick walks that list.
  * Layout: k = pair * 18 + cell with pair = a*3 + b over (x, x_dot) and cell = c*3 + d over
  * (theta, theta_dot); b_k is evaluated as (g_x[a] g_xd[b]) * (g_th[c] g_thd[d]).
  * All factors are <= 1, so a pair or cell product below the threshold rules out every unit it
  * belongs to. The surviving cells are sorted by product, largest first; the kept units of a
  * pair are then a leading run of that order, and V sums over them in that order. */
-#include "icoac_internal.h"
+#include "icoac_priv.h"
 
 #include <float.h>
 
@@ -38,11 +38,11 @@ static inline void dimension_factors(icoac_real_t value, icoac_real_t range, int
     }
     distance = offset - (icoac_real_t)(2 * nearest);
     if (nearest < n - 1) {
-        up = icoac_exp(ICOAC_R(2.0) * distance - ICOAC_R(2.0));
+        up = icoac_priv_exp(ICOAC_R(2.0) * distance - ICOAC_R(2.0));
     }
     if (nearest > 0) {
         /* inside the grid |distance| <= 1, so up >= e^-4 and down = e^-4 / up <= 1 */
-        down = nearest < n - 1 ? exp_minus_4 / up : icoac_exp(ICOAC_R(-2.0) * distance - ICOAC_R(2.0));
+        down = nearest < n - 1 ? exp_minus_4 / up : icoac_priv_exp(ICOAC_R(-2.0) * distance - ICOAC_R(2.0));
     }
     /* Both chains run over the whole array and select, so no branch depends on nearest. */
     for (j = 0; j < n; ++j) {
@@ -71,16 +71,16 @@ static inline void dimension_factors(icoac_real_t value, icoac_real_t range, int
     }
 }
 
-void icoac_critic_factors(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_N_INPUTS],
+void icoac_priv_critic_factors(const icoac_critic_config_t *critic, const icoac_real_t s[ICOAC_N_INPUTS],
                           icoac_real_t factors[ICOAC_CRITIC_FACTORS])
 {
-    dimension_factors(s[ICOAC_IDX_X], cfg->critic_range[ICOAC_IDX_X], ICOAC_CRITIC_N_X, factors);
+    dimension_factors(s[ICOAC_IDX_X], critic->range[ICOAC_IDX_X], ICOAC_CRITIC_N_X, factors);
     factors += ICOAC_CRITIC_N_X;
-    dimension_factors(s[ICOAC_IDX_X_DOT], cfg->critic_range[ICOAC_IDX_X_DOT], ICOAC_CRITIC_N_X_DOT, factors);
+    dimension_factors(s[ICOAC_IDX_X_DOT], critic->range[ICOAC_IDX_X_DOT], ICOAC_CRITIC_N_X_DOT, factors);
     factors += ICOAC_CRITIC_N_X_DOT;
-    dimension_factors(s[ICOAC_IDX_THETA], cfg->critic_range[ICOAC_IDX_THETA], ICOAC_CRITIC_N_THETA, factors);
+    dimension_factors(s[ICOAC_IDX_THETA], critic->range[ICOAC_IDX_THETA], ICOAC_CRITIC_N_THETA, factors);
     factors += ICOAC_CRITIC_N_THETA;
-    dimension_factors(s[ICOAC_IDX_THETA_DOT], cfg->critic_range[ICOAC_IDX_THETA_DOT],
+    dimension_factors(s[ICOAC_IDX_THETA_DOT], critic->range[ICOAC_IDX_THETA_DOT],
                       ICOAC_CRITIC_N_THETA_DOT, factors);
 }
 
@@ -88,25 +88,25 @@ void icoac_critic_factors(const icoac_config_t *cfg, const icoac_real_t s[ICOAC_
 
 /* Units are kept when b_k >= this floor: the threshold, or with threshold 0 the smallest
  * normal number (b_k below it is 0 under flush-to-zero and adds nothing to V either way). */
-static inline icoac_real_t kept_floor(const icoac_config_t *cfg)
+static inline icoac_real_t kept_floor(const icoac_critic_config_t *critic)
 {
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
     const icoac_real_t smallest_normal = DBL_MIN;
 #else
     const icoac_real_t smallest_normal = FLT_MIN;
 #endif
-    return cfg->critic_threshold > smallest_normal ? cfg->critic_threshold : smallest_normal;
+    return critic->threshold > smallest_normal ? critic->threshold : smallest_normal;
 }
 
 /* First and one-past-last index of the factors >= threshold (factors are unimodal). */
 static inline void kept_range(const icoac_real_t *g, int n, icoac_real_t threshold, int *begin, int *end)
 {
     int j = 0;
-    while (j < n && !icoac_nonneg_at_least(g[j], threshold)) {
+    while (j < n && !icoac_priv_nonneg_at_least(g[j], threshold)) {
         ++j;
     }
     *begin = j;
-    while (j < n && icoac_nonneg_at_least(g[j], threshold)) {
+    while (j < n && icoac_priv_nonneg_at_least(g[j], threshold)) {
         ++j;
     }
     *end = j;
@@ -114,7 +114,7 @@ static inline void kept_range(const icoac_real_t *g, int n, icoac_real_t thresho
 
 /* Cells with g_th g_thd >= threshold, sorted by product (largest first, ties in cell order). */
 static int sorted_cells(const icoac_real_t *gth, const icoac_real_t *gthd, icoac_real_t threshold,
-                        icoac_critic_active_t *active)
+                        icoac_priv_critic_active_t *active)
 {
     int cells = 0;
     int c_begin, c_end, d_begin, d_end;
@@ -126,10 +126,10 @@ static int sorted_cells(const icoac_real_t *gth, const icoac_real_t *gthd, icoac
         for (d = d_begin; d < d_end; ++d) {
             const icoac_real_t product = gth[c] * gthd[d];
             int i = cells;
-            if (!icoac_nonneg_at_least(product, threshold)) {
+            if (!icoac_priv_nonneg_at_least(product, threshold)) {
                 continue;
             }
-            while (i > 0 && !icoac_nonneg_at_least(active->cell_product[i - 1], product)) {
+            while (i > 0 && !icoac_priv_nonneg_at_least(active->cell_product[i - 1], product)) {
                 active->cell_product[i] = active->cell_product[i - 1];
                 active->cell[i] = active->cell[i - 1];
                 --i;
@@ -145,11 +145,11 @@ static int sorted_cells(const icoac_real_t *gth, const icoac_real_t *gthd, icoac
     return cells;
 }
 
-icoac_real_t icoac_critic_value(const icoac_config_t *cfg, const icoac_real_t v[ICOAC_CRITIC_UNITS],
+icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic, const icoac_real_t v[ICOAC_CRITIC_UNITS],
                                 const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
-                                icoac_critic_active_t *active)
+                                icoac_priv_critic_active_t *active)
 {
-    const icoac_real_t threshold = kept_floor(cfg);
+    const icoac_real_t threshold = kept_floor(critic);
     const icoac_real_t *gx = factors;
     const icoac_real_t *gxd = gx + ICOAC_CRITIC_N_X;
     const icoac_real_t *gth = gxd + ICOAC_CRITIC_N_X_DOT;
@@ -170,12 +170,12 @@ icoac_real_t icoac_critic_value(const icoac_config_t *cfg, const icoac_real_t v[
             int kept;
             /* threshold <= pair_product <= 1 as bit patterns: false for NaN, Inf and negative
              * values, so pair_product * 0 = 0 and the sentinel ends the scan below */
-            if (!icoac_nonneg_at_least(pair_product, threshold) ||
-                !icoac_nonneg_at_least(ICOAC_R(1.0), pair_product)) {
+            if (!icoac_priv_nonneg_at_least(pair_product, threshold) ||
+                !icoac_priv_nonneg_at_least(ICOAC_R(1.0), pair_product)) {
                 continue;
             }
             unit_b = pair_product * *product;
-            while (icoac_nonneg_at_least(unit_b, threshold)) {
+            while (icoac_priv_nonneg_at_least(unit_b, threshold)) {
                 value += u[*cell++] * unit_b;
                 unit_b = pair_product * *++product;
             }
@@ -194,7 +194,7 @@ icoac_real_t icoac_critic_value(const icoac_config_t *cfg, const icoac_real_t v[
 }
 
 /* v_k += step * b_k over the units listed by icoac_critic_value. */
-void icoac_critic_update(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_critic_active_t *active,
+void icoac_priv_critic_update(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_active_t *active,
                          icoac_real_t step)
 {
     int p;

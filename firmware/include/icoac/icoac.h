@@ -37,46 +37,67 @@ typedef enum {
  * values are rejected everywhere (a host that flushes them to zero would read 0). Each bound
  * keeps a derived quantity representable in float: 1/range and s*n/range (critic) stay finite
  * and normal, sigma_u^2 stays normal, 1/forgetting stays small. */
-#define ICOAC_RANGE_MIN ICOAC_R(1.0e-6)       /* input_range, critic_range (m, m/s, rad, rad/s) */
+#define ICOAC_RANGE_MIN ICOAC_R(1.0e-6)       /* policy.input_range, critic.range (m, m/s, rad, rad/s) */
 #define ICOAC_RANGE_MAX ICOAC_R(1.0e6)
-#define ICOAC_GAIN_MAX ICOAC_R(1.0e4)         /* gain (N per unit feature), >= 0 */
-#define ICOAC_FORCE_MAX ICOAC_R(1.0e4)        /* reflex_force (N), >= 0 */
-#define ICOAC_ZONE_MIN ICOAC_R(1.0e-6)        /* zone_theta (rad), zone_x (m) */
+#define ICOAC_GAIN_MAX ICOAC_R(1.0e4)         /* policy.gain (N per unit feature), >= 0 */
+#define ICOAC_FORCE_MAX ICOAC_R(1.0e4)        /* policy.reflex_force (N), >= 0 */
+#define ICOAC_ZONE_MIN ICOAC_R(1.0e-6)        /* policy.zone_theta (rad), policy.zone_x (m) */
 #define ICOAC_ZONE_THETA_MAX ICOAC_R(3.14159265358979)
 #define ICOAC_ZONE_X_MAX ICOAC_R(1.0e6)
-#define ICOAC_ICO_RATE_MAX ICOAC_R(1.0)       /* ico_rate, >= 0 */
-#define ICOAC_CRITIC_RATE_MAX ICOAC_R(10.0)   /* critic_rate, >= 0 */
-#define ICOAC_TD_CLIP_MIN ICOAC_R(1.0e-6)     /* td_clip */
+#define ICOAC_ICO_RATE_MAX ICOAC_R(1.0)       /* ico.rate, >= 0 */
+#define ICOAC_CRITIC_RATE_MAX ICOAC_R(10.0)   /* critic.rate, >= 0 */
+#define ICOAC_TD_CLIP_MIN ICOAC_R(1.0e-6)     /* critic.td_clip */
 #define ICOAC_TD_CLIP_MAX ICOAC_R(1.0e3)
-#define ICOAC_NOISE_STD_MIN ICOAC_R(1.0e-3)   /* noise_std (N) */
+#define ICOAC_NOISE_STD_MIN ICOAC_R(1.0e-3)   /* actor.noise_std (N) */
 #define ICOAC_NOISE_STD_MAX ICOAC_R(1.0e3)
-#define ICOAC_ACTOR_SCALE_MAX ICOAC_R(1.0e3)  /* actor_scale, >= 0 */
-#define ICOAC_FORGETTING_MIN ICOAC_R(0.5)     /* forgetting, <= 1 */
+#define ICOAC_ACTOR_SCALE_MAX ICOAC_R(1.0e3)  /* actor.scale, >= 0 */
+#define ICOAC_FORGETTING_MIN ICOAC_R(0.5)     /* actor.forgetting, <= 1 */
 
-/* Configuration. Integer switches are int32_t so the layout is the same on every ABI.
- * Ranges: the ICOAC_*_MIN / _MAX bounds above. */
+/* Configuration, one group per concern; a mode validates and uses only its groups (ICO:
+ * policy, ico; RL: policy, critic, actor). Integer switches are int32_t so the layout is the
+ * same on every ABI. Ranges: the ICOAC_*_MIN / _MAX bounds above. */
+
+/* Policy: how the state becomes the feature z = w^T x~ and the force (every mode). */
 typedef struct {
-    int32_t mode;                               /* icoac_mode_t */
-    int32_t reflex_mode;                        /* icoac_reflex_mode_t */
-    int32_t ico_timing;                         /* icoac_ico_timing_t */
-    int32_t clip_inputs;                        /* 1: clip scaled inputs to [-1, 1]; 0: no clip */
-    icoac_real_t input_range[ICOAC_N_INPUTS];   /* (m, m/s, rad, rad/s) maps to +-1; [1e-6, 1e6]. 2.4, 3.5, 0.2094384, 2.0 */
-    icoac_real_t gain;                          /* G (N per unit feature), [0, 1e4]. 10 */
-    icoac_real_t reflex_force;                  /* N per unit U in ICOAC_REFLEX_UNIT, [0, 1e4]. 1 */
-    icoac_real_t zone_theta;                    /* reflex/penalty angle (rad), [1e-6, pi]. 11.5 deg = 0.20071286 */
-    icoac_real_t zone_x;                        /* reflex/penalty cart position (m), [1e-6, 1e6]. 2.35 */
-    icoac_real_t ico_rate;                      /* mu, [0, 1]. 1e-4 */
-    /* RL (ICOAC_MODE_RL) */
-    icoac_real_t critic_rate;                   /* eta_c, [0, 10]. 0.6 */
-    icoac_real_t discount;                      /* gamma per tick, [0, 1]. 0.95 */
-    icoac_real_t td_clip;                       /* |delta| limit, [1e-6, 1e3]. 1 */
-    icoac_real_t critic_range[ICOAC_N_INPUTS];  /* critic grid half-widths (SI), [1e-6, 1e6]. 2.4, 3.5, 0.2094, 2.0 */
-    icoac_real_t critic_threshold;              /* drop normalized activations below this, [0, 1). 0.001 (code); 0 = dense */
-    icoac_real_t noise_std;                     /* sigma_u (N), [1e-3, 1e3]. 1 */
-    icoac_real_t actor_scale;                   /* alpha, [0, 1e3]. 0.5 */
-    icoac_real_t forgetting;                    /* lambda_f, [0.5, 1]. 1 (none) */
-    int32_t rl_reflex;                          /* 1: reflex added to the executed force in RL; 0: off */
-    int32_t act_with_sample;                    /* 1: act with a posterior sample of w per trial; 0: with mu_w */
+    icoac_real_t input_range[ICOAC_N_INPUTS]; /* (m, m/s, rad, rad/s) maps to +-1; [1e-6, 1e6]. 2.4, 3.5, 0.2094384, 2.0 */
+    int32_t clip_inputs;                      /* 1: clip scaled inputs to [-1, 1]; 0: no clip */
+    icoac_real_t gain;                        /* G (N per unit feature), [0, 1e4]. 10 */
+    int32_t reflex_mode;                      /* icoac_reflex_mode_t */
+    icoac_real_t reflex_force;                /* N per unit U in ICOAC_REFLEX_UNIT, [0, 1e4]. 1 */
+    icoac_real_t zone_theta;                  /* reflex/penalty angle (rad), [1e-6, pi]. 11.5 deg = 0.20071286 */
+    icoac_real_t zone_x;                      /* reflex/penalty cart position (m), [1e-6, 1e6]. 2.35 */
+} icoac_policy_config_t;
+
+/* ICO rule (ICOAC_MODE_ICO). */
+typedef struct {
+    icoac_real_t rate; /* mu, [0, 1]. 1e-4 */
+    int32_t timing;    /* icoac_ico_timing_t */
+} icoac_ico_config_t;
+
+/* Normalized-Gaussian critic (ICOAC_MODE_RL). */
+typedef struct {
+    icoac_real_t rate;                  /* eta_c, [0, 10]. 0.6 */
+    icoac_real_t discount;              /* gamma per tick, [0, 1]. 0.95 */
+    icoac_real_t td_clip;               /* |delta| limit, [1e-6, 1e3]. 1 */
+    icoac_real_t range[ICOAC_N_INPUTS]; /* grid half-widths (SI), [1e-6, 1e6]. 2.4, 3.5, 0.2094, 2.0 */
+    icoac_real_t threshold;             /* drop normalized activations below this, [0, 1). 0.001 (code); 0 = dense */
+} icoac_critic_config_t;
+
+/* Bayesian actor and exploration (ICOAC_MODE_RL). */
+typedef struct {
+    icoac_real_t noise_std;  /* sigma_u (N), [1e-3, 1e3]. 1 */
+    icoac_real_t scale;      /* alpha, [0, 1e3]. 0.5 */
+    icoac_real_t forgetting; /* lambda_f, [0.5, 1]. 1 (none) */
+    int32_t reflex;          /* 1: reflex added to the executed force; 0: off */
+    int32_t act_with_sample; /* 1: act with a posterior sample of w per trial; 0: with mu_w */
+} icoac_actor_config_t;
+
+typedef struct {
+    int32_t mode;                 /* icoac_mode_t */
+    icoac_policy_config_t policy;
+    icoac_ico_config_t ico;
+    icoac_critic_config_t critic;
+    icoac_actor_config_t actor;
 } icoac_config_t;
 
 /* Gaussian prior / posterior of the feature weights, (w_x, w_xdot, w_theta, w_thetadot).
@@ -89,40 +110,25 @@ typedef struct {
     icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
 } icoac_prior_t;
 
-/* Critic units kept (b_k >= critic_threshold) at one state: the eligibility of the next TD
- * update. Pair p keeps the units of its first pair_cells[p] cells, in the listed cell order.
- * Part of the state. */
+/* Controller state: caller-owned storage of ICOAC_STATE_SIZE bytes, 8-byte aligned (it may be
+ * a static, a stack or a struct member; no heap). Its layout is private and may change
+ * between releases: read it through icoac_get_posterior and icoac_get_counters. The size has
+ * room for later learners. */
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+#define ICOAC_STATE_SIZE 2560
+#else
+#define ICOAC_STATE_SIZE 1280
+#endif
 typedef struct {
-    icoac_real_t pair_product[ICOAC_CRITIC_PAIRS]; /* g_x * g_xdot of each listed pair */
-    icoac_real_t cell_product[ICOAC_CRITIC_CELLS + 1]; /* g_theta * g_thetadot, largest first; 0 */
-    uint8_t pair[ICOAC_CRITIC_PAIRS];              /* a*3 + b */
-    uint8_t pair_cells[ICOAC_CRITIC_PAIRS];        /* leading cells kept by each pair */
-    uint8_t cell[ICOAC_CRITIC_CELLS];              /* c*3 + d */
-    uint8_t pairs;                                 /* pairs listed */
-    uint8_t cells;                                 /* cells listed */
-} icoac_critic_active_t;
-
-/* Everything the controller owns. Treat as opaque; read it through the output struct. */
-typedef struct {
-    uint32_t magic;                                 /* set by icoac_init */
-    int32_t has_prev;                               /* a previous tick of this trial is cached */
-    icoac_real_t inv_range[ICOAC_N_INPUTS];         /* 1 / input_range, derived by icoac_init */
-    icoac_real_t w[ICOAC_N_INPUTS];                 /* ICO weights, or actor mean mu_w */
-    icoac_real_t weight_norm;                       /* |w|, refreshed when w changes */
-    icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* actor covariance Sigma_w */
-    icoac_real_t w_act[ICOAC_N_INPUTS];             /* weights used to act (mu_w or a sample) */
-    icoac_real_t v[ICOAC_CRITIC_UNITS];             /* critic weights */
-    icoac_critic_active_t active[2];                /* kept critic units of s_t and of s */
-    int32_t active_slot;                            /* index of s_t's entry in active */
-    icoac_real_t x_prev[ICOAC_N_INPUTS];            /* scaled observation of the previous tick */
-    icoac_real_t penalty_prev;                      /* r of the previous ICO observation */
-    icoac_real_t value_prev;                        /* V(s_t) */
-    icoac_real_t noise_prev;                        /* exploration noise eps_t (N) */
-    icoac_rng_t rng;                                /* exploration noise */
-    uint32_t ticks;                                 /* icoac_step calls since init (wraps) */
-    uint32_t nonfinite_count;                       /* rejected observations since init */
-    uint32_t numeric_fault_count;                   /* ticks rejected with ICOAC_ERR_NUMERIC since init */
+    uint64_t opaque[ICOAC_STATE_SIZE / 8];
 } icoac_state_t;
+
+/* Counters since icoac_init (each wraps at 2^32). */
+typedef struct {
+    uint32_t ticks;          /* icoac_step calls on an initialised state */
+    uint32_t nonfinite;      /* ticks rejected with ICOAC_ERR_NONFINITE_INPUT */
+    uint32_t numeric_faults; /* ticks rejected with ICOAC_ERR_NUMERIC */
+} icoac_counters_t;
 
 /* Flags of icoac_input_t. */
 #define ICOAC_INPUT_TERMINAL 1u /* s is a failure state: learn from it, output no action */
@@ -148,11 +154,18 @@ typedef struct {
     int32_t status;           /* icoac_status_t of this tick */
 } icoac_output_t;
 
-/* Paper defaults (spec section 2), ICO mode. */
+/* Paper defaults (spec section 2) of every group, ICO mode. */
 void icoac_config_default(icoac_config_t *cfg);
+void icoac_policy_config_default(icoac_policy_config_t *policy);
+void icoac_ico_config_default(icoac_ico_config_t *ico);
+void icoac_critic_config_default(icoac_critic_config_t *critic);
+void icoac_actor_config_default(icoac_actor_config_t *actor);
 
-/* Validate every field; ICOAC_OK or the status naming the first bad group. */
+/* Validate the mode and the groups it uses; ICOAC_OK or the status of the first bad field's
+ * group. icoac_config_check_field also names that field ("critic.range[0]", a static string;
+ * NULL when OK); field may be NULL. */
 icoac_status_t icoac_config_check(const icoac_config_t *cfg);
+icoac_status_t icoac_config_check_field(const icoac_config_t *cfg, const char **field);
 
 /* Validate a prior (the bounds at icoac_prior_t). */
 icoac_status_t icoac_prior_check(const icoac_prior_t *prior);
@@ -165,8 +178,8 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state,
 /* Start a new trial: forget the previous tick, keep everything learned. */
 icoac_status_t icoac_reset(const icoac_config_t *cfg, icoac_state_t *state);
 
-/* One tick: learn from the transition into in->s, then act on it. The return value and
- * out->status are the same. Contract: with a configuration icoac_config_check accepts and a
+/* One tick: learn from the transition into in->s, then act on it. The return value is the
+ * tick's status; out->status holds the same value, for hosts that log the output. Contract: with a configuration icoac_config_check accepts and a
  * finite in->s, either ICOAC_OK with a finite output and a finite learned state (w, Sigma_w,
  * v), or an error status with force 0 and the state unchanged but for its tick counters:
  * ICOAC_ERR_NONFINITE_INPUT for a NaN/Inf observation, ICOAC_ERR_NUMERIC when a value the tick
@@ -174,10 +187,13 @@ icoac_status_t icoac_reset(const icoac_config_t *cfg, icoac_state_t *state);
 icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
                           const icoac_input_t *in, icoac_output_t *out);
 
-/* Current weights (ICO w or actor mean mu_w) and covariance; either pointer may be NULL. */
+/* Current weights (ICO w or actor mean mu_w) and covariance Sigma_w. */
 icoac_status_t icoac_get_posterior(const icoac_state_t *state, icoac_prior_t *posterior);
 
-/* Layout checks for bindings. */
+/* The state's counters. */
+icoac_status_t icoac_get_counters(const icoac_state_t *state, icoac_counters_t *counters);
+
+/* Layout checks for bindings (field offsets: icoac_sim's layout table on the host). */
 uint32_t icoac_abi_version(void);
 uint32_t icoac_sizeof_real(void);
 uint32_t icoac_sizeof_config(void);

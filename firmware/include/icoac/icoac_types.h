@@ -9,23 +9,15 @@ extern "C" {
 #endif
 
 /* Bump when a public struct layout or an enum value changes. */
-#define ICOAC_ABI_VERSION 3
+#define ICOAC_ABI_VERSION 4
 
 /* Real-number type: float by default; define ICOAC_REAL_DOUBLE=1 for double. */
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
 typedef double icoac_real_t;
 #define ICOAC_R(x) (x)
-#define ICOAC_EXP exp
-#define ICOAC_SQRT sqrt
-#define ICOAC_LOG log
-#define ICOAC_FABS fabs
 #else
 typedef float icoac_real_t;
 #define ICOAC_R(x) (x##f)
-#define ICOAC_EXP expf
-#define ICOAC_SQRT sqrtf
-#define ICOAC_LOG logf
-#define ICOAC_FABS fabsf
 #endif
 
 /* Observation layout: (x, x_dot, theta, theta_dot). */

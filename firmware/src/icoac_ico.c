@@ -1,0 +1,97 @@
+/* ICO rule (Eq. 2-3) in both timings of spec A4, staged: the new weights, their norm and the
+ * force are stored only when finite. */
+#include "icoac_features.h"
+
+/* ICO weights after a penalty onset of size drop > 0 (Eq. 2-3), and their norm. */
+static icoac_real_t learn_weights(const icoac_config_t *cfg, const icoac_priv_state_t *st,
+                              const icoac_real_t trace[ICOAC_N_INPUTS], icoac_real_t drop,
+                              icoac_real_t w[ICOAC_N_INPUTS])
+{
+    const icoac_real_t step = cfg->ico.rate * drop;
+    int i;
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        w[i] = st->w[i] + step * ICOAC_PRIV_FABS(trace[i]);
+    }
+    return ICOAC_PRIV_SQRT(icoac_priv_dot4(w, w));
+}
+
+static void commit_weights(icoac_priv_state_t *st, const icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t norm)
+{
+    icoac_priv_copy4(st->w, w);
+    st->weight_norm = norm;
+}
+
+/* ICO rule, code timing: act with w_t, then learn from the penalty onset at s_t. Failure
+ * states are not seen. The force and the new weights' norm (finite only if every w_i is) are
+ * checked before anything is stored; returns 0, with the state untouched, when one is not. */
+static int code_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
+                           const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
+                           icoac_output_t *out)
+{
+    const icoac_real_t drop = st->penalty_prev - penalty;
+    icoac_real_t w[ICOAC_N_INPUTS];
+    icoac_real_t norm = ICOAC_R(0.0);
+    icoac_real_t z;
+    icoac_real_t force;
+    if (terminal) {
+        return 1;
+    }
+    z = icoac_priv_dot4(st->w, scaled);
+    force = cfg->policy.gain * z + icoac_priv_reflex_force(&cfg->policy, out->reflex);
+    if (drop > ICOAC_R(0.0)) {
+        norm = learn_weights(cfg, st, scaled, drop, w);
+    }
+    if (!icoac_priv_finite(force) || !icoac_priv_finite(norm)) {
+        return 0;
+    }
+    if (drop > ICOAC_R(0.0)) {
+        commit_weights(st, w, norm);
+        out->q = drop;
+    }
+    st->penalty_prev = penalty;
+    out->z = z;
+    out->force = force;
+    return 1;
+}
+
+/* ICO rule, literal timing: learn from r(t+1) - r(t) with x~(t), then act with w_{t+1}; a
+ * terminal tick learns and outputs no force. Checked like the code timing (z stands for the
+ * force on a terminal tick). */
+static int literal_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
+                              const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty,
+                              int terminal, icoac_output_t *out)
+{
+    const icoac_real_t drop = st->penalty_prev - penalty;
+    const int learn = st->has_prev && drop > ICOAC_R(0.0);
+    icoac_real_t w[ICOAC_N_INPUTS];
+    icoac_real_t norm = ICOAC_R(0.0);
+    icoac_real_t z;
+    icoac_real_t force = ICOAC_R(0.0);
+    if (learn) {
+        norm = learn_weights(cfg, st, st->x_prev, drop, w);
+    }
+    z = icoac_priv_dot4(learn ? w : st->w, scaled);
+    if (!terminal) {
+        force = cfg->policy.gain * z + icoac_priv_reflex_force(&cfg->policy, out->reflex);
+    }
+    if (!icoac_priv_finite(terminal ? z : force) || !icoac_priv_finite(norm)) {
+        return 0;
+    }
+    if (learn) {
+        commit_weights(st, w, norm);
+        out->q = drop;
+    }
+    st->penalty_prev = penalty;
+    icoac_priv_cache_tick(st, scaled);
+    out->z = z;
+    out->force = force;
+    return 1;
+}
+
+int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
+                        const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
+                        icoac_output_t *out)
+{
+    return cfg->ico.timing == ICOAC_ICO_TIMING_LITERAL ? literal_timing(cfg, st, scaled, penalty, terminal, out)
+                                                       : code_timing(cfg, st, scaled, penalty, terminal, out);
+}

@@ -1,0 +1,186 @@
+/* Private declarations of the icoac library: numeric helpers and the stages of a tick.
+ * Not installed, not part of the API; every name carries the prefix icoac_priv_. */
+#ifndef ICOAC_PRIV_H
+#define ICOAC_PRIV_H
+
+#include <math.h>
+#include <string.h>
+
+#include "icoac/icoac.h"
+#include "icoac_state.h"
+
+/* Math of the real type. */
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+#define ICOAC_PRIV_SQRT sqrt
+#define ICOAC_PRIV_LOG log
+#define ICOAC_PRIV_FABS fabs
+#define ICOAC_PRIV_LIBM_EXP exp
+#else
+#define ICOAC_PRIV_SQRT sqrtf
+#define ICOAC_PRIV_LOG logf
+#define ICOAC_PRIV_FABS fabsf
+#define ICOAC_PRIV_LIBM_EXP expf
+#endif
+
+/* C99 will not pass T[4][4] to const T[4][4] implicitly. */
+#define ICOAC_PRIV_CONST_MAT4(m) ((const icoac_real_t(*)[ICOAC_N_INPUTS])(m))
+
+/* exp(a) for the critic. Default: the C library's expf/exp. With ICOAC_FAST_EXP=1 (float
+ * builds; the microcontroller presets turn it on): Cody-Waite reduction a = n ln2 + r,
+ * |r| <= ln2/2, a degree-6 Taylor polynomial for e^r and 2^n from the exponent bits.
+ * Relative error < 1e-6 on [-87, 88] (tests/c/test_fast_exp.c); 0 below -87, NaN for NaN. */
+#if defined(ICOAC_FAST_EXP) && ICOAC_FAST_EXP && !(defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE)
+static inline float icoac_priv_exp(float a)
+{
+    const float ln2_hi = 0.693145751953125f;
+    const float ln2_lo = 1.42860676533018704e-06f;
+    const float inv_ln2 = 1.44269504088896341f;
+    union {
+        float f;
+        uint32_t u;
+    } scale;
+    float n_real;
+    float r;
+    float p;
+    int32_t n;
+    if (!(a >= -87.0f)) {
+        return a != a ? a : 0.0f; /* NaN stays NaN (the tick's finiteness check reports it) */
+    }
+    if (a > 88.0f) {
+        a = 88.0f;
+    }
+    n_real = a * inv_ln2;
+    n = (int32_t)(n_real < 0.0f ? n_real - 0.5f : n_real + 0.5f);
+    n_real = (float)n;
+    r = (a - n_real * ln2_hi) - n_real * ln2_lo;
+    p = 1.0f + r * (1.0f + r * (0.5f + r * (1.0f / 6.0f + r * (1.0f / 24.0f +
+                                       r * (1.0f / 120.0f + r * (1.0f / 720.0f))))));
+    scale.u = (uint32_t)(n + 127) << 23;
+    return p * scale.f;
+}
+#else
+static inline icoac_real_t icoac_priv_exp(icoac_real_t a)
+{
+    return ICOAC_PRIV_LIBM_EXP(a);
+}
+#endif
+
+/* a >= b for non-negative, non-NaN a and b. Such IEEE-754 values order like their bit
+ * patterns, so this is an integer compare: a soft-float compare costs ~40 instructions on a
+ * Cortex-M0+, and the sparse critic makes hundreds per tick. */
+static inline int icoac_priv_nonneg_at_least(icoac_real_t a, icoac_real_t b)
+{
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+    uint64_t bits_a;
+    uint64_t bits_b;
+#else
+    uint32_t bits_a;
+    uint32_t bits_b;
+#endif
+    memcpy(&bits_a, &a, sizeof bits_a);
+    memcpy(&bits_b, &b, sizeof bits_b);
+    return bits_a >= bits_b;
+}
+
+/* 1 when v is finite. An IEEE-754 value is NaN or Inf exactly when its exponent bits are all
+ * ones: an integer test, no float compare (costly in soft float). */
+static inline int icoac_priv_finite(icoac_real_t v)
+{
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+    const uint64_t exponent = 0x7FF0000000000000ull;
+    uint64_t bits;
+#else
+    const uint32_t exponent = 0x7F800000u;
+    uint32_t bits;
+#endif
+    memcpy(&bits, &v, sizeof bits);
+    return (bits & exponent) != exponent;
+}
+
+/* 1 when v is +-0 or a normal number (or Inf/NaN): not subnormal. Configuration and prior
+ * values must be, since hosts that flush subnormals to zero would read them as 0. */
+static inline int icoac_priv_zero_or_normal(icoac_real_t v)
+{
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+    const uint64_t exponent = 0x7FF0000000000000ull;
+    const uint64_t magnitude = 0x7FFFFFFFFFFFFFFFull;
+    uint64_t bits;
+#else
+    const uint32_t exponent = 0x7F800000u;
+    const uint32_t magnitude = 0x7FFFFFFFu;
+    uint32_t bits;
+#endif
+    memcpy(&bits, &v, sizeof bits);
+    return (bits & exponent) != 0u || (bits & magnitude) == 0u;
+}
+
+/* 1 when every one of the n values is finite; no branch per value. */
+static inline int icoac_priv_all_finite(const icoac_real_t *values, int n)
+{
+    int finite = 1;
+    int i;
+    for (i = 0; i < n; ++i) {
+        finite &= icoac_priv_finite(values[i]);
+    }
+    return finite;
+}
+
+/* dst = src for 4-vectors; inline, as newlib-nano's memcpy copies byte by byte. */
+static inline void icoac_priv_copy4(icoac_real_t dst[ICOAC_N_INPUTS], const icoac_real_t src[ICOAC_N_INPUTS])
+{
+    dst[0] = src[0];
+    dst[1] = src[1];
+    dst[2] = src[2];
+    dst[3] = src[3];
+}
+
+/* Fixed pairwise order: the same result on every target. */
+static inline icoac_real_t icoac_priv_dot4(const icoac_real_t a[ICOAC_N_INPUTS],
+                                      const icoac_real_t b[ICOAC_N_INPUTS])
+{
+    return (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
+}
+
+/* The tick's per-trial cache: this tick's scaled observation is the next one's previous. */
+static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_real_t scaled[ICOAC_N_INPUTS])
+{
+    icoac_priv_copy4(st->x_prev, scaled);
+    st->has_prev = 1;
+}
+
+/* Stages of a tick. Each tick function stages what it would learn and output, checks that it
+ * is finite, and only then commits it; it returns 0, with the state untouched, when not. */
+
+/* ICO rule, both timings (icoac_ico.c). */
+int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
+                        const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
+                        icoac_output_t *out);
+
+/* Actor-critic tick: critic and actor on the transition into s, then act (icoac_rl.c). */
+int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_N_INPUTS],
+                       const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out);
+
+/* Critic (icoac_critic.c): per-dimension normalized factors of s, V(s) with its kept-unit
+ * list, and the TD update v_k += step * b_k over such a list. */
+void icoac_priv_critic_factors(const icoac_critic_config_t *critic, const icoac_real_t s[ICOAC_N_INPUTS],
+                               icoac_real_t factors[ICOAC_CRITIC_FACTORS]);
+icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic, const icoac_real_t v[ICOAC_CRITIC_UNITS],
+                                     const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+                                     icoac_priv_critic_active_t *active);
+void icoac_priv_critic_update(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_active_t *active,
+                              icoac_real_t step);
+
+/* Actor (icoac_actor.c). The update reads mu_w, Sigma_w from st and writes the candidate
+ * posterior to w, cov (which may be st's own w, cov). */
+void icoac_priv_actor_update(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                             const icoac_real_t h[ICOAC_N_INPUTS], icoac_real_t innovation,
+                             icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+/* w_act = mu_w + L n (L L^T = Sigma_w), or mu_w when Sigma_w is not positive definite. Always
+ * finite: |L_ij| <= sqrt(Sigma_ii) <= sqrt(REAL_MAX) and the polar normals are below 1e8. */
+void icoac_priv_actor_sample(icoac_priv_state_t *st);
+icoac_real_t icoac_priv_trace4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+/* m = L L^T; returns 0 when m is not positive definite. */
+int icoac_priv_cholesky4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS],
+                         icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+
+#endif /* ICOAC_PRIV_H */

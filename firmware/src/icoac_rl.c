@@ -1,0 +1,106 @@
+/* The actor-critic tick (spec 6-8b): the critic's TD error on the transition into s drives
+ * the critic and the Bayesian actor, then the actor acts on s with exploration noise. */
+#include "icoac_features.h"
+
+/* delta clipped to +-td_clip. */
+static icoac_real_t clip_td(icoac_real_t delta, icoac_real_t td_clip)
+{
+    return delta > td_clip ? td_clip : (delta < -td_clip ? -td_clip : delta);
+}
+
+/* Off-diagonal entries of a symmetric 4x4 matrix finite (its trace covers the diagonal). */
+static int off_diagonal_finite(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS])
+{
+    return icoac_priv_all_finite(&m[0][1], 3) && icoac_priv_all_finite(&m[1][2], 2) && icoac_priv_all_finite(&m[2][3], 1);
+}
+
+/* Actor-critic tick: learn from the transition s_t -> s (spec 8b steps 5-8), then act on s.
+ * V(s), delta, the actor's candidate posterior and the force are staged; the critic and the
+ * actor are updated, and the caches advanced, only when they are finite. Returns 0, with the
+ * state untouched, otherwise. Checked: V(s), delta, |w| (covers every w_i), the trace of
+ * Sigma_w (covers its diagonal) and its off-diagonal, and G z (+ reflex). Not checked, as
+ * finite by the configuration's bounds: the noise (|eps| < 1e8 sigma_u), hence the force
+ * G z + eps + reflex; and the critic weights, which move by at most critic_rate * td_clip
+ * <= 1e4 per tick. */
+int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_N_INPUTS],
+                   const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out)
+{
+    icoac_real_t factors[ICOAC_CRITIC_FACTORS];
+    icoac_real_t w[ICOAC_N_INPUTS];
+    icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
+    icoac_real_t checked[5]; /* V(s), delta, |w|, trace of Sigma_w, G z (+ reflex) */
+    const int slot_prev = st->active_slot;
+    const int learn = st->has_prev;
+    const icoac_real_t *w_act = cfg->actor.act_with_sample ? st->w_act : (learn ? w : st->w);
+    icoac_real_t z = ICOAC_R(0.0);
+    icoac_real_t noise;
+    int i;
+    checked[0] = ICOAC_R(0.0);
+    checked[4] = ICOAC_R(0.0);
+    if (!terminal) {
+        icoac_priv_critic_factors(&cfg->critic, s, factors);
+        /* fills the spare slot: the current one stays the eligibility of this update */
+        checked[0] = icoac_priv_critic_value(&cfg->critic, st->v, factors, &st->active[slot_prev ^ 1]);
+    }
+    if (learn) {
+        const icoac_real_t reward = terminal ? ICOAC_R(-1.0) : ICOAC_R(0.0);
+        icoac_real_t h[ICOAC_N_INPUTS];
+        icoac_real_t innovation;
+        checked[1] = clip_td(reward + cfg->critic.discount * checked[0] - st->value_prev, cfg->critic.td_clip);
+        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+            h[i] = cfg->policy.gain * st->x_prev[i];
+        }
+        /* u_ob - h^T mu_w, with u_ob = h^T w_act + alpha * delta * eps (Eq. 7-8). */
+        innovation = icoac_priv_dot4(h, st->w_act) - icoac_priv_dot4(h, st->w) +
+                     cfg->actor.scale * checked[1] * st->noise_prev;
+        icoac_priv_actor_update(&cfg->actor, st, h, innovation, w, cov);
+        checked[2] = ICOAC_PRIV_SQRT(icoac_priv_dot4(w, w));
+        checked[3] = icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov));
+        if (!off_diagonal_finite(ICOAC_PRIV_CONST_MAT4(cov))) {
+            return 0;
+        }
+    } else {
+        checked[1] = ICOAC_R(0.0);
+        checked[2] = st->weight_norm;
+        checked[3] = icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(st->cov));
+    }
+    if (!terminal) {
+        z = icoac_priv_dot4(w_act, scaled);
+        checked[4] = cfg->policy.gain * z;
+    }
+    if (!icoac_priv_all_finite(checked, 5)) {
+        return 0;
+    }
+    /* commit */
+    if (learn) {
+        icoac_priv_critic_update(st->v, &st->active[slot_prev], cfg->critic.rate * checked[1]);
+        icoac_priv_copy4(st->w, w);
+        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+            icoac_priv_copy4(st->cov[i], cov[i]);
+        }
+        st->weight_norm = checked[2];
+        if (!cfg->actor.act_with_sample) {
+            icoac_priv_copy4(st->w_act, w);
+        }
+        out->td_error = checked[1];
+    }
+    out->value = checked[0];
+    out->cov_trace = checked[3];
+    if (terminal) {
+        st->has_prev = 0;
+        return 1;
+    }
+    noise = cfg->actor.noise_std * icoac_rng_normal(&st->rng);
+    out->z = z;
+    out->noise = noise;
+    out->force = checked[4] + noise;
+    if (cfg->actor.reflex) {
+        out->force += icoac_priv_reflex_force(&cfg->policy, out->reflex);
+    }
+    st->active_slot = slot_prev ^ 1;
+    st->value_prev = checked[0];
+    st->noise_prev = noise;
+    icoac_priv_cache_tick(st, scaled);
+    return 1;
+}
+

@@ -1,0 +1,64 @@
+/* Private layout of icoac_state_t; tests and the library include it, callers do not. */
+#ifndef ICOAC_STATE_H
+#define ICOAC_STATE_H
+
+#include "icoac/icoac.h"
+
+/* The layout is read through a cast of the caller's storage: may_alias tells GCC and clang
+ * that it aliases icoac_state_t (other compilers do not exploit the aliasing rule across the
+ * library's translation units). */
+#if defined(__GNUC__)
+#define ICOAC_PRIV_MAY_ALIAS __attribute__((__may_alias__))
+#else
+#define ICOAC_PRIV_MAY_ALIAS
+#endif
+
+#define ICOAC_PRIV_STATE_MAGIC 0x1C0AC001u
+
+/* Critic units kept (b_k >= critic.threshold) at one state: the eligibility of the next TD
+ * update. Pair p keeps the units of its first pair_cells[p] cells, in the listed cell order. */
+typedef struct {
+    icoac_real_t pair_product[ICOAC_CRITIC_PAIRS];     /* g_x * g_xdot of each listed pair */
+    icoac_real_t cell_product[ICOAC_CRITIC_CELLS + 1]; /* g_theta * g_thetadot, largest first; 0 */
+    uint8_t pair[ICOAC_CRITIC_PAIRS];                  /* a*3 + b */
+    uint8_t pair_cells[ICOAC_CRITIC_PAIRS];            /* leading cells kept by each pair */
+    uint8_t cell[ICOAC_CRITIC_CELLS];                  /* c*3 + d */
+    uint8_t pairs;                                     /* pairs listed */
+    uint8_t cells;                                     /* cells listed */
+} icoac_priv_critic_active_t;
+
+/* Everything the controller owns. */
+typedef struct ICOAC_PRIV_MAY_ALIAS {
+    uint32_t magic;                                   /* set by icoac_init */
+    int32_t has_prev;                                 /* a previous tick of this trial is cached */
+    icoac_real_t inv_range[ICOAC_N_INPUTS];           /* 1 / policy.input_range, derived by icoac_init */
+    icoac_real_t w[ICOAC_N_INPUTS];                   /* ICO weights, or actor mean mu_w */
+    icoac_real_t weight_norm;                         /* |w|, refreshed when w changes */
+    icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* actor covariance Sigma_w */
+    icoac_real_t w_act[ICOAC_N_INPUTS];               /* weights used to act (mu_w or a sample) */
+    icoac_real_t v[ICOAC_CRITIC_UNITS];               /* critic weights */
+    icoac_priv_critic_active_t active[2];             /* kept critic units of s_t and of s */
+    int32_t active_slot;                              /* index of s_t's entry in active */
+    icoac_real_t x_prev[ICOAC_N_INPUTS];              /* scaled observation of the previous tick */
+    icoac_real_t penalty_prev;                        /* r of the previous ICO observation */
+    icoac_real_t value_prev;                          /* V(s_t) */
+    icoac_real_t noise_prev;                          /* exploration noise eps_t (N) */
+    icoac_rng_t rng;                                  /* exploration noise */
+    icoac_counters_t counters;
+} icoac_priv_state_t;
+
+ICOAC_STATIC_ASSERT(sizeof(icoac_priv_state_t) <= sizeof(icoac_state_t), state_fits_its_storage);
+ICOAC_STATIC_ASSERT(sizeof(icoac_state_t) == ICOAC_STATE_SIZE, state_size_as_documented);
+
+/* The layout of a caller's state. */
+static inline icoac_priv_state_t *icoac_priv_state(icoac_state_t *state)
+{
+    return (icoac_priv_state_t *)(void *)state;
+}
+
+static inline const icoac_priv_state_t *icoac_priv_state_c(const icoac_state_t *state)
+{
+    return (const icoac_priv_state_t *)(const void *)state;
+}
+
+#endif /* ICOAC_STATE_H */
