@@ -167,7 +167,9 @@ class BenchLog:
                 previous = json.loads(self.path.read_text())
             except ValueError:
                 previous = None
-        if previous and meta.get("resume"):
+        if not isinstance(previous, dict):
+            previous = None
+        if previous and meta.get("resume") and isinstance(previous.get("previous_runs", []), list):
             self.data["previous_runs"] = previous.get("previous_runs", []) + [
                 {"stages": previous.get("stages", []), "total_wall_time": previous.get("total_wall_time")}]
 

@@ -216,16 +216,26 @@ def fig1g_trajectory(cells: np.ndarray, cfg, duration: float = 30.0, seed: int =
     return traj, cell
 
 
+def check_duration(record: Mapping, duration: float) -> int:
+    """Plant steps of the Fig. 1g trajectory for a run record; ConfigError if the duration is not
+    finite and > 0 or needs more than grid.MAX_TRAJECTORY_STEPS steps at the record's dt."""
+    from .config import config_from_dict
+    from .grid import trajectory_steps
+    return trajectory_steps(duration, config_from_dict(record["config"]).plant.dt)
+
+
 def make_figures(cells: np.ndarray, record: Mapping, out: str | Path, *, label: str | None = None,
                  prefix: str = "fig1", duration: float = 30.0) -> list[Path]:
     """Fig. 1b, 1c-f and 1g of one ICO results set; returns the files written."""
     from .config import config_from_dict
+    from .grid import trajectory_steps
 
     out = Path(out)
     label = label or str(record.get("condition", "ICO")).upper()
+    cfg = config_from_dict(record["config"])
+    trajectory_steps(duration, cfg.plant.dt)  # a bad duration fails before any file is written
     written = [plot_success_map(cells, out / f"{prefix}b_success_map.png", label=label),
                plot_weight_maps(cells, out / f"{prefix}cf_weights.png", label=label)]
-    cfg = config_from_dict(record["config"])
     traj, cell = fig1g_trajectory(cells, cfg, duration=duration, seed=int(record.get("seed", 0)))
     if traj is not None:
         state = B.OUTCOME_NAMES.get(int(cell["outcome"]), "?")

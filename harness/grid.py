@@ -4,11 +4,12 @@ from __future__ import annotations
 import ctypes
 import math
 import os
+import re
 import sys
 import threading
 import time
 from dataclasses import dataclass
-from typing import Callable, Iterable, Optional, Sequence
+from typing import Callable, Iterable, Mapping, Optional, Sequence
 
 import numpy as np
 
@@ -16,39 +17,100 @@ from . import _binding as B
 from .config import RunConfig
 
 
+SEED_LIMIT = 2 ** 64          # seeds are uint64
+MAX_THREADS = 1024           # --threads: 0 (all cores) .. MAX_THREADS
+DEFAULT_CHECKPOINT_CELLS = 25  # checkpoint when this many cells finished since the last one ...
+DEFAULT_CHECKPOINT_EVERY = 2.0  # ... or when this many seconds passed with at least one finished
+MAX_TRAJECTORY_STEPS = 1_000_000  # icoac_sim_trajectory buffers: 40 bytes per step (40 MB)
+
+
+def _bad_arg(message: str) -> B.ConfigError:
+    return B.ConfigError(B.SIM_ERR_BAD_ARGUMENT, message)
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def check_seed(seed, what: str = "seed") -> int:
+    """A grid seed as an int in [0, 2^64) (uint64); anything else raises ConfigError."""
+    if not _is_int(seed) or not 0 <= int(seed) < SEED_LIMIT:
+        raise _bad_arg(f"{what} must be an integer in [0, 2^64), got {seed!r:.60}")
+    return int(seed)
+
+
+def check_threads(threads) -> int:
+    """Thread count for the C runner: 0 (all cores) .. MAX_THREADS."""
+    if not _is_int(threads) or not 0 <= int(threads) <= MAX_THREADS:
+        raise _bad_arg(f"threads must be an integer in [0, {MAX_THREADS}] (0: all cores), got {threads!r:.60}")
+    return int(threads)
+
+
 def paper_grid(seed: int = 0) -> np.ndarray:
     """The paper's 25 x 49 grid (row-major over theta0, then x0), every cell PENDING."""
+    seed = check_seed(seed)
     cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
-    B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, int(seed) & 0xFFFFFFFFFFFFFFFF), "paper grid")
+    B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, seed), "paper grid")
     return cells
 
 
+_INDEX = re.compile(r"[0-9]{1,18}")
+_RANGE = re.compile(r"([0-9]{1,18})\s*-\s*([0-9]{1,18})")
+
+
 def parse_cell_indices(text: str | Sequence[int] | None, n_cells: int = B.GRID_CELLS) -> Optional[list[int]]:
-    """'i,j,k' or 'a-b' ranges -> sorted unique indices in [0, n_cells); None means every cell."""
+    """'i,j,k' or 'a-b' ranges -> sorted unique indices in [0, n_cells); None means every cell.
+
+    Ranges are checked against n_cells before they are expanded; anything malformed raises ConfigError."""
     if text is None:
         return None
+    out: set[int] = set()
     if isinstance(text, str):
-        out: list[int] = []
         for part in text.split(","):
             part = part.strip()
             if not part:
                 continue
-            try:
-                if "-" in part[1:]:
-                    lo, hi = part.split("-", 1) if not part.startswith("-") else (None, None)
-                    out.extend(range(int(lo), int(hi) + 1))
-                else:
-                    out.append(int(part))
-            except (TypeError, ValueError):
-                raise B.ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"bad cell index {part!r}")
+            m = _RANGE.fullmatch(part)
+            if m:
+                lo, hi = int(m.group(1)), int(m.group(2))
+                if lo > hi:
+                    raise _bad_arg(f"bad cell range {part!r:.40}: start > end")
+                if hi >= n_cells:
+                    raise _bad_arg(f"cell index {hi} out of range [0, {n_cells})")
+                out.update(range(lo, hi + 1))
+            elif _INDEX.fullmatch(part):
+                i = int(part)
+                if i >= n_cells:
+                    raise _bad_arg(f"cell index {i} out of range [0, {n_cells})")
+                out.add(i)
+            else:
+                raise _bad_arg(f"bad cell index {part!r:.40}; expected i or a-b with 0 <= i < {n_cells}")
     else:
-        out = [int(i) for i in text]
+        if isinstance(text, (bytes, bytearray, Mapping)) or not isinstance(text, Iterable):
+            raise _bad_arg(f"cell indices must be a string or a sequence of integers, got {text!r:.60}")
+        for i in text:
+            if not _is_int(i):
+                raise _bad_arg(f"bad cell index {i!r:.40}; expected an integer")
+            if not 0 <= int(i) < n_cells:
+                raise _bad_arg(f"cell index {int(i)} out of range [0, {n_cells})")
+            out.add(int(i))
     if not out:
-        raise B.ConfigError(B.SIM_ERR_BAD_ARGUMENT, "empty cell list")
-    bad = [i for i in out if not 0 <= i < n_cells]
-    if bad:
-        raise B.ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"cell index {bad[0]} out of range [0, {n_cells})")
-    return sorted(set(out))
+        raise _bad_arg("empty cell list")
+    return sorted(out)
+
+
+def format_cell_indices(indices: Iterable[int]) -> str:
+    """Inverse of parse_cell_indices: sorted unique indices with runs as ranges, e.g. '0,5,600-610'."""
+    idx = sorted(set(int(i) for i in indices))
+    parts = []
+    k = 0
+    while k < len(idx):
+        j = k
+        while j + 1 < len(idx) and idx[j + 1] == idx[j] + 1:
+            j += 1
+        parts.append(str(idx[k]) if j == k else f"{idx[k]}-{idx[j]}")
+        k = j + 1
+    return ",".join(parts)
 
 
 def make_cells(seed: int = 0, indices: Iterable[int] | None = None) -> np.ndarray:
@@ -56,7 +118,9 @@ def make_cells(seed: int = 0, indices: Iterable[int] | None = None) -> np.ndarra
     cells = paper_grid(seed)
     if indices is None:
         return cells
-    return np.ascontiguousarray(cells[np.asarray(list(indices), dtype=np.intp)])
+    indices = list(indices)
+    parse_cell_indices(indices)  # integers in range, else ConfigError
+    return np.ascontiguousarray(cells[np.asarray(indices, dtype=np.intp)])
 
 
 def finished_snapshot(cells: np.ndarray) -> np.ndarray:
@@ -125,26 +189,40 @@ def default_threads() -> int:
 
 
 def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool = True,
-             checkpoint: Callable[[np.ndarray], None] | None = None, checkpoint_every: float = 30.0,
+             checkpoint: Callable[[np.ndarray], None] | None = None,
+             checkpoint_every: float = DEFAULT_CHECKPOINT_EVERY,
+             checkpoint_cells: int = DEFAULT_CHECKPOINT_CELLS,
              poll_interval: float = 0.2, cancel_after: float | None = None,
              cancel_event: threading.Event | None = None, desc: str = "grid") -> GridRun:
     """Run every PENDING cell of ``cells`` (modified in place) on ``threads`` C threads (0: all cores).
 
     The C call runs in a worker thread (ctypes releases the GIL); this thread polls the progress
-    counters. Ctrl-C (or ``cancel_event``, or ``cancel_after`` seconds) raises the C cancel flag and
-    waits for the worker: finished cells are kept, the others stay PENDING so a later call resumes
-    them. ``checkpoint(snapshot)`` is called every ``checkpoint_every`` seconds with the finished cells.
-    Errors other than cancellation raise IcoacError.
+    counters every ``poll_interval`` seconds. Ctrl-C (or ``cancel_event``, or ``cancel_after``
+    seconds) raises the C cancel flag and waits for the worker: finished cells are kept, the others
+    stay PENDING so a later call resumes them.
+
+    ``checkpoint(snapshot)`` is called with the finished cells at the first poll at which either
+    ``checkpoint_cells`` cells finished since the previous checkpoint, or ``checkpoint_every``
+    seconds passed since it and at least one cell finished. Unsaved work is therefore always fewer
+    than ``checkpoint_cells`` finished cells, none finished more than ``checkpoint_every +
+    poll_interval`` seconds ago (plus the cells in progress). An exception from ``checkpoint``
+    stops the C threads and is raised. Errors other than cancellation raise IcoacError.
     """
-    if cells.dtype != B.CELL_DTYPE or not cells.flags.c_contiguous or cells.ndim != 1:
-        raise B.ConfigError(B.SIM_ERR_BAD_ARGUMENT, "cells must be a 1-D contiguous CELL_DTYPE array")
-    if threads < 0:
-        raise B.ConfigError(B.SIM_ERR_BAD_ARGUMENT, "threads must be >= 0")
+    if not isinstance(cells, np.ndarray) or cells.dtype != B.CELL_DTYPE or not cells.flags.c_contiguous \
+            or cells.ndim != 1 or not cells.flags.writeable:
+        raise _bad_arg("cells must be a 1-D contiguous writeable CELL_DTYPE array")
+    threads = check_threads(threads)
+    if not (isinstance(checkpoint_every, (int, float)) and math.isfinite(checkpoint_every) and checkpoint_every > 0):
+        raise _bad_arg(f"checkpoint_every must be a finite number of seconds > 0, got {checkpoint_every!r}")
+    if not _is_int(checkpoint_cells) or checkpoint_cells < 1:
+        raise _bad_arg(f"checkpoint_cells must be an integer >= 1, got {checkpoint_cells!r}")
     cfg.check()
     pending = int(np.count_nonzero(cells["outcome"] == B.PENDING))
     t_start = time.monotonic()
     if pending == 0 or cells.size == 0:
         return GridRun(cells, False, 0.0, B.OK)
+    if not (np.all(np.isfinite(cells["x0"])) and np.all(np.isfinite(cells["theta0"]))):
+        raise _bad_arg("cells must have finite x0 and theta0")
     reset_pending(cells)
 
     cancel = np.zeros(1, dtype=np.int32)
@@ -160,10 +238,19 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
         except BaseException as exc:  # pragma: no cover - ctypes argument errors
             result["error"] = exc
 
+    def stop_worker() -> None:
+        cancel[0] = 1
+        while thread.is_alive():
+            try:
+                thread.join(0.5)
+            except KeyboardInterrupt:
+                pass
+
     bar = _Progress(cells.size, cells.size - pending, progress, desc)
     thread = threading.Thread(target=worker, name="icoac-grid", daemon=True)
     thread.start()
     last_checkpoint = time.monotonic()
+    saved_cells = 0  # value of the finished-cells counter at the last checkpoint
     user_cancelled = False
     try:
         while thread.is_alive():
@@ -174,19 +261,21 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
                 cancel[0] = 1
             if cancel_after is not None and now - t_start >= cancel_after and not cancel[0]:
                 cancel[0] = 1
-            if checkpoint is not None and now - last_checkpoint >= checkpoint_every and thread.is_alive():
+            finished = int(counters[B.PROGRESS_CELLS])
+            new = finished - saved_cells
+            if (checkpoint is not None and new > 0 and thread.is_alive()
+                    and (new >= checkpoint_cells or now - last_checkpoint >= checkpoint_every)):
                 checkpoint(finished_snapshot(cells))
-                last_checkpoint = now
+                saved_cells = finished
+                last_checkpoint = time.monotonic()
     except KeyboardInterrupt:
         user_cancelled = True
-        cancel[0] = 1
         if progress:
             print("\ninterrupted: stopping threads, keeping finished cells ...", file=sys.stderr)
-        while thread.is_alive():
-            try:
-                thread.join(0.5)
-            except KeyboardInterrupt:
-                pass
+        stop_worker()
+    except BaseException:
+        stop_worker()  # e.g. a checkpoint that could not be written: stop C before raising
+        raise
     finally:
         bar.update(counters)
         bar.close()
@@ -205,7 +294,7 @@ def run_cell(cfg: RunConfig, x0: float, theta0: float, seed: int = 0) -> np.ndar
     """One independent run of one cell (icoac_sim_run_cell); returns a 0-d CELL_DTYPE record."""
     cfg.check()
     cell = np.zeros(1, dtype=B.CELL_DTYPE)
-    cell["x0"], cell["theta0"], cell["seed"] = x0, theta0, seed
+    cell["x0"], cell["theta0"], cell["seed"] = x0, theta0, check_seed(seed)
     prior = ctypes.byref(cfg.prior) if cfg.prior is not None else None
     status = B.lib.icoac_sim_run_cell(ctypes.byref(cfg.controller), ctypes.byref(cfg.plant),
                                       ctypes.byref(cfg.run), prior, cell, None, None)
@@ -228,21 +317,34 @@ class Trajectory:
         return np.arange(self.states.shape[0]) * self.dt
 
 
+def trajectory_steps(duration: float, dt: float) -> int:
+    """Plant steps of a trajectory of ``duration`` seconds; ConfigError unless finite, at least one
+    step and at most MAX_TRAJECTORY_STEPS."""
+    if isinstance(duration, bool) or not isinstance(duration, (int, float, np.integer, np.floating)) \
+            or not math.isfinite(duration) or duration <= 0:
+        raise _bad_arg(f"trajectory duration must be a finite number of seconds > 0, got {duration!r:.40}")
+    steps = math.ceil(float(duration) / dt - 1e-9)
+    if steps < 1:
+        raise _bad_arg("trajectory duration must cover at least one step")
+    if steps > MAX_TRAJECTORY_STEPS:
+        raise _bad_arg(f"trajectory duration {float(duration):g} s needs {steps:.3g} steps at dt = {dt:g} s; "
+                       f"at most {MAX_TRAJECTORY_STEPS:.0e} are allowed ({MAX_TRAJECTORY_STEPS * dt:g} s)")
+    return int(steps)
+
+
 def trajectory(cfg: RunConfig, x0: float, theta0: float, duration: float = 30.0,
                seed: int = 0, init_velocity_noise: float | None = None) -> Trajectory:
     """One trial from (x0, theta0) with the controller initialised from cfg.prior (learning on),
     recorded for up to ``duration`` simulated seconds (icoac_sim_trajectory)."""
     cfg.check()
-    max_steps = int(math.ceil(duration / cfg.plant.dt - 1e-9))
-    if max_steps < 1:
-        raise B.ConfigError(B.SIM_ERR_BAD_ARGUMENT, "trajectory duration must cover at least one step")
+    max_steps = trajectory_steps(duration, cfg.plant.dt)
     noise = cfg.run.init_velocity_noise if init_velocity_noise is None else float(init_velocity_noise)
     states = np.zeros((max_steps + 1) * B.N_INPUTS)
     forces = np.zeros(max_steps)
     n = ctypes.c_int64(0)
     prior = ctypes.byref(cfg.prior) if cfg.prior is not None else None
     status = B.lib.icoac_sim_trajectory(ctypes.byref(cfg.controller), ctypes.byref(cfg.plant), prior,
-                                        float(x0), float(theta0), noise, int(seed), max_steps,
+                                        float(x0), float(theta0), noise, check_seed(seed), max_steps,
                                         states, forces, ctypes.byref(n))
     B.check_status(status, "trajectory")
     k = int(n.value)

@@ -57,6 +57,18 @@ def to_grid(cells: np.ndarray, values: np.ndarray, fill: float = np.nan) -> np.n
     return out
 
 
+# Short names of the statuses an ERROR cell can carry (icoac_status_t / icoac_sim_status_t).
+STATUS_NAMES = {B.ERR_NULL: "null", B.ERR_NOT_INITIALISED: "not initialised",
+                B.ERR_NONFINITE_INPUT: "non-finite input", B.ERR_NUMERIC: "numeric"}
+
+
+def error_statuses(cells: np.ndarray) -> dict[str, int]:
+    """{status code (as a string, for JSON): number of ERROR cells with that status}."""
+    status = cells["status"][cells["outcome"] == B.ERROR]
+    codes, counts = np.unique(status, return_counts=True)
+    return {str(int(c)): int(n) for c, n in zip(codes, counts)}
+
+
 def _rate(num: int, den: int) -> float:
     return float(num) / den if den else float("nan")
 
@@ -83,6 +95,8 @@ def summary(cells: np.ndarray) -> dict[str, Any]:
         "mean_elapsed_time_success": float(np.mean(elapsed)) if elapsed.size else None,
         "total_elapsed_time": float(np.sum(cells["elapsed_time"])),
         "total_trials": int(np.sum(cells["trials"])),
+        # ERROR cells (e.g. status 4, ICOAC_ERR_NUMERIC) are neither successes nor failures.
+        "error_statuses": error_statuses(cells),
     }
     if trials.size:
         w = cells["weights"][ok]
@@ -111,5 +125,8 @@ def format_summary(name: str, s: dict[str, Any]) -> str:
     if s["outcomes"].get("pending"):
         lines.append(f"  {s['outcomes']['pending']} cells still PENDING")
     if s["outcomes"].get("error"):
-        lines.append(f"  {s['outcomes']['error']} cells reported a controller ERROR")
+        by = s.get("error_statuses") or {}
+        detail = ", ".join(f"{STATUS_NAMES.get(int(k), 'status ' + k)} ({k}): {n}" for k, n in by.items())
+        lines.append(f"  {s['outcomes']['error']} cells reported a controller ERROR, counted neither as "
+                     f"success nor as failure" + (f" [{detail}]" if detail else ""))
     return "\n".join(lines)

@@ -3,8 +3,11 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import math
 import os
 import subprocess
+import tempfile
+import zipfile
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -19,8 +22,17 @@ RUN_FILE = "run.json"
 FORMAT_VERSION = 1
 
 
+CONDITIONS = ("ico", "rl", "ico-rl")
+MAX_JSON_BYTES = 16 * 2 ** 20   # run.json is a few KiB; refuse anything absurd before parsing
+_X_TOL = 1e-6                   # m, rad: a cell coordinate must be this close to a paper-grid point
+
+
 class ResultsError(B.ConfigError):
     """Missing, unreadable or mismatching results directory."""
+
+
+def _err(message: str) -> ResultsError:
+    return ResultsError(B.SIM_ERR_BAD_ARGUMENT, message)
 
 
 def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
@@ -39,15 +51,46 @@ def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
 
 
 def _atomic_write(path: Path, write) -> None:
+    """write(tmp) then rename over path: a reader (or a kill) sees the old file or the new one."""
     tmp = path.with_name(path.name + ".tmp")
-    write(tmp)
-    os.replace(tmp, path)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            tmp.unlink()
+        except OSError:
+            pass
+        raise
+
+
+def check_writable(out: str | Path, what: str = "--out") -> Path:
+    """Create the directory ``out`` if needed and prove it is writable by creating (and removing) a
+    temporary file in it; any failure is a ResultsError. Permission bits alone are not enough:
+    they do not apply to root, and a read-only mount or a path under a regular file must fail too."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise _err(f"{what} {str(out)!r} exists and is not a directory")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise _err(f"{what}: cannot create directory {str(out)!r}: {exc.strerror or exc}") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise _err(f"{what}: directory {str(out)!r} is not writable")
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".icoac-write-test-", dir=out)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise _err(f"{what}: directory {str(out)!r} is not writable: {exc.strerror or exc}") from None
+    return out
 
 
 def save(out: str | Path, cells: np.ndarray, cfg: RunConfig, *, condition: str, seed: int,
          wall_time: float, threads: int, cell_indices: list[int] | None = None,
-         extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """Write cells.npz and run.json (atomically, so a checkpoint never leaves half a file)."""
+         extra: Mapping[str, Any] | None = None, git: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """Write cells.npz and run.json (atomically, so a checkpoint never leaves half a file).
+    ``git`` is git_info() computed once by the caller (a checkpoint then costs ~1 ms)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     summ = metrics.summary(cells)
@@ -58,7 +101,7 @@ def save(out: str | Path, cells: np.ndarray, cfg: RunConfig, *, condition: str, 
         "cells": cell_indices,
         "complete": bool(np.all(cells["outcome"] != B.PENDING)),
         "config": cfg.to_dict(),
-        "git": git_info(),
+        "git": dict(git) if git is not None else git_info(),
         "abi": B.abi_info(),
         "timestamp": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "wall_time": float(wall_time),
@@ -82,24 +125,194 @@ def exists(path: str | Path) -> bool:
     return (path / RUN_FILE).is_file() and (path / CELLS_FILE).is_file()
 
 
-def load(path: str | Path) -> tuple[np.ndarray, dict[str, Any]]:
-    """(cells, run record) of a results directory."""
+def present(path: str | Path) -> list[str]:
+    """Which of the two results files are in path (a partial directory has exactly one)."""
     path = Path(path)
-    if not path.is_dir():
-        raise ResultsError(B.SIM_ERR_BAD_ARGUMENT, f"results directory {str(path)!r} does not exist")
-    if not exists(path):
-        raise ResultsError(B.SIM_ERR_BAD_ARGUMENT,
-                           f"{str(path)!r} is not a results directory (needs {CELLS_FILE} and {RUN_FILE})")
+    return [name for name in (CELLS_FILE, RUN_FILE) if (path / name).is_file()]
+
+
+def read_cells(file: str | Path) -> np.ndarray:
+    """The cell array of a cells.npz, read without trusting it: one member ``cells.npy`` whose
+    header says a 1-D CELL_DTYPE array of at most GRID_CELLS cells and whose size matches.
+    Anything else (truncated, empty, not a zip, other dtype or shape) raises ResultsError."""
+    file = Path(file)
+    where = repr(str(file))
     try:
-        record = json.loads((path / RUN_FILE).read_text())
-        with np.load(path / CELLS_FILE, allow_pickle=False) as data:
-            cells = np.ascontiguousarray(data["cells"])
-    except (OSError, ValueError, KeyError) as exc:
-        raise ResultsError(B.SIM_ERR_BAD_ARGUMENT, f"cannot read results in {str(path)!r}: {exc}")
-    if cells.dtype != B.CELL_DTYPE:
-        raise ResultsError(B.SIM_ERR_BAD_ARGUMENT,
-                           f"{str(path / CELLS_FILE)!r} has a different cell layout than this library")
+        with zipfile.ZipFile(file) as zf:
+            names = zf.namelist()
+            if names != ["cells.npy"]:
+                raise _err(f"{where} is not a cells file (members {names[:4]!r:.80}, expected ['cells.npy'])")
+            info = zf.getinfo("cells.npy")
+            with zf.open(info) as fh:
+                version = np.lib.format.read_magic(fh)
+                if version == (1, 0):
+                    shape, fortran, dtype = np.lib.format.read_array_header_1_0(fh)
+                elif version == (2, 0):
+                    shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
+                else:
+                    raise _err(f"{where}: unsupported .npy version {version}")
+                if dtype != B.CELL_DTYPE:
+                    raise _err(f"{where} has a different cell layout than this library "
+                               f"({_dtype_difference(dtype)}); it was written by another version")
+                if len(shape) != 1 or not 1 <= shape[0] <= B.GRID_CELLS:
+                    raise _err(f"{where}: expected 1 to {B.GRID_CELLS} cells, got shape {shape}")
+                nbytes = shape[0] * B.CELL_DTYPE.itemsize
+                if info.file_size != fh.tell() + nbytes:
+                    raise _err(f"{where}: size {info.file_size} does not match its header ({shape[0]} cells)")
+                data = fh.read(nbytes + 1)
+            if len(data) != nbytes:
+                raise _err(f"{where} is truncated")
+    except ResultsError:
+        raise
+    except zipfile.BadZipFile as exc:
+        raise _err(f"{where} is not a valid cells file (truncated or corrupt: {exc})") from None
+    except OSError as exc:
+        raise _err(f"cannot read {where}: {exc.strerror or exc}") from None
+    except Exception as exc:  # any other decoding failure of untrusted bytes: zlib, EOF, header syntax
+        raise _err(f"{where} is not a valid cells file ({type(exc).__name__}: {str(exc):.100})") from None
+    return np.frombuffer(data, dtype=B.CELL_DTYPE).copy()
+
+
+def _dtype_difference(dtype: np.dtype) -> str:
+    """First difference between a stored dtype and CELL_DTYPE, in words."""
+    want = B.CELL_DTYPE
+    if dtype.names is None:
+        return f"plain {dtype.str} array, not cell records"
+    if dtype.names != want.names:
+        extra = [n for n in dtype.names if n not in want.names]
+        missing = [n for n in want.names if n not in dtype.names]
+        if extra or missing:
+            return (f"fields {', '.join(missing)} missing" if missing else "") + \
+                   ("; " if extra and missing else "") + (f"unknown fields {', '.join(extra)}" if extra else "")
+        return "fields in another order"
+    for name in want.names:
+        if dtype.fields[name][0] != want.fields[name][0]:
+            return f"field {name} is {dtype.fields[name][0]}, expected {want.fields[name][0]}"
+        if dtype.fields[name][1] != want.fields[name][1]:
+            return f"field {name} at offset {dtype.fields[name][1]}, expected {want.fields[name][1]}"
+    return f"record size {dtype.itemsize}, expected {want.itemsize}"
+
+
+def check_cells(cells: np.ndarray, where: str = "cells") -> None:
+    """Structural checks of a cell array: known outcomes, finite coordinates on the paper grid."""
+    bad = ~np.isin(cells["outcome"], list(B.OUTCOME_NAMES))
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise _err(f"{where}: cell {i} has unknown outcome {int(cells['outcome'][i])} "
+                   f"(valid: {', '.join(f'{k} {v}' for k, v in B.OUTCOME_NAMES.items())})")
+    with np.errstate(all="ignore"):  # absurd values are found below, not warned about
+        x0, th0 = cells["x0"], np.degrees(cells["theta0"])
+        finite = np.isfinite(x0) & np.isfinite(th0)
+        col = np.where(finite, np.rint((x0 - metrics.X_MIN) / metrics.X_STEP), -1)
+        row = np.where(finite, np.rint(th0 - metrics.THETA_MIN_DEG), -1)
+        on_grid = (finite & (col >= 0) & (col < B.GRID_XS) & (row >= 0) & (row < B.GRID_THETAS)
+                   & (np.abs(x0 - (metrics.X_MIN + col * metrics.X_STEP)) <= _X_TOL)
+                   & (np.abs(np.radians(th0) - np.radians(metrics.THETA_MIN_DEG + row * metrics.THETA_STEP_DEG))
+                      <= _X_TOL))
+    if not on_grid.all():
+        i = int(np.flatnonzero(~on_grid)[0])
+        raise _err(f"{where}: cell {i} has x0 = {float(x0[i])!r}, theta0 = {float(cells['theta0'][i])!r}, "
+                   "not a point of the paper grid")
+
+
+def _is_int(v: Any) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def check_record(record: Any, where: str = RUN_FILE) -> dict[str, Any]:
+    """Shape of a run record (a run.json): required keys with the right types, a configuration the
+    C library accepts. Returns the record; raises ResultsError naming the first problem."""
+    if not isinstance(record, dict):
+        raise _err(f"{where}: expected a JSON object, got {type(record).__name__}")
+    missing = [k for k in ("condition", "seed", "cells", "config") if k not in record]
+    if missing:
+        raise _err(f"{where}: missing key(s) {', '.join(missing)}")
+    version = record.get("format_version", FORMAT_VERSION)
+    if version != FORMAT_VERSION:
+        raise _err(f"{where}: format_version {version!r:.40} is not {FORMAT_VERSION}")
+    if record["condition"] not in CONDITIONS:
+        raise _err(f"{where}: condition {record['condition']!r:.40} is not one of {', '.join(CONDITIONS)}")
+    seed = record["seed"]
+    if not _is_int(seed) or not 0 <= seed < 2 ** 64:
+        raise _err(f"{where}: seed {seed!r:.40} is not an integer in [0, 2^64)")
+    cells = record["cells"]
+    if cells is not None:
+        from .grid import parse_cell_indices
+        if not isinstance(cells, list):
+            raise _err(f"{where}: cells must be null or a list of cell indices")
+        try:
+            parsed = parse_cell_indices(cells)
+        except B.ConfigError as exc:
+            raise _err(f"{where}: cells: {exc}") from None
+        if parsed != cells:
+            raise _err(f"{where}: cells must be sorted and unique")
+    for key, kinds in (("git", (dict, type(None))), ("abi", (dict, type(None))), ("summary", dict),
+                       ("prior_info", (dict, type(None))), ("complete", bool), ("timestamp", str)):
+        if key in record and not isinstance(record[key], kinds):
+            raise _err(f"{where}: {key} has the wrong type ({type(record[key]).__name__})")
+    for key in ("wall_time", "threads"):
+        v = record.get(key, 0)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or v < 0 \
+                or (isinstance(v, float) and not math.isfinite(v)):
+            raise _err(f"{where}: {key} {v!r:.40} is not a number >= 0")
+    if not isinstance(record["config"], dict):
+        raise _err(f"{where}: config must be an object, got {type(record['config']).__name__}")
+    try:
+        config_from_dict(record["config"])
+    except B.ConfigError as exc:
+        raise _err(f"{where}: config: {exc}") from None
+    return record
+
+
+def read_record(file: str | Path) -> dict[str, Any]:
+    """A run.json, parsed and checked (check_record)."""
+    file = Path(file)
+    where = repr(str(file))
+    try:
+        if file.stat().st_size > MAX_JSON_BYTES:
+            raise _err(f"{where} is larger than {MAX_JSON_BYTES} bytes; not a run record")
+        record = json.loads(file.read_bytes())
+    except ResultsError:
+        raise
+    except OSError as exc:
+        raise _err(f"cannot read {where}: {exc.strerror or exc}") from None
+    except (ValueError, RecursionError) as exc:  # JSONDecodeError, UnicodeDecodeError, nesting
+        raise _err(f"{where} is not valid JSON ({str(exc):.100})") from None
+    return check_record(record, where)
+
+
+def load(path: str | Path) -> tuple[np.ndarray, dict[str, Any]]:
+    """(cells, run record) of a results directory, both validated (read_cells, check_cells,
+    read_record); every failure is a ResultsError."""
+    path = Path(path)
+    if not path.exists():
+        raise _err(f"results directory {str(path)!r} does not exist")
+    if not path.is_dir():
+        raise _err(f"results directory {str(path)!r} does not exist (it is not a directory)")
+    have = present(path)
+    if len(have) != 2:
+        detail = f"; it holds only {have[0]}" if have else ""
+        raise _err(f"{str(path)!r} is not a results directory (needs {CELLS_FILE} and {RUN_FILE}{detail})")
+    record = read_record(path / RUN_FILE)
+    cells = read_cells(path / CELLS_FILE)
+    check_cells(cells, repr(str(path / CELLS_FILE)))
     return cells, record
+
+
+def check_cells_match(cells: np.ndarray, record: Mapping[str, Any], where: str = CELLS_FILE) -> None:
+    """The cells of a results directory are exactly those its record describes: the number of cells
+    and every (x0, theta0, seed) equal make_cells(record seed, record cells), bitwise."""
+    from .grid import make_cells
+    expected = make_cells(record["seed"], record["cells"])
+    if cells.size != expected.size:
+        raise _err(f"{where} holds {cells.size} cells but run.json describes {expected.size} "
+                   "(cell selection and seed); the two files do not belong together")
+    for name in ("x0", "theta0", "seed"):
+        diff = cells[name] != expected[name]
+        if diff.any():
+            i = int(np.flatnonzero(diff)[0])
+            raise _err(f"{where}: cell {i} has {name} {cells[name][i].item()!r} but run.json's cell selection and "
+                       f"seed give {expected[name][i].item()!r}; the two files do not belong together")
 
 
 def load_config(record: Mapping[str, Any]) -> RunConfig:

@@ -48,6 +48,9 @@ def parse_params(items: list[str]) -> dict[str, list[Any]]:
             raise _err(f"--param {name}: no values")
         if name == "prior_frame" and any(v not in ("central", "all") for v in vals):
             raise _err("--param prior_frame: values must be central or all")
+        if name == "prior_ridge" and any(isinstance(v, bool) or not isinstance(v, (int, float))
+                                         or not math.isfinite(v) or v < 0 for v in vals):
+            raise _err("--param prior_ridge: values must be finite numbers >= 0")
         if name in out:
             raise _err(f"--param {name} given twice")
         out[name] = vals
@@ -126,9 +129,9 @@ def run_sweep(args) -> int:
     try:
         seeds = [int(s) for s in args.seeds.split(",") if s.strip()]
     except ValueError:
-        raise UsageError(f"--seeds expects comma-separated integers, got {args.seeds!r}")
-    if not seeds or any(s < 0 for s in seeds):
-        raise UsageError(f"--seeds expects integers >= 0, got {args.seeds!r}")
+        raise UsageError(f"--seeds expects comma-separated integers, got {args.seeds!r:.60}")
+    if not seeds or any(not 0 <= s < grid.SEED_LIMIT for s in seeds):
+        raise UsageError(f"--seeds expects integers in [0, 2^64), got {args.seeds!r:.60}")
     if args.cells is not None:
         indices = grid.parse_cell_indices(args.cells)
     elif args.subset is not None:
@@ -152,19 +155,27 @@ def run_sweep(args) -> int:
     if args.success_steps is not None:
         fixed["success_steps"] = args.success_steps
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     meta = {"condition": args.condition, "prior_from": str(ico_dir.resolve()), "cells": indices,
             "n_cells": len(indices), "seeds": seeds, "max_trials": args.max_trials,
             "success_steps": args.success_steps, "set": args.set or [], "rl_cov": args.rl_cov}
     meta_path = out / "sweep.json"
     csv_path = out / "sweep.csv"
     if meta_path.is_file() and csv_path.is_file():
-        old = json.loads(meta_path.read_text())
+        try:
+            old = json.loads(meta_path.read_bytes())
+        except (OSError, ValueError, RecursionError) as exc:
+            raise UsageError(f"cannot read {str(meta_path)!r}: {exc}; use another --out")
+        if not isinstance(old, dict):
+            raise UsageError(f"{str(meta_path)!r} is not a sweep record; use another --out")
         diff = [k for k in meta if old.get(k) != meta[k]]
         if diff:
             raise UsageError(f"{str(out)!r} holds a sweep with other {', '.join(diff)}; use another --out")
-    meta_path.write_text(json.dumps(meta, indent=2) + "\n")
-    rows = _read_rows(csv_path)
+    try:
+        rows = _read_rows(csv_path)
+    except (OSError, ValueError, csv.Error) as exc:
+        raise UsageError(f"cannot read {str(csv_path)!r}: {exc}; use another --out")
+    if any(not isinstance(r.get("key"), str) for r in rows):
+        raise UsageError(f"{str(csv_path)!r} is not a sweep table (no key column); use another --out")
     done = {r["key"] for r in rows}
 
     def prior_for(setting):
@@ -176,10 +187,12 @@ def run_sweep(args) -> int:
         info = priors[k]
         return info if args.condition == "ico-rl" else P.rl_prior(info, args.rl_cov)
 
-    for setting in todo:  # every setting valid before the first grid runs
+    for setting in todo:  # every setting valid before the first grid runs (and before any write)
         over = dict(fixed)
         over.update({k: v for k, v in setting.items() if k not in PRIOR_PARAMS})
         build_config(over, condition=args.condition, prior=prior_for(setting).prior())
+    results.check_writable(out)
+    meta_path.write_text(json.dumps(meta, indent=2) + "\n")
 
     t_all = time.monotonic()
     for i, setting in enumerate(todo, 1):

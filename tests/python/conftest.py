@@ -3,8 +3,17 @@ import os
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, settings
 
 REPO = Path(__file__).resolve().parents[2]
+
+# Property tests: a few dozen examples each, reproducible (derandomized), no example database
+# written into the working tree. HYPOTHESIS_PROFILE=explore runs more, random examples.
+settings.register_profile("icoac", max_examples=60, deadline=None, database=None, derandomize=True,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("explore", max_examples=1000, deadline=None, database=None,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "icoac"))
 
 
 def pytest_configure(config):

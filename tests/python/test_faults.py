@@ -1,0 +1,448 @@
+"""Every harness fault is one line `icoac-harness: error: ...` on stderr, exit status 2, and nothing
+on disk is rewritten (issue 8). The CLI runs in-process through harness.cli.main."""
+import errno
+import json
+import shutil
+import tempfile
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from harness import _binding as B
+from harness import cli, grid, metrics, results
+from harness.config import build_config
+
+CELLS = [610, 611, 612, 613]
+SEED = 3
+TINY = {"max_trials": 50, "success_steps": 200}
+TINY_ARGS = ["--max-trials", "50", "--success-steps", "200", "--quiet"]
+
+
+def main(capsys, *args):
+    rc = cli.main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def assert_one_line_error(rc, err, *words):
+    assert rc == 2, err
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("icoac-harness: error: "), err
+    for w in words:
+        assert w in lines[0], lines[0]
+    return lines[0]
+
+
+def snapshot(root: Path) -> dict:
+    """Every file under root with its bytes and modification time (a rewrite with equal bytes counts)."""
+    if not root.exists():
+        return {}
+    return {str(p.relative_to(root)): (p.read_bytes(), p.stat().st_mtime_ns) if p.is_file() else None
+            for p in sorted(root.rglob("*"))}
+
+
+@pytest.fixture(scope="module")
+def partial_dir(tmp_path_factory):
+    """A 4-cell results directory, two cells finished and two PENDING (a resume would run them)."""
+    out = tmp_path_factory.mktemp("partial") / "res"
+    cfg = build_config(TINY)
+    cells = grid.make_cells(SEED, CELLS)
+    grid.run_grid(cfg, cells, threads=2, progress=False)
+    grid.reset_pending(cells, np.arange(cells.size) >= 2)
+    results.save(out, cells, cfg, condition="ico", seed=SEED, wall_time=0.5, threads=2, cell_indices=CELLS)
+    return out
+
+
+@pytest.fixture
+def res(partial_dir, tmp_path):
+    d = tmp_path / "res"
+    shutil.copytree(partial_dir, d)
+    return d
+
+
+def load_cells(d):
+    with np.load(d / "cells.npz") as z:
+        return z["cells"]
+
+
+def save_cells(d, cells):
+    np.savez(d / "cells.npz", cells=cells)
+
+
+def edit_record(d, fn):
+    rec = json.loads((d / "run.json").read_text())
+    rec = fn(rec)
+    (d / "run.json").write_text(json.dumps(rec))
+
+
+def _set(path, value):
+    def fn(rec):
+        node = rec
+        for k in path[:-1]:
+            node = node[k]
+        node[path[-1]] = value
+        return rec
+    return fn
+
+
+def _del(key):
+    def fn(rec):
+        del rec[key]
+        return rec
+    return fn
+
+
+def _cells_edit(fn):
+    def apply(d):
+        c = load_cells(d)
+        c = fn(c)
+        save_cells(d, c)
+    return apply
+
+
+def _x0_nan(c):
+    c["x0"][1] = np.nan
+    return c
+
+
+def _outcome(c):
+    c["outcome"][0] = 7
+    return c
+
+
+def _other_dtype(c):
+    d = [(n, c.dtype[n]) for n in c.dtype.names]
+    d[3] = ("outcome", "<i8")
+    return c.astype(d)
+
+
+CORRUPTIONS = {
+    "truncated cells.npz": (lambda d: (d / "cells.npz").write_bytes((d / "cells.npz").read_bytes()[:700]),
+                            ["cells.npz", "not a valid cells file"]),
+    "empty cells.npz": (lambda d: (d / "cells.npz").write_bytes(b""), ["cells.npz", "not a valid cells file"]),
+    "cut inside the data": (lambda d: (d / "cells.npz").write_bytes((d / "cells.npz").read_bytes()[:-30]),
+                            ["cells.npz"]),
+    "cells.npz not a zip": (lambda d: (d / "cells.npz").write_bytes(b"\x93NUMPY garbage"), ["cells.npz"]),
+    "run.json [1,2]": (lambda d: (d / "run.json").write_text("[1, 2]"), ["run.json", "expected a JSON object"]),
+    "run.json {}": (lambda d: (d / "run.json").write_text("{}"), ["run.json", "missing key"]),
+    "run.json not JSON": (lambda d: (d / "run.json").write_text('{"seed": '), ["run.json", "not valid JSON"]),
+    "run.json config 5": (lambda d: edit_record(d, _set(["config"], 5)), ["config must be an object"]),
+    "run.json controller 5": (lambda d: edit_record(d, _set(["config", "controller"], 5)), ["controller"]),
+    "run.json no seed": (lambda d: edit_record(d, _del("seed")), ["missing key(s) seed"]),
+    "run.json no config": (lambda d: edit_record(d, _del("config")), ["missing key(s) config"]),
+    "run.json seed 2^64": (lambda d: edit_record(d, _set(["seed"], 2 ** 64)), ["seed"]),
+    "run.json seed string": (lambda d: edit_record(d, _set(["seed"], "3")), ["seed"]),
+    "run.json cells out of range": (lambda d: edit_record(d, _set(["cells"], [5000])), ["cells", "5000"]),
+    "run.json bad condition": (lambda d: edit_record(d, _set(["condition"], "pid")), ["condition"]),
+    "run.json gain -1": (lambda d: edit_record(d, _set(["config", "controller", "gain"], -1)), ["gain"]),
+    "run.json dt NaN": (lambda d: edit_record(d, _set(["config", "plant", "dt"], float("nan"))), ["dt"]),
+    "run.json wall_time string": (lambda d: edit_record(d, _set(["wall_time"], "x")), ["wall_time"]),
+    "NaN cell coordinate": (_cells_edit(_x0_nan), ["cell 1", "x0 = nan"]),
+    "unknown outcome": (_cells_edit(_outcome), ["unknown outcome 7"]),
+    "other dtype": (_cells_edit(_other_dtype), ["different cell layout"]),
+}
+
+
+@pytest.mark.parametrize("name", list(CORRUPTIONS))
+def test_resume_of_corrupt_results_refused_nothing_written(capsys, res, name):
+    corrupt, words = CORRUPTIONS[name]
+    corrupt(res)
+    before = snapshot(res)
+    rc, _, err = main(capsys, "grid", "--out", res, "--resume", "--quiet")
+    assert_one_line_error(rc, err, *words)
+    assert snapshot(res) == before
+    # The same directory given with explicit (matching) settings, as a plain `grid`, fails alike.
+    rc, _, err = main(capsys, "grid", "--out", res, "--cells", "610-613", "--seed", SEED, *TINY_ARGS)
+    assert_one_line_error(rc, err)
+    assert snapshot(res) == before
+
+
+@pytest.mark.parametrize("name", list(CORRUPTIONS))
+def test_figures_of_corrupt_results_refused(capsys, res, tmp_path, name):
+    corrupt, words = CORRUPTIONS[name]
+    corrupt(res)
+    rc, _, err = main(capsys, "figures", "--results", res, "--out", tmp_path / "fig")
+    assert_one_line_error(rc, err, *words)
+    assert not (tmp_path / "fig").exists()
+
+
+@pytest.mark.parametrize("make, words", [
+    (lambda: grid.make_cells(SEED, range(10)), ["holds 10 cells", "describes 4"]),
+    (lambda: grid.make_cells(SEED), ["holds 1225 cells"]),
+    (lambda: grid.make_cells(SEED, [0, 1, 2, 3]), ["cell 0 has x0"]),
+    (lambda: grid.make_cells(SEED + 1, CELLS), ["cell 0 has seed"]),
+])
+def test_resume_checks_number_and_coordinates_of_cells(capsys, res, make, words):
+    save_cells(res, make())
+    before = snapshot(res)
+    rc, _, err = main(capsys, "grid", "--out", res, "--resume", "--quiet")
+    assert_one_line_error(rc, err, *words, "do not belong together")
+    assert snapshot(res) == before
+
+
+def test_resume_with_other_settings_writes_nothing(capsys, res):
+    before = snapshot(res)
+    rc, _, err = main(capsys, "grid", "--out", res, "--cells", "610-613", "--seed", SEED, "--set", "gain=5",
+                      *TINY_ARGS)
+    assert_one_line_error(rc, err, "does not match", "gain")
+    assert snapshot(res) == before
+
+
+def test_c_failure_during_resume_leaves_files_intact(capsys, res, monkeypatch):
+    calls = []
+
+    def failing_run_grid(*args):
+        calls.append(args)
+        return B.SIM_ERR_THREAD
+
+    monkeypatch.setattr(B.lib, "icoac_sim_run_grid", failing_run_grid)
+    before = snapshot(res)
+    rc, _, err = main(capsys, "grid", "--out", res, "--resume", "--quiet")
+    assert calls, "the C runner was not reached"
+    assert_one_line_error(rc, err, B.status_str(B.SIM_ERR_THREAD))
+    assert snapshot(res) == before
+
+
+def test_resume_then_succeeds_and_keeps_finished_cells(capsys, res):
+    old = load_cells(res)
+    rc, _, err = main(capsys, "grid", "--out", res, "--resume", "--quiet")
+    assert rc == 0, err
+    new = load_cells(res)
+    assert np.all(new["outcome"] != B.PENDING)
+    assert new[:2].tobytes() == old[:2].tobytes()
+    ref = grid.make_cells(SEED, CELLS)
+    grid.run_grid(build_config(TINY), ref, threads=1, progress=False)
+    assert new.tobytes() == ref.tobytes()
+
+
+# -- one of the two files missing ----------------------------------------------------------------------
+@pytest.mark.parametrize("keep", ["cells.npz", "run.json"])
+def test_lone_results_file_is_not_replaced(capsys, res, keep):
+    (res / ({"cells.npz", "run.json"} - {keep}).pop()).unlink()
+    before = snapshot(res)
+    rc, _, err = main(capsys, "grid", "--out", res, "--cells", "610-613", "--seed", SEED, *TINY_ARGS)
+    assert_one_line_error(rc, err, keep, "--overwrite")
+    assert snapshot(res) == before
+    rc, _, err = main(capsys, "grid", "--out", res, "--resume", "--quiet")
+    assert_one_line_error(rc, err, keep)
+    assert snapshot(res) == before
+    # told to start over: a complete new result
+    rc, _, err = main(capsys, "grid", "--out", res, "--cells", "611", "--seed", 9, "--overwrite", *TINY_ARGS)
+    assert rc == 0, err
+    cells, record = results.load(res)
+    assert record["cells"] == [611] and record["seed"] == 9 and record["complete"]
+    assert cells.size == 1
+
+
+def test_overwrite_replaces_complete_results_after_checks(capsys, res):
+    before = snapshot(res)
+    rc, _, err = main(capsys, "grid", "--out", res, "--overwrite", "--set", "gain=-1", *TINY_ARGS)
+    assert_one_line_error(rc, err, "gain")
+    assert snapshot(res) == before  # a bad configuration deletes nothing
+    rc, _, err = main(capsys, "grid", "--out", res, "--cells", "612", "--overwrite", *TINY_ARGS)
+    assert rc == 0, err
+    assert results.load(res)[1]["cells"] == [612]
+
+
+def test_overwrite_and_resume_exclude_each_other(capsys, res):
+    before = snapshot(res)
+    rc, _, err = main(capsys, "grid", "--out", res, "--resume", "--overwrite")
+    assert_one_line_error(rc, err, "--overwrite", "--resume")
+    assert snapshot(res) == before
+
+
+# -- bad numbers on the command line --------------------------------------------------------------------
+BAD_GRID_ARGS = [
+    (["--max-trials", "inf"], "--max-trials"),
+    (["--max-trials", "nan"], "--max-trials"),
+    (["--max-trials", "1e30"], "--max-trials"),
+    (["--max-trials", "9223372036854775808"], "--max-trials"),
+    (["--max-trials", "1.5"], "--max-trials"),
+    (["--success-steps", "inf"], "--success-steps"),
+    (["--success-steps", "-1"], "--success-steps"),
+    (["--seed", "18446744073709551616"], "--seed"),
+    (["--seed", "-1"], "--seed"),
+    (["--seed", "1e400"], "--seed"),
+    (["--threads", "4294967296"], "--threads"),
+    (["--threads", "2000"], "--threads"),
+    (["--threads", "-1"], "--threads"),
+    (["--cells", "5-3"], "start > end"),
+    (["--cells", "-5"], "bad cell index"),
+    (["--cells", "1_0"], "bad cell index"),
+    (["--cells", "1225"], "out of range"),
+    (["--cells", ","], "empty cell list"),
+    (["--checkpoint-every", "nan"], "--checkpoint-every"),
+    (["--checkpoint-every", "0"], "--checkpoint-every"),
+    (["--checkpoint-every", "inf"], "--checkpoint-every"),
+    (["--checkpoint-cells", "0"], "--checkpoint-cells"),
+    (["--set", "dt=1e-310"], "dt"),           # subnormal
+    (["--set", "dt=2"], "dt=2.0"),            # rejected by C, parameter named
+    (["--set", "gravity=-1"], "gravity=-1.0"),
+    (["--set", "x_limit=0"], "x_limit=0.0"),
+    (["--set", "dt=nan"], "dt"),
+    (["--set", "gain=Infinity"], "gain"),
+    (["--set", "gain=1e999"], "gain"),
+    (["--set", "gain=1e39"], "gain"),          # overflows float32
+    (["--set", "noise_std=1e-50"], "noise_std"),  # underflows float32
+    (["--set", "init_velocity_noise=1e-320"], "init_velocity_noise"),
+    (["--set", "input_range=[1,2,3,NaN]"], "input_range"),
+    (["--set", "mode=4294967296"], "int32"),
+    (["--set", "integrator=4294967297"], "int32"),
+    (["--set", "clip_inputs=4294967297"], "clip_inputs"),
+    (["--set", "max_trials=1e30"], "int64"),
+    (["--set", "max_trials=9223372036854775808"], "int64"),
+    (["--set", "success_steps=inf"], "success_steps"),
+    (["--set", "max_trials=" + "9" * 5000], "max_trials"),
+    (["--set", "gain=" + "[" * 5000], "gain"),
+]
+
+
+@pytest.mark.parametrize("args, words", BAD_GRID_ARGS, ids=[" ".join(a)[:40] for a, _ in BAD_GRID_ARGS])
+def test_bad_grid_numbers(capsys, tmp_path, args, words):
+    out = tmp_path / "out"
+    rc, _, err = main(capsys, "grid", "--out", out, "--cells", "611", "--quiet", *args)
+    assert_one_line_error(rc, err, words)
+    assert not out.exists()
+
+
+def test_huge_cell_range_checked_before_expanding(capsys, tmp_path):
+    tracemalloc.start()
+    t0 = time.monotonic()
+    try:
+        rc, _, err = main(capsys, "grid", "--out", tmp_path / "o", "--cells", "0-30000000", *TINY_ARGS)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert_one_line_error(rc, err, "--cells", "30000000", "out of range")
+    assert peak < 20 * 2 ** 20 and time.monotonic() - t0 < 5, (peak, time.monotonic() - t0)
+
+
+@pytest.mark.parametrize("duration, words", [("nan", "--duration"), ("inf", "--duration"), ("-1", "--duration"),
+                                             ("0", "--duration"), ("1e12", "steps"), ("20000", "steps")])
+def test_figures_duration_bounded(capsys, res, tmp_path, duration, words):
+    rc, _, err = main(capsys, "figures", "--results", res, "--out", tmp_path / "fig", "--duration", duration)
+    assert_one_line_error(rc, err, words)
+    assert not (tmp_path / "fig").exists()
+
+
+def test_sweep_and_bench_numbers(capsys, res, tmp_path):
+    for args, words in [
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1", "--subset", "inf"],
+         "--subset"),
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1", "--subset", "5000"],
+         "--subset"),
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1",
+          "--seeds", "18446744073709551616"], "--seeds"),
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "prior_ridge=abc"], "prior_ridge"),
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1", "--threads", "1e10"],
+         "--threads"),
+        (["bench", "--out", tmp_path / "b", "--seed", "18446744073709551615", "--seeds", "2"], "2^64"),
+        (["bench", "--out", tmp_path / "b", "--set", "gain=nan"], "gain"),
+        (["bench", "--out", tmp_path / "b", "--rl-max-trials", "inf"], "--rl-max-trials"),
+    ]:
+        rc, _, err = main(capsys, *args)
+        assert_one_line_error(rc, err, words)
+        assert not (tmp_path / "w").exists() and not (tmp_path / "b").exists(), args
+
+
+# -- output directories ---------------------------------------------------------------------------------
+def test_out_is_a_regular_file(capsys, tmp_path):
+    f = tmp_path / "file"
+    f.write_text("keep me")
+    rc, _, err = main(capsys, "grid", "--out", f, "--cells", "611", *TINY_ARGS)
+    assert_one_line_error(rc, err, "not a directory")
+    rc, _, err = main(capsys, "grid", "--out", f / "sub", "--cells", "611", *TINY_ARGS)
+    assert_one_line_error(rc, err, "cannot create directory", "Not a directory")
+    assert f.read_text() == "keep me" and sorted(p.name for p in tmp_path.iterdir()) == ["file"]
+
+
+def test_figures_out_is_a_regular_file(capsys, res, tmp_path):
+    f = tmp_path / "file"
+    f.write_text("keep me")
+    rc, _, err = main(capsys, "figures", "--results", res, "--out", f)
+    assert_one_line_error(rc, err, "not a directory")
+    assert f.read_text() == "keep me"
+
+
+def test_read_only_directory(capsys, tmp_path, monkeypatch):
+    """chmod does not stop root: the permission bits are checked (os.access) and honoured here even
+    for root, and a real write probe catches what permission bits do not show."""
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    real_access = results.os.access
+
+    def access(path, mode, *a, **k):  # what a non-root user sees
+        if Path(path) == ro and mode & results.os.W_OK:
+            return False
+        return real_access(path, mode, *a, **k)
+
+    monkeypatch.setattr(results.os, "access", access)
+    try:
+        rc, _, err = main(capsys, "grid", "--out", ro, "--cells", "611", *TINY_ARGS)
+        assert_one_line_error(rc, err, "not writable")
+        assert list(ro.iterdir()) == []
+    finally:
+        ro.chmod(0o755)
+
+
+def test_write_probe_failure_is_one_line(capsys, tmp_path, monkeypatch):
+    """A read-only mount: permission bits say yes, creating a file fails (EROFS)."""
+    def mkstemp(*a, **k):
+        raise OSError(errno.EROFS, "Read-only file system")
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+    out = tmp_path / "rofs"
+    rc, _, err = main(capsys, "grid", "--out", out, "--cells", "611", *TINY_ARGS)
+    assert_one_line_error(rc, err, "not writable", "Read-only file system")
+    assert list(out.iterdir()) == []
+
+
+def test_checkpoint_write_failure_is_one_line(capsys, tmp_path, monkeypatch):
+    real_save = results.save
+    calls = []
+
+    def save(*a, **k):
+        calls.append(1)
+        if len(calls) > 1:
+            raise OSError(errno.ENOSPC, "No space left on device", str(tmp_path / "o" / "cells.npz.tmp"))
+        return real_save(*a, **k)
+
+    monkeypatch.setattr(results, "save", save)
+    rc, _, err = main(capsys, "grid", "--out", tmp_path / "o", "--cells", "611", *TINY_ARGS)
+    assert_one_line_error(rc, err, "No space left on device", "cells.npz.tmp")
+    assert len(calls) == 2
+    results.load(tmp_path / "o")  # the first (all PENDING) save is intact
+
+
+# -- ERROR cells -----------------------------------------------------------------------------------------
+def test_error_cells_are_neither_success_nor_failure():
+    cells = grid.make_cells(0, range(610, 620))
+    cells["outcome"] = [B.SUCCESS] * 4 + [B.FAILED] * 3 + [B.ERROR] * 3
+    cells["status"][7:] = [B.ERR_NUMERIC, B.ERR_NUMERIC, B.ERR_NONFINITE_INPUT]
+    cells["trials"] = 5
+    s = metrics.summary(cells)
+    assert s["outcomes"] == {"pending": 0, "success": 4, "failed": 3, "error": 3}
+    assert s["n_success"] == 4 and s["success_rate"] == pytest.approx(0.4)
+    assert s["error_statuses"] == {str(B.ERR_NONFINITE_INPUT): 1, str(B.ERR_NUMERIC): 2}
+    assert np.isnan(metrics.trials_to_success(cells)[7:]).all()
+    text = metrics.format_summary("ico", s)
+    assert "3 cells reported a controller ERROR" in text and "numeric (4): 2" in text
+    assert B.ERR_NUMERIC == 4 and B.lib.icoac_abi_version() == B.ABI_VERSION
+
+
+def test_help_documents_bounds(capsys):
+    with pytest.raises(SystemExit):
+        cli.main(["grid", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "--overwrite" in text and f"max({grid.DEFAULT_CHECKPOINT_CELLS} cells" in text
+    assert cli.CHECKPOINT_CELLS == grid.DEFAULT_CHECKPOINT_CELLS
+    assert cli.CHECKPOINT_EVERY == grid.DEFAULT_CHECKPOINT_EVERY
+    assert float(cli.MAX_DURATION_STEPS) == grid.MAX_TRAJECTORY_STEPS and cli.MAX_THREADS == grid.MAX_THREADS
+    with pytest.raises(SystemExit):
+        cli.main(["figures", "--help"])
+    assert "1e6 plant steps" in " ".join(capsys.readouterr().out.split())

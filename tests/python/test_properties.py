@@ -1,0 +1,276 @@
+"""Property tests (hypothesis): configuration building, `--set` parsing, cell lists and results
+loading accept an input and round-trip it, or reject it with the harness's own error type - never
+another exception. Profile (examples, derandomized) in conftest.py."""
+import io
+import json
+import math
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import assume, given
+from hypothesis import strategies as st
+
+from harness import _binding as B
+from harness import grid, metrics, results
+from harness.cli import UsageError, _parse_sets
+from harness.config import ALL_FIELDS, ENUMS, BOOLS, RunConfig, build_config, config_from_dict, parse_value
+
+HARNESS_ERRORS = (B.ConfigError, results.ResultsError, UsageError)
+
+# -- strategies ----------------------------------------------------------------------------------------
+floats = st.floats(allow_nan=True, allow_infinity=True) | st.floats(min_value=-1e-300, max_value=1e-300) \
+    | st.sampled_from([0.0, -0.0, 1e-310, 5e-324, 1e-40, 1e-46, 3.5e38, 1e39, 1e308, 0.5, 2.0, 1e-6, 1e6])
+ints = st.integers() | st.integers(min_value=-2 ** 70, max_value=2 ** 70) \
+    | st.sampled_from([0, 1, 2, -1, 2 ** 31 - 1, 2 ** 31, 2 ** 32 + 1, 2 ** 63 - 1, 2 ** 63, 2 ** 64, 10 ** 400])
+scalars = st.none() | st.booleans() | ints | floats | st.text(max_size=12) \
+    | st.sampled_from(["nan", "inf", "-inf", "1e999", "1e-310", "true", "off", "rk4", "gain", "1e5", " 7 ",
+                       "0x10", "1_0", "NaN", "Infinity"] + [n for names in ENUMS.values() for n in names])
+json_values = st.recursive(scalars, lambda kids: st.lists(kids, max_size=5)
+                           | st.dictionaries(st.text(max_size=8), kids, max_size=4), max_leaves=12)
+field_values = scalars | st.lists(floats | ints, min_size=3, max_size=5) | json_values
+names = st.sampled_from(ALL_FIELDS + ("reserved", "gian", "", "Gain")) | st.text(max_size=10)
+
+
+def total(fn, *args, **kw):
+    """fn(...) or None if it raised one of the harness's own errors; anything else propagates."""
+    try:
+        return fn(*args, **kw)
+    except HARNESS_ERRORS:
+        return None
+
+
+def assert_round_trip(cfg: RunConfig):
+    d = cfg.to_dict()
+    assert json.loads(json.dumps(d)) == d           # JSON-clean: finite, plain types
+    again = config_from_dict(d)
+    assert again.to_dict() == d
+    # the same configuration from `--set` strings of the dict's values
+    sets = [f"{name}={json.dumps(value)}" for group in ("controller", "plant", "run")
+            for name, value in d[group].items() if name != "reserved"]
+    assert build_config(_parse_sets(sets), prior=cfg.prior).to_dict() == d
+
+
+# -- configuration ---------------------------------------------------------------------------------------
+@given(st.dictionaries(names, field_values, max_size=4))
+def test_build_config_accepts_and_round_trips_or_rejects(overrides):
+    cfg = total(build_config, overrides)
+    if cfg is not None:
+        assert_round_trip(cfg)
+
+
+@given(st.sampled_from([n for n in ALL_FIELDS if n != "reserved"]), field_values)
+def test_single_field_override(name, value):
+    cfg = total(build_config, {name: value})
+    if cfg is None:
+        return
+    assert_round_trip(cfg)
+    d = cfg.to_dict()
+    group = "controller" if name in d["controller"] else "plant" if name in d["plant"] else "run"
+    got = d[group][name]
+    # what was accepted is what is stored: no truncation, wrap-around or rounding beyond the C type
+    is_int = isinstance(value, int) and not isinstance(value, bool)
+    if name in ENUMS and is_int:
+        assert ENUMS[name].get(got, got) == value
+    elif name in BOOLS and is_int:
+        assert value in (0, 1) and got is bool(value)
+    elif isinstance(got, int) and not isinstance(got, bool) and isinstance(value, (int, float)) \
+            and not isinstance(value, bool):
+        assert got == value
+    elif isinstance(got, float) and isinstance(value, (int, float)) and not isinstance(value, bool):
+        kind = B.real_dtype.type if group == "controller" else np.float64
+        assert kind(got) == kind(value) and math.isfinite(got)
+
+
+INT_FIELDS = [n for n in ALL_FIELDS if n in ENUMS or n in BOOLS or n in ("max_trials", "success_steps")]
+
+
+# k + m * 2^32 (and 2^64) wraps to a valid small value if anything truncates to int32 (int64)
+aliases = st.builds(lambda k, m, w: k + m * w, st.integers(0, 2), st.integers(-3, 3), st.sampled_from([2 ** 32, 2 ** 64]))
+
+
+@given(st.sampled_from(INT_FIELDS), aliases | ints | aliases.map(str) | ints.map(str) | ints.map(float))
+def test_integer_fields_are_range_checked_not_truncated(name, value):
+    cfg = total(build_config, {name: value})
+    if cfg is None:
+        return
+    number = int(float(value)) if isinstance(value, str) and not value.strip().lstrip("-").isdigit() else int(value)
+    d = cfg.to_dict()
+    got = d["controller"].get(name, d["plant"].get(name, d["run"].get(name)))
+    if name in ENUMS:
+        got = ENUMS[name].get(got, got)
+    assert int(got) == number
+
+
+@given(st.sampled_from([n for n in ALL_FIELDS if n != "reserved"]),
+       st.text(max_size=20) | floats.map(repr) | ints.map(str) | json_values.map(json.dumps))
+def test_set_option_parsing(name, text):
+    over = total(_parse_sets, [f"{name}={text}"])
+    assert over is not None and set(over) == {name}
+    cfg = total(build_config, over)
+    if cfg is not None:
+        assert_round_trip(cfg)
+
+
+@given(st.lists(st.text(max_size=25), max_size=3))
+def test_set_option_arbitrary_text(items):
+    over = total(_parse_sets, items)
+    if over is not None:
+        cfg = total(build_config, over)
+        if cfg is not None:
+            assert_round_trip(cfg)
+
+
+@given(st.text(max_size=40))
+def test_parse_value_never_raises(text):
+    parse_value(text)
+
+
+@given(json_values)
+def test_parse_value_reads_json(value):
+    text = json.dumps(value)
+    assume("NaN" not in text)
+    assert parse_value(text) == value
+
+
+def _paths(d, prefix=()):
+    for k, v in d.items():
+        yield prefix + (k,)
+        if isinstance(v, dict):
+            yield from _paths(v, prefix + (k,))
+
+
+DEFAULT_DICT = build_config().to_dict()
+DEFAULT_DICT["prior"] = {"mean": [0.1, 0.0, 0.3, 0.0], "cov": np.eye(4).tolist()}
+DICT_PATHS = sorted(_paths(DEFAULT_DICT))
+
+
+@given(st.sampled_from(DICT_PATHS), json_values, st.booleans())
+def test_config_from_dict_of_edited_dict(path, value, delete):
+    data = json.loads(json.dumps(DEFAULT_DICT))
+    node = data
+    for k in path[:-1]:
+        node = node[k]
+    if delete:
+        del node[path[-1]]
+    else:
+        node[path[-1]] = value
+    cfg = total(config_from_dict, data)
+    if cfg is not None:
+        assert_round_trip(cfg)
+
+
+@given(json_values)
+def test_config_from_dict_of_anything(data):
+    cfg = total(config_from_dict, data)
+    if cfg is not None:
+        assert_round_trip(cfg)
+
+
+# -- cell lists ------------------------------------------------------------------------------------------
+@given(st.lists(st.integers(0, B.GRID_CELLS - 1), min_size=1, max_size=60), st.randoms(use_true_random=False))
+def test_cell_list_round_trip(indices, rnd):
+    want = sorted(set(indices))
+    assert grid.parse_cell_indices(grid.format_cell_indices(indices)) == want
+    assert grid.parse_cell_indices(indices) == want
+    # the same cells written another way: shuffled parts, some ranges split, spaces, empty parts
+    parts = grid.format_cell_indices(indices).split(",")
+    rnd.shuffle(parts)
+    text = " , ".join(p.replace("-", " - ") if rnd.random() < 0.5 else p for p in parts) + ("," if rnd.random() < .3 else "")
+    assert grid.parse_cell_indices(text) == want
+
+
+@given(st.text(alphabet="0123456789-, x+_.e", max_size=30) | st.text(max_size=30))
+def test_cell_text_accepted_or_config_error(text):
+    got = total(grid.parse_cell_indices, text)
+    if got is not None:
+        assert got == sorted(set(got)) and all(0 <= i < B.GRID_CELLS for i in got)
+        assert grid.parse_cell_indices(grid.format_cell_indices(got)) == got
+
+
+@given(st.lists(scalars | st.integers(-5, 1300), max_size=8))
+def test_cell_sequence_accepted_or_config_error(items):
+    got = total(grid.parse_cell_indices, items)
+    if got is not None:
+        assert got == sorted({int(i) for i in items})
+
+
+# -- results loading -------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def valid_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("valid") / "res"
+    cfg = build_config({"max_trials": 20, "success_steps": 100})
+    cells = grid.make_cells(1, [0, 611, 612])
+    grid.run_grid(cfg, cells, threads=1, progress=False)
+    results.save(out, cells, cfg, condition="ico", seed=1, wall_time=0.1, threads=1, cell_indices=[0, 611, 612])
+    return out
+
+
+def _load_with(valid_dir, name, data: bytes):
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp) / "r"
+        shutil.copytree(valid_dir, d)
+        (d / name).write_bytes(data)
+        got = total(results.load, d)
+    if got is not None:
+        cells, record = got
+        assert cells.dtype == B.CELL_DTYPE and cells.ndim == 1 and 1 <= cells.size <= B.GRID_CELLS
+        assert np.isin(cells["outcome"], list(B.OUTCOME_NAMES)).all()
+        assert np.isfinite(cells["x0"]).all() and np.isfinite(cells["theta0"]).all()
+        rows, cols = metrics.grid_index(cells)
+        assert ((rows >= 0) & (rows < B.GRID_THETAS) & (cols >= 0) & (cols < B.GRID_XS)).all()
+        assert isinstance(record, dict) and isinstance(record["config"], dict)
+        config_from_dict(record["config"])
+    return got
+
+
+def _mutations(blob: bytes):
+    return st.one_of(
+        st.integers(0, len(blob)).map(lambda k: blob[:k]),                                 # truncated
+        st.tuples(st.integers(0, len(blob) - 1), st.integers(1, 255)).map(
+            lambda t: blob[:t[0]] + bytes([blob[t[0]] ^ t[1]]) + blob[t[0] + 1:]),          # one byte flipped
+        st.tuples(st.integers(0, len(blob)), st.binary(min_size=1, max_size=16)).map(
+            lambda t: blob[:t[0]] + t[1] + blob[t[0]:]),                                    # bytes inserted
+        st.binary(max_size=300))                                                           # anything
+
+
+@given(data=st.data())
+def test_load_arbitrary_cells_bytes(valid_dir, data):
+    blob = (valid_dir / "cells.npz").read_bytes()
+    _load_with(valid_dir, "cells.npz", data.draw(_mutations(blob)))
+
+
+@given(data=st.data())
+def test_load_arbitrary_run_json_bytes(valid_dir, data):
+    blob = (valid_dir / "run.json").read_bytes()
+    _load_with(valid_dir, "run.json", data.draw(_mutations(blob)))
+
+
+@given(st.sampled_from(["condition", "seed", "cells", "config", "wall_time", "complete", "summary", "git",
+                        "prior_info", "format_version", "threads"]), json_values, st.booleans())
+def test_load_edited_run_record(valid_dir, key, value, delete):
+    record = json.loads((valid_dir / "run.json").read_text())
+    if delete:
+        record.pop(key, None)
+    else:
+        record[key] = value
+    _load_with(valid_dir, "run.json", json.dumps(record).encode())
+
+
+@given(st.sampled_from(["x0", "theta0", "seed", "outcome", "status", "trials"]),
+       st.integers(0, 2), floats | ints)
+def test_load_edited_cells(valid_dir, field, index, value):
+    with np.load(valid_dir / "cells.npz") as z:
+        cells = z["cells"]
+    try:
+        with np.errstate(all="ignore"):
+            cells[field][index] = value
+    except (OverflowError, ValueError, TypeError):
+        assume(False)
+    buf = io.BytesIO()
+    np.savez(buf, cells=cells)
+    got = _load_with(valid_dir, "cells.npz", buf.getvalue())
+    if got is not None:
+        assert got[0].tobytes() == cells.tobytes()
