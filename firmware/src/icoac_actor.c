@@ -49,7 +49,7 @@ void icoac_priv_actor_sample(icoac_priv_state_t *st)
     for (i = 0; i < N; ++i) {
         normal[i] = icoac_rng_normal(&st->rng);
     }
-    if (!icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(st->cov), lower)) {
+    if (!icoac_priv_cholesky4(icoac_priv_cov_c(st), lower)) {
         icoac_priv_copy4(st->w_act, st->w);
         return;
     }
@@ -70,7 +70,7 @@ void icoac_priv_actor_update(const icoac_actor_config_t *actor, const icoac_priv
                         icoac_real_t cov[N][N])
 {
     const icoac_real_t noise_var = actor->noise_std * actor->noise_std;
-    const icoac_real_t (*prior)[N] = ICOAC_PRIV_CONST_MAT4(st->cov);
+    const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
     icoac_real_t cov_h[N];
     icoac_real_t gain[N];
     icoac_real_t a_cov[N][N];
@@ -83,7 +83,7 @@ void icoac_priv_actor_update(const icoac_actor_config_t *actor, const icoac_priv
         const icoac_real_t inflate = ICOAC_R(1.0) / actor->forgetting;
         for (i = 0; i < N; ++i) {
             for (j = 0; j < N; ++j) {
-                cov[i][j] = st->cov[i][j] * inflate;
+                cov[i][j] = prior[i][j] * inflate;
             }
         }
         prior = ICOAC_PRIV_CONST_MAT4(cov);

@@ -34,6 +34,9 @@ static int code_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
     icoac_real_t z;
     icoac_real_t force;
     if (terminal) {
+        out->q = ICOAC_R(0.0);
+        out->z = ICOAC_R(0.0);
+        out->force = ICOAC_R(0.0);
         return 1;
     }
     z = icoac_priv_dot4(st->w, scaled);
@@ -44,6 +47,7 @@ static int code_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
     if (!icoac_priv_finite(force) || !icoac_priv_finite(norm)) {
         return 0;
     }
+    out->q = ICOAC_R(0.0);
     if (drop > ICOAC_R(0.0)) {
         commit_weights(st, w, norm);
         out->q = drop;
@@ -77,6 +81,7 @@ static int literal_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
     if (!icoac_priv_finite(terminal ? z : force) || !icoac_priv_finite(norm)) {
         return 0;
     }
+    out->q = ICOAC_R(0.0);
     if (learn) {
         commit_weights(st, w, norm);
         out->q = drop;
@@ -88,10 +93,15 @@ static int literal_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
     return 1;
 }
 
+/* Writes every output field but reflex, penalty, weight_norm and status. */
 int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
                         const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
                         icoac_output_t *out)
 {
+    out->value = ICOAC_R(0.0);
+    out->td_error = ICOAC_R(0.0);
+    out->noise = ICOAC_R(0.0);
+    out->cov_trace = ICOAC_R(0.0);
     return cfg->ico.timing == ICOAC_ICO_TIMING_LITERAL ? literal_timing(cfg, st, scaled, penalty, terminal, out)
                                                        : code_timing(cfg, st, scaled, penalty, terminal, out);
 }

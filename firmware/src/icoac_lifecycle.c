@@ -30,10 +30,10 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const
     memset(state, 0, sizeof *state);
     if (prior != 0) {
         memcpy(st->w, prior->mean, sizeof st->w);
-        memcpy(st->cov, prior->cov, sizeof st->cov);
+        memcpy(st->cov_buffer[0], prior->cov, sizeof st->cov_buffer[0]);
     } else {
         for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-            st->cov[i][i] = ICOAC_R(1.0);
+            st->cov_buffer[0][i][i] = ICOAC_R(1.0);
         }
     }
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
@@ -73,7 +73,7 @@ icoac_status_t icoac_get_posterior(const icoac_state_t *state, icoac_prior_t *po
         return ICOAC_ERR_NOT_INITIALISED;
     }
     memcpy(posterior->mean, st->w, sizeof posterior->mean);
-    memcpy(posterior->cov, st->cov, sizeof posterior->cov);
+    memcpy(posterior->cov, icoac_priv_cov_c(st), sizeof posterior->cov);
     return ICOAC_OK;
 }
 

@@ -21,13 +21,13 @@ static int off_diagonal_finite(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPU
  * Sigma_w (covers its diagonal) and its off-diagonal, and G z (+ reflex). Not checked, as
  * finite by the configuration's bounds: the noise (|eps| < 1e8 sigma_u), hence the force
  * G z + eps + reflex; and the critic weights, which move by at most critic_rate * td_clip
- * <= 1e4 per tick. */
+ * <= 1e4 per tick. Writes every output field but reflex, penalty, weight_norm and status. */
 int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_N_INPUTS],
-                   const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out)
+                       const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out)
 {
     icoac_real_t factors[ICOAC_CRITIC_FACTORS];
     icoac_real_t w[ICOAC_N_INPUTS];
-    icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
+    icoac_real_t (*cov)[ICOAC_N_INPUTS] = st->cov_buffer[st->cov_slot ^ 1]; /* the spare */
     icoac_real_t checked[5]; /* V(s), delta, |w|, trace of Sigma_w, G z (+ reflex) */
     const int slot_prev = st->active_slot;
     const int learn = st->has_prev;
@@ -62,7 +62,7 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     } else {
         checked[1] = ICOAC_R(0.0);
         checked[2] = st->weight_norm;
-        checked[3] = icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(st->cov));
+        checked[3] = icoac_priv_trace4(icoac_priv_cov_c(st));
     }
     if (!terminal) {
         z = icoac_priv_dot4(w_act, scaled);
@@ -75,18 +75,20 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     if (learn) {
         icoac_priv_critic_update(st->v, &st->active[slot_prev], cfg->critic.rate * checked[1]);
         icoac_priv_copy4(st->w, w);
-        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-            icoac_priv_copy4(st->cov[i], cov[i]);
-        }
+        st->cov_slot ^= 1;
         st->weight_norm = checked[2];
         if (!cfg->actor.act_with_sample) {
             icoac_priv_copy4(st->w_act, w);
         }
-        out->td_error = checked[1];
     }
+    out->q = ICOAC_R(0.0);
+    out->td_error = checked[1];
     out->value = checked[0];
     out->cov_trace = checked[3];
     if (terminal) {
+        out->z = ICOAC_R(0.0);
+        out->noise = ICOAC_R(0.0);
+        out->force = ICOAC_R(0.0);
         st->has_prev = 0;
         return 1;
     }

@@ -34,7 +34,8 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
     icoac_real_t inv_range[ICOAC_N_INPUTS];           /* 1 / policy.input_range, derived by icoac_init */
     icoac_real_t w[ICOAC_N_INPUTS];                   /* ICO weights, or actor mean mu_w */
     icoac_real_t weight_norm;                         /* |w|, refreshed when w changes */
-    icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* actor covariance Sigma_w */
+    icoac_real_t cov_buffer[2][ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* Sigma_w, and the spare the RL tick stages into */
+    int32_t cov_slot;                                 /* index of Sigma_w in cov_buffer */
     icoac_real_t w_act[ICOAC_N_INPUTS];               /* weights used to act (mu_w or a sample) */
     icoac_real_t v[ICOAC_CRITIC_UNITS];               /* critic weights */
     icoac_priv_critic_active_t active[2];             /* kept critic units of s_t and of s */
@@ -59,6 +60,17 @@ static inline icoac_priv_state_t *icoac_priv_state(icoac_state_t *state)
 static inline const icoac_priv_state_t *icoac_priv_state_c(const icoac_state_t *state)
 {
     return (const icoac_priv_state_t *)(const void *)state;
+}
+
+/* The actor covariance Sigma_w. */
+static inline icoac_real_t (*icoac_priv_cov(icoac_priv_state_t *st))[ICOAC_N_INPUTS]
+{
+    return st->cov_buffer[st->cov_slot];
+}
+
+static inline const icoac_real_t (*icoac_priv_cov_c(const icoac_priv_state_t *st))[ICOAC_N_INPUTS]
+{
+    return (const icoac_real_t(*)[ICOAC_N_INPUTS])st->cov_buffer[st->cov_slot];
 }
 
 #endif /* ICOAC_STATE_H */

@@ -17,7 +17,8 @@ static void clear_output(icoac_output_t *out)
     out->status = ICOAC_OK;
 }
 
-/* An error status: the output cleared but for |w| and the status. */
+/* An error status: the output cleared but for |w| and the status. (On success the mode's
+ * tick writes every field it does not share with the dispatcher.) */
 static icoac_status_t rejected(const icoac_priv_state_t *st, icoac_output_t *out, icoac_status_t status)
 {
     clear_output(out);
@@ -36,16 +37,15 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state, const
     icoac_priv_zone_t zone;
     int terminal;
     int ok;
-    if (out != 0) {
-        clear_output(out);
-    }
     if (cfg == 0 || state == 0 || in == 0 || out == 0) {
         if (out != 0) {
+            clear_output(out);
             out->status = ICOAC_ERR_NULL;
         }
         return ICOAC_ERR_NULL;
     }
     if (st->magic != ICOAC_PRIV_STATE_MAGIC) {
+        clear_output(out);
         out->status = ICOAC_ERR_NOT_INITIALISED;
         return ICOAC_ERR_NOT_INITIALISED;
     }

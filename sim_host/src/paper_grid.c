@@ -13,8 +13,8 @@ int32_t icoac_sim_paper_grid(icoac_sim_cell_t *cells, int64_t n_cells, uint64_t 
     for (i = 0; i < n_cells; ++i) {
         const int64_t row = i / ICOAC_SIM_GRID_XS;
         const int64_t col = i % ICOAC_SIM_GRID_XS;
-        cells[i].theta0 = (double)(-12 + row) * ICOAC_SIM_PI / 180.0;
-        cells[i].x0 = -2.4 + 0.1 * (double)col;
+        cells[i].theta0 = (double)(ICOAC_SIM_GRID_THETA_FIRST_DEG + row) * ICOAC_SIM_PI / 180.0;
+        cells[i].x0 = ICOAC_SIM_GRID_X_FIRST + ICOAC_SIM_GRID_X_STEP * (double)col;
         cells[i].seed = icoac_mix_seed(seed, (uint64_t)i);
         cells[i].outcome = ICOAC_SIM_PENDING;
     }

@@ -11,7 +11,7 @@
 extern "C" {
 #endif
 
-#define ICOAC_SIM_ABI_VERSION 1
+#define ICOAC_SIM_ABI_VERSION 2
 
 /* Status of sim functions: values below 100 are icoac_status_t, passed through. */
 typedef enum {
@@ -92,6 +92,9 @@ typedef struct {
 #define ICOAC_SIM_GRID_THETAS 25
 #define ICOAC_SIM_GRID_XS 49
 #define ICOAC_SIM_GRID_CELLS (ICOAC_SIM_GRID_THETAS * ICOAC_SIM_GRID_XS)
+#define ICOAC_SIM_GRID_THETA_FIRST_DEG (-12) /* row i: theta0 = (-12 + i) deg */
+#define ICOAC_SIM_GRID_X_FIRST (-2.4)        /* column j: x0 = -2.4 + 0.1 j m */
+#define ICOAC_SIM_GRID_X_STEP 0.1
 
 const char *icoac_sim_status_str(int32_t status);
 uint32_t icoac_sim_abi_version(void);
@@ -113,6 +116,23 @@ int32_t icoac_sim_failed(const icoac_sim_plant_t *plant, const double state[ICOA
 /* Fill the paper's grid, row-major over theta (row i: theta0 = (-12 + i) deg) then x
  * (column j: x0 = -2.4 + 0.1 j m); cell seeds derive from seed; outcomes set PENDING. */
 int32_t icoac_sim_paper_grid(icoac_sim_cell_t *cells, int64_t n_cells, uint64_t seed);
+
+/* Constants and struct layouts for bindings, so that C is their single source. */
+typedef struct {
+    const char *name; /* the C macro or enum name, e.g. "ICOAC_MODE_RL" */
+    double value;
+} icoac_sim_constant_t;
+
+typedef struct {
+    const char *type;  /* "icoac_config_t", ... */
+    const char *field; /* member designator, e.g. "policy.gain" or "cov" */
+    uint32_t offset;   /* offsetof(type, field) */
+    uint32_t size;     /* sizeof the member */
+} icoac_sim_field_t;
+
+/* Static tables; *count receives their length. */
+const icoac_sim_constant_t *icoac_sim_constants(int32_t *count);
+const icoac_sim_field_t *icoac_sim_fields(int32_t *count);
 
 /* One independent run of a cell from a fresh controller (prior NULL: icoac_init default). */
 int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
