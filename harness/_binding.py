@@ -1,57 +1,36 @@
 """ctypes binding of libicoac_sim (sim_host/include/icoac_sim/icoac_sim.h, firmware/include/icoac/*.h).
 
-Every prototype is declared once here; struct layouts are checked against the C ``sizeof``
-functions and the ABI versions at import, so a stale or mismatched library fails loudly.
+C is the single source of every number this module exposes: at import it reads the library's
+constant table (icoac_sim_constants: sizes, enum values, statuses, outcomes, progress indices,
+grid geometry) and its field table (icoac_sim_fields: offset and size of every member of every
+public struct), and checks each ctypes mirror below (and the cell numpy dtype) against the field
+table - same fields, same offsets and sizes, same total size - so that a stale or mismatched
+library fails loudly with a LibraryError naming the field. The controller state is opaque
+storage of icoac_sizeof_state() bytes, read through icoac_get_posterior / icoac_get_counters.
+Every prototype is declared once here.
 """
 from __future__ import annotations
 
 import ctypes
 import os
 from pathlib import Path
+from typing import Mapping, Union
 
 import numpy as np
 from numpy.ctypeslib import ndpointer
+
+from .errors import HarnessError, LibraryError
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 LIBRARY_ENV = "ICOAC_SIM_LIBRARY"
 DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.so"
 
-ABI_VERSION = 3
-SIM_ABI_VERSION = 1
-N_INPUTS = 4
-GRID_THETAS = 25
-GRID_XS = 49
-GRID_CELLS = GRID_THETAS * GRID_XS
-PROGRESS_CELLS, PROGRESS_TRIALS, PROGRESS_STEPS, PROGRESS_LEN = 0, 1, 2, 3
-
-# Status codes (icoac_status_t, icoac_sim_status_t).
-OK = 0
-ERR_NULL = 1
-ERR_NOT_INITIALISED = 2
-ERR_NONFINITE_INPUT = 3
-ERR_NUMERIC = 4
-ERR_BAD_MODE = 10
-ERR_BAD_SCALE = 11
-ERR_BAD_GAIN = 12
-ERR_BAD_ZONE = 13
-ERR_BAD_ICO_RATE = 14
-ERR_BAD_CRITIC = 15
-ERR_BAD_ACTOR = 16
-ERR_BAD_PRIOR = 17
-SIM_ERR_BAD_PLANT = 100
-SIM_ERR_BAD_RUN = 101
-SIM_ERR_BAD_ARGUMENT = 102
-SIM_ERR_THREAD = 103
-SIM_CANCELLED = 104
-
-# Cell outcomes (icoac_sim_outcome_t).
-PENDING, SUCCESS, FAILED, ERROR = 0, 1, 2, 3
-OUTCOME_NAMES = {PENDING: "pending", SUCCESS: "success", FAILED: "failed", ERROR: "error"}
-
-_CONFIG_STATUSES = set(range(10, 18)) | {SIM_ERR_BAD_PLANT, SIM_ERR_BAD_RUN, SIM_ERR_BAD_ARGUMENT}
+# The ABI versions the mirrors below are written for (everything else is read from the library).
+ABI_VERSION = 4
+SIM_ABI_VERSION = 2
 
 
-class IcoacError(RuntimeError):
+class IcoacError(HarnessError):
     """A non-OK status from the C library; ``.status`` is the code, the message is the C text."""
 
     def __init__(self, status: int, message: str | None = None, context: str | None = None):
@@ -64,18 +43,15 @@ class IcoacError(RuntimeError):
 
 
 class ConfigError(IcoacError):
-    """A configuration, prior, plant, run or argument rejected (status 10-17, 100-102) or a bad name."""
+    """A configuration, prior, plant, run or argument rejected (a bad-parameter status of the C
+    library, or the status C would give for a value rejected on the Python side), or a bad name."""
 
     def __init__(self, status: int | None = None, message: str | None = None, context: str | None = None):
         super().__init__(SIM_ERR_BAD_ARGUMENT if status is None else status, message, context)
 
 
 class Cancelled(IcoacError):
-    """The cancel flag was raised (status 104); finished cells are kept."""
-
-
-class LibraryError(RuntimeError):
-    """The shared library is missing or does not match this binding."""
+    """The cancel flag was raised (ICOAC_SIM_CANCELLED); finished cells are kept."""
 
 
 def _library_path() -> Path:
@@ -98,14 +74,141 @@ def _load() -> ctypes.CDLL:
 lib = _load()
 LIBRARY_PATH = _library_path()
 
-# -- sizes first: the real type decides the structure layouts ----------------------------------
-for _name in ("icoac_abi_version", "icoac_sizeof_real", "icoac_sizeof_config", "icoac_sizeof_state",
-              "icoac_sizeof_input", "icoac_sizeof_output", "icoac_sizeof_prior",
-              "icoac_sim_abi_version", "icoac_sim_sizeof_plant", "icoac_sim_sizeof_run",
-              "icoac_sim_sizeof_cell"):
+
+def _stale(detail: str) -> LibraryError:
+    return LibraryError(f"{LIBRARY_PATH} does not match the harness binding ({detail}); "
+                        "rebuild it with `make build`")
+
+
+# -- ABI versions and sizes first ---------------------------------------------------------------
+_SIZE_FUNCTIONS = ("icoac_abi_version", "icoac_sizeof_real", "icoac_sizeof_config", "icoac_sizeof_state",
+                   "icoac_sizeof_input", "icoac_sizeof_output", "icoac_sizeof_prior",
+                   "icoac_sim_abi_version", "icoac_sim_sizeof_plant", "icoac_sim_sizeof_run",
+                   "icoac_sim_sizeof_cell")
+for _name in _SIZE_FUNCTIONS:
     getattr(lib, _name).argtypes = []
     getattr(lib, _name).restype = ctypes.c_uint32
 
+if lib.icoac_abi_version() != ABI_VERSION or lib.icoac_sim_abi_version() != SIM_ABI_VERSION:
+    raise _stale(f"ABI versions icoac {lib.icoac_abi_version()}, icoac_sim {lib.icoac_sim_abi_version()}; "
+                 f"the binding needs icoac {ABI_VERSION}, icoac_sim {SIM_ABI_VERSION}")
+
+
+# -- the C tables ----------------------------------------------------------------------------------
+class _Constant(ctypes.Structure):
+    """icoac_sim_constant_t."""
+    _fields_ = [("name", ctypes.c_char_p), ("value", ctypes.c_double)]
+
+
+class _Field(ctypes.Structure):
+    """icoac_sim_field_t."""
+    _fields_ = [("type", ctypes.c_char_p), ("field", ctypes.c_char_p),
+                ("offset", ctypes.c_uint32), ("size", ctypes.c_uint32)]
+
+
+for _name, _row in (("icoac_sim_constants", _Constant), ("icoac_sim_fields", _Field)):
+    getattr(lib, _name).argtypes = [ctypes.POINTER(ctypes.c_int32)]
+    getattr(lib, _name).restype = ctypes.POINTER(_row)
+
+
+def _table(fn) -> list:
+    count = ctypes.c_int32(0)
+    rows = fn(ctypes.byref(count))
+    return [rows[i] for i in range(count.value)]
+
+
+def _number(value: float) -> Union[int, float]:
+    return int(value) if float(value).is_integer() else float(value)
+
+
+# {C macro or enum name: value}, e.g. "ICOAC_MODE_RL": 1 (integral values as int).
+CONSTANTS: dict[str, Union[int, float]] = {
+    row.name.decode(): _number(row.value) for row in _table(lib.icoac_sim_constants)}
+
+# {C type: {member designator: (offset, size)}}, e.g. "icoac_config_t": {"policy.gain": (24, 4), ...}.
+FIELDS: dict[str, dict[str, tuple[int, int]]] = {}
+for _row in _table(lib.icoac_sim_fields):
+    FIELDS.setdefault(_row.type.decode(), {})[_row.field.decode()] = (int(_row.offset), int(_row.size))
+
+
+def constant(name: str) -> Union[int, float]:
+    """Value of a C constant from the library's table; LibraryError if the library lacks it."""
+    try:
+        return CONSTANTS[name]
+    except KeyError:
+        raise _stale(f"constant {name} missing from icoac_sim_constants") from None
+
+
+def enum(prefix: str, members: tuple[str, ...] | None = None) -> dict[str, int]:
+    """{symbolic name: value} of the C constants PREFIX + MEMBER (every constant with the prefix
+    when members is None); the symbolic name is MEMBER in lower case, e.g. "ICOAC_MODE_RL" -> "rl"."""
+    names = members if members is not None else tuple(
+        n[len(prefix):] for n in CONSTANTS if n.startswith(prefix))
+    out = {m.lower(): int(constant(prefix + m)) for m in names}
+    if not out or len(set(out.values())) != len(out):
+        raise _stale(f"enum {prefix}* is empty or has repeated values: {out}")
+    return out
+
+
+N_INPUTS = int(constant("ICOAC_N_INPUTS"))
+CRITIC_UNITS = int(constant("ICOAC_CRITIC_UNITS"))
+STATE_SIZE = int(constant("ICOAC_STATE_SIZE"))
+INPUT_TERMINAL = int(constant("ICOAC_INPUT_TERMINAL"))
+
+# Switches: {symbolic name: value}.
+MODES = enum("ICOAC_MODE_")                       # ico, rl
+REFLEX_MODES = enum("ICOAC_REFLEX_")              # unit, gain
+ICO_TIMINGS = enum("ICOAC_ICO_TIMING_")           # code, literal
+INTEGRATORS = enum("ICOAC_SIM_", ("EULER", "RK4"))  # euler, rk4
+MODE_ICO, MODE_RL = MODES["ico"], MODES["rl"]
+
+# Statuses (icoac_status_t, then icoac_sim_status_t).
+OK = int(constant("ICOAC_OK"))
+ERR_NULL = int(constant("ICOAC_ERR_NULL"))
+ERR_NOT_INITIALISED = int(constant("ICOAC_ERR_NOT_INITIALISED"))
+ERR_NONFINITE_INPUT = int(constant("ICOAC_ERR_NONFINITE_INPUT"))
+ERR_NUMERIC = int(constant("ICOAC_ERR_NUMERIC"))
+ERR_BAD_MODE = int(constant("ICOAC_ERR_BAD_MODE"))
+ERR_BAD_SCALE = int(constant("ICOAC_ERR_BAD_SCALE"))
+ERR_BAD_GAIN = int(constant("ICOAC_ERR_BAD_GAIN"))
+ERR_BAD_ZONE = int(constant("ICOAC_ERR_BAD_ZONE"))
+ERR_BAD_ICO_RATE = int(constant("ICOAC_ERR_BAD_ICO_RATE"))
+ERR_BAD_CRITIC = int(constant("ICOAC_ERR_BAD_CRITIC"))
+ERR_BAD_ACTOR = int(constant("ICOAC_ERR_BAD_ACTOR"))
+ERR_BAD_PRIOR = int(constant("ICOAC_ERR_BAD_PRIOR"))
+SIM_OK = int(constant("ICOAC_SIM_OK"))
+SIM_ERR_BAD_PLANT = int(constant("ICOAC_SIM_ERR_BAD_PLANT"))
+SIM_ERR_BAD_RUN = int(constant("ICOAC_SIM_ERR_BAD_RUN"))
+SIM_ERR_BAD_ARGUMENT = int(constant("ICOAC_SIM_ERR_BAD_ARGUMENT"))
+SIM_ERR_THREAD = int(constant("ICOAC_SIM_ERR_THREAD"))
+SIM_CANCELLED = int(constant("ICOAC_SIM_CANCELLED"))
+
+# Status ranges, from the names: icoac_status_t (ICOAC_OK, ICOAC_ERR_*), the bad-parameter
+# statuses of both libraries (a rejected configuration, prior, plant, run or argument).
+CONTROLLER_STATUSES = frozenset(int(v) for n, v in CONSTANTS.items() if n == "ICOAC_OK" or n.startswith("ICOAC_ERR_"))
+CONFIG_STATUSES = frozenset(int(v) for n, v in CONSTANTS.items()
+                            if n.startswith("ICOAC_ERR_BAD_") or n.startswith("ICOAC_SIM_ERR_BAD_"))
+
+# Cell outcomes (icoac_sim_outcome_t).
+OUTCOME_NAMES = {v: k for k, v in enum("ICOAC_SIM_", ("PENDING", "SUCCESS", "FAILED", "ERROR")).items()}
+PENDING, SUCCESS, FAILED, ERROR = (int(constant("ICOAC_SIM_" + n)) for n in ("PENDING", "SUCCESS", "FAILED", "ERROR"))
+
+# Progress counters of icoac_sim_run_grid.
+PROGRESS_CELLS = int(constant("ICOAC_SIM_PROGRESS_CELLS"))
+PROGRESS_TRIALS = int(constant("ICOAC_SIM_PROGRESS_TRIALS"))
+PROGRESS_STEPS = int(constant("ICOAC_SIM_PROGRESS_STEPS"))
+PROGRESS_LEN = int(constant("ICOAC_SIM_PROGRESS_LEN"))
+
+# The paper grid (harness.geometry derives the rest and checks it against icoac_sim_paper_grid).
+GRID_THETAS = int(constant("ICOAC_SIM_GRID_THETAS"))
+GRID_XS = int(constant("ICOAC_SIM_GRID_XS"))
+GRID_CELLS = int(constant("ICOAC_SIM_GRID_CELLS"))
+GRID_THETA_FIRST_DEG = float(constant("ICOAC_SIM_GRID_THETA_FIRST_DEG"))
+GRID_X_FIRST = float(constant("ICOAC_SIM_GRID_X_FIRST"))
+GRID_X_STEP = float(constant("ICOAC_SIM_GRID_X_STEP"))
+PI = float(constant("ICOAC_SIM_PI"))
+
+# -- structure mirrors ------------------------------------------------------------------------------
 _SIZEOF_REAL = lib.icoac_sizeof_real()
 if _SIZEOF_REAL == 4:
     c_real = ctypes.c_float
@@ -120,29 +223,54 @@ _R4 = c_real * N_INPUTS
 _R44 = (c_real * N_INPUTS) * N_INPUTS
 
 
-class Config(ctypes.Structure):
-    """icoac_config_t."""
+class PolicyConfig(ctypes.Structure):
+    """icoac_policy_config_t: state -> feature z -> force (every mode)."""
     _fields_ = [
-        ("mode", ctypes.c_int32),
-        ("reflex_mode", ctypes.c_int32),
-        ("ico_timing", ctypes.c_int32),
-        ("clip_inputs", ctypes.c_int32),
         ("input_range", _R4),
+        ("clip_inputs", ctypes.c_int32),
         ("gain", c_real),
+        ("reflex_mode", ctypes.c_int32),
         ("reflex_force", c_real),
         ("zone_theta", c_real),
         ("zone_x", c_real),
-        ("ico_rate", c_real),
-        ("critic_rate", c_real),
+    ]
+
+
+class IcoConfig(ctypes.Structure):
+    """icoac_ico_config_t: the ICO rule (ICO mode)."""
+    _fields_ = [("rate", c_real), ("timing", ctypes.c_int32)]
+
+
+class CriticConfig(ctypes.Structure):
+    """icoac_critic_config_t: the normalized-Gaussian critic (RL mode)."""
+    _fields_ = [
+        ("rate", c_real),
         ("discount", c_real),
         ("td_clip", c_real),
-        ("critic_range", _R4),
-        ("critic_threshold", c_real),
+        ("range", _R4),
+        ("threshold", c_real),
+    ]
+
+
+class ActorConfig(ctypes.Structure):
+    """icoac_actor_config_t: the Bayesian actor and its exploration (RL mode)."""
+    _fields_ = [
         ("noise_std", c_real),
-        ("actor_scale", c_real),
+        ("scale", c_real),
         ("forgetting", c_real),
-        ("rl_reflex", ctypes.c_int32),
+        ("reflex", ctypes.c_int32),
         ("act_with_sample", ctypes.c_int32),
+    ]
+
+
+class Config(ctypes.Structure):
+    """icoac_config_t: the mode and one group per concern."""
+    _fields_ = [
+        ("mode", ctypes.c_int32),
+        ("policy", PolicyConfig),
+        ("ico", IcoConfig),
+        ("critic", CriticConfig),
+        ("actor", ActorConfig),
     ]
 
 
@@ -151,53 +279,15 @@ class Prior(ctypes.Structure):
     _fields_ = [("mean", _R4), ("cov", _R44)]
 
 
-class Rng(ctypes.Structure):
-    """icoac_rng_t."""
-    _fields_ = [("state", ctypes.c_uint64), ("increment", ctypes.c_uint64),
-                ("spare_normal", c_real), ("has_spare", ctypes.c_int32)]
-
-
-CRITIC_UNITS = 3 * 3 * 6 * 3
-CRITIC_PAIRS = 3 * 3
-CRITIC_CELLS = 6 * 3
-INPUT_TERMINAL = 1
-
-
-class CriticActive(ctypes.Structure):
-    """icoac_critic_active_t: critic units kept at one state."""
-    _fields_ = [
-        ("pair_product", c_real * CRITIC_PAIRS),
-        ("cell_product", c_real * (CRITIC_CELLS + 1)),
-        ("pair", ctypes.c_uint8 * CRITIC_PAIRS),
-        ("pair_cells", ctypes.c_uint8 * CRITIC_PAIRS),
-        ("cell", ctypes.c_uint8 * CRITIC_CELLS),
-        ("pairs", ctypes.c_uint8),
-        ("cells", ctypes.c_uint8),
-    ]
+class Counters(ctypes.Structure):
+    """icoac_counters_t (icoac_get_counters)."""
+    _fields_ = [("ticks", ctypes.c_uint32), ("nonfinite", ctypes.c_uint32), ("numeric_faults", ctypes.c_uint32)]
 
 
 class State(ctypes.Structure):
-    """icoac_state_t (opaque to callers; mirrored for size checks and direct controller tests)."""
-    _fields_ = [
-        ("magic", ctypes.c_uint32),
-        ("has_prev", ctypes.c_int32),
-        ("inv_range", _R4),
-        ("w", _R4),
-        ("weight_norm", c_real),
-        ("cov", _R44),
-        ("w_act", _R4),
-        ("v", c_real * CRITIC_UNITS),
-        ("active", CriticActive * 2),
-        ("active_slot", ctypes.c_int32),
-        ("x_prev", _R4),
-        ("penalty_prev", c_real),
-        ("value_prev", c_real),
-        ("noise_prev", c_real),
-        ("rng", Rng),
-        ("ticks", ctypes.c_uint32),
-        ("nonfinite_count", ctypes.c_uint32),
-        ("numeric_fault_count", ctypes.c_uint32),
-    ]
+    """icoac_state_t: opaque, 8-byte aligned storage of icoac_sizeof_state() bytes; no layout is
+    mirrored (read it with get_posterior and get_counters)."""
+    _fields_ = [("opaque", ctypes.c_uint64 * (STATE_SIZE // 8))]
 
 
 class Input(ctypes.Structure):
@@ -260,6 +350,97 @@ CELL_DTYPE = np.dtype([
     ("cov", np.float64, (N_INPUTS, N_INPUTS)),
 ], align=True)
 
+Mirror = Union[type, np.dtype]
+
+# C type -> (mirror, C sizeof function or None). icoac_counters_t has no sizeof function: its size
+# is the C rule applied to the C field table (end of the last member, rounded up to the alignment).
+MIRRORS: dict[str, tuple[Mirror, str | None]] = {
+    "icoac_config_t": (Config, "icoac_sizeof_config"),
+    "icoac_prior_t": (Prior, "icoac_sizeof_prior"),
+    "icoac_counters_t": (Counters, None),
+    "icoac_input_t": (Input, "icoac_sizeof_input"),
+    "icoac_output_t": (Output, "icoac_sizeof_output"),
+    "icoac_sim_plant_t": (Plant, "icoac_sim_sizeof_plant"),
+    "icoac_sim_run_t": (Run, "icoac_sim_sizeof_run"),
+    "icoac_sim_cell_t": (CELL_DTYPE, "icoac_sim_sizeof_cell"),
+}
+
+
+# -- layout checks -----------------------------------------------------------------------------------
+def mirror_fields(mirror: Mirror) -> dict[str, tuple[int, int]]:
+    """{member designator: (offset, size)} of a ctypes structure or numpy record dtype, nested
+    structures flattened with dotted names ("policy.gain"); arrays are one member."""
+    if isinstance(mirror, np.dtype):
+        return {name: (int(mirror.fields[name][1]), int(mirror.fields[name][0].itemsize)) for name in mirror.names}
+    out: dict[str, tuple[int, int]] = {}
+    for name, ctype in mirror._fields_:
+        offset = getattr(mirror, name).offset
+        if isinstance(ctype, type) and issubclass(ctype, ctypes.Structure):
+            for sub, (off, size) in mirror_fields(ctype).items():
+                out[f"{name}.{sub}"] = (offset + off, size)
+        else:
+            out[name] = (offset, ctypes.sizeof(ctype))
+    return out
+
+
+def mirror_size(mirror: Mirror) -> int:
+    return int(mirror.itemsize) if isinstance(mirror, np.dtype) else ctypes.sizeof(mirror)
+
+
+def check_mirror(c_type: str, mirror: Mirror, c_fields: Mapping[str, tuple[int, int]] | None = None,
+                 c_size: int | None = None) -> None:
+    """Raise LibraryError naming the first member of ``c_type`` whose name, offset or size differs
+    between the C field table (default: the library's) and ``mirror``, or a different total size."""
+    if c_fields is None:
+        if c_type not in FIELDS:
+            raise _stale(f"{c_type} missing from icoac_sim_fields")
+        c_fields = FIELDS[c_type]
+    py = mirror_fields(mirror)
+    for name in c_fields:
+        if name not in py:
+            raise _stale(f"{c_type}.{name} is in the C layout but not in the binding")
+    for name in py:
+        if name not in c_fields:
+            raise _stale(f"{c_type}.{name} is in the binding but not in the C layout")
+    for name, (offset, size) in c_fields.items():
+        if py[name] != (offset, size):
+            raise _stale(f"{c_type}.{name}: C offset {offset} size {size}, binding offset {py[name][0]} "
+                         f"size {py[name][1]}")
+    if c_size is not None and mirror_size(mirror) != c_size:
+        raise _stale(f"sizeof({c_type}): C {c_size}, binding {mirror_size(mirror)}")
+
+
+def _c_size(c_type: str, size_fn: str | None) -> int:
+    if size_fn is not None:
+        return int(getattr(lib, size_fn)())
+    ends = [off + size for off, size in FIELDS[c_type].values()]
+    align = max(min(size, 8) for _, size in FIELDS[c_type].values())  # scalar members only here
+    return -(-max(ends) // align) * align
+
+
+def layout_report() -> dict:
+    """Python vs C sizes of every mirrored type and of the state, and the ABI versions."""
+    report = {
+        "abi_version": (ABI_VERSION, lib.icoac_abi_version()),
+        "sim_abi_version": (SIM_ABI_VERSION, lib.icoac_sim_abi_version()),
+        "real": (ctypes.sizeof(c_real), _SIZEOF_REAL),
+        "state": (ctypes.sizeof(State), lib.icoac_sizeof_state()),
+    }
+    for c_type, (mirror, size_fn) in MIRRORS.items():
+        report[c_type] = (mirror_size(mirror), _c_size(c_type, size_fn) if c_type in FIELDS else None)
+    return report
+
+
+def _check_layout() -> None:
+    for c_type, (mirror, size_fn) in MIRRORS.items():
+        check_mirror(c_type, mirror, c_size=_c_size(c_type, size_fn) if c_type in FIELDS else None)
+    if ctypes.sizeof(State) != lib.icoac_sizeof_state() or STATE_SIZE % 8 or ctypes.alignment(State) != 8:
+        raise _stale(f"icoac_state_t: C {lib.icoac_sizeof_state()} bytes, ICOAC_STATE_SIZE {STATE_SIZE}, "
+                     f"binding {ctypes.sizeof(State)} bytes aligned to {ctypes.alignment(State)}")
+
+
+_check_layout()
+
 # -- prototypes ----------------------------------------------------------------------------------
 _P = ctypes.POINTER
 _cells_p = ndpointer(CELL_DTYPE, flags="C_CONTIGUOUS,WRITEABLE")
@@ -284,10 +465,12 @@ _PROTOTYPES = {
     "icoac_status_str": ([ctypes.c_int], ctypes.c_char_p),
     "icoac_config_default": ([_P(Config)], None),
     "icoac_config_check": ([_P(Config)], ctypes.c_int),
+    "icoac_config_check_field": ([_P(Config), _P(ctypes.c_char_p)], ctypes.c_int),
     "icoac_init": ([_P(Config), _P(State), _P(Prior), ctypes.c_uint64], ctypes.c_int),
     "icoac_reset": ([_P(Config), _P(State)], ctypes.c_int),
     "icoac_step": ([_P(Config), _P(State), _P(Input), _P(Output)], ctypes.c_int),
     "icoac_get_posterior": ([_P(State), _P(Prior)], ctypes.c_int),
+    "icoac_get_counters": ([_P(State), _P(Counters)], ctypes.c_int),
     "icoac_prior_check": ([_P(Prior)], ctypes.c_int),
     "icoac_mix_seed": ([ctypes.c_uint64, ctypes.c_uint64], ctypes.c_uint64),
     "icoac_sim_status_str": ([ctypes.c_int32], ctypes.c_char_p),
@@ -316,9 +499,22 @@ for _name, (_args, _res) in _PROTOTYPES.items():
 
 
 def status_str(status: int) -> str:
-    """C message of a status (icoac_sim_status_str passes values < 100 to icoac_status_str)."""
-    text = lib.icoac_sim_status_str(int(status))
+    """C message of a status: icoac_status_str for icoac_status_t values, icoac_sim_status_str
+    for the others."""
+    status = int(status)
+    if not -2 ** 31 <= status < 2 ** 31:
+        return f"status {status}"
+    fn = lib.icoac_status_str if status in CONTROLLER_STATUSES else lib.icoac_sim_status_str
+    text = fn(status)
     return text.decode("utf-8", "replace") if text else f"status {status}"
+
+
+def status_name(status: int) -> str:
+    """Short name of a status: its C message up to the first ':' or ' (' ("numeric failure")."""
+    text = status_str(status)
+    for stop in (":", " ("):
+        text = text.split(stop, 1)[0]
+    return text
 
 
 def check_status(status: int, context: str | None = None) -> None:
@@ -326,39 +522,25 @@ def check_status(status: int, context: str | None = None) -> None:
     status = int(status)
     if status == OK:
         return
-    if status in _CONFIG_STATUSES:
+    if status in CONFIG_STATUSES:
         raise ConfigError(status, context=context)
     if status == SIM_CANCELLED:
         raise Cancelled(status, context=context)
     raise IcoacError(status, context=context)
 
 
-# -- layout checks ---------------------------------------------------------------------------------
-def layout_report() -> dict:
-    """Python vs C sizes of every mirrored type, and the ABI versions."""
-    return {
-        "abi_version": (ABI_VERSION, lib.icoac_abi_version()),
-        "sim_abi_version": (SIM_ABI_VERSION, lib.icoac_sim_abi_version()),
-        "config": (ctypes.sizeof(Config), lib.icoac_sizeof_config()),
-        "prior": (ctypes.sizeof(Prior), lib.icoac_sizeof_prior()),
-        "state": (ctypes.sizeof(State), lib.icoac_sizeof_state()),
-        "input": (ctypes.sizeof(Input), lib.icoac_sizeof_input()),
-        "output": (ctypes.sizeof(Output), lib.icoac_sizeof_output()),
-        "plant": (ctypes.sizeof(Plant), lib.icoac_sim_sizeof_plant()),
-        "run": (ctypes.sizeof(Run), lib.icoac_sim_sizeof_run()),
-        "cell": (CELL_DTYPE.itemsize, lib.icoac_sim_sizeof_cell()),
-    }
+def get_posterior(state: State) -> Prior:
+    """Current weights and covariance of a controller state (icoac_get_posterior)."""
+    post = Prior()
+    check_status(lib.icoac_get_posterior(ctypes.byref(state), ctypes.byref(post)), "get posterior")
+    return post
 
 
-def _check_layout() -> None:
-    bad = {k: v for k, v in layout_report().items() if v[0] != v[1]}
-    if bad:
-        detail = ", ".join(f"{k}: python {p} != C {c}" for k, (p, c) in bad.items())
-        raise LibraryError(f"{LIBRARY_PATH} does not match the harness binding ({detail}); "
-                           "rebuild it with `make build`")
-
-
-_check_layout()
+def get_counters(state: State) -> Counters:
+    """Tick counters of a controller state (icoac_get_counters)."""
+    counters = Counters()
+    check_status(lib.icoac_get_counters(ctypes.byref(state), ctypes.byref(counters)), "get counters")
+    return counters
 
 
 def abi_info() -> dict:

@@ -9,20 +9,23 @@ import json
 import math
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from . import _binding as B
-from . import metrics
+from . import figures, geometry, grid, metrics, results
+from . import prior as P
+from .conditions import run_condition
+from .config import build_config, parse_sets
+from .metrics import percent
+from .options import CONDITION_LABELS as LABELS, CONDITIONS, PROFILE_NAMES
 
-CONDITIONS = ("ico", "ico-rl", "rl")
-LABELS = {"ico": "ICO", "rl": "RL", "ico-rl": "ICO->RL"}
 # Paper (Fig. 1b, 2b, 3a): ~68 % ICO, ~84 % ICO->RL; RL alone only "smaller" and "very slow" (Fig. 3 bars).
 PAPER = {
-    "ico": {"success_rate": 0.68, "note": "Fig. 1b: ~68 %; fast (Fig. 3b)"},
-    "ico-rl": {"success_rate": 0.84, "note": "Fig. 2b: ~84 %; most cells 5-2000 trials, a few > 2000"},
+    "ico": {"success_rate": 0.68, "note": "Fig. 1b; fast (Fig. 3b)"},
+    "ico-rl": {"success_rate": 0.84, "note": "Fig. 2b; most cells 5-2000 trials, a few > 2000"},
     "rl": {"success_rate": None, "note": "Fig. 3: smaller domain than ICO, very slow; no number in the text"},
 }
 
@@ -30,7 +33,7 @@ PAPER = {
 # Fig. 1g's start (row 8, column 19) and enough central cells for a prior.
 QUICK_ROWS = (2, 8, 10, 12, 14, 22)
 QUICK_COLS = (4, 19, 22, 24, 26, 44)
-QUICK_CELLS = sorted(r * B.GRID_XS + c for r in QUICK_ROWS for c in QUICK_COLS)
+QUICK_CELLS = sorted(int(geometry.cell_index(r, c)) for r in QUICK_ROWS for c in QUICK_COLS)
 
 PROFILES: dict[str, dict[str, Any]] = {
     # ICO at the paper's caps (1e5 trials, 1e5 steps), RL conditions with a reduced trial cap.
@@ -42,6 +45,7 @@ PROFILES: dict[str, dict[str, Any]] = {
     "quick": {"seeds": 2, "ico": {"max_trials": 6000, "success_steps": 2000},
               "rl": {"max_trials": 600, "success_steps": 2000}, "cells": QUICK_CELLS},
 }
+assert tuple(PROFILES) == PROFILE_NAMES
 
 
 def seed_dir(out: Path, condition: str, seed: int) -> Path:
@@ -92,7 +96,7 @@ def _fmt(stat: Mapping[str, Any] | None, pct: bool = False) -> str:
     if not stat or stat.get("mean") is None:
         return "n/a"
     if pct:
-        return f"{100 * stat['mean']:.1f} ± {100 * stat['sd']:.1f} %"
+        return f"{percent(stat['mean'])} ± {percent(stat['sd'])}"
     return f"{stat['mean']:.4g} ± {stat['sd']:.2g}"
 
 
@@ -106,7 +110,7 @@ def summary_markdown(agg: Mapping[str, Any]) -> str:
             continue
         e = agg[cond]
         paper = e["paper"] or {}
-        ptxt = (f"{100 * paper['success_rate']:.0f} %; " if paper.get("success_rate") else "") + paper.get("note", "")
+        ptxt = (f"{percent(paper['success_rate'], 0)}; " if paper.get("success_rate") else "") + paper.get("note", "")
         lines.append(f"| {LABELS[cond]} | {len(e['seeds'])} | {e['max_trials']:g} / {e['success_steps']:g} | "
                      f"{_fmt(e['success_rate'], True)} of {e['n_cells']} | "
                      f"{_fmt(e['success_rate_interior'], True)} of {e['n_interior']} | "
@@ -114,8 +118,9 @@ def summary_markdown(agg: Mapping[str, Any]) -> str:
     if "ico-rl" in agg and agg["ico-rl"].get("ico_phase_simulated_time", {}).get("mean") is not None:
         lines += ["", "ICO->RL counts RL-phase trials only (A17); the ICO phase that produced each prior took "
                   f"{_fmt(agg['ico-rl']['ico_phase_simulated_time'])} s of simulated time (whole ICO grid)."]
-    lines += ["", "Success rates use the cells run as denominator (1225 / 1081 on the full grid). "
-              "The paper's ~68 % / ~84 % are read as fractions of all 1225 cells."]
+    lines += ["", f"Success rates use the cells run as denominator ({geometry.CELLS} / {geometry.N_INTERIOR} on "
+              f"the full grid). The paper's ~{percent(PAPER['ico']['success_rate'], 0)} / "
+              f"~{percent(PAPER['ico-rl']['success_rate'], 0)} are read as fractions of all {geometry.CELLS} cells."]
     return "\n".join(lines) + "\n"
 
 
@@ -131,14 +136,12 @@ def write_summary(out: Path, agg: Mapping[str, Any]) -> tuple[Path, Path]:
 def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarray | None,
                        icorl_cells: np.ndarray | None, frame=None) -> list[Path]:
     """Fig. 2b (first ICO->RL seed, ICO success domain outlined), Fig. 3a, Fig. 3b."""
-    from . import figures
-
     figdir = Path(figdir)
     written = []
     if icorl_cells is not None:
         outline = None
         if ico_cells is not None:
-            outline = metrics.to_grid(ico_cells, metrics.success_mask(ico_cells).astype(float), fill=0) > 0
+            outline = geometry.to_grid(ico_cells, metrics.success_mask(ico_cells).astype(float), fill=0) > 0
         written.append(figures.plot_success_map(icorl_cells, figdir / "fig2b_icorl_success_map.png",
                                                 label="ICO->RL", outline=outline, frame=frame))
     conds = [c for c in CONDITIONS if c in agg]
@@ -185,3 +188,128 @@ class BenchLog:
 
 def progress(msg: str) -> None:
     print(f"[bench] {msg}", file=sys.stderr, flush=True)
+
+
+# -- the stages ---------------------------------------------------------------------------------------
+@dataclass
+class Stage:
+    name: str
+    run: Callable[[dict], None]
+
+
+@dataclass
+class BenchOptions:
+    """What `bench` runs: a profile, seeds --seed .. --seed + seeds - 1 (seeds None: the profile's
+    number), overrides and prior options; see harness.cli for the command line."""
+    profile: str
+    out: Path
+    figures: Path | None = None
+    seed: int = 0
+    seeds: int | None = None
+    rl_max_trials: int | None = None
+    threads: int = 0
+    sets: Sequence[str] = ()
+    resume: bool = False
+    quiet: bool = False
+    frame: tuple[float, float] | None = P.DEFAULT_FRAME
+    ridge: float = P.DEFAULT_RIDGE
+    rl_cov: str = "ico"
+
+    def seed_list(self) -> list[int]:
+        n = self.seeds if self.seeds is not None else PROFILES[self.profile]["seeds"]
+        return grid.seed_range(self.seed, n)
+
+
+def stages(opt: BenchOptions) -> list[Stage]:
+    """ICO grid per seed, prior per seed, ICO->RL and RL grids per seed, summary, figures. Every
+    argument and override is validated here, before anything runs or is written."""
+    profile = PROFILES[opt.profile]
+    out = Path(opt.out)
+    figdir = Path(opt.figures) if opt.figures else None
+    seeds = opt.seed_list()
+    sets = parse_sets(opt.sets)
+    cells_spec = profile["cells"]
+
+    def overrides(condition):
+        over = dict(profile["ico"] if condition == "ico" else profile["rl"])
+        if condition != "ico" and opt.rl_max_trials is not None:
+            over["max_trials"] = opt.rl_max_trials
+        over.update(sets)
+        return over
+
+    def grid_stage(condition: str, seed: int):
+        def run(ctx):
+            d = seed_dir(out, condition, seed)
+            cells, record, cancelled = run_condition(
+                condition=condition, out=d, seed=seed, threads=opt.threads, overrides=overrides(condition),
+                cell_spec=cells_spec, resume=opt.resume and results.exists(d), fresh=not opt.resume,
+                progress=not opt.quiet, info=ctx.get(("prior", condition, seed)),
+                start_over="rerun bench without --resume")
+            ctx[(condition, seed)] = (cells, record)
+            s = record["summary"]
+            progress(f"  {condition} seed {seed}: success {s['n_success']}/{s['n_cells']}, "
+                     f"grid wall time {record['wall_time']:.1f} s")
+            if cancelled:
+                raise KeyboardInterrupt
+        return Stage(f"grid {condition} seed-{seed}", run)
+
+    def prior_stage(seed: int):
+        def run(ctx):
+            info = P.from_results(seed_dir(out, "ico", seed), opt.frame, opt.ridge)
+            ctx[("prior", "ico-rl", seed)] = info
+            ctx[("prior", "rl", seed)] = P.rl_prior(info, opt.rl_cov)
+            progress(f"  prior seed {seed}: {info.n_cells} cells, mean "
+                     + ", ".join(f"{v:.4g}" for v in info.mean))
+        return Stage(f"prior seed-{seed}", run)
+
+    def figures_stage(ctx):
+        if figdir is None:
+            return
+        cells, record = ctx[("ico", seeds[0])]
+        for path in figures.make_figures(cells, record, figdir):
+            progress(f"  wrote {path}")
+        for path in comparison_figures(ctx["aggregate"], figdir, cells, ctx[("ico-rl", seeds[0])][0],
+                                       frame=opt.frame):
+            progress(f"  wrote {path}")
+
+    def summary_stage(ctx):
+        recs = {c: [ctx[(c, s)][1] for s in seeds if (c, s) in ctx] for c in CONDITIONS}
+        agg = aggregate(recs)
+        ctx["aggregate"] = agg
+        md, js = write_summary(out, agg)
+        print(md.read_text(), end="")
+        progress(f"  wrote {md} and {js}")
+
+    for condition in CONDITIONS:  # every override valid before the first grid runs
+        build_config(overrides(condition), condition=condition)
+
+    out_stages = [grid_stage("ico", s) for s in seeds]
+    out_stages += [prior_stage(s) for s in seeds]
+    out_stages += [grid_stage("ico-rl", s) for s in seeds]
+    out_stages += [grid_stage("rl", s) for s in seeds]
+    out_stages += [Stage("summary", summary_stage), Stage("figures", figures_stage)]
+    return out_stages
+
+
+def run_bench(opt: BenchOptions, argv: Sequence[str] = ()) -> int:
+    """Validate, then run every stage, logging wall times to OUT/bench.json; 130 if interrupted."""
+    ctx: dict = {}
+    todo = stages(opt)  # validates the arguments before anything is written
+    results.check_writable(opt.out)
+    log = BenchLog(Path(opt.out), {
+        "profile": opt.profile, "seeds": opt.seed_list(),
+        "rl_max_trials": opt.rl_max_trials, "resume": bool(opt.resume), "threads": opt.threads,
+        "set": list(opt.sets), "argv": list(argv)})
+    for i, stage in enumerate(todo, 1):
+        progress(f"({i}/{len(todo)}) {stage.name}")
+        t0 = time.monotonic()
+        try:
+            stage.run(ctx)
+        except KeyboardInterrupt:
+            log.stage(stage.name, time.monotonic() - t0, interrupted=True)
+            print(f"interrupted during {stage.name}; finished cells saved, rerun with --resume", file=sys.stderr)
+            return 130
+        log.stage(stage.name, time.monotonic() - t0)
+    log.flush(complete=True)
+    progress(f"total wall time {log.data['total_wall_time']:.1f} s -> {Path(opt.out) / 'bench.json'}")
+    return 0

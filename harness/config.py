@@ -1,39 +1,132 @@
-"""Configurations: C defaults plus overrides by field name, validated by the C check functions."""
+"""Configurations: C defaults plus overrides by field name, validated by the C check functions.
+
+Names. The canonical name of a controller field is its member designator in icoac_config_t,
+"group.field" (``mode``, ``policy.gain``, ``ico.timing``, ``critic.range``, ``actor.noise_std``);
+plant and run fields keep their member names (``dt``, ``integrator``, ``max_trials``). The flat
+names of the ABI-3 configuration (``gain``, ``ico_timing``, ``noise_std``, ``actor_scale``,
+``rl_reflex``, ...) are aliases, defined once in ALIASES; ``--set``, ``sweep --param``, the Python
+API and old run.json files accept both, and every record is written with the canonical names,
+the controller nested by group.
+"""
 from __future__ import annotations
 
 import ctypes
+import difflib
 import json
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any, Iterable, Mapping
 
 import numpy as np
 
 from . import _binding as B
+from . import options
 from ._binding import ConfigError
+from .errors import UsageError
 
-# Symbolic names of the enum / boolean switches.
-ENUMS: dict[str, dict[str, int]] = {
-    "mode": {"ico": 0, "rl": 1},
-    "reflex_mode": {"unit": 0, "gain": 1},
-    "ico_timing": {"code": 0, "literal": 1},
-    "integrator": {"euler": 0, "rk4": 1},
+GROUPS = ("controller", "plant", "run")
+CONTROLLER_GROUPS = tuple(name for name, ctype in B.Config._fields_ if issubclass(ctype, ctypes.Structure))
+
+# Canonical names, in C order (nested members flattened with dots, as in the C field table).
+CONTROLLER_FIELDS = tuple(B.mirror_fields(B.Config))
+PLANT_FIELDS = tuple(n for n in B.mirror_fields(B.Plant) if n != "reserved")
+RUN_FIELDS = tuple(B.mirror_fields(B.Run))
+ALL_FIELDS = CONTROLLER_FIELDS + PLANT_FIELDS + RUN_FIELDS
+_GROUP_OF = {**{n: "controller" for n in CONTROLLER_FIELDS}, **{n: "plant" for n in PLANT_FIELDS},
+             **{n: "run" for n in RUN_FIELDS}}
+
+# The one alias table: flat ABI-3 name -> canonical name.
+ALIASES: dict[str, str] = {
+    "input_range": "policy.input_range",
+    "clip_inputs": "policy.clip_inputs",
+    "gain": "policy.gain",
+    "reflex_mode": "policy.reflex_mode",
+    "reflex_force": "policy.reflex_force",
+    "zone_theta": "policy.zone_theta",
+    "zone_x": "policy.zone_x",
+    "ico_rate": "ico.rate",
+    "ico_timing": "ico.timing",
+    "critic_rate": "critic.rate",
+    "discount": "critic.discount",
+    "td_clip": "critic.td_clip",
+    "critic_range": "critic.range",
+    "critic_threshold": "critic.threshold",
+    "noise_std": "actor.noise_std",
+    "actor_scale": "actor.scale",
+    "forgetting": "actor.forgetting",
+    "rl_reflex": "actor.reflex",
+    "act_with_sample": "actor.act_with_sample",
 }
-BOOLS = ("clip_inputs", "rl_reflex", "act_with_sample")
+assert set(ALIASES.values()) <= set(CONTROLLER_FIELDS) and not set(ALIASES) & set(ALL_FIELDS), ALIASES
+
+# Symbolic values of the switches (values from the C constant table) and the 0/1 flags.
+ENUMS: dict[str, dict[str, int]] = {
+    "mode": B.MODES,
+    "policy.reflex_mode": B.REFLEX_MODES,
+    "ico.timing": B.ICO_TIMINGS,
+    "integrator": B.INTEGRATORS,
+}
+BOOLS = ("policy.clip_inputs", "actor.reflex", "actor.act_with_sample")
 _BOOL_NAMES = {"true": 1, "false": 0, "on": 1, "off": 0, "yes": 1, "no": 0, "1": 1, "0": 0}
 
-CONTROLLER_FIELDS = tuple(name for name, _ in B.Config._fields_)
-PLANT_FIELDS = tuple(name for name, _ in B.Plant._fields_)
-RUN_FIELDS = tuple(name for name, _ in B.Run._fields_)
-ALL_FIELDS = CONTROLLER_FIELDS + PLANT_FIELDS + RUN_FIELDS
-
-# Named learning conditions: overrides applied on top of the defaults.
-CONDITIONS: dict[str, dict[str, Any]] = {
+# Overrides of each learning condition on top of the defaults.
+CONDITION_OVERRIDES: dict[str, dict[str, Any]] = {
     "ico": {"mode": "ico"},
     "rl": {"mode": "rl"},       # prior mean 0 (spec A16)
     "ico-rl": {"mode": "rl"},   # prior from an ICO grid (spec 7)
 }
+assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS)
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    """repr of a value, shortened for one-line messages."""
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def canonical(name: Any) -> str:
+    """The canonical name of a parameter given by its canonical name or an alias; ConfigError
+    (listing the valid names) for anything else."""
+    if isinstance(name, str):
+        if name in _GROUP_OF:
+            return name
+        if name in ALIASES:
+            return ALIASES[name]
+    hint = ""
+    if isinstance(name, str):
+        close = difflib.get_close_matches(name, list(ALL_FIELDS) + list(ALIASES), n=1)
+        hint = f" (did you mean {close[0]}?)" if close else ""
+    raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
+                      f"unknown parameter {_short(name)}{hint}; valid names: {', '.join(ALL_FIELDS)} "
+                      f"(or the flat aliases {', '.join(ALIASES)})")
+
+
+def group_of(name: str) -> str:
+    """'controller', 'plant' or 'run' of a canonical name."""
+    return _GROUP_OF[name]
+
+
+# -- fields of the ctypes structures, by canonical name ------------------------------------------------
+def _owner(struct: ctypes.Structure, name: str) -> tuple[ctypes.Structure, str]:
+    """(structure holding the member, member name) of a dotted name."""
+    *path, leaf = name.split(".")
+    for part in path:
+        struct = getattr(struct, part)
+    return struct, leaf
+
+
+def _ctype(struct: ctypes.Structure, name: str):
+    owner, leaf = _owner(struct, name)
+    return dict(owner._fields_)[leaf]
+
+
+def _get(struct: ctypes.Structure, name: str):
+    owner, leaf = _owner(struct, name)
+    value = getattr(owner, leaf)
+    if isinstance(value, ctypes.Array):
+        return [list(v) if isinstance(v, ctypes.Array) else v for v in value]
+    return value
 
 
 def _real_out(value: float) -> float:
@@ -44,64 +137,78 @@ def _real_out(value: float) -> float:
     return float(value)
 
 
-def _struct_to_dict(struct: ctypes.Structure) -> dict[str, Any]:
+def _value_out(name: str, ctype, value) -> Any:
+    """A field's value as written to JSON: symbolic switches, booleans, shortest reals."""
+    if isinstance(value, list):
+        return [_value_out(name, ctype._type_, v) for v in value]
+    if ctype is B.c_real:
+        value = _real_out(value)
+    elif ctype is ctypes.c_double:
+        value = float(value)
+    else:
+        value = int(value)
+    if name in ENUMS:
+        reverse = {v: k for k, v in ENUMS[name].items()}
+        return reverse.get(value, value)
+    if name in BOOLS:
+        return bool(value)
+    return value
+
+
+def _struct_to_dict(struct: ctypes.Structure, prefix: str = "") -> dict[str, Any]:
+    """Nested dict of a structure (nested structures as sub-dicts), canonical names' last parts as keys."""
     out: dict[str, Any] = {}
     for name, ctype in struct._fields_:
         value = getattr(struct, name)
-        if hasattr(value, "__len__"):
-            out[name] = [_real_out(v) if ctype._type_ is B.c_real else v for v in value]
-        elif ctype is B.c_real:
-            out[name] = _real_out(value)
-        elif ctype is ctypes.c_double:
-            out[name] = float(value)
+        if isinstance(value, ctypes.Structure):
+            out[name] = _struct_to_dict(value, f"{prefix}{name}.")
         else:
-            out[name] = int(value)
-    for name, names in ENUMS.items():
-        if name in out:
-            reverse = {v: k for k, v in names.items()}
-            out[name] = reverse.get(out[name], out[name])
-    for name in BOOLS:
-        if name in out:
-            out[name] = bool(out[name])
+            out[name] = _value_out(prefix + name, ctype, _get(struct, name))
     return out
 
 
+# -- parsing of values ---------------------------------------------------------------------------------
 _INT_LIMITS = {ctypes.c_int32: (-2 ** 31, 2 ** 31 - 1), ctypes.c_int64: (-2 ** 63, 2 ** 63 - 1)}
 _INT_TEXT = re.compile(r"[+-]?[0-9]{1,30}")
 
-# Status of a value rejected on the Python side: the one the C check would give for that field.
-_FIELD_STATUS: dict[str, int] = {
-    "input_range": B.ERR_BAD_SCALE, "gain": B.ERR_BAD_GAIN, "reflex_force": B.ERR_BAD_GAIN,
-    "zone_theta": B.ERR_BAD_ZONE, "zone_x": B.ERR_BAD_ZONE, "ico_rate": B.ERR_BAD_ICO_RATE,
-    "critic_rate": B.ERR_BAD_CRITIC, "discount": B.ERR_BAD_CRITIC, "td_clip": B.ERR_BAD_CRITIC,
-    "critic_range": B.ERR_BAD_CRITIC, "critic_threshold": B.ERR_BAD_CRITIC,
-    "noise_std": B.ERR_BAD_ACTOR, "actor_scale": B.ERR_BAD_ACTOR, "forgetting": B.ERR_BAD_ACTOR,
-}
+
+def _probe_statuses() -> dict[str, int]:
+    """Status the C checks give when each field alone is invalid (NaN, or -1 for integers), so
+    that a value rejected on the Python side carries the status C would give for that field.
+    A controller field is probed in each mode until one validates its group."""
+    out: dict[str, int] = {}
+    probes = ((B.Config, B.lib.icoac_config_default, B.lib.icoac_config_check, CONTROLLER_FIELDS),
+              (B.Plant, B.lib.icoac_sim_plant_default, B.lib.icoac_sim_plant_check, PLANT_FIELDS),
+              (B.Run, B.lib.icoac_sim_run_default, B.lib.icoac_sim_run_check, RUN_FIELDS))
+    for kind, default, check, names in probes:
+        for name in names:
+            for mode in (B.MODES.values() if kind is B.Config and name != "mode" else (None,)):
+                probe = kind()
+                default(ctypes.byref(probe))
+                if mode is not None:
+                    probe.mode = mode
+                owner, leaf = _owner(probe, name)
+                ctype = dict(owner._fields_)[leaf]
+                scalar = ctype._type_ if issubclass(ctype, ctypes.Array) else ctype
+                bad = -1 if scalar in _INT_LIMITS else math.nan
+                if issubclass(ctype, ctypes.Array):
+                    getattr(owner, leaf)[0] = bad
+                else:
+                    setattr(owner, leaf, bad)
+                status = int(check(ctypes.byref(probe)))
+                if status != B.OK:
+                    out[name] = status
+                    break
+            else:
+                raise B.LibraryError(f"the C check accepts {name} = {bad}; rebuild the library")
+    return out
 
 
-def _group(name: str) -> str:
-    if name in CONTROLLER_FIELDS:
-        return "controller"
-    return "plant" if name in PLANT_FIELDS else "run"
-
-
-def _status_of(name: str) -> int:
-    if name in _FIELD_STATUS:
-        return _FIELD_STATUS[name]
-    group = _group(name)
-    if group == "controller":
-        return B.ERR_BAD_MODE
-    return B.SIM_ERR_BAD_PLANT if group == "plant" else B.SIM_ERR_BAD_RUN
-
-
-def _short(value: Any, limit: int = 60) -> str:
-    """repr of a value, shortened for one-line messages."""
-    text = repr(value)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
+_FIELD_STATUS = _probe_statuses()
 
 
 def _bad(name: str, message: str) -> ConfigError:
-    return ConfigError(_status_of(name), f"{_group(name)} parameter {name}: {message}")
+    return ConfigError(_FIELD_STATUS[name], f"{group_of(name)} parameter {name}: {message}")
 
 
 def _is_number(value: Any) -> bool:
@@ -165,11 +272,11 @@ def _parse_scalar(name: str, ctype, value: Any):
         if isinstance(value, str):
             key = value.strip().lower()
             if key not in names:
-                raise ConfigError(_status_of(name), f"bad value {_short(value)} for {name}; valid: {', '.join(names)}")
+                raise _bad(name, f"bad value {_short(value)}; valid: {', '.join(names)}")
             return names[key]
         if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
             return _parse_int(name, ctypes.c_int32, value)  # value range checked by C
-        raise ConfigError(_status_of(name), f"bad value {_short(value)} for {name}; valid: {', '.join(names)}")
+        raise _bad(name, f"bad value {_short(value)}; valid: {', '.join(names)}")
     if name in BOOLS:
         if isinstance(value, (bool, np.bool_)):
             return int(value)
@@ -177,14 +284,16 @@ def _parse_scalar(name: str, ctype, value: Any):
             return _BOOL_NAMES[value.strip().lower()]
         if isinstance(value, (int, np.integer)) and int(value) in (0, 1):
             return int(value)
-        raise ConfigError(B.ERR_BAD_MODE, f"bad value {_short(value)} for {name}; expected true/false")
+        raise _bad(name, f"bad value {_short(value)}; expected true/false")
     if ctype in _INT_LIMITS:
         return _parse_int(name, ctype, value)
     return _parse_real(name, ctype, value)  # range checked by C
 
 
 def _set_field(struct: ctypes.Structure, name: str, value: Any) -> None:
-    ctype = dict(struct._fields_)[name]
+    """Set a field by canonical name (relative to struct), parsing and range-checking the value."""
+    owner, leaf = _owner(struct, name)
+    ctype = dict(owner._fields_)[leaf]
     if issubclass(ctype, ctypes.Array):
         if isinstance(value, str):
             try:
@@ -195,10 +304,9 @@ def _set_field(struct: ctypes.Structure, name: str, value: Any) -> None:
             value = value.tolist()
         if not isinstance(value, (list, tuple)) or len(value) != ctype._length_:
             raise _bad(name, f"bad value {_short(value)}; expected {ctype._length_} numbers")
-        arr = ctype(*[_parse_scalar(name, ctype._type_, v) for v in value])
-        setattr(struct, name, arr)
+        setattr(owner, leaf, ctype(*[_parse_scalar(name, ctype._type_, v) for v in value]))
     else:
-        setattr(struct, name, _parse_scalar(name, ctype, value))
+        setattr(owner, leaf, _parse_scalar(name, ctype, value))
 
 
 def parse_value(text: str) -> Any:
@@ -209,6 +317,21 @@ def parse_value(text: str) -> Any:
         return text
 
 
+def parse_sets(items: Iterable[str] | None, option: str = "--set") -> dict[str, Any]:
+    """``NAME=VALUE`` strings -> {canonical name: value}; a later item for the same field (under
+    any of its names) wins. UsageError for an item without '=', ConfigError for an unknown name."""
+    out: dict[str, Any] = {}
+    for item in items or []:
+        if "=" not in item:
+            raise UsageError(f"{option} expects name=value, got {_short(item)}")
+        name, value = item.split("=", 1)
+        name = canonical(name.strip())
+        out.pop(name, None)
+        out[name] = parse_value(value.strip())
+    return out
+
+
+# -- configurations ------------------------------------------------------------------------------------
 @dataclass
 class RunConfig:
     """Controller, plant and run parameters of one benchmark, plus an optional prior."""
@@ -218,24 +341,40 @@ class RunConfig:
     prior: B.Prior | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        out = {"controller": _struct_to_dict(self.controller),
-               "plant": _struct_to_dict(self.plant),
-               "run": _struct_to_dict(self.run)}
-        out["prior"] = prior_to_dict(self.prior) if self.prior is not None else None
-        return out
+        """The record of run.json: canonical names, the controller nested by group."""
+        plant = _struct_to_dict(self.plant)
+        return {"controller": _struct_to_dict(self.controller), "plant": plant,
+                "run": _struct_to_dict(self.run),
+                "prior": prior_to_dict(self.prior) if self.prior is not None else None}
+
+    def flat(self) -> dict[str, Any]:
+        """{canonical name: value as in to_dict} of every parameter (plant.reserved excluded)."""
+        return {name: _value_out(name, _ctype(self._struct(name), name), _get(self._struct(name), name))
+                for name in ALL_FIELDS}
+
+    def _struct(self, name: str) -> ctypes.Structure:
+        return getattr(self, group_of(name))
 
     def check(self) -> "RunConfig":
         """Validate with the C check functions; raise ConfigError carrying the C message and naming
-        the parameter(s) the C check rejects."""
+        the field the C check rejects (icoac_config_check_field for the controller)."""
+        bad = ctypes.c_char_p()
+        status = int(B.lib.icoac_config_check_field(ctypes.byref(self.controller), ctypes.byref(bad)))
+        if status != B.OK:
+            designator = bad.value.decode() if bad.value else None
+            text = B.status_str(status) + (f"; rejected: {_designated(self.controller, designator)}"
+                                           if designator else "")
+            if status not in B.CONFIG_STATUSES:
+                B.check_status(status, "controller config")
+            raise ConfigError(status, text, context="controller config")
         for label, struct, check_fn, default_fn in (
-                ("controller config", self.controller, B.lib.icoac_config_check, B.lib.icoac_config_default),
                 ("plant config", self.plant, B.lib.icoac_sim_plant_check, B.lib.icoac_sim_plant_default),
                 ("run config", self.run, B.lib.icoac_sim_run_check, B.lib.icoac_sim_run_default)):
             status = int(check_fn(ctypes.byref(struct)))
             if status != B.OK:
                 culprits = _culprits(struct, check_fn, default_fn)
                 text = B.status_str(status) + (f"; rejected: {culprits}" if culprits else "")
-                if status not in B._CONFIG_STATUSES:
+                if status not in B.CONFIG_STATUSES:
                     B.check_status(status, label)
                 raise ConfigError(status, text, context=label)
         if self.prior is not None:
@@ -243,21 +382,32 @@ class RunConfig:
         return self
 
 
+_DESIGNATOR = re.compile(r"([a-z_.]+)((?:\[[0-9]+\])*)")
+
+
+def _designated(controller: B.Config, designator: str) -> str:
+    """'critic.range[0]=0.0': the member C names, with its value."""
+    m = _DESIGNATOR.fullmatch(designator)
+    if not m or m.group(1) not in CONTROLLER_FIELDS:
+        return designator
+    value = _value_out(m.group(1), _ctype(controller, m.group(1)), _get(controller, m.group(1)))
+    for index in re.findall(r"\[([0-9]+)\]", m.group(2)):
+        if isinstance(value, list) and int(index) < len(value):
+            value = value[int(index)]
+    return f"{designator}={value!r}"
+
+
 def _culprits(struct: ctypes.Structure, check_fn, default_fn) -> str:
-    """The fields of a struct the C check rejects: those that differ from the C default and fail
-    the check on their own (or, when only a combination fails, every field that differs)."""
+    """The fields of a plant or run the C check rejects: those that differ from the C default and
+    fail the check on their own (or, when only a combination fails, every field that differs)."""
     def fresh():
         out = type(struct)()
         default_fn(ctypes.byref(out))
         return out
 
-    def value(s, name):
-        v = getattr(s, name)
-        return list(v) if hasattr(v, "__len__") else v
-
     ref = fresh()
     differ = [name for name, _ in struct._fields_
-              if name != "reserved" and not _same(value(struct, name), value(ref, name))]
+              if name != "reserved" and not _same(_get(struct, name), _get(ref, name))]
     alone = []
     for name in differ:
         probe = fresh()
@@ -274,6 +424,7 @@ def _same(a, b) -> bool:
     return a == b
 
 
+# -- priors --------------------------------------------------------------------------------------------
 def prior_to_dict(prior: B.Prior) -> dict[str, Any]:
     return {"mean": [_real_out(v) for v in prior.mean],
             "cov": [[_real_out(v) for v in row] for row in prior.cov]}
@@ -327,16 +478,11 @@ def check_prior(prior: B.Prior) -> None:
     B.check_status(B.lib.icoac_prior_check(ctypes.byref(prior)), "prior")
 
 
-def _resolve(name: Any) -> str:
-    if not isinstance(name, str) or name not in ALL_FIELDS or name == "reserved":
-        valid = ", ".join(n for n in ALL_FIELDS if n != "reserved")
-        raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"unknown parameter {_short(name)}; valid names: {valid}")
-    return name
-
-
+# -- building and reading configurations ---------------------------------------------------------------
 def build_config(overrides: Mapping[str, Any] | None = None, condition: str | None = None,
                  prior: B.Prior | None = None, check: bool = True) -> RunConfig:
-    """C defaults, then the condition's overrides, then ``overrides`` by field name; validated by C."""
+    """C defaults, then the condition's overrides, then ``overrides`` by field name (canonical or
+    alias; a later name for the same field wins); validated by C."""
     if overrides is not None and not isinstance(overrides, Mapping):
         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"overrides must be a mapping name -> value, got {_short(overrides)}")
     if prior is not None and not isinstance(prior, B.Prior):
@@ -345,53 +491,64 @@ def build_config(overrides: Mapping[str, Any] | None = None, condition: str | No
     B.lib.icoac_config_default(ctypes.byref(cfg.controller))
     B.lib.icoac_sim_plant_default(ctypes.byref(cfg.plant))
     B.lib.icoac_sim_run_default(ctypes.byref(cfg.run))
-    merged: dict[str, Any] = {}
+    items: list[tuple[Any, Any]] = []
     if condition is not None:
-        if not isinstance(condition, str) or condition not in CONDITIONS:
+        if not isinstance(condition, str) or condition not in CONDITION_OVERRIDES:
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
-                              f"unknown condition {_short(condition)}; valid: {', '.join(CONDITIONS)}")
-        merged.update(CONDITIONS[condition])
-    merged.update(overrides or {})
-    for name, value in merged.items():
-        name = _resolve(name)
-        if name in CONTROLLER_FIELDS:
-            target = cfg.controller
-        elif name in PLANT_FIELDS:
-            target = cfg.plant
-        else:
-            target = cfg.run
-        _set_field(target, name, value)
+                              f"unknown condition {_short(condition)}; valid: {', '.join(options.CONDITIONS)}")
+        items += CONDITION_OVERRIDES[condition].items()
+    items += (overrides or {}).items()
+    for name, value in items:
+        name = canonical(name)
+        _set_field(cfg._struct(name), name, value)
     if check:
         cfg.check()
     return cfg
 
 
-_GROUP_FIELDS = {"controller": CONTROLLER_FIELDS, "plant": PLANT_FIELDS, "run": RUN_FIELDS}
+def _controller_items(values: Mapping[str, Any], prefix: str = ""):
+    """(name, value) of a controller dict: nested groups ({"policy": {"gain": 10}}), dotted names
+    ("policy.gain") or flat aliases ("gain"); names not canonicalized yet."""
+    for key, value in values.items():
+        if not isinstance(key, str):
+            raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"configuration key {_short(key)} is not a name")
+        name = prefix + key
+        if name in CONTROLLER_GROUPS:
+            if not isinstance(value, Mapping):
+                raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
+                                  f"controller group {name!r} must be a mapping, got {_short(value)}")
+            yield from _controller_items(value, name + ".")
+        else:
+            yield name, value
 
 
 def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
-    """Inverse of RunConfig.to_dict. Groups may be partial (missing fields keep the C default);
-    a field in the wrong group, an unknown group or a malformed value raises ConfigError."""
+    """Inverse of RunConfig.to_dict; also reads the flat controller dict of ABI-3 records (names
+    mapped through ALIASES). Groups may be partial (missing fields keep the C default); a field in
+    the wrong group, an unknown group or a malformed value raises ConfigError."""
     if not isinstance(data, Mapping):
         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"configuration must be a mapping, got {_short(data)}")
-    unknown = [k for k in data if k not in ("controller", "plant", "run", "prior")]
+    unknown = [k for k in data if k not in GROUPS + ("prior",)]
     if unknown:
         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
-                          f"unknown configuration group {_short(unknown[0])}; valid: controller, plant, run, prior")
-    overrides: dict[str, Any] = {}
-    for group, names in _GROUP_FIELDS.items():
+                          f"unknown configuration group {_short(unknown[0])}; valid: {', '.join(GROUPS)}, prior")
+    overrides: list[tuple[str, Any]] = []
+    for group in GROUPS:
         values = data.get(group)
         if values is None:
             continue
         if not isinstance(values, Mapping):
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"configuration group {group!r} must be a mapping, got {_short(values)}")
-        for name, value in values.items():
+        items = _controller_items(values) if group == "controller" else values.items()
+        for name, value in items:
             if name == "reserved" and group == "plant":
                 if not (isinstance(value, int) and not isinstance(value, bool) and value == 0):
                     raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant parameter reserved must be 0, got {_short(value)}")
                 continue
-            if name not in names:
-                _resolve(name)  # unknown names list the valid ones
-                raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"{_short(name)} is a {_group(name)} parameter, not a {group} one")
-            overrides[name] = value
-    return build_config(overrides, prior=prior_from_dict(data.get("prior")), check=check)
+            name = canonical(name)
+            if group_of(name) != group:
+                raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
+                                  f"{_short(name)} is a {group_of(name)} parameter, not a {group} one")
+            overrides.append((name, value))
+    cfg = build_config(dict(overrides), prior=prior_from_dict(data.get("prior")), check=False)
+    return cfg.check() if check else cfg

@@ -14,7 +14,11 @@ from matplotlib import colors  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
 from . import _binding as B  # noqa: E402
-from . import metrics  # noqa: E402
+from . import geometry, metrics  # noqa: E402
+from .config import config_from_dict, make_prior  # noqa: E402
+from .grid import trajectory, trajectory_steps  # noqa: E402
+from .metrics import percent  # noqa: E402
+from .options import PRIOR_FRAME, TRAJECTORY_DURATION  # noqa: E402
 
 DPI = 150
 STYLE = {
@@ -30,9 +34,8 @@ STYLE = {
     "path.simplify": False,
     "svg.hashsalt": "icoac",
 }
-# Map extent: cell centres x0 = -2.4..2.4 m (0.1 m), theta0 = -12..12 deg (1 deg).
-MAP_EXTENT = (-2.45, 2.45, -12.5, 12.5)
-PRIOR_FRAME = (1.2, 6.0)  # |x0| <= 1.2 m, |theta0| <= 6 deg
+# Map extent: cells centred on the grid points (x0 = -2.4..2.4 m, theta0 = -12..12 deg).
+MAP_EXTENT = geometry.map_extent()
 # Paper panel order of Fig. 1c-f and index into (w_x, w_xdot, w_theta, w_thetadot).
 WEIGHT_PANELS = (("c", r"$w_\theta$", 2), ("d", r"$w_x$", 0), ("e", r"$w_{\dot\theta}$", 3), ("f", r"$w_{\dot x}$", 1))
 FIG1G_START = (-0.5, -4.0)  # x0 m, theta0 deg
@@ -56,27 +59,29 @@ def draw_frame(ax, half_x: float, half_theta_deg: float, **kw) -> None:
     """Dashed rectangle |x0| <= half_x, |theta0| <= half_theta_deg on a map axis."""
     style = dict(fill=False, linestyle="--", linewidth=1.2, edgecolor="black")
     style.update(kw)
-    ax.add_patch(Rectangle((-half_x - 0.05, -half_theta_deg - 0.5), 2 * half_x + 0.1, 2 * half_theta_deg + 1, **style))
+    dx, dth = geometry.X_STEP, geometry.THETA_STEP_DEG  # the frame encloses whole cells
+    ax.add_patch(Rectangle((-half_x - dx / 2, -half_theta_deg - dth / 2), 2 * half_x + dx, 2 * half_theta_deg + dth,
+                           **style))
 
 
 def draw_outline(ax, mask: np.ndarray, **kw) -> None:
     """Outline of a (25, 49) boolean domain (e.g. the ICO success domain on an RL map)."""
     style = dict(colors="black", linewidths=1.0, linestyles="--")
     style.update(kw)
-    x = np.linspace(MAP_EXTENT[0], MAP_EXTENT[1], B.GRID_XS + 1)
-    y = np.linspace(MAP_EXTENT[2], MAP_EXTENT[3], B.GRID_THETAS + 1)
+    x = np.linspace(MAP_EXTENT[0], MAP_EXTENT[1], geometry.XS + 1)
+    y = np.linspace(MAP_EXTENT[2], MAP_EXTENT[3], geometry.THETAS + 1)
     m = np.asarray(mask, dtype=bool)
-    for i in range(B.GRID_THETAS):
-        for j in range(B.GRID_XS):
+    for i in range(geometry.THETAS):
+        for j in range(geometry.XS):
             if not m[i, j]:
                 continue
             if i == 0 or not m[i - 1, j]:
                 ax.hlines(y[i], x[j], x[j + 1], **style)
-            if i == B.GRID_THETAS - 1 or not m[i + 1, j]:
+            if i == geometry.THETAS - 1 or not m[i + 1, j]:
                 ax.hlines(y[i + 1], x[j], x[j + 1], **style)
             if j == 0 or not m[i, j - 1]:
                 ax.vlines(x[j], y[i], y[i + 1], **style)
-            if j == B.GRID_XS - 1 or not m[i, j + 1]:
+            if j == geometry.XS - 1 or not m[i, j + 1]:
                 ax.vlines(x[j + 1], y[i], y[i + 1], **style)
 
 
@@ -92,8 +97,8 @@ def plot_map(ax, values: np.ndarray, *, cmap="viridis", norm=None, title: str | 
                     cmap=cm, norm=norm, interpolation="nearest")
     ax.set_xlabel(r"$x_0$ (m)")
     ax.set_ylabel(r"$\theta_0$ (deg)")
-    ax.set_xticks([-2.4, -1.2, 0.0, 1.2, 2.4])
-    ax.set_yticks([-12, -6, 0, 6, 12])
+    ax.set_xticks(np.linspace(geometry.X_FIRST, geometry.X_LAST, 5).round(6))
+    ax.set_yticks(np.linspace(geometry.THETA_FIRST_DEG, geometry.THETA_LAST_DEG, 5).round(6))
     for side in ax.spines.values():
         side.set_linewidth(0.8)
     if title:
@@ -109,10 +114,8 @@ def plot_map(ax, values: np.ndarray, *, cmap="viridis", norm=None, title: str | 
 
 
 def success_title(label: str, summary: Mapping) -> str:
-    def pct(v):
-        return "n/a" if v is None else f"{100 * v:.1f}%"
-    return (f"{label}: success {pct(summary['success_rate'])} ({summary['n_cells']} cells), "
-            f"interior {pct(summary['success_rate_interior'])}")
+    return (f"{label}: success {percent(summary['success_rate'])} ({summary['n_cells']} cells), "
+            f"interior {percent(summary['success_rate_interior'])}")
 
 
 def plot_success_map(cells: np.ndarray, path: str | Path, *, label: str = "ICO",
@@ -197,16 +200,12 @@ def plot_bars(path: str | Path, labels: Sequence[str], values: Sequence[float],
         return save_figure(fig, path)
 
 
-def fig1g_trajectory(cells: np.ndarray, cfg, duration: float = 30.0, seed: int = 0):
+def fig1g_trajectory(cells: np.ndarray, cfg, duration: float = TRAJECTORY_DURATION, seed: int = 0):
     """Trajectory from x0 = -0.5 m, theta0 = -4 deg with the final weights of that grid cell as prior mean.
     Returns None when the grid has no such cell."""
-    from .config import make_prior
-    from .grid import trajectory
-
     x0, th0 = FIG1G_START
-    rows, cols = metrics.grid_index(cells)
-    row = int(round(th0 - metrics.THETA_MIN_DEG))
-    col = int(round((x0 - metrics.X_MIN) / metrics.X_STEP))
+    rows, cols = geometry.grid_index(cells)
+    row, col = (int(v) for v in geometry.row_col(x0, th0))
     hit = np.flatnonzero((rows == row) & (cols == col))
     if hit.size == 0:
         return None, None
@@ -218,18 +217,13 @@ def fig1g_trajectory(cells: np.ndarray, cfg, duration: float = 30.0, seed: int =
 
 def check_duration(record: Mapping, duration: float) -> int:
     """Plant steps of the Fig. 1g trajectory for a run record; ConfigError if the duration is not
-    finite and > 0 or needs more than grid.MAX_TRAJECTORY_STEPS steps at the record's dt."""
-    from .config import config_from_dict
-    from .grid import trajectory_steps
+    finite and > 0 or needs more than options.MAX_TRAJECTORY_STEPS steps at the record's dt."""
     return trajectory_steps(duration, config_from_dict(record["config"]).plant.dt)
 
 
 def make_figures(cells: np.ndarray, record: Mapping, out: str | Path, *, label: str | None = None,
-                 prefix: str = "fig1", duration: float = 30.0) -> list[Path]:
+                 prefix: str = "fig1", duration: float = TRAJECTORY_DURATION) -> list[Path]:
     """Fig. 1b, 1c-f and 1g of one ICO results set; returns the files written."""
-    from .config import config_from_dict
-    from .grid import trajectory_steps
-
     out = Path(out)
     label = label or str(record.get("condition", "ICO")).upper()
     cfg = config_from_dict(record["config"])
@@ -270,7 +264,7 @@ def plot_fig3a(path: str | Path, labels: Sequence[str], all_stats: Sequence[Mapp
                 continue
             ax.hlines(100 * value, p - 0.45, p + 0.45, colors="black", linestyles="--", linewidth=1.2,
                       label="paper" if first else None)
-            ax.annotate(f"paper ~{100 * value:.0f} %", (p, 100 * value), textcoords="offset points",
+            ax.annotate(f"paper ~{percent(value, 0)}", (p, 100 * value), textcoords="offset points",
                         xytext=(0, 3), ha="center", fontsize=7)
             first = False
         ax.set_xticks(pos)

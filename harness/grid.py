@@ -15,13 +15,12 @@ import numpy as np
 
 from . import _binding as B
 from .config import RunConfig
+from .options import (DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, MAX_THREADS,  # noqa: F401
+                      MAX_TRAJECTORY_STEPS, SEED_LIMIT, TRAJECTORY_DURATION)
 
-
-SEED_LIMIT = 2 ** 64          # seeds are uint64
-MAX_THREADS = 1024           # --threads: 0 (all cores) .. MAX_THREADS
-DEFAULT_CHECKPOINT_CELLS = 25  # checkpoint when this many cells finished since the last one ...
-DEFAULT_CHECKPOINT_EVERY = 2.0  # ... or when this many seconds passed with at least one finished
-MAX_TRAJECTORY_STEPS = 1_000_000  # icoac_sim_trajectory buffers: 40 bytes per step (40 MB)
+# What icoac_sim_run_grid fills in; the caller sets the others (icoac_sim_cell_t).
+INPUT_FIELDS = ("x0", "theta0", "seed")
+RESULT_FIELDS = tuple(n for n in B.CELL_DTYPE.names if n not in INPUT_FIELDS)
 
 
 def _bad_arg(message: str) -> B.ConfigError:
@@ -39,6 +38,17 @@ def check_seed(seed, what: str = "seed") -> int:
     return int(seed)
 
 
+def seed_range(first, count, what: str = "--seed") -> list[int]:
+    """The seeds first .. first + count - 1 (the meaning of --seed S --seeds N everywhere);
+    ConfigError unless they are all uint64 and count >= 1."""
+    first = check_seed(first, what)
+    if not _is_int(count) or int(count) < 1:
+        raise _bad_arg(f"number of seeds must be an integer >= 1, got {count!r:.60}")
+    if first + int(count) > SEED_LIMIT:
+        raise _bad_arg(f"{what} {first} with {int(count)} seeds goes past 2^64 - 1")
+    return [first + i for i in range(int(count))]
+
+
 def check_threads(threads) -> int:
     """Thread count for the C runner: 0 (all cores) .. MAX_THREADS."""
     if not _is_int(threads) or not 0 <= int(threads) <= MAX_THREADS:
@@ -47,7 +57,7 @@ def check_threads(threads) -> int:
 
 
 def paper_grid(seed: int = 0) -> np.ndarray:
-    """The paper's 25 x 49 grid (row-major over theta0, then x0), every cell PENDING."""
+    """The paper's grid (row-major over theta0, then x0; harness.geometry), every cell PENDING."""
     seed = check_seed(seed)
     cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
     B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, seed), "paper grid")
@@ -137,8 +147,7 @@ def reset_pending(cells: np.ndarray, mask: np.ndarray | None = None) -> None:
     """Clear the result fields of cells in mask (default: every PENDING cell)."""
     if mask is None:
         mask = cells["outcome"] == B.PENDING
-    for name in ("outcome", "status", "trials", "total_steps", "last_trial_steps", "elapsed_time",
-                 "weights", "cov"):
+    for name in RESULT_FIELDS:
         cells[name][mask] = 0
 
 
@@ -332,7 +341,7 @@ def trajectory_steps(duration: float, dt: float) -> int:
     return int(steps)
 
 
-def trajectory(cfg: RunConfig, x0: float, theta0: float, duration: float = 30.0,
+def trajectory(cfg: RunConfig, x0: float, theta0: float, duration: float = TRAJECTORY_DURATION,
                seed: int = 0, init_velocity_noise: float | None = None) -> Trajectory:
     """One trial from (x0, theta0) with the controller initialised from cfg.prior (learning on),
     recorded for up to ``duration`` simulated seconds (icoac_sim_trajectory)."""

@@ -7,26 +7,7 @@ from typing import Any
 import numpy as np
 
 from . import _binding as B
-
-THETA_STEP_DEG = 1.0
-X_STEP = 0.1
-THETA_MIN_DEG = -12.0
-X_MIN = -2.4
-# Cells on the failure threshold rows/columns: |theta0| = 12 deg or |x0| = 2.4 m.
-_EDGE_TOL = 1e-9
-
-
-def grid_index(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(row, column) of each cell in the 25 x 49 paper grid: row = theta0 + 12 deg, column = (x0 + 2.4) / 0.1."""
-    rows = np.rint(np.degrees(cells["theta0"]) - THETA_MIN_DEG).astype(int)
-    cols = np.rint((cells["x0"] - X_MIN) / X_STEP).astype(int)
-    return rows, cols
-
-
-def interior_mask(cells: np.ndarray) -> np.ndarray:
-    """True for the 23 x 47 interior cells (theta0 = +-12 deg rows and x0 = +-2.4 m columns excluded)."""
-    rows, cols = grid_index(cells)
-    return (rows > 0) & (rows < B.GRID_THETAS - 1) & (cols > 0) & (cols < B.GRID_XS - 1)
+from .geometry import grid_index, interior_mask, to_grid  # noqa: F401 (part of this API)
 
 
 def success_mask(cells: np.ndarray) -> np.ndarray:
@@ -48,18 +29,12 @@ def weights(cells: np.ndarray, successful_only: bool = False) -> np.ndarray:
     return w
 
 
-def to_grid(cells: np.ndarray, values: np.ndarray, fill: float = np.nan) -> np.ndarray:
-    """Scatter per-cell values into a (25, 49) map (rows theta0 ascending, columns x0 ascending)."""
-    values = np.asarray(values, dtype=float)
-    out = np.full((B.GRID_THETAS, B.GRID_XS) + values.shape[1:], fill, dtype=float)
-    rows, cols = grid_index(cells)
-    out[rows, cols] = values
-    return out
-
-
-# Short names of the statuses an ERROR cell can carry (icoac_status_t / icoac_sim_status_t).
-STATUS_NAMES = {B.ERR_NULL: "null", B.ERR_NOT_INITIALISED: "not initialised",
-                B.ERR_NONFINITE_INPUT: "non-finite input", B.ERR_NUMERIC: "numeric"}
+def percent(value, digits: int = 1) -> str:
+    """A rate in [0, 1] as a percentage, e.g. 0.6016 -> '60.2 %'; 'n/a' for None or NaN. The one
+    formatting of rates in summaries, tables, progress lines and figure titles."""
+    if value is None or math.isnan(float(value)):
+        return "n/a"
+    return f"{100.0 * float(value):.{digits}f} %"
 
 
 def error_statuses(cells: np.ndarray) -> dict[str, int]:
@@ -110,8 +85,7 @@ def summary(cells: np.ndarray) -> dict[str, Any]:
 
 
 def format_summary(name: str, s: dict[str, Any]) -> str:
-    def pct(v):
-        return "n/a" if v is None else f"{100.0 * v:.1f}%"
+    pct = percent
 
     lines = [
         f"{name}: success {pct(s['success_rate'])} of {s['n_cells']} cells "
@@ -126,7 +100,7 @@ def format_summary(name: str, s: dict[str, Any]) -> str:
         lines.append(f"  {s['outcomes']['pending']} cells still PENDING")
     if s["outcomes"].get("error"):
         by = s.get("error_statuses") or {}
-        detail = ", ".join(f"{STATUS_NAMES.get(int(k), 'status ' + k)} ({k}): {n}" for k, n in by.items())
+        detail = ", ".join(f"{B.status_name(int(k))} ({k}): {n}" for k, n in by.items())
         lines.append(f"  {s['outcomes']['error']} cells reported a controller ERROR, counted neither as "
                      f"success nor as failure" + (f" [{detail}]" if detail else ""))
     return "\n".join(lines)

@@ -14,16 +14,12 @@ from typing import Any
 import numpy as np
 
 from . import _binding as B
-from . import metrics
+from . import metrics, results
+from .config import make_prior
+from .errors import PriorError
+from .options import FRAME_NAMES, PRIOR_FRAME as DEFAULT_FRAME, PRIOR_RIDGE as DEFAULT_RIDGE, RL_COV_NAMES
 
-DEFAULT_FRAME = (1.2, 6.0)  # |x0| <= 1.2 m, |theta0| <= 6 deg
-DEFAULT_RIDGE = 1e-6
-FRAME_NAMES = ("central", "all")
 _TOL = 1e-9
-
-
-class PriorError(B.ConfigError):
-    """No (or too few) ICO-successful cells to build a prior from, or a bad prior option."""
 
 
 @dataclass
@@ -59,7 +55,6 @@ class PriorInfo:
         return out
 
     def prior(self) -> B.Prior:
-        from .config import make_prior
         return make_prior(self.mean, self.cov)
 
 
@@ -77,13 +72,13 @@ def parse_frame(text: str | None, x_max: float | None = None, theta_max_deg: flo
     """'central' (default, bounds overridable) or 'all' -> frame tuple or None."""
     name = (text or "central").strip().lower()
     if name not in FRAME_NAMES:
-        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, f"bad prior frame {text!r}; valid: {', '.join(FRAME_NAMES)}")
+        raise PriorError(f"bad prior frame {text!r}; valid: {', '.join(FRAME_NAMES)}")
     if name == "all":
         return None
     x = DEFAULT_FRAME[0] if x_max is None else float(x_max)
     th = DEFAULT_FRAME[1] if theta_max_deg is None else float(theta_max_deg)
     if not (math.isfinite(x) and math.isfinite(th) and x > 0 and th > 0):
-        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, f"prior frame bounds must be > 0, got x {x}, theta {th}")
+        raise PriorError(f"prior frame bounds must be > 0, got x {x}, theta {th}")
     return (x, th)
 
 
@@ -91,17 +86,15 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | None = DEFAULT_FRAME
             ridge: float = DEFAULT_RIDGE) -> PriorInfo:
     """ICO->RL prior from an ICO cell array: successful cells inside frame, mean and sample cov + ridge*I."""
     if not (math.isfinite(ridge) and ridge >= 0):
-        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, f"prior ridge must be finite and >= 0, got {ridge}")
+        raise PriorError(f"prior ridge must be finite and >= 0, got {ridge}")
     sel = metrics.success_mask(cells) & frame_mask(cells, frame)
     n = int(np.count_nonzero(sel))
     where = "any cell" if frame is None else f"|x0| <= {frame[0]:g} m, |theta0| <= {frame[1]:g} deg"
     if n == 0:
-        raise PriorError(B.SIM_ERR_BAD_ARGUMENT,
-                         f"no ICO-successful cell in the prior frame ({where}); "
+        raise PriorError(f"no ICO-successful cell in the prior frame ({where}); "
                          "widen the frame or use --prior-frame all")
     if n < 2:
-        raise PriorError(B.SIM_ERR_BAD_ARGUMENT,
-                         f"only {n} ICO-successful cell in the prior frame ({where}); "
+        raise PriorError(f"only {n} ICO-successful cell in the prior frame ({where}); "
                          "a sample covariance needs at least 2")
     w = cells["weights"][sel].astype(np.float64)
     mean = w.mean(axis=0)
@@ -123,10 +116,10 @@ def rl_prior(ico_rl: PriorInfo | None, rl_cov: str = "ico") -> PriorInfo:
                          source=base.source if base else None,
                          source_commit=base.source_commit if base else None,
                          source_seed=base.source_seed if base else None)
-    if rl_cov != "ico":
-        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, f"bad --rl-cov {rl_cov!r}; valid: ico, identity")
+    if rl_cov not in RL_COV_NAMES:
+        raise PriorError(f"bad --rl-cov {rl_cov!r}; valid: {', '.join(RL_COV_NAMES)}")
     if ico_rl is None:
-        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, "condition rl needs --prior-from (or --rl-cov identity)")
+        raise PriorError("condition rl needs --prior-from (or --rl-cov identity)")
     return PriorInfo(mean=np.zeros(B.N_INPUTS), cov=ico_rl.cov.copy(), frame=ico_rl.frame,
                      n_cells=ico_rl.n_cells, ridge=ico_rl.ridge, kind="rl", source=ico_rl.source,
                      source_commit=ico_rl.source_commit, source_seed=ico_rl.source_seed)
@@ -135,18 +128,12 @@ def rl_prior(ico_rl: PriorInfo | None, rl_cov: str = "ico") -> PriorInfo:
 def from_results(path: str | Path, frame: tuple[float, float] | None = DEFAULT_FRAME,
                  ridge: float = DEFAULT_RIDGE) -> PriorInfo:
     """ICO->RL prior from an ICO results directory, with its provenance and ICO-phase simulated time."""
-    from . import results
-
     path = Path(path)
-    if not path.is_dir():
-        raise PriorError(B.SIM_ERR_BAD_ARGUMENT, f"--prior-from: directory {str(path)!r} does not exist")
-    cells, record = results.load(path)
+    cells, record = results.load(path, what="--prior-from")
     if record.get("condition") != "ico":
-        raise PriorError(B.SIM_ERR_BAD_ARGUMENT,
-                         f"--prior-from: {str(path)!r} holds condition {record.get('condition')!r}, not ico")
+        raise PriorError(f"--prior-from: {str(path)!r} holds condition {record.get('condition')!r}, not ico")
     if not record.get("complete", False):
-        raise PriorError(B.SIM_ERR_BAD_ARGUMENT,
-                         f"--prior-from: {str(path)!r} is incomplete (PENDING cells); finish it with --resume")
+        raise PriorError(f"--prior-from: {str(path)!r} is incomplete (PENDING cells); finish it with --resume")
     info = compute(cells, frame, ridge)
     info.source = str(path.resolve())
     info.source_commit = (record.get("git") or {}).get("commit")
@@ -154,9 +141,3 @@ def from_results(path: str | Path, frame: tuple[float, float] | None = DEFAULT_F
     info.ico_phase_simulated_time = float(np.sum(cells["elapsed_time"]))
     info.extra = {"source_cells": int(cells.size), "source_success_rate": record.get("summary", {}).get("success_rate")}
     return info
-
-
-def load_ico_cells(path: str | Path) -> np.ndarray:
-    from . import results
-    cells, _ = results.load(path)
-    return cells

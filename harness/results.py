@@ -14,25 +14,20 @@ from typing import Any, Mapping
 import numpy as np
 
 from . import _binding as B
-from . import metrics
+from . import geometry, metrics
 from .config import RunConfig, config_from_dict
+from .errors import ResultsError
+from .grid import make_cells, parse_cell_indices
+from .options import CONDITIONS, SEED_LIMIT
 
 CELLS_FILE = "cells.npz"
 RUN_FILE = "run.json"
 FORMAT_VERSION = 1
-
-
-CONDITIONS = ("ico", "rl", "ico-rl")
 MAX_JSON_BYTES = 16 * 2 ** 20   # run.json is a few KiB; refuse anything absurd before parsing
-_X_TOL = 1e-6                   # m, rad: a cell coordinate must be this close to a paper-grid point
-
-
-class ResultsError(B.ConfigError):
-    """Missing, unreadable or mismatching results directory."""
 
 
 def _err(message: str) -> ResultsError:
-    return ResultsError(B.SIM_ERR_BAD_ARGUMENT, message)
+    return ResultsError(message)
 
 
 def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
@@ -64,13 +59,19 @@ def _atomic_write(path: Path, write) -> None:
         raise
 
 
+def check_out_dir(out: str | Path, what: str = "--out") -> Path:
+    """An output directory path that is not a file (it may not exist yet); nothing is created."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise _err(f"{what} {str(out)!r} exists and is not a directory")
+    return out
+
+
 def check_writable(out: str | Path, what: str = "--out") -> Path:
     """Create the directory ``out`` if needed and prove it is writable by creating (and removing) a
     temporary file in it; any failure is a ResultsError. Permission bits alone are not enough:
     they do not apply to root, and a read-only mount or a path under a regular file must fail too."""
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise _err(f"{what} {str(out)!r} exists and is not a directory")
+    out = check_out_dir(out, what)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -200,18 +201,10 @@ def check_cells(cells: np.ndarray, where: str = "cells") -> None:
         i = int(np.flatnonzero(bad)[0])
         raise _err(f"{where}: cell {i} has unknown outcome {int(cells['outcome'][i])} "
                    f"(valid: {', '.join(f'{k} {v}' for k, v in B.OUTCOME_NAMES.items())})")
-    with np.errstate(all="ignore"):  # absurd values are found below, not warned about
-        x0, th0 = cells["x0"], np.degrees(cells["theta0"])
-        finite = np.isfinite(x0) & np.isfinite(th0)
-        col = np.where(finite, np.rint((x0 - metrics.X_MIN) / metrics.X_STEP), -1)
-        row = np.where(finite, np.rint(th0 - metrics.THETA_MIN_DEG), -1)
-        on_grid = (finite & (col >= 0) & (col < B.GRID_XS) & (row >= 0) & (row < B.GRID_THETAS)
-                   & (np.abs(x0 - (metrics.X_MIN + col * metrics.X_STEP)) <= _X_TOL)
-                   & (np.abs(np.radians(th0) - np.radians(metrics.THETA_MIN_DEG + row * metrics.THETA_STEP_DEG))
-                      <= _X_TOL))
+    on_grid = geometry.on_grid(cells)
     if not on_grid.all():
         i = int(np.flatnonzero(~on_grid)[0])
-        raise _err(f"{where}: cell {i} has x0 = {float(x0[i])!r}, theta0 = {float(cells['theta0'][i])!r}, "
+        raise _err(f"{where}: cell {i} has x0 = {float(cells['x0'][i])!r}, theta0 = {float(cells['theta0'][i])!r}, "
                    "not a point of the paper grid")
 
 
@@ -233,11 +226,10 @@ def check_record(record: Any, where: str = RUN_FILE) -> dict[str, Any]:
     if record["condition"] not in CONDITIONS:
         raise _err(f"{where}: condition {record['condition']!r:.40} is not one of {', '.join(CONDITIONS)}")
     seed = record["seed"]
-    if not _is_int(seed) or not 0 <= seed < 2 ** 64:
+    if not _is_int(seed) or not 0 <= seed < SEED_LIMIT:
         raise _err(f"{where}: seed {seed!r:.40} is not an integer in [0, 2^64)")
     cells = record["cells"]
     if cells is not None:
-        from .grid import parse_cell_indices
         if not isinstance(cells, list):
             raise _err(f"{where}: cells must be null or a list of cell indices")
         try:
@@ -281,18 +273,26 @@ def read_record(file: str | Path) -> dict[str, Any]:
     return check_record(record, where)
 
 
-def load(path: str | Path) -> tuple[np.ndarray, dict[str, Any]]:
-    """(cells, run record) of a results directory, both validated (read_cells, check_cells,
-    read_record); every failure is a ResultsError."""
+def check_results_dir(path: str | Path, what: str | None = None) -> Path:
+    """A directory holding both results files; ResultsError (prefixed with ``what``, e.g. the
+    option that named it) if it does not exist, is not a directory or lacks a file."""
     path = Path(path)
+    lead = f"{what}: " if what else ""
     if not path.exists():
-        raise _err(f"results directory {str(path)!r} does not exist")
+        raise _err(f"{lead}results directory {str(path)!r} does not exist")
     if not path.is_dir():
-        raise _err(f"results directory {str(path)!r} does not exist (it is not a directory)")
+        raise _err(f"{lead}results directory {str(path)!r} does not exist (it is not a directory)")
     have = present(path)
     if len(have) != 2:
         detail = f"; it holds only {have[0]}" if have else ""
-        raise _err(f"{str(path)!r} is not a results directory (needs {CELLS_FILE} and {RUN_FILE}{detail})")
+        raise _err(f"{lead}{str(path)!r} is not a results directory (needs {CELLS_FILE} and {RUN_FILE}{detail})")
+    return path
+
+
+def load(path: str | Path, what: str | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+    """(cells, run record) of a results directory, both validated (check_results_dir, read_cells,
+    check_cells, read_record); every failure is a ResultsError."""
+    path = check_results_dir(path, what)
     record = read_record(path / RUN_FILE)
     cells = read_cells(path / CELLS_FILE)
     check_cells(cells, repr(str(path / CELLS_FILE)))
@@ -302,7 +302,6 @@ def load(path: str | Path) -> tuple[np.ndarray, dict[str, Any]]:
 def check_cells_match(cells: np.ndarray, record: Mapping[str, Any], where: str = CELLS_FILE) -> None:
     """The cells of a results directory are exactly those its record describes: the number of cells
     and every (x0, theta0, seed) equal make_cells(record seed, record cells), bitwise."""
-    from .grid import make_cells
     expected = make_cells(record["seed"], record["cells"])
     if cells.size != expected.size:
         raise _err(f"{where} holds {cells.size} cells but run.json describes {expected.size} "
@@ -329,17 +328,15 @@ def check_resumable(record: Mapping[str, Any], *, condition: str, seed: int, cfg
         diffs.append(f"seed {record.get('seed')} != {seed}")
     if record.get("cells") != cell_indices:
         diffs.append("cell selection differs")
-    new = cfg.to_dict()
-    old = record.get("config", {})
-    for group in ("controller", "plant", "run", "prior"):
-        a, b = old.get(group), new.get(group)
-        if isinstance(a, dict) and isinstance(b, dict):
-            for key in sorted(set(a) | set(b)):
-                if a.get(key) != b.get(key):
-                    diffs.append(f"{key} {a.get(key)!r} != {b.get(key)!r}")
-        elif a != b:
-            diffs.append(f"{group} differs")
+    new = cfg.flat()
+    try:  # canonical names (an ABI-3 record's flat names map through the alias table)
+        old_cfg = config_from_dict(record.get("config", {}))
+    except B.ConfigError as exc:
+        raise _err(f"recorded configuration: {exc}") from None
+    old = old_cfg.flat()
+    diffs += [f"{key} {old[key]!r} != {new[key]!r}" for key in new if old[key] != new[key]]
+    if old_cfg.to_dict()["prior"] != cfg.to_dict()["prior"]:
+        diffs.append("prior differs")
     if diffs:
-        raise ResultsError(B.SIM_ERR_BAD_ARGUMENT,
-                           "recorded run does not match the requested configuration (" + "; ".join(diffs)
+        raise ResultsError("recorded run does not match the requested configuration (" + "; ".join(diffs)
                            + "); use another --out directory")

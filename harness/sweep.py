@@ -11,51 +11,56 @@ import json
 import math
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
-from . import _binding as B
-from . import metrics
+from . import geometry, grid, metrics, results
+from . import prior as P
+from ._binding import ConfigError
+from .config import build_config, canonical, parse_sets, parse_value
+from .errors import SweepError, UsageError
+from .metrics import percent
+from .options import FRAME_NAMES, RL_COV_NAMES, SWEEP_MAX_TRIALS
 
 PRIOR_PARAMS = ("prior_frame", "prior_ridge")
-DEFAULT_CELLS = list(range(0, B.GRID_CELLS, 25))  # 49 cells spread over the grid
+DEFAULT_CELLS = list(range(0, geometry.CELLS, 25))  # 49 cells spread over the grid
 COLUMNS = ("key", "n_seeds", "n_cells", "success_rate_mean", "success_rate_sd", "success_rate_ico_failed",
            "n_ico_failed", "median_trials", "mean_elapsed_time", "wall_time")
 
 
-class SweepError(B.ConfigError):
-    pass
+def _name(name: str) -> str:
+    """Canonical name of a sweep parameter (configuration fields through config.canonical)."""
+    return name if name in PRIOR_PARAMS else canonical(name)
 
 
-def _err(msg: str) -> SweepError:
-    return SweepError(B.SIM_ERR_BAD_ARGUMENT, msg)
-
-
-def parse_params(items: list[str]) -> dict[str, list[Any]]:
-    """['noise_std=0.5,1', ...] -> {'noise_std': [0.5, 1.0]}; names checked against the config fields."""
-    from .config import ALL_FIELDS, parse_value
+def parse_params(items: Sequence[str]) -> dict[str, list[Any]]:
+    """['noise_std=0.5,1', ...] -> {'actor.noise_std': [0.5, 1.0]}: canonical names (aliases
+    accepted) of configuration fields, or prior_frame / prior_ridge."""
     out: dict[str, list[Any]] = {}
     for item in items:
         if "=" not in item:
-            raise _err(f"--param expects name=v1,v2,..., got {item!r}")
+            raise SweepError(f"--param expects name=v1,v2,..., got {item!r}")
         name, values = (t.strip() for t in item.split("=", 1))
-        if name not in ALL_FIELDS and name not in PRIOR_PARAMS or name == "reserved":
-            raise _err(f"--param: unknown parameter {name!r}")
+        try:
+            name = _name(name)
+        except ConfigError as exc:  # names the valid names
+            raise SweepError(f"--param: {exc}") from None
         vals = [parse_value(v.strip()) for v in values.split(",") if v.strip()]
         if not vals:
-            raise _err(f"--param {name}: no values")
-        if name == "prior_frame" and any(v not in ("central", "all") for v in vals):
-            raise _err("--param prior_frame: values must be central or all")
+            raise SweepError(f"--param {name}: no values")
+        if name == "prior_frame" and any(v not in FRAME_NAMES for v in vals):
+            raise SweepError(f"--param prior_frame: values must be {' or '.join(FRAME_NAMES)}")
         if name == "prior_ridge" and any(isinstance(v, bool) or not isinstance(v, (int, float))
                                          or not math.isfinite(v) or v < 0 for v in vals):
-            raise _err("--param prior_ridge: values must be finite numbers >= 0")
+            raise SweepError("--param prior_ridge: values must be finite numbers >= 0")
         if name in out:
-            raise _err(f"--param {name} given twice")
+            raise SweepError(f"--param {name} given twice")
         out[name] = vals
     if not out:
-        raise _err("sweep needs at least one --param NAME=V1,V2,...")
+        raise SweepError("sweep needs at least one --param NAME=V1,V2,...")
     return out
 
 
@@ -77,17 +82,25 @@ def key_of(setting: dict[str, Any]) -> str:
     return json.dumps(setting, sort_keys=True)
 
 
+def canonical_key(key: str) -> str:
+    """The key of a sweep.csv row with canonical names (rows written with ABI-3 flat names map
+    through the alias table); SweepError if it is not a setting."""
+    try:
+        setting = json.loads(key)
+        if not isinstance(setting, dict):
+            raise ValueError("not an object")
+        return key_of({_name(k): v for k, v in setting.items()})
+    except (ValueError, RecursionError, ConfigError) as exc:
+        raise SweepError(f"bad setting key {key!r:.60} in sweep.csv ({exc}); use another --out") from None
+
+
 def subset_cells(n: int) -> list[int]:
-    if n >= B.GRID_CELLS:
-        return list(range(B.GRID_CELLS))
-    return sorted(set(int(round(v)) for v in np.linspace(0, B.GRID_CELLS - 1, n)))
-
-
-def _read_rows(path: Path) -> list[dict[str, str]]:
-    if not path.is_file():
-        return []
-    with open(path, newline="") as fh:
-        return list(csv.DictReader(fh))
+    """n cell indices evenly spread over the grid (1 <= n <= the grid's cells)."""
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= geometry.CELLS:
+        raise SweepError(f"--subset expects a number of cells in [1, {geometry.CELLS}], got {n!r:.40}")
+    if n == geometry.CELLS:
+        return list(range(geometry.CELLS))
+    return sorted(set(int(round(v)) for v in np.linspace(0, geometry.CELLS - 1, n)))
 
 
 def _write_md(path: Path, rows: list[dict[str, str]], names: list[str], meta: dict[str, Any]) -> None:
@@ -97,13 +110,14 @@ def _write_md(path: Path, rows: list[dict[str, str]], names: list[str], meta: di
              "mean elapsed time (s) |",
              "|" + "---|" * (len(names) + 4)]
 
+    def number(v):
+        return None if v in (None, "", "nan") or math.isnan(float(v)) else float(v)
+
     def f(v, pct=False):
-        if v in (None, "", "nan"):
+        v = number(v)
+        if v is None:
             return "n/a"
-        v = float(v)
-        if math.isnan(v):
-            return "n/a"
-        return f"{100 * v:.1f} %" if pct else f"{v:.4g}"
+        return percent(v) if pct else f"{v:.4g}"
 
     for r in rows:
         setting = json.loads(r["key"])
@@ -114,32 +128,72 @@ def _write_md(path: Path, rows: list[dict[str, str]], names: list[str], meta: di
     path.write_text("\n".join(lines) + "\n")
 
 
-def run_sweep(args) -> int:
-    from . import grid
-    from . import prior as P
-    from .cli import UsageError, _parse_sets
-    from .config import build_config
+@dataclass
+class SweepOptions:
+    """What `sweep` runs (see harness.cli): parameter lists, a cell selection (cells or subset),
+    seeds --seed .. --seed + seeds - 1, caps, fixed overrides."""
+    prior_from: Path
+    out: Path
+    params: Sequence[str]
+    condition: str = "ico-rl"
+    cells: str | None = None
+    subset: int | None = None
+    seed: int = 0
+    seeds: int = 1
+    max_trials: int = SWEEP_MAX_TRIALS
+    success_steps: int | None = None
+    sets: Sequence[str] = ()
+    one_at_a_time: bool = False
+    threads: int = 0
+    rl_cov: str = RL_COV_NAMES[0]
+    quiet: bool = False
 
-    ico_dir = Path(args.prior_from)
-    if not ico_dir.is_dir():
-        raise UsageError(f"--prior-from: directory {str(ico_dir)!r} does not exist")
-    params = parse_params(args.param)
-    names = list(params)
-    todo = settings(params, args.one_at_a_time)
+
+def _read_table(csv_path: Path) -> tuple[list[str] | None, list[dict[str, str]]]:
+    """(header, rows with canonical keys) of an existing sweep.csv, (None, []) if there is none."""
+    if not csv_path.is_file():
+        return None, []
     try:
-        seeds = [int(s) for s in args.seeds.split(",") if s.strip()]
-    except ValueError:
-        raise UsageError(f"--seeds expects comma-separated integers, got {args.seeds!r:.60}")
-    if not seeds or any(not 0 <= s < grid.SEED_LIMIT for s in seeds):
-        raise UsageError(f"--seeds expects integers in [0, 2^64), got {args.seeds!r:.60}")
-    if args.cells is not None:
-        indices = grid.parse_cell_indices(args.cells)
-    elif args.subset is not None:
-        indices = subset_cells(args.subset)
+        with open(csv_path, newline="") as fh:
+            reader = csv.DictReader(fh)
+            rows = list(reader)
+            header = list(reader.fieldnames or [])
+    except (OSError, ValueError, csv.Error) as exc:
+        raise UsageError(f"cannot read {str(csv_path)!r}: {exc}; use another --out")
+    if any(not isinstance(r.get("key"), str) for r in rows) or (rows and "key" not in header):
+        raise UsageError(f"{str(csv_path)!r} is not a sweep table (no key column); use another --out")
+    for r in rows:
+        r["key"] = canonical_key(r["key"])
+    return header, rows
+
+
+def _param_columns(header: list[str]) -> dict[str, str]:
+    """{canonical name: column} of the parameter columns of a sweep.csv header."""
+    out = {}
+    for col in header:
+        if col in COLUMNS:
+            continue
+        try:
+            out[_name(col)] = col
+        except ConfigError:
+            continue
+    return out
+
+
+def run_sweep(opt: SweepOptions) -> int:
+    """Run every setting not yet in OUT/sweep.csv; 130 if interrupted."""
+    ico_dir = results.check_results_dir(opt.prior_from, "--prior-from")
+    params = parse_params(opt.params)
+    names = list(params)
+    todo = settings(params, opt.one_at_a_time)
+    seeds = grid.seed_range(opt.seed, opt.seeds)
+    if opt.cells is not None:
+        indices = grid.parse_cell_indices(opt.cells)
+    elif opt.subset is not None:
+        indices = subset_cells(opt.subset)
     else:
         indices = DEFAULT_CELLS
-    from . import results
-    ico_cells, _ = results.load(ico_dir)
+    ico_cells, _ = results.load(ico_dir, what="--prior-from")
     priors: dict = {}
 
     # ICO outcome on the sweep cells (matched by grid position).
@@ -150,14 +204,14 @@ def run_sweep(args) -> int:
     ico_failed = np.array([(int(r), int(c)) in ico_known and (int(r), int(c)) not in ico_rc
                            for r, c in zip(pr, pc)], dtype=bool)
 
-    fixed = _parse_sets(args.set)
-    fixed["max_trials"] = args.max_trials
-    if args.success_steps is not None:
-        fixed["success_steps"] = args.success_steps
-    out = Path(args.out)
-    meta = {"condition": args.condition, "prior_from": str(ico_dir.resolve()), "cells": indices,
-            "n_cells": len(indices), "seeds": seeds, "max_trials": args.max_trials,
-            "success_steps": args.success_steps, "set": args.set or [], "rl_cov": args.rl_cov}
+    fixed = parse_sets(opt.sets)
+    fixed["max_trials"] = opt.max_trials
+    if opt.success_steps is not None:
+        fixed["success_steps"] = opt.success_steps
+    out = results.check_out_dir(opt.out)
+    meta = {"condition": opt.condition, "prior_from": str(ico_dir.resolve()), "cells": indices,
+            "n_cells": len(indices), "seeds": seeds, "max_trials": opt.max_trials,
+            "success_steps": opt.success_steps, "set": list(opt.sets), "rl_cov": opt.rl_cov}
     meta_path = out / "sweep.json"
     csv_path = out / "sweep.csv"
     if meta_path.is_file() and csv_path.is_file():
@@ -170,27 +224,29 @@ def run_sweep(args) -> int:
         diff = [k for k in meta if old.get(k) != meta[k]]
         if diff:
             raise UsageError(f"{str(out)!r} holds a sweep with other {', '.join(diff)}; use another --out")
-    try:
-        rows = _read_rows(csv_path)
-    except (OSError, ValueError, csv.Error) as exc:
-        raise UsageError(f"cannot read {str(csv_path)!r}: {exc}; use another --out")
-    if any(not isinstance(r.get("key"), str) for r in rows):
-        raise UsageError(f"{str(csv_path)!r} is not a sweep table (no key column); use another --out")
+    header, rows = _read_table(csv_path)
+    if header is not None:
+        missing = [n for n in names if n not in _param_columns(header)]
+        if missing:
+            raise UsageError(f"{csv_path} has other parameter columns (no {', '.join(missing)}); use another --out")
     done = {r["key"] for r in rows}
 
     def prior_for(setting):
-        frame = P.parse_frame(str(setting.get("prior_frame", "central")))
+        frame = P.parse_frame(str(setting.get("prior_frame", FRAME_NAMES[0])))
         ridge = float(setting.get("prior_ridge", P.DEFAULT_RIDGE))
         k = (frame, ridge)
         if k not in priors:
             priors[k] = P.from_results(ico_dir, frame, ridge)
         info = priors[k]
-        return info if args.condition == "ico-rl" else P.rl_prior(info, args.rl_cov)
+        return info if opt.condition == "ico-rl" else P.rl_prior(info, opt.rl_cov)
 
-    for setting in todo:  # every setting valid before the first grid runs (and before any write)
+    def config_for(setting):
         over = dict(fixed)
         over.update({k: v for k, v in setting.items() if k not in PRIOR_PARAMS})
-        build_config(over, condition=args.condition, prior=prior_for(setting).prior())
+        return build_config(over, condition=opt.condition, prior=prior_for(setting).prior())
+
+    for setting in todo:  # every setting valid before the first grid runs (and before any write)
+        config_for(setting)
     results.check_writable(out)
     meta_path.write_text(json.dumps(meta, indent=2) + "\n")
 
@@ -201,15 +257,12 @@ def run_sweep(args) -> int:
         if key in done:
             print(f"[sweep] ({i}/{len(todo)}) {label}: already in {csv_path.name}, skipped", file=sys.stderr)
             continue
-        over = dict(fixed)
-        over.update({k: v for k, v in setting.items() if k not in PRIOR_PARAMS})
-        info = prior_for(setting)
-        cfg = build_config(over, condition=args.condition, prior=info.prior())
+        cfg = config_for(setting)
         t0 = time.monotonic()
         rates, rates_failed, trials, elapsed = [], [], [], []
         for seed in seeds:
             cells = grid.make_cells(seed, indices)
-            res = grid.run_grid(cfg, cells, threads=args.threads, progress=False)
+            res = grid.run_grid(cfg, cells, threads=opt.threads, progress=False)
             if res.cancelled:
                 print("[sweep] interrupted: finished settings are in the CSV; rerun to resume", file=sys.stderr)
                 return 130
@@ -228,25 +281,19 @@ def run_sweep(args) -> int:
                "median_trials": f"{np.median(trials):.6g}" if trials else "",
                "mean_elapsed_time": f"{np.mean(elapsed):.6g}" if elapsed else "",
                "wall_time": f"{wall:.3f}"}
+        if header is None:
+            header = names + list(COLUMNS)
+            with open(csv_path, "w", newline="") as fh:
+                csv.DictWriter(fh, fieldnames=header).writeheader()
+        columns = _param_columns(header)
         for n in names:
-            row[n] = setting.get(n, "")
-        new_file = not csv_path.is_file()
-        header = names + list(COLUMNS)
-        if not new_file:
-            with open(csv_path, newline="") as fh:
-                header = next(csv.reader(fh), header)
-            missing = [n for n in names if n not in header]
-            if missing:
-                raise UsageError(f"{csv_path} has other parameter columns; use another --out")
+            row[columns[n]] = setting.get(n, "")
         with open(csv_path, "a", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=header, extrasaction="ignore")
-            if new_file:
-                w.writeheader()
-            w.writerow(row)
+            csv.DictWriter(fh, fieldnames=header, extrasaction="ignore").writerow(row)
         rows.append({k: str(v) for k, v in row.items()})
         done.add(key)
-        rf = f", ICO-failed cells {100 * np.mean(rates_failed):.1f} %" if rates_failed else ""
-        print(f"[sweep] ({i}/{len(todo)}) {label}: success {100 * np.mean(rates):.1f} %{rf}, "
+        rf = f", ICO-failed cells {percent(np.mean(rates_failed))}" if rates_failed else ""
+        print(f"[sweep] ({i}/{len(todo)}) {label}: success {percent(np.mean(rates))}{rf}, "
               f"{wall:.1f} s", file=sys.stderr, flush=True)
     _write_md(out / "sweep.md", rows, names, meta)
     print(f"[sweep] {len(todo)} settings, wall time {time.monotonic() - t_all:.1f} s -> {csv_path}")

@@ -193,9 +193,9 @@ icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic, const 
     return value;
 }
 
-/* v_k += step * b_k over the units listed by icoac_critic_value. */
+/* v_k += step * b_k over the units listed by icoac_priv_critic_value. */
 void icoac_priv_critic_update(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_active_t *active,
-                         icoac_real_t step)
+                              icoac_real_t step)
 {
     int p;
     int i;

@@ -149,7 +149,9 @@ static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_rea
 }
 
 /* Stages of a tick. Each tick function stages what it would learn and output, checks that it
- * is finite, and only then commits it; it returns 0, with the state untouched, when not. */
+ * is finite, and only then commits it; it returns 0 when not, with the state untouched but for
+ * its scratch (the spare covariance buffer and the spare kept-unit list, never read before a
+ * commit). */
 
 /* ICO rule, both timings (icoac_ico.c). */
 int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,

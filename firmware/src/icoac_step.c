@@ -23,7 +23,7 @@ static icoac_status_t rejected(const icoac_priv_state_t *st, icoac_output_t *out
 {
     clear_output(out);
     out->weight_norm = st->weight_norm;
-    out->status = status;
+    out->status = (int32_t)status;
     return status;
 }
 

@@ -2,15 +2,28 @@
  * long-run symmetry / positive definiteness, forgetting, and the Eq. 7-8 wiring in icoac_step. */
 #include "test_common.h"
 
-#include "icoac_internal.h"
+#include "icoac_priv.h"
 
 #define N ICOAC_N_INPUTS
 
-/* The update writes its candidate posterior over the state's own (mu_w, Sigma_w). */
+/* The update writes its candidate posterior over the state's own (mu_w, Sigma_w): the
+ * outputs alias what it reads. */
 static void actor_update_in_place(const icoac_config_t *cfg, icoac_state_t *state, const icoac_real_t h[N],
                                   icoac_real_t innovation)
 {
-    icoac_actor_update(cfg, state, h, innovation, state->w, state->cov);
+    icoac_priv_state_t *st = icoac_priv_state(state);
+    icoac_priv_actor_update(&cfg->actor, st, h, innovation, st->w, icoac_priv_cov(st));
+}
+
+/* The state's mean and covariance. */
+static icoac_real_t *mean_of(icoac_state_t *state)
+{
+    return icoac_priv_state(state)->w;
+}
+
+static icoac_real_t (*cov_of(icoac_state_t *state))[N]
+{
+    return icoac_priv_cov(icoac_priv_state(state));
 }
 
 typedef struct {
@@ -64,13 +77,15 @@ static void random_gauss(test_rng_t *rng, double scale, gauss_t *g)
 /* Store g in the state (rounded to icoac_real_t) and read the rounded values back into g. */
 static void load_state(icoac_state_t *state, gauss_t *g)
 {
+    icoac_real_t *w = mean_of(state);
+    icoac_real_t(*cov)[N] = cov_of(state);
     int i, j;
     for (i = 0; i < N; ++i) {
-        state->w[i] = (icoac_real_t)g->mean[i];
-        g->mean[i] = (double)state->w[i];
+        w[i] = (icoac_real_t)g->mean[i];
+        g->mean[i] = (double)w[i];
         for (j = 0; j < N; ++j) {
-            state->cov[i][j] = (icoac_real_t)g->cov[i][j];
-            g->cov[i][j] = (double)state->cov[i][j];
+            cov[i][j] = (icoac_real_t)g->cov[i][j];
+            g->cov[i][j] = (double)cov[i][j];
         }
     }
 }
@@ -111,16 +126,16 @@ static void compare_with_closed_form(const icoac_config_t *cfg, test_rng_t *rng,
         hd[i] = (double)h[i];
     }
     innovation = (double)(icoac_real_t)test_uniform(rng, -3, 3);
-    r = (double)cfg->noise_std * (double)cfg->noise_std;
+    r = (double)cfg->actor.noise_std * (double)cfg->actor.noise_std;
     closed_form(&prior, hd, innovation, r, &post);
     actor_update_in_place(cfg, &state, h, (icoac_real_t)innovation);
     /* float: a few hundred ulps of the largest prior entry (the update subtracts nearly equal terms) */
     tol = (REAL_IS_FLOAT ? 2e-5 : 1e-12) * (1.0 + max_abs(prior.cov));
     for (i = 0; i < N; ++i) {
-        assert_close(state.w[i], post.mean[i], tol * (1.0 + fabs(innovation)));
+        assert_close(mean_of(&state)[i], post.mean[i], tol * (1.0 + fabs(innovation)));
         for (j = 0; j < N; ++j) {
-            assert_close(state.cov[i][j], post.cov[i][j], tol);
-            assert_true(state.cov[i][j] == state.cov[j][i]);
+            assert_close(cov_of(&state)[i][j], post.cov[i][j], tol);
+            assert_true(cov_of(&state)[i][j] == cov_of(&state)[j][i]);
         }
     }
 }
@@ -133,7 +148,7 @@ static void test_update_matches_closed_form(void **unused)
     (void)unused;
     (void)rl_state(&cfg);
     for (n = 0; n < 300; ++n) {
-        cfg.noise_std = (icoac_real_t)(n % 3 == 0 ? 1.0 : (n % 3 == 1 ? 0.5 : 3.0));
+        cfg.actor.noise_std = (icoac_real_t)(n % 3 == 0 ? 1.0 : (n % 3 == 1 ? 0.5 : 3.0));
         compare_with_closed_form(&cfg, &rng, n % 2 ? 10.0 : 1.0);
     }
 }
@@ -150,12 +165,12 @@ static void test_zero_innovation_keeps_mean(void **unused)
     (void)unused;
     random_gauss(&rng, 1.0, &prior);
     load_state(&state, &prior);
-    memcpy(mean_before, state.w, sizeof mean_before);
-    trace_before = (double)icoac_trace4(ICOAC_CONST_MAT4(state.cov));
+    memcpy(mean_before, mean_of(&state), sizeof mean_before);
+    trace_before = (double)icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov_of(&state)));
     actor_update_in_place(&cfg, &state, h, (icoac_real_t)0.0);
-    assert_memory_equal(state.w, mean_before, sizeof mean_before);
+    assert_memory_equal(mean_of(&state), mean_before, sizeof mean_before);
     /* the covariance still shrinks */
-    assert_true((double)icoac_trace4(ICOAC_CONST_MAT4(state.cov)) < trace_before);
+    assert_true((double)icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov_of(&state))) < trace_before);
 }
 
 static void test_forgetting_inflates_first(void **unused)
@@ -169,7 +184,7 @@ static void test_forgetting_inflates_first(void **unused)
     const double lambda = 0.9;
     int i, j;
     (void)unused;
-    cfg.forgetting = (icoac_real_t)lambda;
+    cfg.actor.forgetting = (icoac_real_t)lambda;
     random_gauss(&rng, 0.5, &prior);
     load_state(&state, &prior);
     for (i = 0; i < N; ++i) {
@@ -179,15 +194,15 @@ static void test_forgetting_inflates_first(void **unused)
     inflated = prior;
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
-            inflated.cov[i][j] = prior.cov[i][j] / (double)cfg.forgetting;
+            inflated.cov[i][j] = prior.cov[i][j] / (double)cfg.actor.forgetting;
         }
     }
     closed_form(&inflated, hd, 0.7, 1.0, &post);
     actor_update_in_place(&cfg, &state, h, (icoac_real_t)0.7);
     for (i = 0; i < N; ++i) {
-        assert_close(state.w[i], post.mean[i], REAL_IS_FLOAT ? 1e-4 : 1e-12);
+        assert_close(mean_of(&state)[i], post.mean[i], REAL_IS_FLOAT ? 1e-4 : 1e-12);
         for (j = 0; j < N; ++j) {
-            assert_close(state.cov[i][j], post.cov[i][j], REAL_IS_FLOAT ? 1e-4 : 1e-12);
+            assert_close(cov_of(&state)[i][j], post.cov[i][j], REAL_IS_FLOAT ? 1e-4 : 1e-12);
         }
     }
     /* with h = 0 (no information) the step is pure inflation: Sigma / lambda */
@@ -195,10 +210,51 @@ static void test_forgetting_inflates_first(void **unused)
     memset(h, 0, sizeof h);
     actor_update_in_place(&cfg, &state, h, (icoac_real_t)0.3);
     for (i = 0; i < N; ++i) {
-        assert_true(state.w[i] == (icoac_real_t)prior.mean[i]);
+        assert_true(mean_of(&state)[i] == (icoac_real_t)prior.mean[i]);
         for (j = 0; j < N; ++j) {
-            assert_close(state.cov[i][j], prior.cov[i][j] / lambda, 4.0 * REAL_EPS * (1.0 + fabs(prior.cov[i][j])));
+            assert_close(cov_of(&state)[i][j], prior.cov[i][j] / lambda,
+                         4.0 * REAL_EPS * (1.0 + fabs(prior.cov[i][j])));
         }
+    }
+}
+
+/* The RL tick stages the update: it reads (mu_w, Sigma_w) from the state and writes the
+ * candidate to a local w and the spare covariance buffer, leaving the state's own posterior
+ * as it was. The staged result is bitwise the in-place one, with and without forgetting. */
+static void test_update_staged_into_spare(void **unused)
+{
+    test_rng_t rng = {0x57A6Eu};
+    int n, i;
+    (void)unused;
+    for (n = 0; n < 200; ++n) {
+        icoac_config_t cfg;
+        icoac_state_t state = rl_state(&cfg);
+        icoac_state_t in_place;
+        icoac_state_t before;
+        icoac_priv_state_t *st = icoac_priv_state(&state);
+        const int spare = st->cov_slot ^ 1;
+        gauss_t prior;
+        icoac_real_t h[N];
+        icoac_real_t w[N];
+        const icoac_real_t innovation = (icoac_real_t)test_uniform(&rng, -3, 3);
+        cfg.actor.forgetting = n % 2 ? ICOAC_R(1.0) : (icoac_real_t)0.95;
+        random_gauss(&rng, test_uniform(&rng, 0.01, 2.0), &prior);
+        load_state(&state, &prior);
+        for (i = 0; i < N; ++i) {
+            h[i] = (icoac_real_t)test_uniform(&rng, -10, 10);
+        }
+        in_place = state;
+        before = state;
+        icoac_priv_actor_update(&cfg.actor, st, h, innovation, w, st->cov_buffer[spare]);
+        actor_update_in_place(&cfg, &in_place, h, innovation);
+        /* the state's posterior and slot are untouched ... */
+        assert_int_equal(st->cov_slot, icoac_priv_state_c(&before)->cov_slot);
+        assert_memory_equal(st->w, icoac_priv_state_c(&before)->w, sizeof st->w);
+        assert_memory_equal(icoac_priv_cov_c(st), icoac_priv_cov_c(icoac_priv_state_c(&before)),
+                            sizeof(icoac_real_t) * N * N);
+        /* ... and the staged candidate is the in-place result */
+        assert_memory_equal(w, mean_of(&in_place), sizeof w);
+        assert_memory_equal(st->cov_buffer[spare], cov_of(&in_place), sizeof(icoac_real_t) * N * N);
     }
 }
 
@@ -212,7 +268,7 @@ static void run_long(double forgetting, int n_updates)
     test_rng_t rng = {0x5EEDu};
     double info[N][N];
     int n, i, j;
-    cfg.forgetting = (icoac_real_t)forgetting;
+    cfg.actor.forgetting = (icoac_real_t)forgetting;
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
             info[i][j] = i == j ? 1.0 : 0.0; /* Sigma_0 = I from icoac_init */
@@ -220,31 +276,32 @@ static void run_long(double forgetting, int n_updates)
     }
     for (n = 0; n < n_updates; ++n) {
         icoac_real_t h[N];
-        double prev_trace = (double)icoac_trace4(ICOAC_CONST_MAT4(state.cov));
+        double prev_trace = (double)icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov_of(&state)));
         for (i = 0; i < N; ++i) {
             h[i] = (icoac_real_t)(10.0 * test_uniform(&rng, -1, 1)); /* G x~, |x~| <= 1 */
         }
         actor_update_in_place(&cfg, &state, h, (icoac_real_t)test_uniform(&rng, -3, 3));
         for (i = 0; i < N; ++i) {
             for (j = 0; j < N; ++j) {
-                if (state.cov[i][j] != state.cov[j][i]) {
+                if (cov_of(&state)[i][j] != cov_of(&state)[j][i]) {
                     print_error("update %d: cov not symmetric at (%d, %d)\n", n, i, j);
                     fail();
                 }
                 info[i][j] = forgetting * info[i][j] + (double)h[i] * (double)h[j];
             }
         }
-        if (!icoac_cholesky4(ICOAC_CONST_MAT4(state.cov), lower)) {
+        if (!icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov_of(&state)), lower)) {
             print_error("update %d: cov not positive definite\n", n);
             fail();
         }
         if (forgetting == 1.0) {
             /* without forgetting Sigma never grows (up to rounding) */
-            assert_true((double)icoac_trace4(ICOAC_CONST_MAT4(state.cov)) <= prev_trace * (1.0 + 64.0 * REAL_EPS));
+            assert_true((double)icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov_of(&state))) <=
+                        prev_trace * (1.0 + 64.0 * REAL_EPS));
         }
     }
     for (i = 0; i < N; ++i) {
-        assert_true(isfinite(state.w[i]));
+        assert_true(isfinite(mean_of(&state)[i]));
     }
     /* Sigma * info should be I: check the trace and the largest off-diagonal. */
     {
@@ -254,7 +311,7 @@ static void run_long(double forgetting, int n_updates)
             for (j = 0; j < N; ++j) {
                 double p = 0;
                 for (k = 0; k < N; ++k) {
-                    p += (double)state.cov[i][k] * info[k][j];
+                    p += (double)cov_of(&state)[i][k] * info[k][j];
                 }
                 if (i == j) {
                     tr += p;
@@ -290,8 +347,10 @@ static void test_step_wiring(void **unused)
     icoac_input_t s1 = test_input(0.4, -0.2, 0.08, 0.6, 0);
     icoac_input_t s2 = test_input(0.41, -0.2, 0.25, 0.6, ICOAC_INPUT_TERMINAL);
     gauss_t prior, post;
+    icoac_prior_t posterior;
     double hd[N], z = 0, eps;
     int i, j;
+    int32_t slot;
     (void)unused;
     cfg.mode = ICOAC_MODE_RL;
     p.cov[0][2] = p.cov[2][0] = (icoac_real_t)0.1;
@@ -309,13 +368,19 @@ static void test_step_wiring(void **unused)
     assert_true(eps != 0.0);
     assert_close(out.z, z, 1e-5);
     assert_close(out.force, 10.0 * z + eps, 1e-4); /* no reflex at s1 */
+    slot = icoac_priv_state_c(&state)->cov_slot;
     assert_int_equal(icoac_step(&cfg, &state, &s2, &out), ICOAC_OK);
     assert_close(out.td_error, -1.0, 0.0);
+    /* the learning tick committed the staged covariance by flipping the slot */
+    assert_int_equal(icoac_priv_state_c(&state)->cov_slot, slot ^ 1);
+    assert_int_equal(icoac_get_posterior(&state, &posterior), ICOAC_OK);
+    assert_memory_equal(posterior.cov, cov_of(&state), sizeof posterior.cov);
+    assert_memory_equal(posterior.mean, mean_of(&state), sizeof posterior.mean);
     closed_form(&prior, hd, 0.5 * -1.0 * eps, 1.0, &post);
     for (i = 0; i < N; ++i) {
-        assert_close(state.w[i], post.mean[i], REAL_IS_FLOAT ? 1e-5 : 1e-12);
+        assert_close(mean_of(&state)[i], post.mean[i], REAL_IS_FLOAT ? 1e-5 : 1e-12);
         for (j = 0; j < N; ++j) {
-            assert_close(state.cov[i][j], post.cov[i][j], REAL_IS_FLOAT ? 1e-5 : 1e-12);
+            assert_close(cov_of(&state)[i][j], post.cov[i][j], REAL_IS_FLOAT ? 1e-5 : 1e-12);
         }
     }
     assert_close(out.cov_trace, post.cov[0][0] + post.cov[1][1] + post.cov[2][2] + post.cov[3][3],
@@ -329,12 +394,13 @@ static void test_posterior_sample_per_trial(void **unused)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
+    const icoac_priv_state_t *st = icoac_priv_state_c(&state);
     icoac_prior_t p = test_prior(0.1, -0.2, 0.3, 0.05, 0.0);
     double cov[N][N], lower[N][N];
     int i, j, k, trial;
     (void)unused;
     cfg.mode = ICOAC_MODE_RL;
-    cfg.act_with_sample = 1;
+    cfg.actor.act_with_sample = 1;
     /* a full SPD covariance */
     {
         const double m[N][N] = {{0.5, 0.1, 0.0, 0.05}, {0.1, 0.4, 0.02, 0.0},
@@ -346,7 +412,7 @@ static void test_posterior_sample_per_trial(void **unused)
             }
         }
     }
-    /* Cholesky-Banachiewicz in double, independent of icoac_cholesky4 */
+    /* Cholesky-Banachiewicz in double, independent of icoac_priv_cholesky4 */
     memset(lower, 0, sizeof lower);
     for (i = 0; i < N; ++i) {
         for (j = 0; j <= i; ++j) {
@@ -362,24 +428,24 @@ static void test_posterior_sample_per_trial(void **unused)
     {
         icoac_state_t fresh;
         assert_int_equal(icoac_init(&cfg, &fresh, &p, 31u), ICOAC_OK);
-        assert_memory_equal(fresh.w_act, state.w_act, sizeof fresh.w_act);
+        assert_memory_equal(icoac_priv_state_c(&fresh)->w_act, st->w_act, sizeof st->w_act);
     }
     /* direct check: draw the normals from a copy of the generator, then reset */
     for (trial = 0; trial < 5; ++trial) {
-        icoac_rng_t copy = state.rng;
+        icoac_rng_t copy = st->rng;
         double n[N];
         for (i = 0; i < N; ++i) {
             n[i] = (double)icoac_rng_normal(&copy);
         }
         assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
         for (i = 0; i < N; ++i) {
-            double expect = (double)state.w[i];
+            double expect = (double)mean_of(&state)[i];
             for (j = 0; j <= i; ++j) {
                 expect += lower[i][j] * n[j];
             }
-            assert_close(state.w_act[i], expect, REAL_IS_FLOAT ? 1e-6 : 1e-13);
+            assert_close(st->w_act[i], expect, REAL_IS_FLOAT ? 1e-6 : 1e-13);
         }
-        assert_true(memcmp(state.w_act, state.w, sizeof state.w) != 0);
+        assert_true(memcmp(st->w_act, st->w, sizeof st->w) != 0);
     }
 }
 
@@ -389,6 +455,7 @@ int main(void)
         cmocka_unit_test(test_update_matches_closed_form),
         cmocka_unit_test(test_zero_innovation_keeps_mean),
         cmocka_unit_test(test_forgetting_inflates_first),
+        cmocka_unit_test(test_update_staged_into_spare),
         cmocka_unit_test(test_long_run_symmetric_pd),
         cmocka_unit_test(test_long_run_with_forgetting),
         cmocka_unit_test(test_step_wiring),

@@ -1,7 +1,8 @@
-/* Configuration, prior and argument checks; status names; layout functions. */
+/* Configuration, prior and argument checks; the named bad field; status names; layout
+ * functions. */
 #include "test_common.h"
 
-#include "icoac_internal.h"
+#include "icoac_priv.h"
 
 #define NAN_R ((icoac_real_t)NAN)
 #define INF_R ((icoac_real_t)INFINITY)
@@ -9,219 +10,290 @@
 static void test_defaults_match_spec(void **unused)
 {
     icoac_config_t cfg = test_default_config();
+    icoac_config_t filled;
+    icoac_policy_config_t policy;
+    icoac_ico_config_t ico;
+    icoac_critic_config_t critic;
+    icoac_actor_config_t actor;
     const double tol = 4.0 * REAL_EPS;
     (void)unused;
     assert_int_equal(cfg.mode, ICOAC_MODE_ICO);
-    assert_int_equal(cfg.reflex_mode, ICOAC_REFLEX_UNIT);
-    assert_int_equal(cfg.ico_timing, ICOAC_ICO_TIMING_CODE);
-    assert_int_equal(cfg.clip_inputs, 1);
-    assert_close(cfg.input_range[0], 2.4, tol * 2.4);
-    assert_close(cfg.input_range[1], 3.5, tol * 3.5);
-    assert_close(cfg.input_range[2], 0.2094384, tol);
-    assert_close(cfg.input_range[3], 2.0, 0.0);
-    assert_close(cfg.gain, 10.0, 0.0);
-    assert_close(cfg.reflex_force, 1.0, 0.0);
-    assert_close(cfg.zone_theta, DEG(11.5), tol);
-    assert_close(cfg.zone_x, 2.35, tol * 2.35);
-    assert_close(cfg.ico_rate, 1e-4, tol * 1e-4);
-    assert_close(cfg.critic_rate, 0.6, tol);
-    assert_close(cfg.discount, 0.95, tol);
-    assert_close(cfg.td_clip, 1.0, 0.0);
-    assert_close(cfg.critic_range[0], 2.4, tol * 2.4);
-    assert_close(cfg.critic_range[1], 3.5, tol * 3.5);
-    assert_close(cfg.critic_range[2], 0.2094384, tol);
-    assert_close(cfg.critic_range[3], 2.0, 0.0);
-    assert_close(cfg.noise_std, 1.0, 0.0);
-    assert_close(cfg.actor_scale, 0.5, 0.0);
-    assert_close(cfg.forgetting, 1.0, 0.0);
-    assert_int_equal(cfg.rl_reflex, 1);
-    assert_int_equal(cfg.act_with_sample, 0);
-    icoac_config_default(NULL); /* must not crash */
+    assert_int_equal(cfg.policy.reflex_mode, ICOAC_REFLEX_UNIT);
+    assert_int_equal(cfg.ico.timing, ICOAC_ICO_TIMING_CODE);
+    assert_int_equal(cfg.policy.clip_inputs, 1);
+    assert_close(cfg.policy.input_range[0], 2.4, tol * 2.4);
+    assert_close(cfg.policy.input_range[1], 3.5, tol * 3.5);
+    assert_close(cfg.policy.input_range[2], 0.2094384, tol);
+    assert_close(cfg.policy.input_range[3], 2.0, 0.0);
+    assert_close(cfg.policy.gain, 10.0, 0.0);
+    assert_close(cfg.policy.reflex_force, 1.0, 0.0);
+    assert_close(cfg.policy.zone_theta, DEG(11.5), tol);
+    assert_close(cfg.policy.zone_x, 2.35, tol * 2.35);
+    assert_close(cfg.ico.rate, 1e-4, tol * 1e-4);
+    assert_close(cfg.critic.rate, 0.6, tol);
+    assert_close(cfg.critic.discount, 0.95, tol);
+    assert_close(cfg.critic.td_clip, 1.0, 0.0);
+    assert_close(cfg.critic.range[0], 2.4, tol * 2.4);
+    assert_close(cfg.critic.range[1], 3.5, tol * 3.5);
+    assert_close(cfg.critic.range[2], 0.2094384, tol);
+    assert_close(cfg.critic.range[3], 2.0, 0.0);
+    assert_close(cfg.critic.threshold, 0.001, tol * 0.001);
+    assert_close(cfg.actor.noise_std, 1.0, 0.0);
+    assert_close(cfg.actor.scale, 0.5, 0.0);
+    assert_close(cfg.actor.forgetting, 1.0, 0.0);
+    assert_int_equal(cfg.actor.reflex, 1);
+    assert_int_equal(cfg.actor.act_with_sample, 0);
+    /* Each group's default is the configuration default's group (same fill: padding agrees). */
+    memset(&filled, 0xA5, sizeof filled);
+    memset(&policy, 0xA5, sizeof policy);
+    memset(&ico, 0xA5, sizeof ico);
+    memset(&critic, 0xA5, sizeof critic);
+    memset(&actor, 0xA5, sizeof actor);
+    icoac_config_default(&filled);
+    icoac_policy_config_default(&policy);
+    icoac_ico_config_default(&ico);
+    icoac_critic_config_default(&critic);
+    icoac_actor_config_default(&actor);
+    assert_int_equal(filled.mode, ICOAC_MODE_ICO);
+    assert_memory_equal(&policy, &filled.policy, sizeof policy);
+    assert_memory_equal(&ico, &filled.ico, sizeof ico);
+    assert_memory_equal(&critic, &filled.critic, sizeof critic);
+    assert_memory_equal(&actor, &filled.actor, sizeof actor);
+    /* and the default over a 0xA5 fill equals the default over zeros, field by field */
+    assert_true(memcmp(filled.policy.input_range, cfg.policy.input_range, sizeof cfg.policy.input_range) == 0);
+    assert_true(filled.policy.gain == cfg.policy.gain && filled.policy.zone_x == cfg.policy.zone_x);
+    assert_true(filled.critic.threshold == cfg.critic.threshold && filled.actor.reflex == cfg.actor.reflex);
+    /* must not crash */
+    icoac_config_default(NULL);
+    icoac_policy_config_default(NULL);
+    icoac_ico_config_default(NULL);
+    icoac_critic_config_default(NULL);
+    icoac_actor_config_default(NULL);
 }
 
-/* One mutation of the default configuration and the status it must produce. */
+/* One mutation of the default configuration, the status it must produce and the field
+ * icoac_config_check_field must name (NULL when OK). */
 typedef void (*mutate_fn)(icoac_config_t *cfg);
 typedef struct {
     const char *name;
     mutate_fn mutate;
     icoac_status_t expected;
+    const char *field;
 } config_case_t;
 
+/* MUT: on the default (ICO) configuration; RLMUT: in RL mode, which validates critic and actor. */
 #define MUT(fname, body) \
     static void fname(icoac_config_t *c) { body; }
+#define RLMUT(fname, body)           \
+    static void fname(icoac_config_t *c) \
+    {                                \
+        c->mode = ICOAC_MODE_RL;     \
+        body;                        \
+    }
 
 MUT(m_mode_2, c->mode = 2)
 MUT(m_mode_neg, c->mode = -1)
-MUT(m_reflex_mode_2, c->reflex_mode = 2)
-MUT(m_reflex_mode_neg, c->reflex_mode = -1)
-MUT(m_timing_2, c->ico_timing = 2)
-MUT(m_clip_2, c->clip_inputs = 2)
-MUT(m_clip_neg, c->clip_inputs = -1)
-MUT(m_rl_reflex_2, c->rl_reflex = 2)
-MUT(m_sample_2, c->act_with_sample = 2)
-MUT(m_range0_zero, c->input_range[0] = 0)
-MUT(m_range1_neg, c->input_range[1] = -3.5f)
-MUT(m_range2_nan, c->input_range[2] = NAN_R)
-MUT(m_range3_inf, c->input_range[3] = INF_R)
-MUT(m_gain_neg, c->gain = -1.0f)
-MUT(m_gain_nan, c->gain = NAN_R)
-MUT(m_gain_inf, c->gain = INF_R)
-MUT(m_reflex_force_neg, c->reflex_force = -0.1f)
-MUT(m_reflex_force_nan, c->reflex_force = NAN_R)
-MUT(m_zone_theta_zero, c->zone_theta = 0)
-MUT(m_zone_theta_nan, c->zone_theta = NAN_R)
-MUT(m_zone_x_neg, c->zone_x = -2.35f)
-MUT(m_zone_x_inf, c->zone_x = INF_R)
-MUT(m_ico_rate_neg, c->ico_rate = -1e-9f)
-MUT(m_ico_rate_nan, c->ico_rate = NAN_R)
-MUT(m_ico_rate_inf, c->ico_rate = INF_R)
-MUT(m_critic_rate_neg, c->critic_rate = -0.1f)
-MUT(m_critic_rate_big, c->critic_rate = 10.5f)
-MUT(m_critic_rate_nan, c->critic_rate = NAN_R)
-MUT(m_discount_neg, c->discount = -0.01f)
-MUT(m_discount_big, c->discount = 1.01f)
-MUT(m_discount_nan, c->discount = NAN_R)
-MUT(m_td_clip_zero, c->td_clip = 0)
-MUT(m_td_clip_nan, c->td_clip = NAN_R)
-MUT(m_critic_range0_zero, c->critic_range[0] = 0)
-MUT(m_critic_range2_nan, c->critic_range[2] = NAN_R)
-MUT(m_critic_range3_neg, c->critic_range[3] = -2.0f)
-MUT(m_threshold_neg, c->critic_threshold = -0.001f)
-MUT(m_threshold_one, c->critic_threshold = 1.0f)
-MUT(m_threshold_nan, c->critic_threshold = NAN_R)
-MUT(m_noise_zero, c->noise_std = 0)
-MUT(m_noise_nan, c->noise_std = NAN_R)
-MUT(m_noise_inf, c->noise_std = INF_R)
-MUT(m_scale_neg, c->actor_scale = -0.5f)
-MUT(m_scale_nan, c->actor_scale = NAN_R)
-MUT(m_forget_zero, c->forgetting = 0)
-MUT(m_forget_big, c->forgetting = 1.001f)
-MUT(m_forget_nan, c->forgetting = NAN_R)
+MUT(m_reflex_mode_2, c->policy.reflex_mode = 2)
+MUT(m_reflex_mode_neg, c->policy.reflex_mode = -1)
+RLMUT(m_rl_reflex_mode_2, c->policy.reflex_mode = 2)
+MUT(m_timing_2, c->ico.timing = 2)
+MUT(m_timing_neg, c->ico.timing = -1)
+MUT(m_clip_2, c->policy.clip_inputs = 2)
+MUT(m_clip_neg, c->policy.clip_inputs = -1)
+RLMUT(m_rl_reflex_2, c->actor.reflex = 2)
+RLMUT(m_sample_2, c->actor.act_with_sample = 2)
+MUT(m_range0_zero, c->policy.input_range[0] = 0)
+MUT(m_range1_neg, c->policy.input_range[1] = -3.5f)
+MUT(m_range2_nan, c->policy.input_range[2] = NAN_R)
+MUT(m_range3_inf, c->policy.input_range[3] = INF_R)
+RLMUT(m_rl_range3_inf, c->policy.input_range[3] = INF_R)
+MUT(m_gain_neg, c->policy.gain = -1.0f)
+MUT(m_gain_nan, c->policy.gain = NAN_R)
+MUT(m_gain_inf, c->policy.gain = INF_R)
+RLMUT(m_rl_gain_nan, c->policy.gain = NAN_R)
+MUT(m_reflex_force_neg, c->policy.reflex_force = -0.1f)
+MUT(m_reflex_force_nan, c->policy.reflex_force = NAN_R)
+MUT(m_zone_theta_zero, c->policy.zone_theta = 0)
+MUT(m_zone_theta_nan, c->policy.zone_theta = NAN_R)
+MUT(m_zone_x_neg, c->policy.zone_x = -2.35f)
+MUT(m_zone_x_inf, c->policy.zone_x = INF_R)
+RLMUT(m_rl_zone_x_inf, c->policy.zone_x = INF_R)
+MUT(m_ico_rate_neg, c->ico.rate = -1e-9f)
+MUT(m_ico_rate_nan, c->ico.rate = NAN_R)
+MUT(m_ico_rate_inf, c->ico.rate = INF_R)
+RLMUT(m_critic_rate_neg, c->critic.rate = -0.1f)
+RLMUT(m_critic_rate_big, c->critic.rate = 10.5f)
+RLMUT(m_critic_rate_nan, c->critic.rate = NAN_R)
+RLMUT(m_discount_neg, c->critic.discount = -0.01f)
+RLMUT(m_discount_big, c->critic.discount = 1.01f)
+RLMUT(m_discount_nan, c->critic.discount = NAN_R)
+RLMUT(m_td_clip_zero, c->critic.td_clip = 0)
+RLMUT(m_td_clip_nan, c->critic.td_clip = NAN_R)
+RLMUT(m_critic_range0_zero, c->critic.range[0] = 0)
+RLMUT(m_critic_range2_nan, c->critic.range[2] = NAN_R)
+RLMUT(m_critic_range3_neg, c->critic.range[3] = -2.0f)
+RLMUT(m_threshold_neg, c->critic.threshold = -0.001f)
+RLMUT(m_threshold_one, c->critic.threshold = 1.0f)
+RLMUT(m_threshold_nan, c->critic.threshold = NAN_R)
+RLMUT(m_noise_zero, c->actor.noise_std = 0)
+RLMUT(m_noise_nan, c->actor.noise_std = NAN_R)
+RLMUT(m_noise_inf, c->actor.noise_std = INF_R)
+RLMUT(m_scale_neg, c->actor.scale = -0.5f)
+RLMUT(m_scale_nan, c->actor.scale = NAN_R)
+RLMUT(m_forget_zero, c->actor.forgetting = 0)
+RLMUT(m_forget_big, c->actor.forgetting = 1.001f)
+RLMUT(m_forget_nan, c->actor.forgetting = NAN_R)
 /* Issue 8: accepted before, then NaN/Inf (or a critic overrun) in the tick. Both ends bounded. */
-MUT(m_range0_subnormal, c->input_range[0] = (icoac_real_t)1e-39)
-MUT(m_range1_tiny, c->input_range[1] = (icoac_real_t)9e-7)
-MUT(m_range2_huge, c->input_range[2] = (icoac_real_t)1.1e6)
-MUT(m_gain_huge, c->gain = (icoac_real_t)1e30)
-MUT(m_reflex_force_huge, c->reflex_force = (icoac_real_t)1e38)
-MUT(m_zone_theta_big, c->zone_theta = (icoac_real_t)3.2)
-MUT(m_zone_x_huge, c->zone_x = (icoac_real_t)1e30)
-MUT(m_ico_rate_huge, c->ico_rate = (icoac_real_t)1e30)
-MUT(m_td_clip_subnormal, c->td_clip = (icoac_real_t)1e-39)
-MUT(m_td_clip_huge, c->td_clip = (icoac_real_t)1e30)
-MUT(m_critic_range0_subnormal, { c->mode = ICOAC_MODE_RL; c->critic_range[0] = (icoac_real_t)1e-39; })
-MUT(m_critic_range1_huge, c->critic_range[1] = (icoac_real_t)1e30)
-MUT(m_noise_tiny, { c->mode = ICOAC_MODE_RL; c->noise_std = (icoac_real_t)1e-20; })
-MUT(m_noise_huge, c->noise_std = (icoac_real_t)1e30)
-MUT(m_scale_huge, c->actor_scale = (icoac_real_t)1e30)
-MUT(m_forget_tiny, c->forgetting = (icoac_real_t)1e-30)
-MUT(m_forget_below_half, c->forgetting = (icoac_real_t)0.49)
-MUT(m_zone_theta_subnormal, c->zone_theta = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
-MUT(m_zone_x_tiny, c->zone_x = (icoac_real_t)9e-7)
-MUT(m_gain_subnormal, c->gain = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
-MUT(m_threshold_subnormal, c->critic_threshold = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
+MUT(m_range0_subnormal, c->policy.input_range[0] = (icoac_real_t)1e-39)
+MUT(m_range1_tiny, c->policy.input_range[1] = (icoac_real_t)9e-7)
+MUT(m_range2_huge, c->policy.input_range[2] = (icoac_real_t)1.1e6)
+MUT(m_gain_huge, c->policy.gain = (icoac_real_t)1e30)
+MUT(m_reflex_force_huge, c->policy.reflex_force = (icoac_real_t)1e38)
+MUT(m_zone_theta_big, c->policy.zone_theta = (icoac_real_t)3.2)
+MUT(m_zone_x_huge, c->policy.zone_x = (icoac_real_t)1e30)
+MUT(m_ico_rate_huge, c->ico.rate = (icoac_real_t)1e30)
+RLMUT(m_td_clip_subnormal, c->critic.td_clip = (icoac_real_t)1e-39)
+RLMUT(m_td_clip_huge, c->critic.td_clip = (icoac_real_t)1e30)
+RLMUT(m_critic_range0_subnormal, c->critic.range[0] = (icoac_real_t)1e-39)
+RLMUT(m_critic_range1_huge, c->critic.range[1] = (icoac_real_t)1e30)
+RLMUT(m_noise_tiny, c->actor.noise_std = (icoac_real_t)1e-20)
+RLMUT(m_noise_huge, c->actor.noise_std = (icoac_real_t)1e30)
+RLMUT(m_scale_huge, c->actor.scale = (icoac_real_t)1e30)
+RLMUT(m_forget_tiny, c->actor.forgetting = (icoac_real_t)1e-30)
+RLMUT(m_forget_below_half, c->actor.forgetting = (icoac_real_t)0.49)
+MUT(m_zone_theta_subnormal, c->policy.zone_theta = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
+MUT(m_zone_x_tiny, c->policy.zone_x = (icoac_real_t)9e-7)
+MUT(m_gain_subnormal, c->policy.gain = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
+RLMUT(m_threshold_subnormal, c->critic.threshold = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
+/* Several bad fields: the first in struct order (mode, policy, then the mode's groups) is named. */
+MUT(m_two_policy_fields, { c->policy.zone_x = INF_R; c->policy.input_range[2] = NAN_R; })
+RLMUT(m_policy_before_critic, { c->critic.rate = NAN_R; c->policy.gain = -1.0f; })
+RLMUT(m_critic_before_actor, { c->actor.noise_std = 0; c->critic.threshold = 1.0f; })
+MUT(m_mode_before_all, { c->mode = 7; c->policy.gain = NAN_R; c->ico.rate = NAN_R; })
 /* Boundary values that are valid. */
-MUT(ok_range_bounds, { c->input_range[0] = (icoac_real_t)1e-6; c->input_range[1] = (icoac_real_t)1e6;
-                       c->critic_range[2] = (icoac_real_t)1e-6; c->critic_range[3] = (icoac_real_t)1e6; })
-MUT(ok_upper_bounds, { c->gain = (icoac_real_t)1e4; c->reflex_force = (icoac_real_t)1e4;
-                       c->ico_rate = 1; c->td_clip = (icoac_real_t)1e3; c->noise_std = (icoac_real_t)1e3;
-                       c->actor_scale = (icoac_real_t)1e3; })
-MUT(ok_lower_bounds, { c->td_clip = (icoac_real_t)1e-6; c->noise_std = (icoac_real_t)1e-3; })
-MUT(ok_gain_zero, c->gain = 0)
-MUT(ok_reflex_force_zero, c->reflex_force = 0)
-MUT(ok_ico_rate_zero, c->ico_rate = 0)
-MUT(ok_discount_zero, c->discount = 0)
-MUT(ok_discount_one, c->discount = 1)
-MUT(ok_critic_rate_ten, c->critic_rate = 10)
-MUT(ok_threshold, c->critic_threshold = 0.999f)
-MUT(ok_forget, c->forgetting = 0.5f)
-MUT(ok_scale_zero, c->actor_scale = 0)
-MUT(ok_rl_gain_literal, { c->mode = ICOAC_MODE_RL; c->reflex_mode = ICOAC_REFLEX_GAIN;
-                          c->ico_timing = ICOAC_ICO_TIMING_LITERAL; c->clip_inputs = 0;
-                          c->rl_reflex = 0; c->act_with_sample = 1; })
+RLMUT(ok_range_bounds, { c->policy.input_range[0] = (icoac_real_t)1e-6; c->policy.input_range[1] = (icoac_real_t)1e6;
+                         c->critic.range[2] = (icoac_real_t)1e-6; c->critic.range[3] = (icoac_real_t)1e6; })
+MUT(ok_upper_bounds_ico, { c->policy.gain = (icoac_real_t)1e4; c->policy.reflex_force = (icoac_real_t)1e4;
+                           c->ico.rate = 1; })
+RLMUT(ok_upper_bounds_rl, { c->policy.gain = (icoac_real_t)1e4; c->policy.reflex_force = (icoac_real_t)1e4;
+                            c->critic.td_clip = (icoac_real_t)1e3; c->actor.noise_std = (icoac_real_t)1e3;
+                            c->actor.scale = (icoac_real_t)1e3; })
+RLMUT(ok_lower_bounds, { c->critic.td_clip = (icoac_real_t)1e-6; c->actor.noise_std = (icoac_real_t)1e-3; })
+MUT(ok_gain_zero, c->policy.gain = 0)
+MUT(ok_reflex_force_zero, c->policy.reflex_force = 0)
+MUT(ok_ico_rate_zero, c->ico.rate = 0)
+RLMUT(ok_discount_zero, c->critic.discount = 0)
+RLMUT(ok_discount_one, c->critic.discount = 1)
+RLMUT(ok_critic_rate_ten, c->critic.rate = 10)
+RLMUT(ok_threshold, c->critic.threshold = 0.999f)
+RLMUT(ok_forget, c->actor.forgetting = 0.5f)
+RLMUT(ok_scale_zero, c->actor.scale = 0)
+RLMUT(ok_rl_gain_literal, { c->policy.reflex_mode = ICOAC_REFLEX_GAIN; c->ico.timing = ICOAC_ICO_TIMING_LITERAL;
+                            c->policy.clip_inputs = 0; c->actor.reflex = 0; c->actor.act_with_sample = 1; })
+MUT(ok_ico_gain_literal, { c->policy.reflex_mode = ICOAC_REFLEX_GAIN; c->ico.timing = ICOAC_ICO_TIMING_LITERAL;
+                           c->policy.clip_inputs = 0; })
 
 static const config_case_t config_cases[] = {
-    {"mode=2", m_mode_2, ICOAC_ERR_BAD_MODE},
-    {"mode=-1", m_mode_neg, ICOAC_ERR_BAD_MODE},
-    {"reflex_mode=2", m_reflex_mode_2, ICOAC_ERR_BAD_MODE},
-    {"reflex_mode=-1", m_reflex_mode_neg, ICOAC_ERR_BAD_MODE},
-    {"ico_timing=2", m_timing_2, ICOAC_ERR_BAD_MODE},
-    {"clip_inputs=2", m_clip_2, ICOAC_ERR_BAD_MODE},
-    {"clip_inputs=-1", m_clip_neg, ICOAC_ERR_BAD_MODE},
-    {"rl_reflex=2", m_rl_reflex_2, ICOAC_ERR_BAD_MODE},
-    {"act_with_sample=2", m_sample_2, ICOAC_ERR_BAD_MODE},
-    {"input_range[0]=0", m_range0_zero, ICOAC_ERR_BAD_SCALE},
-    {"input_range[1]<0", m_range1_neg, ICOAC_ERR_BAD_SCALE},
-    {"input_range[2]=NaN", m_range2_nan, ICOAC_ERR_BAD_SCALE},
-    {"input_range[3]=Inf", m_range3_inf, ICOAC_ERR_BAD_SCALE},
-    {"gain<0", m_gain_neg, ICOAC_ERR_BAD_GAIN},
-    {"gain=NaN", m_gain_nan, ICOAC_ERR_BAD_GAIN},
-    {"gain=Inf", m_gain_inf, ICOAC_ERR_BAD_GAIN},
-    {"reflex_force<0", m_reflex_force_neg, ICOAC_ERR_BAD_GAIN},
-    {"reflex_force=NaN", m_reflex_force_nan, ICOAC_ERR_BAD_GAIN},
-    {"zone_theta=0", m_zone_theta_zero, ICOAC_ERR_BAD_ZONE},
-    {"zone_theta=NaN", m_zone_theta_nan, ICOAC_ERR_BAD_ZONE},
-    {"zone_x<0", m_zone_x_neg, ICOAC_ERR_BAD_ZONE},
-    {"zone_x=Inf", m_zone_x_inf, ICOAC_ERR_BAD_ZONE},
-    {"ico_rate<0", m_ico_rate_neg, ICOAC_ERR_BAD_ICO_RATE},
-    {"ico_rate=NaN", m_ico_rate_nan, ICOAC_ERR_BAD_ICO_RATE},
-    {"ico_rate=Inf", m_ico_rate_inf, ICOAC_ERR_BAD_ICO_RATE},
-    {"critic_rate<0", m_critic_rate_neg, ICOAC_ERR_BAD_CRITIC},
-    {"critic_rate>10", m_critic_rate_big, ICOAC_ERR_BAD_CRITIC},
-    {"critic_rate=NaN", m_critic_rate_nan, ICOAC_ERR_BAD_CRITIC},
-    {"discount<0", m_discount_neg, ICOAC_ERR_BAD_CRITIC},
-    {"discount>1", m_discount_big, ICOAC_ERR_BAD_CRITIC},
-    {"discount=NaN", m_discount_nan, ICOAC_ERR_BAD_CRITIC},
-    {"td_clip=0", m_td_clip_zero, ICOAC_ERR_BAD_CRITIC},
-    {"td_clip=NaN", m_td_clip_nan, ICOAC_ERR_BAD_CRITIC},
-    {"critic_range[0]=0", m_critic_range0_zero, ICOAC_ERR_BAD_CRITIC},
-    {"critic_range[2]=NaN", m_critic_range2_nan, ICOAC_ERR_BAD_CRITIC},
-    {"critic_range[3]<0", m_critic_range3_neg, ICOAC_ERR_BAD_CRITIC},
-    {"critic_threshold<0", m_threshold_neg, ICOAC_ERR_BAD_CRITIC},
-    {"critic_threshold=1", m_threshold_one, ICOAC_ERR_BAD_CRITIC},
-    {"critic_threshold=NaN", m_threshold_nan, ICOAC_ERR_BAD_CRITIC},
-    {"noise_std=0", m_noise_zero, ICOAC_ERR_BAD_ACTOR},
-    {"noise_std=NaN", m_noise_nan, ICOAC_ERR_BAD_ACTOR},
-    {"noise_std=Inf", m_noise_inf, ICOAC_ERR_BAD_ACTOR},
-    {"actor_scale<0", m_scale_neg, ICOAC_ERR_BAD_ACTOR},
-    {"actor_scale=NaN", m_scale_nan, ICOAC_ERR_BAD_ACTOR},
-    {"forgetting=0", m_forget_zero, ICOAC_ERR_BAD_ACTOR},
-    {"forgetting>1", m_forget_big, ICOAC_ERR_BAD_ACTOR},
-    {"forgetting=NaN", m_forget_nan, ICOAC_ERR_BAD_ACTOR},
-    {"input_range[0]=1e-39", m_range0_subnormal, ICOAC_ERR_BAD_SCALE},
-    {"input_range[1]=9e-7", m_range1_tiny, ICOAC_ERR_BAD_SCALE},
-    {"input_range[2]=1.1e6", m_range2_huge, ICOAC_ERR_BAD_SCALE},
-    {"gain=1e30", m_gain_huge, ICOAC_ERR_BAD_GAIN},
-    {"reflex_force=1e38", m_reflex_force_huge, ICOAC_ERR_BAD_GAIN},
-    {"zone_theta=3.2", m_zone_theta_big, ICOAC_ERR_BAD_ZONE},
-    {"zone_x=1e30", m_zone_x_huge, ICOAC_ERR_BAD_ZONE},
-    {"ico_rate=1e30", m_ico_rate_huge, ICOAC_ERR_BAD_ICO_RATE},
-    {"td_clip=1e-39", m_td_clip_subnormal, ICOAC_ERR_BAD_CRITIC},
-    {"td_clip=1e30", m_td_clip_huge, ICOAC_ERR_BAD_CRITIC},
-    {"RL, critic_range[0]=1e-39", m_critic_range0_subnormal, ICOAC_ERR_BAD_CRITIC},
-    {"critic_range[1]=1e30", m_critic_range1_huge, ICOAC_ERR_BAD_CRITIC},
-    {"RL, noise_std=1e-20", m_noise_tiny, ICOAC_ERR_BAD_ACTOR},
-    {"noise_std=1e30", m_noise_huge, ICOAC_ERR_BAD_ACTOR},
-    {"actor_scale=1e30", m_scale_huge, ICOAC_ERR_BAD_ACTOR},
-    {"forgetting=1e-30", m_forget_tiny, ICOAC_ERR_BAD_ACTOR},
-    {"forgetting=0.49", m_forget_below_half, ICOAC_ERR_BAD_ACTOR},
-    {"zone_theta subnormal", m_zone_theta_subnormal, ICOAC_ERR_BAD_ZONE},
-    {"zone_x=9e-7", m_zone_x_tiny, ICOAC_ERR_BAD_ZONE},
-    {"gain subnormal", m_gain_subnormal, ICOAC_ERR_BAD_GAIN},
-    {"critic_threshold subnormal", m_threshold_subnormal, ICOAC_ERR_BAD_CRITIC},
-    {"ranges at their bounds", ok_range_bounds, ICOAC_OK},
-    {"upper bounds", ok_upper_bounds, ICOAC_OK},
-    {"lower bounds", ok_lower_bounds, ICOAC_OK},
-    {"gain=0", ok_gain_zero, ICOAC_OK},
-    {"reflex_force=0", ok_reflex_force_zero, ICOAC_OK},
-    {"ico_rate=0", ok_ico_rate_zero, ICOAC_OK},
-    {"discount=0", ok_discount_zero, ICOAC_OK},
-    {"discount=1", ok_discount_one, ICOAC_OK},
-    {"critic_rate=10", ok_critic_rate_ten, ICOAC_OK},
-    {"critic_threshold=0.999", ok_threshold, ICOAC_OK},
-    {"forgetting=0.5", ok_forget, ICOAC_OK},
-    {"actor_scale=0", ok_scale_zero, ICOAC_OK},
-    {"all switches at their alternative", ok_rl_gain_literal, ICOAC_OK},
+    {"mode=2", m_mode_2, ICOAC_ERR_BAD_MODE, "mode"},
+    {"mode=-1", m_mode_neg, ICOAC_ERR_BAD_MODE, "mode"},
+    {"policy.reflex_mode=2", m_reflex_mode_2, ICOAC_ERR_BAD_MODE, "policy.reflex_mode"},
+    {"policy.reflex_mode=-1", m_reflex_mode_neg, ICOAC_ERR_BAD_MODE, "policy.reflex_mode"},
+    {"RL, policy.reflex_mode=2", m_rl_reflex_mode_2, ICOAC_ERR_BAD_MODE, "policy.reflex_mode"},
+    {"ico.timing=2", m_timing_2, ICOAC_ERR_BAD_MODE, "ico.timing"},
+    {"ico.timing=-1", m_timing_neg, ICOAC_ERR_BAD_MODE, "ico.timing"},
+    {"policy.clip_inputs=2", m_clip_2, ICOAC_ERR_BAD_MODE, "policy.clip_inputs"},
+    {"policy.clip_inputs=-1", m_clip_neg, ICOAC_ERR_BAD_MODE, "policy.clip_inputs"},
+    {"RL, actor.reflex=2", m_rl_reflex_2, ICOAC_ERR_BAD_MODE, "actor.reflex"},
+    {"RL, actor.act_with_sample=2", m_sample_2, ICOAC_ERR_BAD_MODE, "actor.act_with_sample"},
+    {"policy.input_range[0]=0", m_range0_zero, ICOAC_ERR_BAD_SCALE, "policy.input_range[0]"},
+    {"policy.input_range[1]<0", m_range1_neg, ICOAC_ERR_BAD_SCALE, "policy.input_range[1]"},
+    {"policy.input_range[2]=NaN", m_range2_nan, ICOAC_ERR_BAD_SCALE, "policy.input_range[2]"},
+    {"policy.input_range[3]=Inf", m_range3_inf, ICOAC_ERR_BAD_SCALE, "policy.input_range[3]"},
+    {"RL, policy.input_range[3]=Inf", m_rl_range3_inf, ICOAC_ERR_BAD_SCALE, "policy.input_range[3]"},
+    {"policy.gain<0", m_gain_neg, ICOAC_ERR_BAD_GAIN, "policy.gain"},
+    {"policy.gain=NaN", m_gain_nan, ICOAC_ERR_BAD_GAIN, "policy.gain"},
+    {"policy.gain=Inf", m_gain_inf, ICOAC_ERR_BAD_GAIN, "policy.gain"},
+    {"RL, policy.gain=NaN", m_rl_gain_nan, ICOAC_ERR_BAD_GAIN, "policy.gain"},
+    {"policy.reflex_force<0", m_reflex_force_neg, ICOAC_ERR_BAD_GAIN, "policy.reflex_force"},
+    {"policy.reflex_force=NaN", m_reflex_force_nan, ICOAC_ERR_BAD_GAIN, "policy.reflex_force"},
+    {"policy.zone_theta=0", m_zone_theta_zero, ICOAC_ERR_BAD_ZONE, "policy.zone_theta"},
+    {"policy.zone_theta=NaN", m_zone_theta_nan, ICOAC_ERR_BAD_ZONE, "policy.zone_theta"},
+    {"policy.zone_x<0", m_zone_x_neg, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
+    {"policy.zone_x=Inf", m_zone_x_inf, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
+    {"RL, policy.zone_x=Inf", m_rl_zone_x_inf, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
+    {"ico.rate<0", m_ico_rate_neg, ICOAC_ERR_BAD_ICO_RATE, "ico.rate"},
+    {"ico.rate=NaN", m_ico_rate_nan, ICOAC_ERR_BAD_ICO_RATE, "ico.rate"},
+    {"ico.rate=Inf", m_ico_rate_inf, ICOAC_ERR_BAD_ICO_RATE, "ico.rate"},
+    {"RL, critic.rate<0", m_critic_rate_neg, ICOAC_ERR_BAD_CRITIC, "critic.rate"},
+    {"RL, critic.rate>10", m_critic_rate_big, ICOAC_ERR_BAD_CRITIC, "critic.rate"},
+    {"RL, critic.rate=NaN", m_critic_rate_nan, ICOAC_ERR_BAD_CRITIC, "critic.rate"},
+    {"RL, critic.discount<0", m_discount_neg, ICOAC_ERR_BAD_CRITIC, "critic.discount"},
+    {"RL, critic.discount>1", m_discount_big, ICOAC_ERR_BAD_CRITIC, "critic.discount"},
+    {"RL, critic.discount=NaN", m_discount_nan, ICOAC_ERR_BAD_CRITIC, "critic.discount"},
+    {"RL, critic.td_clip=0", m_td_clip_zero, ICOAC_ERR_BAD_CRITIC, "critic.td_clip"},
+    {"RL, critic.td_clip=NaN", m_td_clip_nan, ICOAC_ERR_BAD_CRITIC, "critic.td_clip"},
+    {"RL, critic.range[0]=0", m_critic_range0_zero, ICOAC_ERR_BAD_CRITIC, "critic.range[0]"},
+    {"RL, critic.range[2]=NaN", m_critic_range2_nan, ICOAC_ERR_BAD_CRITIC, "critic.range[2]"},
+    {"RL, critic.range[3]<0", m_critic_range3_neg, ICOAC_ERR_BAD_CRITIC, "critic.range[3]"},
+    {"RL, critic.threshold<0", m_threshold_neg, ICOAC_ERR_BAD_CRITIC, "critic.threshold"},
+    {"RL, critic.threshold=1", m_threshold_one, ICOAC_ERR_BAD_CRITIC, "critic.threshold"},
+    {"RL, critic.threshold=NaN", m_threshold_nan, ICOAC_ERR_BAD_CRITIC, "critic.threshold"},
+    {"RL, actor.noise_std=0", m_noise_zero, ICOAC_ERR_BAD_ACTOR, "actor.noise_std"},
+    {"RL, actor.noise_std=NaN", m_noise_nan, ICOAC_ERR_BAD_ACTOR, "actor.noise_std"},
+    {"RL, actor.noise_std=Inf", m_noise_inf, ICOAC_ERR_BAD_ACTOR, "actor.noise_std"},
+    {"RL, actor.scale<0", m_scale_neg, ICOAC_ERR_BAD_ACTOR, "actor.scale"},
+    {"RL, actor.scale=NaN", m_scale_nan, ICOAC_ERR_BAD_ACTOR, "actor.scale"},
+    {"RL, actor.forgetting=0", m_forget_zero, ICOAC_ERR_BAD_ACTOR, "actor.forgetting"},
+    {"RL, actor.forgetting>1", m_forget_big, ICOAC_ERR_BAD_ACTOR, "actor.forgetting"},
+    {"RL, actor.forgetting=NaN", m_forget_nan, ICOAC_ERR_BAD_ACTOR, "actor.forgetting"},
+    {"policy.input_range[0]=1e-39", m_range0_subnormal, ICOAC_ERR_BAD_SCALE, "policy.input_range[0]"},
+    {"policy.input_range[1]=9e-7", m_range1_tiny, ICOAC_ERR_BAD_SCALE, "policy.input_range[1]"},
+    {"policy.input_range[2]=1.1e6", m_range2_huge, ICOAC_ERR_BAD_SCALE, "policy.input_range[2]"},
+    {"policy.gain=1e30", m_gain_huge, ICOAC_ERR_BAD_GAIN, "policy.gain"},
+    {"policy.reflex_force=1e38", m_reflex_force_huge, ICOAC_ERR_BAD_GAIN, "policy.reflex_force"},
+    {"policy.zone_theta=3.2", m_zone_theta_big, ICOAC_ERR_BAD_ZONE, "policy.zone_theta"},
+    {"policy.zone_x=1e30", m_zone_x_huge, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
+    {"ico.rate=1e30", m_ico_rate_huge, ICOAC_ERR_BAD_ICO_RATE, "ico.rate"},
+    {"RL, critic.td_clip=1e-39", m_td_clip_subnormal, ICOAC_ERR_BAD_CRITIC, "critic.td_clip"},
+    {"RL, critic.td_clip=1e30", m_td_clip_huge, ICOAC_ERR_BAD_CRITIC, "critic.td_clip"},
+    {"RL, critic.range[0]=1e-39", m_critic_range0_subnormal, ICOAC_ERR_BAD_CRITIC, "critic.range[0]"},
+    {"RL, critic.range[1]=1e30", m_critic_range1_huge, ICOAC_ERR_BAD_CRITIC, "critic.range[1]"},
+    {"RL, actor.noise_std=1e-20", m_noise_tiny, ICOAC_ERR_BAD_ACTOR, "actor.noise_std"},
+    {"RL, actor.noise_std=1e30", m_noise_huge, ICOAC_ERR_BAD_ACTOR, "actor.noise_std"},
+    {"RL, actor.scale=1e30", m_scale_huge, ICOAC_ERR_BAD_ACTOR, "actor.scale"},
+    {"RL, actor.forgetting=1e-30", m_forget_tiny, ICOAC_ERR_BAD_ACTOR, "actor.forgetting"},
+    {"RL, actor.forgetting=0.49", m_forget_below_half, ICOAC_ERR_BAD_ACTOR, "actor.forgetting"},
+    {"policy.zone_theta subnormal", m_zone_theta_subnormal, ICOAC_ERR_BAD_ZONE, "policy.zone_theta"},
+    {"policy.zone_x=9e-7", m_zone_x_tiny, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
+    {"policy.gain subnormal", m_gain_subnormal, ICOAC_ERR_BAD_GAIN, "policy.gain"},
+    {"RL, critic.threshold subnormal", m_threshold_subnormal, ICOAC_ERR_BAD_CRITIC, "critic.threshold"},
+    {"policy.zone_x and policy.input_range[2]", m_two_policy_fields, ICOAC_ERR_BAD_SCALE, "policy.input_range[2]"},
+    {"RL, critic.rate and policy.gain", m_policy_before_critic, ICOAC_ERR_BAD_GAIN, "policy.gain"},
+    {"RL, actor.noise_std and critic.threshold", m_critic_before_actor, ICOAC_ERR_BAD_CRITIC, "critic.threshold"},
+    {"mode=7 and more", m_mode_before_all, ICOAC_ERR_BAD_MODE, "mode"},
+    {"RL, ranges at their bounds", ok_range_bounds, ICOAC_OK, NULL},
+    {"ICO upper bounds", ok_upper_bounds_ico, ICOAC_OK, NULL},
+    {"RL upper bounds", ok_upper_bounds_rl, ICOAC_OK, NULL},
+    {"RL lower bounds", ok_lower_bounds, ICOAC_OK, NULL},
+    {"policy.gain=0", ok_gain_zero, ICOAC_OK, NULL},
+    {"policy.reflex_force=0", ok_reflex_force_zero, ICOAC_OK, NULL},
+    {"ico.rate=0", ok_ico_rate_zero, ICOAC_OK, NULL},
+    {"RL, critic.discount=0", ok_discount_zero, ICOAC_OK, NULL},
+    {"RL, critic.discount=1", ok_discount_one, ICOAC_OK, NULL},
+    {"RL, critic.rate=10", ok_critic_rate_ten, ICOAC_OK, NULL},
+    {"RL, critic.threshold=0.999", ok_threshold, ICOAC_OK, NULL},
+    {"RL, actor.forgetting=0.5", ok_forget, ICOAC_OK, NULL},
+    {"RL, actor.scale=0", ok_scale_zero, ICOAC_OK, NULL},
+    {"RL, all switches at their alternative", ok_rl_gain_literal, ICOAC_OK, NULL},
+    {"ICO, all switches at their alternative", ok_ico_gain_literal, ICOAC_OK, NULL},
 };
+
+#define N_CONFIG_CASES (sizeof config_cases / sizeof config_cases[0])
+
+static int starts_with(const char *s, const char *prefix)
+{
+    return s != NULL && strncmp(s, prefix, strlen(prefix)) == 0;
+}
 
 static void test_bad_configs_rejected_state_untouched(void **unused)
 {
@@ -229,7 +301,7 @@ static void test_bad_configs_rejected_state_untouched(void **unused)
     int seen[ICOAC_ERR_BAD_PRIOR + 1] = {0};
     int s;
     (void)unused;
-    for (n = 0; n < sizeof config_cases / sizeof config_cases[0]; ++n) {
+    for (n = 0; n < N_CONFIG_CASES; ++n) {
         const config_case_t *c = &config_cases[n];
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
@@ -255,13 +327,249 @@ static void test_bad_configs_rejected_state_untouched(void **unused)
                 fail();
             }
         } else {
-            assert_int_equal(state.magic, ICOAC_STATE_MAGIC);
+            assert_int_equal(icoac_priv_state_c(&state)->magic, ICOAC_PRIV_STATE_MAGIC);
         }
         seen[c->expected] = 1;
     }
     /* Every named configuration status is exercised. */
     for (s = ICOAC_ERR_BAD_MODE; s <= ICOAC_ERR_BAD_ACTOR; ++s) {
         assert_true(seen[s]);
+    }
+}
+
+/* icoac_config_check_field names the first bad field of every case, agrees with
+ * icoac_config_check, and writes NULL when the configuration is OK. */
+static void test_config_cases_name_their_field(void **unused)
+{
+    size_t n;
+    (void)unused;
+    for (n = 0; n < N_CONFIG_CASES; ++n) {
+        const config_case_t *c = &config_cases[n];
+        icoac_config_t cfg = test_default_config();
+        const char *field = "not written";
+        icoac_status_t got;
+        c->mutate(&cfg);
+        got = icoac_config_check_field(&cfg, &field);
+        assert_int_equal(got, c->expected);
+        assert_int_equal(got, icoac_config_check(&cfg));
+        assert_int_equal(icoac_config_check_field(&cfg, NULL), got); /* field may be NULL */
+        if (c->field == NULL) {
+            if (field != NULL) {
+                print_error("case %s: field %s, expected NULL\n", c->name, field);
+            }
+            assert_null(field);
+        } else {
+            if (field == NULL || strcmp(field, c->field) != 0) {
+                print_error("case %s: field %s, expected %s\n", c->name, field ? field : "NULL", c->field);
+                fail();
+            }
+            /* a static string: the same pointer each time, unchanged by the configuration */
+            {
+                const char *again = NULL;
+                assert_int_equal(icoac_config_check_field(&cfg, &again), got);
+                assert_ptr_equal(again, field);
+            }
+        }
+    }
+    {
+        const char *field = "not written";
+        assert_int_equal(icoac_config_check_field(NULL, &field), ICOAC_ERR_NULL);
+        assert_null(field);
+        assert_int_equal(icoac_config_check_field(NULL, NULL), ICOAC_ERR_NULL);
+    }
+}
+
+/* Every field of the configuration, in struct order, with the group that validates it: the
+ * policy in both modes, ico in ICO mode only, critic and actor in RL mode only. */
+typedef enum { G_POLICY, G_ICO, G_RL } group_t;
+typedef struct {
+    const char *name;
+    size_t offset;
+    int is_int;
+    group_t group;
+    icoac_status_t status;
+} config_field_t;
+
+#define REAL_FIELD(member, group, status) {#member, offsetof(icoac_config_t, member), 0, group, status}
+#define INT_FIELD(member, group, status) {#member, offsetof(icoac_config_t, member), 1, group, status}
+
+static const config_field_t config_fields[] = {
+    REAL_FIELD(policy.input_range[0], G_POLICY, ICOAC_ERR_BAD_SCALE),
+    REAL_FIELD(policy.input_range[1], G_POLICY, ICOAC_ERR_BAD_SCALE),
+    REAL_FIELD(policy.input_range[2], G_POLICY, ICOAC_ERR_BAD_SCALE),
+    REAL_FIELD(policy.input_range[3], G_POLICY, ICOAC_ERR_BAD_SCALE),
+    INT_FIELD(policy.clip_inputs, G_POLICY, ICOAC_ERR_BAD_MODE),
+    REAL_FIELD(policy.gain, G_POLICY, ICOAC_ERR_BAD_GAIN),
+    INT_FIELD(policy.reflex_mode, G_POLICY, ICOAC_ERR_BAD_MODE),
+    REAL_FIELD(policy.reflex_force, G_POLICY, ICOAC_ERR_BAD_GAIN),
+    REAL_FIELD(policy.zone_theta, G_POLICY, ICOAC_ERR_BAD_ZONE),
+    REAL_FIELD(policy.zone_x, G_POLICY, ICOAC_ERR_BAD_ZONE),
+    REAL_FIELD(ico.rate, G_ICO, ICOAC_ERR_BAD_ICO_RATE),
+    INT_FIELD(ico.timing, G_ICO, ICOAC_ERR_BAD_MODE),
+    REAL_FIELD(critic.rate, G_RL, ICOAC_ERR_BAD_CRITIC),
+    REAL_FIELD(critic.discount, G_RL, ICOAC_ERR_BAD_CRITIC),
+    REAL_FIELD(critic.td_clip, G_RL, ICOAC_ERR_BAD_CRITIC),
+    REAL_FIELD(critic.range[0], G_RL, ICOAC_ERR_BAD_CRITIC),
+    REAL_FIELD(critic.range[1], G_RL, ICOAC_ERR_BAD_CRITIC),
+    REAL_FIELD(critic.range[2], G_RL, ICOAC_ERR_BAD_CRITIC),
+    REAL_FIELD(critic.range[3], G_RL, ICOAC_ERR_BAD_CRITIC),
+    REAL_FIELD(critic.threshold, G_RL, ICOAC_ERR_BAD_CRITIC),
+    REAL_FIELD(actor.noise_std, G_RL, ICOAC_ERR_BAD_ACTOR),
+    REAL_FIELD(actor.scale, G_RL, ICOAC_ERR_BAD_ACTOR),
+    REAL_FIELD(actor.forgetting, G_RL, ICOAC_ERR_BAD_ACTOR),
+    INT_FIELD(actor.reflex, G_RL, ICOAC_ERR_BAD_MODE),
+    INT_FIELD(actor.act_with_sample, G_RL, ICOAC_ERR_BAD_MODE),
+};
+
+#define N_CONFIG_FIELDS ((int)(sizeof config_fields / sizeof config_fields[0]))
+
+/* NaN for a real, 7 for a switch: invalid in every field. */
+static void spoil(icoac_config_t *cfg, const config_field_t *f)
+{
+    unsigned char *bytes = (unsigned char *)cfg;
+    if (f->is_int) {
+        const int32_t bad = 7;
+        memcpy(bytes + f->offset, &bad, sizeof bad);
+    } else {
+        const icoac_real_t bad = NAN_R;
+        memcpy(bytes + f->offset, &bad, sizeof bad);
+    }
+}
+
+static int validated(const config_field_t *f, int32_t mode)
+{
+    return f->group == G_POLICY || (f->group == G_ICO) == (mode == ICOAC_MODE_ICO);
+}
+
+/* One bad field at a time: named with its group's status where the mode uses the group,
+ * ignored (OK, and a working controller) where it does not. */
+static void test_each_field_named_or_ignored(void **unused)
+{
+    int32_t mode;
+    int i;
+    (void)unused;
+    for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
+        for (i = 0; i < N_CONFIG_FIELDS; ++i) {
+            const config_field_t *f = &config_fields[i];
+            icoac_config_t cfg = test_default_config();
+            const char *field = "not written";
+            icoac_status_t got;
+            cfg.mode = mode;
+            spoil(&cfg, f);
+            got = icoac_config_check_field(&cfg, &field);
+            if (validated(f, mode)) {
+                if (got != f->status || field == NULL || strcmp(field, f->name) != 0) {
+                    print_error("mode %d, bad %s: status %d field %s\n", (int)mode, f->name, (int)got,
+                                field ? field : "NULL");
+                    fail();
+                }
+            } else {
+                icoac_state_t state;
+                icoac_output_t out;
+                icoac_input_t in = test_input(0.1, -0.2, 0.05, 0.3, 0);
+                if (got != ICOAC_OK || field != NULL) {
+                    print_error("mode %d ignores %s, but: status %d field %s\n", (int)mode, f->name, (int)got,
+                                field ? field : "NULL");
+                    fail();
+                }
+                assert_int_equal(icoac_init(&cfg, &state, NULL, 3u), ICOAC_OK);
+                assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+                assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+                assert_true(isfinite((double)out.force));
+            }
+        }
+    }
+}
+
+/* Spoiling the fields from the last to the first, each check names the one just spoiled: the
+ * check walks the mode, the policy, then the mode's groups, in struct order. */
+static void test_check_order_is_struct_order(void **unused)
+{
+    int32_t mode;
+    int i;
+    (void)unused;
+    for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
+        icoac_config_t cfg = test_default_config();
+        const char *field = NULL;
+        cfg.mode = mode;
+        for (i = N_CONFIG_FIELDS - 1; i >= 0; --i) {
+            const config_field_t *f = &config_fields[i];
+            if (!validated(f, mode)) {
+                continue;
+            }
+            spoil(&cfg, f);
+            assert_int_equal(icoac_config_check_field(&cfg, &field), f->status);
+            assert_non_null(field);
+            assert_string_equal(field, f->name);
+        }
+        cfg.mode = 2;
+        assert_int_equal(icoac_config_check_field(&cfg, &field), ICOAC_ERR_BAD_MODE);
+        assert_string_equal(field, "mode");
+    }
+}
+
+/* A mode ignores the groups it does not use, even when every field of them is bad: ICO runs
+ * with a spoilt critic and actor, RL with a spoilt ico group (new with issue 9). The
+ * controller behaves exactly as with valid unused groups. */
+static void test_unused_groups_ignored(void **unused)
+{
+    int32_t mode;
+    (void)unused;
+    for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
+        icoac_config_t cfg = test_default_config();
+        icoac_config_t clean;
+        icoac_state_t state, twin;
+        test_rng_t rng = {(uint64_t)mode + 17u};
+        const char *field = "not written";
+        int i, k;
+        cfg.mode = mode;
+        clean = cfg;
+        for (i = 0; i < N_CONFIG_FIELDS; ++i) {
+            if (!validated(&config_fields[i], mode)) {
+                spoil(&cfg, &config_fields[i]);
+            }
+        }
+        assert_int_equal(icoac_config_check_field(&cfg, &field), ICOAC_OK);
+        assert_null(field);
+        assert_int_equal(icoac_init(&cfg, &state, NULL, 21u), ICOAC_OK);
+        assert_int_equal(icoac_init(&clean, &twin, NULL, 21u), ICOAC_OK);
+        for (k = 0; k < 300; ++k) {
+            icoac_output_t out, out_twin;
+            icoac_input_t in = test_input(test_uniform(&rng, -2.5, 2.5), test_uniform(&rng, -3, 3),
+                                          test_uniform(&rng, -0.25, 0.25), test_uniform(&rng, -3, 3),
+                                          k % 40 == 39 ? ICOAC_INPUT_TERMINAL : 0u);
+            memset(&out, 0, sizeof out);
+            memset(&out_twin, 0, sizeof out_twin);
+            assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+            assert_int_equal(icoac_step(&clean, &twin, &in, &out_twin), ICOAC_OK);
+            assert_memory_equal(&out, &out_twin, sizeof out);
+            if (k % 40 == 39) {
+                assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+                assert_int_equal(icoac_reset(&clean, &twin), ICOAC_OK);
+            }
+        }
+        assert_memory_equal(&state, &twin, sizeof state);
+    }
+    /* the case table's rejections of unused groups, in the other mode */
+    {
+        size_t n;
+        for (n = 0; n < N_CONFIG_CASES; ++n) {
+            const config_case_t *c = &config_cases[n];
+            icoac_config_t cfg = test_default_config();
+            icoac_state_t state;
+            const char *field = "not written";
+            const int rl_group = starts_with(c->field, "critic.") || starts_with(c->field, "actor.");
+            if (!rl_group && !starts_with(c->field, "ico.")) {
+                continue;
+            }
+            c->mutate(&cfg);
+            cfg.mode = rl_group ? ICOAC_MODE_ICO : ICOAC_MODE_RL;
+            if (icoac_config_check_field(&cfg, &field) != ICOAC_OK || field != NULL) {
+                print_error("case %s in the other mode: not ignored (field %s)\n", c->name, field ? field : "NULL");
+                fail();
+            }
+            assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
+        }
     }
 }
 
@@ -343,10 +651,15 @@ static void test_init_prior_copied(void **unused)
             assert_true(post.cov[i][j] == (i == j ? 1 : 0));
         }
     }
-    for (i = 0; i < ICOAC_CRITIC_UNITS; ++i) {
-        assert_true(state.v[i] == 0);
+    {
+        const icoac_priv_state_t *st = icoac_priv_state_c(&state);
+        for (i = 0; i < ICOAC_CRITIC_UNITS; ++i) {
+            assert_true(st->v[i] == 0);
+        }
+        assert_true(st->penalty_prev == 0);
+        assert_int_equal(st->cov_slot, 0);
+        assert_memory_equal(icoac_priv_cov_c(st), post.cov, sizeof post.cov);
     }
-    assert_true(state.penalty_prev == 0);
 }
 
 static void test_null_pointers(void **unused)
@@ -356,6 +669,7 @@ static void test_null_pointers(void **unused)
     icoac_input_t in = test_input(0, 0, 0, 0, 0);
     icoac_output_t out;
     icoac_prior_t post;
+    icoac_counters_t counters;
     (void)unused;
     assert_int_equal(icoac_config_check(NULL), ICOAC_ERR_NULL);
     assert_int_equal(icoac_prior_check(NULL), ICOAC_ERR_NULL);
@@ -379,8 +693,14 @@ static void test_null_pointers(void **unused)
     assert_int_equal(icoac_step(&cfg, &state, &in, NULL), ICOAC_ERR_NULL);
     assert_int_equal(icoac_get_posterior(NULL, &post), ICOAC_ERR_NULL);
     assert_int_equal(icoac_get_posterior(&state, NULL), ICOAC_ERR_NULL);
+    assert_int_equal(icoac_get_counters(NULL, &counters), ICOAC_ERR_NULL);
+    assert_int_equal(icoac_get_counters(&state, NULL), ICOAC_ERR_NULL);
     /* None of the rejected calls counted a tick. */
-    assert_int_equal(state.ticks, 0);
+    memset(&counters, 0xA5, sizeof counters);
+    assert_int_equal(icoac_get_counters(&state, &counters), ICOAC_OK);
+    assert_int_equal(counters.ticks, 0);
+    assert_int_equal(counters.nonfinite, 0);
+    assert_int_equal(counters.numeric_faults, 0);
 }
 
 static void test_not_initialised(void **unused)
@@ -391,6 +711,7 @@ static void test_not_initialised(void **unused)
     icoac_input_t in = test_input(0.1, 0, 0.05, 0, 0);
     icoac_output_t out;
     icoac_prior_t post;
+    icoac_counters_t counters;
     (void)unused;
     memset(&state, 0, sizeof state);
     memset(&out, 0x7F, sizeof out);
@@ -400,10 +721,14 @@ static void test_not_initialised(void **unused)
     assert_true(out.force == 0);
     assert_int_equal(icoac_reset(&cfg, &state), ICOAC_ERR_NOT_INITIALISED);
     assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_ERR_NOT_INITIALISED);
+    assert_int_equal(icoac_get_counters(&state, &counters), ICOAC_ERR_NOT_INITIALISED);
     assert_memory_equal(&state, &copy, sizeof state);
     /* Garbage is not mistaken for an initialised state. */
     memset(&state, 0xA5, sizeof state);
+    copy = state;
     assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_ERR_NOT_INITIALISED);
+    assert_int_equal(icoac_get_counters(&state, &counters), ICOAC_ERR_NOT_INITIALISED);
+    assert_memory_equal(&state, &copy, sizeof state);
 }
 
 static void test_status_strings(void **unused)
@@ -438,6 +763,7 @@ static void test_sizeof_functions(void **unused)
 {
     (void)unused;
     assert_int_equal(icoac_abi_version(), ICOAC_ABI_VERSION);
+    assert_int_equal(ICOAC_ABI_VERSION, 4);
     assert_int_equal(icoac_sizeof_real(), sizeof(icoac_real_t));
     assert_int_equal(icoac_sizeof_real(), REAL_IS_FLOAT ? 4 : 8);
     assert_int_equal(icoac_sizeof_config(), sizeof(icoac_config_t));
@@ -445,6 +771,11 @@ static void test_sizeof_functions(void **unused)
     assert_int_equal(icoac_sizeof_input(), sizeof(icoac_input_t));
     assert_int_equal(icoac_sizeof_output(), sizeof(icoac_output_t));
     assert_int_equal(icoac_sizeof_prior(), sizeof(icoac_prior_t));
+    /* The caller's storage is the documented size, 8-byte aligned, and holds the private layout. */
+    assert_int_equal(sizeof(icoac_state_t), ICOAC_STATE_SIZE);
+    assert_true(_Alignof(icoac_state_t) >= 8);
+    assert_true(sizeof(icoac_priv_state_t) <= sizeof(icoac_state_t));
+    assert_true(_Alignof(icoac_priv_state_t) <= _Alignof(icoac_state_t));
 }
 
 int main(void)
@@ -452,6 +783,10 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_defaults_match_spec),
         cmocka_unit_test(test_bad_configs_rejected_state_untouched),
+        cmocka_unit_test(test_config_cases_name_their_field),
+        cmocka_unit_test(test_each_field_named_or_ignored),
+        cmocka_unit_test(test_check_order_is_struct_order),
+        cmocka_unit_test(test_unused_groups_ignored),
         cmocka_unit_test(test_bad_priors),
         cmocka_unit_test(test_init_prior_copied),
         cmocka_unit_test(test_null_pointers),

@@ -7,22 +7,29 @@
 
 #include <float.h>
 
-#include "icoac_internal.h"
+#include "icoac_priv.h"
 
 static int finite_real(icoac_real_t v)
 {
     return isfinite((double)v) ? 1 : 0;
 }
 
-static int state_finite(const icoac_state_t *s)
+static const icoac_priv_state_t *priv(const icoac_state_t *state)
 {
+    return icoac_priv_state_c(state);
+}
+
+static int state_finite(const icoac_state_t *state)
+{
+    const icoac_priv_state_t *s = priv(state);
+    const icoac_real_t(*cov)[ICOAC_N_INPUTS] = icoac_priv_cov_c(s);
     int i, j;
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
         if (!finite_real(s->w[i]) || !finite_real(s->w_act[i])) {
             return 0;
         }
         for (j = 0; j < ICOAC_N_INPUTS; ++j) {
-            if (!finite_real(s->cov[i][j])) {
+            if (!finite_real(cov[i][j])) {
                 return 0;
             }
         }
@@ -42,26 +49,54 @@ static int output_finite(const icoac_output_t *o)
            finite_real(o->td_error) && finite_real(o->noise) && finite_real(o->cov_trace);
 }
 
-/* One tick under the contract; returns the status. A rejected tick must leave every byte of
- * the state as it was, except the counters and the critic's spare kept-unit slot. */
+/* Every real of an error output is 0 but |w|, which is the unchanged state's. */
+static int output_cleared(const icoac_output_t *o, icoac_real_t weight_norm)
+{
+    return o->force == 0 && o->z == 0 && o->reflex == 0 && o->penalty == 0 && o->q == 0 &&
+           o->weight_norm == weight_norm && o->value == 0 && o->td_error == 0 && o->noise == 0 &&
+           o->cov_trace == 0;
+}
+
+/* A rejected tick leaves every byte of the state as it was, except the counters and the
+ * scratch the tick stages into: the critic's spare kept-unit slot (active[active_slot ^ 1])
+ * and the spare covariance buffer (cov_buffer[cov_slot ^ 1]). The slots themselves stay. */
+static void assert_rejected_state(const icoac_state_t *state, const icoac_state_t *before)
+{
+    icoac_state_t expect = *before;
+    icoac_priv_state_t *e = icoac_priv_state(&expect);
+    const icoac_priv_state_t *s = priv(state);
+    const int active_spare = e->active_slot ^ 1;
+    const int cov_spare = e->cov_slot ^ 1;
+    assert_true(active_spare == 0 || active_spare == 1);
+    assert_true(cov_spare == 0 || cov_spare == 1);
+    e->counters = s->counters;
+    memcpy(&e->active[active_spare], &s->active[active_spare], sizeof e->active[active_spare]);
+    memcpy(e->cov_buffer[cov_spare], s->cov_buffer[cov_spare], sizeof e->cov_buffer[cov_spare]);
+    assert_memory_equal(state, &expect, sizeof expect);
+}
+
+/* One tick under the contract; returns the status. */
 static icoac_status_t checked_step(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in)
 {
-    icoac_state_t before = *state;
+    const icoac_state_t before = *state;
     icoac_output_t out;
-    icoac_status_t status = icoac_step(cfg, state, in, &out);
+    icoac_status_t status;
+    memset(&out, 0x7F, sizeof out);
+    status = icoac_step(cfg, state, in, &out);
     assert_int_equal(status, out.status);
+    assert_int_equal(priv(state)->counters.ticks, priv(&before)->counters.ticks + 1u);
     if (status == ICOAC_OK) {
         assert_true(output_finite(&out));
         assert_true(state_finite(state));
+        assert_true(out.weight_norm == priv(state)->weight_norm);
+        assert_int_equal(priv(state)->counters.numeric_faults, priv(&before)->counters.numeric_faults);
         return status;
     }
     assert_int_equal(status, ICOAC_ERR_NUMERIC);
-    assert_true(out.force == 0);
-    assert_int_equal(state->numeric_fault_count, before.numeric_fault_count + 1u);
-    before.ticks = state->ticks;
-    before.numeric_fault_count = state->numeric_fault_count;
-    before.active[before.active_slot ^ 1] = state->active[state->active_slot ^ 1];
-    assert_memory_equal(state, &before, sizeof before);
+    assert_true(output_cleared(&out, priv(state)->weight_norm));
+    assert_int_equal(priv(state)->counters.numeric_faults, priv(&before)->counters.numeric_faults + 1u);
+    assert_int_equal(priv(state)->counters.nonfinite, priv(&before)->counters.nonfinite);
+    assert_rejected_state(state, &before);
     return status;
 }
 
@@ -70,14 +105,14 @@ static icoac_status_t checked_step(const icoac_config_t *cfg, icoac_state_t *sta
  * cell_product (ASan: stack-buffer-overflow) and wrote through the indices they found. Here
  * NaN in every factor, then only in the (theta, theta_dot) factors: the value is then NaN,
  * which the tick rejects. */
-static void check_scan(const icoac_config_t *cfg, const icoac_real_t v[ICOAC_CRITIC_UNITS],
+static void check_scan(const icoac_critic_config_t *critic, const icoac_real_t v[ICOAC_CRITIC_UNITS],
                        const icoac_real_t factors[ICOAC_CRITIC_FACTORS], int expect_nan)
 {
-    icoac_critic_active_t active[2]; /* a neighbour to overrun into, as in the state */
+    icoac_priv_critic_active_t active[2]; /* a neighbour to overrun into, as in the state */
     icoac_real_t value;
     int i;
     memset(active, 0, sizeof active);
-    value = icoac_critic_value(cfg, v, factors, &active[0]);
+    value = icoac_priv_critic_value(critic, v, factors, &active[0]);
     assert_int_equal(isnan((double)value) ? 1 : 0, expect_nan);
     assert_true(active[0].cells <= ICOAC_CRITIC_CELLS);
     assert_true(active[0].pairs <= ICOAC_CRITIC_PAIRS);
@@ -105,14 +140,14 @@ static void test_critic_scan_bounded_for_nan(void **unused)
     for (i = 0; i < ICOAC_CRITIC_FACTORS; ++i) {
         factors[i] = (icoac_real_t)NAN;
     }
-    check_scan(&cfg, v, factors, 0); /* no pair passes: nothing kept */
-    icoac_critic_factors(&cfg, s, factors);
+    check_scan(&cfg.critic, v, factors, 0); /* no pair passes: nothing kept */
+    icoac_priv_critic_factors(&cfg.critic, s, factors);
     for (i = ICOAC_CRITIC_N_X + ICOAC_CRITIC_N_X_DOT; i < ICOAC_CRITIC_FACTORS; ++i) {
         factors[i] = (icoac_real_t)(i % 2 ? NAN : -NAN);
     }
-    check_scan(&cfg, v, factors, 1);
-    cfg.critic_threshold = 0; /* the smallest-normal floor */
-    check_scan(&cfg, v, factors, 1);
+    check_scan(&cfg.critic, v, factors, 1);
+    cfg.critic.threshold = 0; /* the smallest-normal floor */
+    check_scan(&cfg.critic, v, factors, 1);
 }
 
 /* Reproducer 1, second half: the configuration is now rejected, and an RL tick at s = 0 from
@@ -122,12 +157,14 @@ static void test_subnormal_critic_range(void **unused)
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
     icoac_input_t in = test_input(0, 0, 0, 0, 0);
+    const char *field = NULL;
     (void)unused;
     cfg.mode = ICOAC_MODE_RL;
-    cfg.critic_range[0] = (icoac_real_t)1e-39;
-    assert_int_equal(icoac_config_check(&cfg), ICOAC_ERR_BAD_CRITIC);
+    cfg.critic.range[0] = (icoac_real_t)1e-39;
+    assert_int_equal(icoac_config_check_field(&cfg, &field), ICOAC_ERR_BAD_CRITIC);
+    assert_string_equal(field, "critic.range[0]");
     assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_ERR_BAD_CRITIC);
-    cfg.critic_range[0] = ICOAC_RANGE_MIN;
+    cfg.critic.range[0] = ICOAC_RANGE_MIN;
     assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
     assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_OK);
     in.s[0] = (icoac_real_t)1e30; /* far outside the narrow grid: s * n / range overflows */
@@ -151,16 +188,18 @@ static void test_unclipped_huge_input(void **unused)
         /* finite, but x / input_range overflows; in the penalty zone, so ICO learns from it */
         icoac_input_t huge = test_input(REAL_IS_FLOAT ? 3e38 : 1e303, 0, 0.3, 0, 0);
         cfg.mode = mode;
-        cfg.clip_inputs = 0;
-        cfg.input_range[0] = ICOAC_RANGE_MIN;
+        cfg.policy.clip_inputs = 0;
+        cfg.policy.input_range[0] = ICOAC_RANGE_MIN;
         assert_int_equal(icoac_init(&cfg, &state, NULL, 3u), ICOAC_OK);
         assert_int_equal(checked_step(&cfg, &state, &calm), ICOAC_OK);
         twin = state;
         assert_int_equal(checked_step(&cfg, &state, &huge), ICOAC_ERR_NUMERIC);
         assert_int_equal(checked_step(&cfg, &state, &calm), ICOAC_OK);
         assert_int_equal(checked_step(&cfg, &twin, &calm), ICOAC_OK);
-        assert_memory_equal(state.w, twin.w, sizeof state.w);
-        assert_memory_equal(state.v, twin.v, sizeof state.v);
+        assert_memory_equal(priv(&state)->w, priv(&twin)->w, sizeof priv(&state)->w);
+        assert_memory_equal(priv(&state)->v, priv(&twin)->v, sizeof priv(&state)->v);
+        assert_memory_equal(icoac_priv_cov_c(priv(&state)), icoac_priv_cov_c(priv(&twin)),
+                            sizeof(icoac_real_t) * ICOAC_N_INPUTS * ICOAC_N_INPUTS);
     }
 }
 
@@ -191,14 +230,14 @@ static void test_prior_bounds(void **unused)
 
     prior = test_prior(ICOAC_PRIOR_MEAN_MAX, 0.1, 0.5, 0.1, (double)ICOAC_PRIOR_COV_MAX);
     cfg.mode = ICOAC_MODE_RL;
-    cfg.forgetting = ICOAC_FORGETTING_MIN;
+    cfg.actor.forgetting = ICOAC_FORGETTING_MIN;
     assert_int_equal(icoac_prior_check(&prior), ICOAC_OK);
     assert_int_equal(icoac_init(&cfg, &state, &prior, 5u), ICOAC_OK);
     for (k = 0; k < (REAL_IS_FLOAT ? 200 : 1200); ++k) {
         faults += checked_step(&cfg, &state, &in) == ICOAC_ERR_NUMERIC;
     }
     assert_true(faults > 0);
-    assert_int_equal(state.numeric_fault_count, (uint32_t)faults);
+    assert_int_equal(priv(&state)->counters.numeric_faults, (uint32_t)faults);
 }
 
 /* Forgetting inflates Sigma_w by 1/lambda per tick; at s = 0 no observation informs it, so it
@@ -213,7 +252,7 @@ static void test_forgetting_overflow_is_a_fault(void **unused)
     int first_fault = -1;
     (void)unused;
     cfg.mode = ICOAC_MODE_RL;
-    cfg.forgetting = ICOAC_FORGETTING_MIN;
+    cfg.actor.forgetting = ICOAC_FORGETTING_MIN;
     assert_int_equal(icoac_init(&cfg, &state, NULL, 11u), ICOAC_OK);
     for (k = 0; k < (REAL_IS_FLOAT ? 400 : 2200); ++k) {
         const icoac_status_t status = checked_step(&cfg, &state, &in);
@@ -225,7 +264,7 @@ static void test_forgetting_overflow_is_a_fault(void **unused)
         }
     }
     assert_true(first_fault > 100);
-    assert_int_equal(state.numeric_fault_count, (uint32_t)((REAL_IS_FLOAT ? 400 : 2200) - first_fault));
+    assert_int_equal(priv(&state)->counters.numeric_faults, (uint32_t)((REAL_IS_FLOAT ? 400 : 2200) - first_fault));
 }
 
 /* Random walks over accepted extreme configurations and extreme finite inputs: every tick
@@ -242,19 +281,19 @@ static void test_contract_random_extremes(void **unused)
         icoac_state_t state;
         int k;
         cfg.mode = run % 2;
-        cfg.clip_inputs = (run / 2) % 2;
-        cfg.act_with_sample = (run / 4) % 2;
-        cfg.ico_timing = (run / 8) % 2;
-        cfg.gain = ICOAC_GAIN_MAX;
-        cfg.ico_rate = ICOAC_ICO_RATE_MAX;
-        cfg.noise_std = run % 3 ? ICOAC_NOISE_STD_MIN : ICOAC_NOISE_STD_MAX;
-        cfg.actor_scale = ICOAC_ACTOR_SCALE_MAX;
-        cfg.td_clip = ICOAC_TD_CLIP_MAX;
-        cfg.critic_rate = ICOAC_CRITIC_RATE_MAX;
-        cfg.forgetting = run % 5 ? ICOAC_R(1.0) : ICOAC_FORGETTING_MIN;
-        cfg.input_range[run % 4] = ICOAC_RANGE_MIN;
-        cfg.critic_range[(run + 1) % 4] = ICOAC_RANGE_MIN;
-        cfg.critic_threshold = run % 7 ? cfg.critic_threshold : ICOAC_R(0.0);
+        cfg.policy.clip_inputs = (run / 2) % 2;
+        cfg.actor.act_with_sample = (run / 4) % 2;
+        cfg.ico.timing = (run / 8) % 2;
+        cfg.policy.gain = ICOAC_GAIN_MAX;
+        cfg.ico.rate = ICOAC_ICO_RATE_MAX;
+        cfg.actor.noise_std = run % 3 ? ICOAC_NOISE_STD_MIN : ICOAC_NOISE_STD_MAX;
+        cfg.actor.scale = ICOAC_ACTOR_SCALE_MAX;
+        cfg.critic.td_clip = ICOAC_TD_CLIP_MAX;
+        cfg.critic.rate = ICOAC_CRITIC_RATE_MAX;
+        cfg.actor.forgetting = run % 5 ? ICOAC_R(1.0) : ICOAC_FORGETTING_MIN;
+        cfg.policy.input_range[run % 4] = ICOAC_RANGE_MIN;
+        cfg.critic.range[(run + 1) % 4] = ICOAC_RANGE_MIN;
+        cfg.critic.threshold = run % 7 ? cfg.critic.threshold : ICOAC_R(0.0);
         assert_int_equal(icoac_init(&cfg, &state, NULL, (uint64_t)run), ICOAC_OK);
         for (k = 0; k < 300; ++k) {
             icoac_input_t in;
@@ -278,18 +317,18 @@ static void test_all_finite(void **unused)
 {
     icoac_real_t values[4] = {ICOAC_R(0.0), ICOAC_R(-0.0), ICOAC_R(1.0), ICOAC_R(-3.0e38)};
     (void)unused;
-    assert_true(icoac_all_finite(values, 4));
+    assert_true(icoac_priv_all_finite(values, 4));
     values[2] = (icoac_real_t)1e-39; /* subnormal (float) is finite */
-    assert_true(icoac_all_finite(values, 4));
+    assert_true(icoac_priv_all_finite(values, 4));
     values[1] = (icoac_real_t)INFINITY;
-    assert_false(icoac_all_finite(values, 4));
+    assert_false(icoac_priv_all_finite(values, 4));
     values[1] = (icoac_real_t)-INFINITY;
-    assert_false(icoac_all_finite(values, 4));
+    assert_false(icoac_priv_all_finite(values, 4));
     values[1] = (icoac_real_t)NAN;
-    assert_false(icoac_all_finite(values, 4));
+    assert_false(icoac_priv_all_finite(values, 4));
     values[1] = -(icoac_real_t)NAN;
-    assert_false(icoac_all_finite(values, 4));
-    assert_true(icoac_all_finite(values, 1));
+    assert_false(icoac_priv_all_finite(values, 4));
+    assert_true(icoac_priv_all_finite(values, 1));
 }
 
 int main(void)

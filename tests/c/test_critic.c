@@ -2,7 +2,7 @@
  * threshold and the kept-unit list, and the TD(0) update through icoac_step in RL mode. */
 #include "test_common.h"
 
-#include "icoac_internal.h"
+#include "icoac_priv.h"
 
 #define K ICOAC_CRITIC_UNITS
 
@@ -62,16 +62,16 @@ static int near_threshold(double b, double threshold)
 
 /* b_k(s) from the library: the value pass lists the kept units, and an update with step 1 on
  * v = 0 writes their b_k into v. */
-static void library_b(const icoac_config_t *cfg, const icoac_real_t s[4], double b[K])
+static void library_b(const icoac_critic_config_t *critic, const icoac_real_t s[4], double b[K])
 {
     icoac_real_t factors[ICOAC_CRITIC_FACTORS];
     icoac_real_t v[K];
-    icoac_critic_active_t active;
+    icoac_priv_critic_active_t active;
     int k;
     memset(v, 0, sizeof v);
-    icoac_critic_factors(cfg, s, factors);
-    assert_true(icoac_critic_value(cfg, v, factors, &active) == 0);
-    icoac_critic_update(v, &active, (icoac_real_t)1.0);
+    icoac_priv_critic_factors(critic, s, factors);
+    assert_true(icoac_priv_critic_value(critic, v, factors, &active) == 0);
+    icoac_priv_critic_update(v, &active, (icoac_real_t)1.0);
     for (k = 0; k < K; ++k) {
         b[k] = (double)v[k];
     }
@@ -103,13 +103,13 @@ static void test_nonneg_at_least(void **unused)
     (void)unused;
     for (i = 0; i < n_special; ++i) {
         for (j = 0; j < n_special; ++j) {
-            assert_int_equal(icoac_nonneg_at_least(special[i], special[j]), special[i] >= special[j]);
+            assert_int_equal(icoac_priv_nonneg_at_least(special[i], special[j]), special[i] >= special[j]);
         }
     }
     for (i = 0; i < 100000; ++i) {
         const icoac_real_t a = (icoac_real_t)pow(10.0, test_uniform(&rng, -40, 3));
         const icoac_real_t b = i % 3 == 0 ? a : (icoac_real_t)pow(10.0, test_uniform(&rng, -40, 3));
-        assert_int_equal(icoac_nonneg_at_least(a, b), a >= b);
+        assert_int_equal(icoac_priv_nonneg_at_least(a, b), a >= b);
     }
 }
 
@@ -135,7 +135,7 @@ static void test_separable_equals_direct(void **unused)
     double bl[K], bd[K];
     int n, k;
     (void)unused;
-    cfg.critic_threshold = 0; /* every unit */
+    cfg.critic.threshold = 0; /* every unit */
     for (n = 0; n < 400; ++n) {
         icoac_real_t s[4];
         double sum = 0;
@@ -148,7 +148,7 @@ static void test_separable_equals_direct(void **unused)
             s[2] = (icoac_real_t)100.0;
             s[3] = (icoac_real_t)-1e4;
         }
-        library_b(&cfg, s, bl);
+        library_b(&cfg.critic, s, bl);
         direct_b(s, bd);
         for (k = 0; k < K; ++k) {
             if (!(fabs(bl[k] - bd[k]) <= b_tol())) {
@@ -167,7 +167,7 @@ static void check_value(icoac_config_t cfg, unsigned seed)
 {
     test_rng_t rng = {seed};
     icoac_real_t v[K], factors[ICOAC_CRITIC_FACTORS], s[4];
-    icoac_critic_active_t active;
+    icoac_priv_critic_active_t active;
     double bd[K];
     int n, k;
     for (n = 0; n < 200; ++n) {
@@ -176,13 +176,13 @@ static void check_value(icoac_config_t cfg, unsigned seed)
             v[k] = (icoac_real_t)test_uniform(&rng, -1, 1);
         }
         random_state(&rng, n & 1, s);
-        icoac_critic_factors(&cfg, s, factors);
-        direct_b_kept(s, (double)cfg.critic_threshold, bd);
+        icoac_priv_critic_factors(&cfg.critic, s, factors);
+        direct_b_kept(s, (double)cfg.critic.threshold, bd);
         for (k = 0; k < K; ++k) {
             expected += (double)v[k] * bd[k];
-            slack += near_threshold(bd[k], (double)cfg.critic_threshold) ? fabs((double)v[k]) * bd[k] : 0;
+            slack += near_threshold(bd[k], (double)cfg.critic.threshold) ? fabs((double)v[k]) * bd[k] : 0;
         }
-        assert_close(icoac_critic_value(&cfg, v, factors, &active), expected,
+        assert_close(icoac_priv_critic_value(&cfg.critic, v, factors, &active), expected,
                      slack + (REAL_IS_FLOAT ? 1e-5 : 1e-12));
     }
 }
@@ -192,9 +192,9 @@ static void test_value_is_weighted_sum(void **unused)
     icoac_config_t cfg = test_default_config();
     (void)unused;
     check_value(cfg, 31u); /* default threshold 0.001 */
-    cfg.critic_threshold = 0;
+    cfg.critic.threshold = 0;
     check_value(cfg, 32u);
-    cfg.critic_threshold = (icoac_real_t)0.05;
+    cfg.critic.threshold = (icoac_real_t)0.05;
     check_value(cfg, 33u);
 }
 
@@ -205,11 +205,11 @@ static void test_threshold_drops_small_activations(void **unused)
     double bl[K], bd[K];
     int n, k, dropped = 0, kept = 0;
     (void)unused;
-    assert_true(cfg.critic_threshold == (icoac_real_t)0.001); /* the authors' cut-off is the default */
+    assert_true(cfg.critic.threshold == (icoac_real_t)0.001); /* the authors' cut-off is the default */
     for (n = 0; n < 200; ++n) {
         icoac_real_t s[4];
         random_state(&rng, n >= 150, s);
-        library_b(&cfg, s, bl);
+        library_b(&cfg.critic, s, bl);
         direct_b(s, bd);
         for (k = 0; k < K; ++k) {
             if (near_threshold(bd[k], 0.001)) {
@@ -234,7 +234,7 @@ static void test_kept_unit_list(void **unused)
     icoac_config_t cfg = test_default_config();
     test_rng_t rng = {12u};
     icoac_real_t factors[ICOAC_CRITIC_FACTORS], v[K], s[4];
-    icoac_critic_active_t active;
+    icoac_priv_critic_active_t active;
     int n, i, p, total_kept = 0;
     (void)unused;
     memset(v, 0, sizeof v);
@@ -242,8 +242,8 @@ static void test_kept_unit_list(void **unused)
         double bd[K];
         int listed[K];
         random_state(&rng, n % 3 == 2, s);
-        icoac_critic_factors(&cfg, s, factors);
-        (void)icoac_critic_value(&cfg, v, factors, &active);
+        icoac_priv_critic_factors(&cfg.critic, s, factors);
+        (void)icoac_priv_critic_value(&cfg.critic, v, factors, &active);
         direct_b(s, bd);
         assert_true(active.cells <= ICOAC_CRITIC_CELLS && active.pairs <= ICOAC_CRITIC_PAIRS);
         assert_true(active.cell_product[active.cells] == 0);
@@ -270,13 +270,13 @@ static void test_kept_unit_list(void **unused)
     assert_true(total_kept > 0 && total_kept < 300 * K / 2); /* the threshold does prune */
 
     /* threshold 0: a state inside the grid keeps all 162 units */
-    cfg.critic_threshold = 0;
+    cfg.critic.threshold = 0;
     s[0] = (icoac_real_t)0.3;
     s[1] = (icoac_real_t)-0.2;
     s[2] = (icoac_real_t)0.01;
     s[3] = (icoac_real_t)0.1;
-    icoac_critic_factors(&cfg, s, factors);
-    (void)icoac_critic_value(&cfg, v, factors, &active);
+    icoac_priv_critic_factors(&cfg.critic, s, factors);
+    (void)icoac_priv_critic_value(&cfg.critic, v, factors, &active);
     assert_int_equal(active.pairs, ICOAC_CRITIC_PAIRS);
     assert_int_equal(active.cells, ICOAC_CRITIC_CELLS);
     for (p = 0; p < active.pairs; ++p) {
@@ -293,6 +293,7 @@ static void test_td_update_through_step(void **unused)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
+    const icoac_priv_state_t *priv = icoac_priv_state_c(&state);
     icoac_output_t out;
     icoac_input_t st = test_input(0.3, -0.4, 0.05, 0.2, 0);
     icoac_input_t fail_in = test_input(0.31, -0.4, 0.22, 0.2, ICOAC_INPUT_TERMINAL);
@@ -309,7 +310,7 @@ static void test_td_update_through_step(void **unused)
     step_ok(&cfg, &state, &st, &out);
     assert_true(out.value == 0 && out.td_error == 0);
     for (k = 0; k < K; ++k) {
-        assert_true(state.v[k] == 0);
+        assert_true(priv->v[k] == 0);
     }
     /* tick 2: terminal: delta = -1 + 0 - V(s_t) = -1, v += eta * delta * b(s_t) */
     step_ok(&cfg, &state, &fail_in, &out);
@@ -317,8 +318,8 @@ static void test_td_update_through_step(void **unused)
     assert_true(out.force == 0);
     direct_b_kept(st.s, 0.001, b_t);
     for (k = 0; k < K; ++k) {
-        assert_close(state.v[k], -0.6 * b_t[k], b_tol());
-        v1[k] = (double)state.v[k];
+        assert_close(priv->v[k], -0.6 * b_t[k], b_tol());
+        v1[k] = (double)priv->v[k];
     }
 
     /* a non-terminal transition s_a -> s_b: delta = gamma V(s_b) - V(s_a) */
@@ -338,7 +339,7 @@ static void test_td_update_through_step(void **unused)
     assert_true(fabs(delta) < 1.0);
     assert_close(out.td_error, delta, REAL_IS_FLOAT ? 2e-6 : 1e-12);
     for (k = 0; k < K; ++k) {
-        assert_close(state.v[k], v1[k] + 0.6 * delta * b_a[k], REAL_IS_FLOAT ? 2e-6 : 1e-12);
+        assert_close(priv->v[k], v1[k] + 0.6 * delta * b_a[k], REAL_IS_FLOAT ? 2e-6 : 1e-12);
     }
 }
 
@@ -346,6 +347,7 @@ static void test_td_clip(void **unused)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
+    const icoac_priv_state_t *priv = icoac_priv_state_c(&state);
     icoac_output_t out;
     icoac_input_t st = test_input(-1.0, 0.4, -0.1, 0.5, 0);
     icoac_input_t fail_in = test_input(-2.41, 0.4, -0.1, 0.5, ICOAC_INPUT_TERMINAL);
@@ -353,15 +355,15 @@ static void test_td_clip(void **unused)
     int k;
     (void)unused;
     cfg.mode = ICOAC_MODE_RL;
-    cfg.td_clip = (icoac_real_t)0.25;
-    cfg.critic_rate = (icoac_real_t)0.5;
+    cfg.critic.td_clip = (icoac_real_t)0.25;
+    cfg.critic.rate = (icoac_real_t)0.5;
     assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
     step_ok(&cfg, &state, &st, &out);
     step_ok(&cfg, &state, &fail_in, &out);
     assert_close(out.td_error, -0.25, 0.0);
     direct_b_kept(st.s, 0.001, b_t);
     for (k = 0; k < K; ++k) {
-        assert_close(state.v[k], -0.5 * 0.25 * b_t[k], b_tol());
+        assert_close(priv->v[k], -0.5 * 0.25 * b_t[k], b_tol());
     }
 }
 

@@ -111,7 +111,7 @@ static void test_numeric_fault_marks_cell_error(void **unused)
     int i, j, k;
     (void)unused;
     cfg.mode = ICOAC_MODE_RL;
-    cfg.forgetting = ICOAC_FORGETTING_MIN;
+    cfg.actor.forgetting = ICOAC_FORGETTING_MIN;
     cells[0] = make_cell(0.0, 0.0, 1u);
     cells[1] = make_cell(0.5, DEG(1.0), 2u);
     assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, &prior, cells, 2, 1, NULL, NULL), ICOAC_SIM_OK);
@@ -254,7 +254,7 @@ static void test_bad_parameters(void **unused)
     assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL), ICOAC_SIM_ERR_BAD_RUN);
     run = good_run;
 
-    cfg.gain = (icoac_real_t)NAN;
+    cfg.policy.gain = (icoac_real_t)NAN;
     assert_int_equal(icoac_sim_run_cell(&cfg, &plant, &run, NULL, &cells[0], NULL, NULL), ICOAC_ERR_BAD_GAIN);
     assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL), ICOAC_ERR_BAD_GAIN);
     cfg = good_cfg;
@@ -286,7 +286,7 @@ static void test_trajectory_recorder(void **unused)
     int64_t n = -1, n2 = -1, k;
     int i;
     (void)unused;
-    cfg.ico_rate = 0; /* fixed w: the recorded force can be recomputed */
+    cfg.ico.rate = 0; /* fixed w: the recorded force can be recomputed */
     assert_int_equal(icoac_sim_trajectory(&cfg, &plant, &prior, -0.5, DEG(-4.0), 1e-4, 9u, MAX, states, forces, &n),
                      ICOAC_SIM_OK);
     assert_true(n >= 1 && n <= MAX);

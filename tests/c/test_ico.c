@@ -2,7 +2,7 @@
  * and the ICO update (Eq. 2-3) in code and literal timing. */
 #include "test_common.h"
 
-#include "icoac_internal.h"
+#include "icoac_features.h"
 
 static double tol_of(double magnitude)
 {
@@ -51,8 +51,8 @@ static void run_scaling(int clip)
         double w[4] = {0, 0, 0, 0};
         icoac_input_t in;
         double expected;
-        cfg.clip_inputs = clip;
-        cfg.ico_rate = 0; /* keep w fixed even when the row enters the reflex zone */
+        cfg.policy.clip_inputs = clip;
+        cfg.ico.rate = 0; /* keep w fixed even when the row enters the reflex zone */
         s[scale_rows[r].component] = scale_rows[r].value;
         w[scale_rows[r].component] = 1.0;
         init_with_w(&cfg, &state, w[0], w[1], w[2], w[3]);
@@ -93,12 +93,12 @@ static void test_feature_is_dot_product(void **unused)
         icoac_input_t in = test_input(test_uniform(&rng, -3, 3), test_uniform(&rng, -5, 5),
                                       test_uniform(&rng, -0.3, 0.3), test_uniform(&rng, -3, 3), 0);
         double z = 0;
-        cfg.clip_inputs = (int32_t)(k & 1);
-        cfg.ico_rate = 0;
+        cfg.policy.clip_inputs = (int32_t)(k & 1);
+        cfg.ico.rate = 0;
         init_with_w(&cfg, &state, w[0], w[1], w[2], w[3]);
         assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
         for (i = 0; i < 4; ++i) {
-            z += w[i] * test_scale(i, (double)in.s[i], cfg.clip_inputs);
+            z += w[i] * test_scale(i, (double)in.s[i], cfg.policy.clip_inputs);
         }
         assert_close(out.z, z, tol_of(8.0 * fabs(z) + 4.0));
     }
@@ -146,8 +146,8 @@ static void run_zone_table(int reflex_mode, double reflex_force, const double w[
         icoac_output_t out;
         icoac_input_t in = test_input(row->x, 0.3, row->theta, -0.4, 0);
         double z = 0, force;
-        cfg.reflex_mode = reflex_mode;
-        cfg.reflex_force = (icoac_real_t)reflex_force;
+        cfg.policy.reflex_mode = reflex_mode;
+        cfg.policy.reflex_force = (icoac_real_t)reflex_force;
         init_with_w(&cfg, &state, w[0], w[1], w[2], w[3]);
         assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
         if (out.reflex != row->reflex || out.penalty != row->penalty) {
@@ -199,10 +199,46 @@ static void test_zone_edges_are_strict(void **unused)
     for (e = 0; e < 4; ++e) {
         assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
         in = test_input(0, 0, 0, 0, 0);
-        in.s[0] = (icoac_real_t)edges[e][0] * cfg.zone_x;
-        in.s[2] = (icoac_real_t)edges[e][1] * cfg.zone_theta;
+        in.s[0] = (icoac_real_t)edges[e][0] * cfg.policy.zone_x;
+        in.s[2] = (icoac_real_t)edges[e][1] * cfg.policy.zone_theta;
         assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
         assert_true(out.reflex == 0 && out.penalty == 0);
+    }
+}
+
+/* The private feature helpers of the tick (icoac_features.h) on the same tables. */
+static void test_feature_helpers(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_state_t state;
+    size_t r;
+    int clip, i;
+    (void)unused;
+    for (r = 0; r < sizeof zone_rows / sizeof zone_rows[0]; ++r) {
+        const icoac_real_t s[ICOAC_N_INPUTS] = {(icoac_real_t)zone_rows[r].x, ICOAC_R(0.3),
+                                                (icoac_real_t)zone_rows[r].theta, ICOAC_R(-0.4)};
+        const icoac_priv_zone_t zone = icoac_priv_zone(&cfg.policy, s);
+        assert_true(zone.reflex == zone_rows[r].reflex && zone.penalty == zone_rows[r].penalty);
+    }
+    cfg.policy.reflex_force = (icoac_real_t)2.5;
+    cfg.policy.reflex_mode = ICOAC_REFLEX_UNIT;
+    assert_true(icoac_priv_reflex_force(&cfg.policy, ICOAC_R(-1.0)) == (icoac_real_t)-2.5);
+    cfg.policy.reflex_mode = ICOAC_REFLEX_GAIN;
+    assert_true(icoac_priv_reflex_force(&cfg.policy, ICOAC_R(1.0)) == cfg.policy.gain);
+    assert_true(icoac_priv_reflex_force(&cfg.policy, ICOAC_R(0.0)) == 0);
+    for (clip = 0; clip <= 1; ++clip) {
+        cfg.policy.clip_inputs = clip;
+        assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
+        for (r = 0; r < sizeof scale_rows / sizeof scale_rows[0]; ++r) {
+            icoac_real_t s[ICOAC_N_INPUTS] = {ICOAC_R(0.0), ICOAC_R(0.0), ICOAC_R(0.0), ICOAC_R(0.0)};
+            icoac_real_t scaled[ICOAC_N_INPUTS];
+            s[scale_rows[r].component] = (icoac_real_t)scale_rows[r].value;
+            icoac_priv_scale_inputs(&cfg.policy, icoac_priv_state_c(&state), s, scaled);
+            for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+                const double expected = test_scale(i, (double)s[i], clip);
+                assert_close(scaled[i], expected, tol_of(expected));
+            }
+        }
     }
 }
 
@@ -331,7 +367,7 @@ static void test_ico_literal_timing(void **unused)
     double w[4], expect_w[4], z;
     int i;
     (void)unused;
-    cfg.ico_timing = ICOAC_ICO_TIMING_LITERAL;
+    cfg.ico.timing = ICOAC_ICO_TIMING_LITERAL;
     init_with_w(&cfg, &state, w0[0], w0[1], w0[2], w0[3]);
 
     a = test_input(0.5, -0.2, 0.15, 1.5, 0); /* outside the zone */
@@ -374,7 +410,7 @@ static void test_ico_literal_timing_terminal(void **unused)
     double w[4];
     int i;
     (void)unused;
-    cfg.ico_timing = ICOAC_ICO_TIMING_LITERAL;
+    cfg.ico.timing = ICOAC_ICO_TIMING_LITERAL;
     init_with_w(&cfg, &state, 0, 0, 0, 0);
     a = test_input(-0.3, 0.8, -0.19, -1.7, 0);
     assert_int_equal(icoac_step(&cfg, &state, &a, &out), ICOAC_OK);
@@ -406,7 +442,7 @@ static void test_jump_over_zone(void **unused)
         icoac_output_t out;
         icoac_input_t a = test_input(0.0, 0.0, DEG(11.0), 1.0, 0);
         icoac_input_t f = test_input(0.0, 0.0, DEG(12.5), 1.0, ICOAC_INPUT_TERMINAL);
-        cfg.ico_timing = timing;
+        cfg.ico.timing = timing;
         assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
         assert_int_equal(icoac_step(&cfg, &state, &a, &out), ICOAC_OK);
         assert_int_equal(icoac_step(&cfg, &state, &f, &out), ICOAC_OK);
@@ -424,6 +460,7 @@ int main(void)
         cmocka_unit_test(test_zone_table_unit_reflex),
         cmocka_unit_test(test_zone_table_gain_reflex),
         cmocka_unit_test(test_zone_edges_are_strict),
+        cmocka_unit_test(test_feature_helpers),
         cmocka_unit_test(test_ico_code_timing),
         cmocka_unit_test(test_ico_code_timing_ignores_terminal),
         cmocka_unit_test(test_ico_literal_timing),

@@ -4,12 +4,14 @@
  *
  * Input format, read front to back (a byte past the end reads as 0):
  *   config  mode byte c. c odd: sizeof(icoac_config_t) raw bytes laid over
- *           icoac_config_default (fewer when the input ends). c even: the default with
- *           (c >> 1) % 8 mutations, each a field byte (% 26; indices in fuzz_input.c:
- *           0 mode, 1 reflex_mode, 2 ico_timing, 3 clip_inputs, 4-7 input_range, 8 gain,
- *           9 reflex_force, 10 zone_theta, 11 zone_x, 12 ico_rate, 13 critic_rate,
- *           14 discount, 15 td_clip, 16-19 critic_range, 20 critic_threshold, 21 noise_std,
- *           22 actor_scale, 23 forgetting, 24 rl_reflex, 25 act_with_sample) and a value.
+ *           icoac_config_default (fewer when the input ends; the nested layout of icoac.h,
+ *           padding included). c even: the default with (c >> 1) % 8 mutations, each a field
+ *           byte (% 26; indices in struct order, table in fuzz_input.c: 0 mode,
+ *           1-4 policy.input_range, 5 policy.clip_inputs, 6 policy.gain, 7 policy.reflex_mode,
+ *           8 policy.reflex_force, 9 policy.zone_theta, 10 policy.zone_x, 11 ico.rate,
+ *           12 ico.timing, 13 critic.rate, 14 critic.discount, 15 critic.td_clip,
+ *           16-19 critic.range, 20 critic.threshold, 21 actor.noise_std, 22 actor.scale,
+ *           23 actor.forgetting, 24 actor.reflex, 25 actor.act_with_sample) and a value.
  *   prior   byte p. p % 3: 0 NULL, 1 mean 0 and cov I, 2 that with (p / 3) % 8 mutations,
  *           each a field byte b ((b & 127) % 20: 0-3 mean[i], 4 + 4i + j cov[i][j];
  *           b & 128 also sets cov[j][i]) and a value.
@@ -28,11 +30,17 @@
  *
  * Contract, checked after every call (abort on violation):
  *   init    status = icoac_config_check when that fails, else icoac_prior_check when that
- *           fails, else OK or ICOAC_ERR_NUMERIC; the checks accept only documented ranges;
- *           after OK the learned state (w, |w|, cov, w_act, v) is finite and holds the prior.
- *   step    returned status = out.status, a known status; non-finite s <=> NONFINITE_INPUT.
- *           OK: every real output and the learned state finite, cov exactly symmetric,
- *           force 0 on a terminal step. Not OK: force 0, learned state bytewise unchanged.
+ *           fails, else OK or ICOAC_ERR_NUMERIC; icoac_config_check_field agrees and names a
+ *           field exactly when the check fails; the checks accept only documented ranges of
+ *           the groups the mode uses (ICO: policy, ico; RL: policy, critic, actor); after OK
+ *           the learned state (w, |w|, cov, w_act, v) is finite and holds the prior.
+ *   step    returned status = out.status, a known status; non-finite s <=> NONFINITE_INPUT;
+ *           the counters count the tick and its rejection.
+ *           OK: every real output written (out is NaN-filled before the call) and finite, the
+ *           learned state finite, cov exactly symmetric, out.weight_norm = |w|; force and
+ *           noise 0 on a terminal step; q 0 in RL; value, td_error, noise, cov_trace 0 in ICO.
+ *           Not OK: every real output 0 but weight_norm = |w|, learned state bytewise
+ *           unchanged (the spare kept-unit slot and covariance buffer are scratch, not learned).
  *   reset   OK or ICOAC_ERR_NUMERIC; w, |w|, cov, v unchanged; w_act = w unless acting with a
  *           sample (and always after ICOAC_ERR_NUMERIC); w_act finite after OK.
  */
@@ -43,6 +51,7 @@
 #include "fuzz_check.h"
 #include "fuzz_input.h"
 #include "icoac/icoac.h"
+#include "icoac_state.h" /* private layout of the state (firmware/src) */
 
 #define FZ_MAX_OPS 128
 #define FZ_MAX_STEPS 512
@@ -63,11 +72,19 @@ typedef struct {
 
 static void learned_take(const icoac_state_t *state, learned_t *l)
 {
-    memcpy(l->w, state->w, sizeof l->w);
-    l->weight_norm = state->weight_norm;
-    memcpy(l->cov, state->cov, sizeof l->cov);
-    memcpy(l->v, state->v, sizeof l->v);
-    memcpy(l->w_act, state->w_act, sizeof l->w_act);
+    const icoac_priv_state_t *st = icoac_priv_state_c(state);
+    memcpy(l->w, st->w, sizeof l->w);
+    l->weight_norm = st->weight_norm;
+    memcpy(l->cov, icoac_priv_cov_c(st), sizeof l->cov);
+    memcpy(l->v, st->v, sizeof l->v);
+    memcpy(l->w_act, st->w_act, sizeof l->w_act);
+}
+
+static icoac_counters_t counters_of(const icoac_state_t *state)
+{
+    icoac_counters_t c;
+    FZ_CHECK(icoac_get_counters(state, &c) == ICOAC_OK, "icoac_get_counters failed on an initialised state");
+    return c;
 }
 
 static int finite_n(const icoac_real_t *p, int n)
@@ -166,25 +183,104 @@ static int is_flag(int32_t v)
     return v == 0 || v == 1;
 }
 
-/* Necessary conditions from the documented ranges (icoac.h); the check may be stricter. */
-static int config_documented(const icoac_config_t *cfg)
+/* Necessary conditions from the documented ranges (icoac.h) of the groups a mode uses (ICO:
+ * policy and ico; RL: policy, critic and actor; the others are ignored); the check may be
+ * stricter. */
+static int policy_documented(const icoac_policy_config_t *p)
 {
     int i;
     for (i = 0; i < N; ++i) {
-        if (!finite_positive(cfg->input_range[i]) || !finite_positive(cfg->critic_range[i])) {
+        if (!finite_positive(p->input_range[i])) {
             return 0;
         }
     }
-    return is_flag(cfg->mode) && is_flag(cfg->reflex_mode) && is_flag(cfg->ico_timing) &&
-           is_flag(cfg->clip_inputs) && is_flag(cfg->rl_reflex) && is_flag(cfg->act_with_sample) &&
-           finite_non_negative(cfg->gain) && finite_non_negative(cfg->reflex_force) &&
-           finite_positive(cfg->zone_theta) && finite_positive(cfg->zone_x) &&
-           finite_non_negative(cfg->ico_rate) && finite_non_negative(cfg->critic_rate) &&
-           cfg->critic_rate <= ICOAC_R(10.0) && finite_non_negative(cfg->discount) &&
-           cfg->discount <= ICOAC_R(1.0) && finite_positive(cfg->td_clip) &&
-           finite_non_negative(cfg->critic_threshold) && cfg->critic_threshold < ICOAC_R(1.0) &&
-           finite_positive(cfg->noise_std) && finite_non_negative(cfg->actor_scale) &&
-           finite_positive(cfg->forgetting) && cfg->forgetting <= ICOAC_R(1.0);
+    return is_flag(p->clip_inputs) && finite_non_negative(p->gain) &&
+           (p->reflex_mode == ICOAC_REFLEX_UNIT || p->reflex_mode == ICOAC_REFLEX_GAIN) &&
+           finite_non_negative(p->reflex_force) && finite_positive(p->zone_theta) && finite_positive(p->zone_x);
+}
+
+static int ico_documented(const icoac_ico_config_t *ico)
+{
+    return finite_non_negative(ico->rate) && ico->rate <= ICOAC_R(1.0) &&
+           (ico->timing == ICOAC_ICO_TIMING_CODE || ico->timing == ICOAC_ICO_TIMING_LITERAL);
+}
+
+static int critic_documented(const icoac_critic_config_t *c)
+{
+    int i;
+    for (i = 0; i < N; ++i) {
+        if (!finite_positive(c->range[i])) {
+            return 0;
+        }
+    }
+    return finite_non_negative(c->rate) && c->rate <= ICOAC_R(10.0) && finite_non_negative(c->discount) &&
+           c->discount <= ICOAC_R(1.0) && finite_positive(c->td_clip) && finite_non_negative(c->threshold) &&
+           c->threshold < ICOAC_R(1.0);
+}
+
+static int actor_documented(const icoac_actor_config_t *a)
+{
+    return finite_positive(a->noise_std) && finite_non_negative(a->scale) && finite_positive(a->forgetting) &&
+           a->forgetting <= ICOAC_R(1.0) && is_flag(a->reflex) && is_flag(a->act_with_sample);
+}
+
+static int config_documented(const icoac_config_t *cfg)
+{
+    if (cfg->mode == ICOAC_MODE_ICO) {
+        return policy_documented(&cfg->policy) && ico_documented(&cfg->ico);
+    }
+    return cfg->mode == ICOAC_MODE_RL && policy_documented(&cfg->policy) && critic_documented(&cfg->critic) &&
+           actor_documented(&cfg->actor);
+}
+
+/* The fields icoac_config_check_field may name, with their group's status and the mode that
+ * checks them. */
+typedef struct {
+    const char *name;
+    int32_t status;
+    int32_t mode; /* -1: every mode */
+} named_field_t;
+
+static const named_field_t named_fields[] = {
+    {"mode", ICOAC_ERR_BAD_MODE, -1},
+    {"policy.input_range[0]", ICOAC_ERR_BAD_SCALE, -1},
+    {"policy.input_range[1]", ICOAC_ERR_BAD_SCALE, -1},
+    {"policy.input_range[2]", ICOAC_ERR_BAD_SCALE, -1},
+    {"policy.input_range[3]", ICOAC_ERR_BAD_SCALE, -1},
+    {"policy.clip_inputs", ICOAC_ERR_BAD_MODE, -1},
+    {"policy.gain", ICOAC_ERR_BAD_GAIN, -1},
+    {"policy.reflex_mode", ICOAC_ERR_BAD_MODE, -1},
+    {"policy.reflex_force", ICOAC_ERR_BAD_GAIN, -1},
+    {"policy.zone_theta", ICOAC_ERR_BAD_ZONE, -1},
+    {"policy.zone_x", ICOAC_ERR_BAD_ZONE, -1},
+    {"ico.rate", ICOAC_ERR_BAD_ICO_RATE, ICOAC_MODE_ICO},
+    {"ico.timing", ICOAC_ERR_BAD_MODE, ICOAC_MODE_ICO},
+    {"critic.rate", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.discount", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.td_clip", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.range[0]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.range[1]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.range[2]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.range[3]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.threshold", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"actor.noise_std", ICOAC_ERR_BAD_ACTOR, ICOAC_MODE_RL},
+    {"actor.scale", ICOAC_ERR_BAD_ACTOR, ICOAC_MODE_RL},
+    {"actor.forgetting", ICOAC_ERR_BAD_ACTOR, ICOAC_MODE_RL},
+    {"actor.reflex", ICOAC_ERR_BAD_MODE, ICOAC_MODE_RL},
+    {"actor.act_with_sample", ICOAC_ERR_BAD_MODE, ICOAC_MODE_RL},
+};
+
+/* field is a known name with this status, of a group cfg's mode checks. */
+static int field_matches(const icoac_config_t *cfg, const char *field, int32_t status)
+{
+    size_t i;
+    for (i = 0; i < sizeof named_fields / sizeof named_fields[0]; ++i) {
+        const named_field_t *f = &named_fields[i];
+        if (strcmp(f->name, field) == 0) {
+            return f->status == status && (f->mode < 0 || f->mode == cfg->mode);
+        }
+    }
+    return 0;
 }
 
 /* Finite mean, finite exactly symmetric covariance with a positive diagonal. */
@@ -206,22 +302,41 @@ static int output_finite(const icoac_output_t *out)
            isfinite(out->td_error) && isfinite(out->noise) && isfinite(out->cov_trace);
 }
 
+/* Every real output 0 but weight_norm, which is the (unchanged) |w|. */
+static int output_cleared(const icoac_output_t *out, icoac_real_t weight_norm)
+{
+    return out->force == ICOAC_R(0.0) && out->z == ICOAC_R(0.0) && out->reflex == ICOAC_R(0.0) &&
+           out->penalty == ICOAC_R(0.0) && out->q == ICOAC_R(0.0) && out->weight_norm == weight_norm &&
+           out->value == ICOAC_R(0.0) && out->td_error == ICOAC_R(0.0) && out->noise == ICOAC_R(0.0) &&
+           out->cov_trace == ICOAC_R(0.0);
+}
+
 static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in, int op)
 {
     learned_t before;
     learned_t after;
     icoac_output_t out;
+    icoac_counters_t counted;
+    icoac_counters_t counted_after;
     const char *field;
     int32_t status;
     int finite_in = 1;
     int i;
     learned_take(state, &before);
+    counted = counters_of(state);
     memset(&out, 0xff, sizeof out); /* NaN in every real: each must be written */
     status = (int32_t)icoac_step(cfg, state, in, &out);
     learned_take(state, &after);
+    counted_after = counters_of(state);
     for (i = 0; i < N; ++i) {
         finite_in = finite_in && isfinite(in->s[i]);
     }
+    FZ_CHECK(counted_after.ticks == counted.ticks + 1u &&
+                 counted_after.nonfinite == counted.nonfinite + (status == ICOAC_ERR_NONFINITE_INPUT ? 1u : 0u) &&
+                 counted_after.numeric_faults == counted.numeric_faults + (status == ICOAC_ERR_NUMERIC ? 1u : 0u),
+             "op %d: status %d, counters %u/%u/%u -> %u/%u/%u", op, (int)status, (unsigned)counted.ticks,
+             (unsigned)counted.nonfinite, (unsigned)counted.numeric_faults, (unsigned)counted_after.ticks,
+             (unsigned)counted_after.nonfinite, (unsigned)counted_after.numeric_faults);
     FZ_CHECK(status == out.status, "op %d: icoac_step returned %d, out.status %d", op, (int)status,
              (int)out.status);
     FZ_CHECK(known_status(status), "op %d: icoac_step returned unknown status %d", op, (int)status);
@@ -241,13 +356,25 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
                  field, (double)after.w[0], (double)after.w[1], (double)after.w[2], (double)after.w[3],
                  (double)after.weight_norm);
         FZ_CHECK(cov_symmetric(CONST_MAT(after.cov)), "op %d: covariance not exactly symmetric", op);
-        FZ_CHECK((in->flags & ICOAC_INPUT_TERMINAL) == 0u || out.force == ICOAC_R(0.0),
-                 "op %d: terminal step with force %g", op, (double)out.force);
+        FZ_CHECK((in->flags & ICOAC_INPUT_TERMINAL) == 0u || (out.force == ICOAC_R(0.0) && out.noise == ICOAC_R(0.0)),
+                 "op %d: terminal step with force %g noise %g", op, (double)out.force, (double)out.noise);
         FZ_CHECK(out.weight_norm == after.weight_norm, "op %d: out.weight_norm %g, state |w| %g", op,
                  (double)out.weight_norm, (double)after.weight_norm);
+        if (cfg->mode == ICOAC_MODE_RL) {
+            FZ_CHECK(out.q == ICOAC_R(0.0), "op %d: RL step with q %g", op, (double)out.q);
+        } else {
+            FZ_CHECK(out.value == ICOAC_R(0.0) && out.td_error == ICOAC_R(0.0) && out.noise == ICOAC_R(0.0) &&
+                         out.cov_trace == ICOAC_R(0.0),
+                     "op %d: ICO step with value %g td %g noise %g trace %g", op, (double)out.value,
+                     (double)out.td_error, (double)out.noise, (double)out.cov_trace);
+        }
     } else {
-        FZ_CHECK(out.force == ICOAC_R(0.0), "op %d: status %d (%s) with force %g", op, (int)status,
-                 status_name(status), (double)out.force);
+        FZ_CHECK(output_cleared(&out, after.weight_norm),
+                 "op %d: status %d (%s) with an output not cleared: force %g z %g reflex %g penalty %g q %g "
+                 "|w| %g (state %g) value %g td %g noise %g trace %g",
+                 op, (int)status, status_name(status), (double)out.force, (double)out.z, (double)out.reflex,
+                 (double)out.penalty, (double)out.q, (double)out.weight_norm, (double)after.weight_norm,
+                 (double)out.value, (double)out.td_error, (double)out.noise, (double)out.cov_trace);
         field = learned_changed(&before, &after, 1);
         FZ_CHECK(field == 0, "op %d: status %d (%s) changed the learned %s", op, (int)status,
                  status_name(status), field);
@@ -256,7 +383,7 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
 
 static void check_reset(const icoac_config_t *cfg, icoac_state_t *state, int op)
 {
-    const int sampled = cfg->mode == ICOAC_MODE_RL && cfg->act_with_sample;
+    const int sampled = cfg->mode == ICOAC_MODE_RL && cfg->actor.act_with_sample;
     learned_t before;
     learned_t after;
     const char *field;
@@ -295,6 +422,11 @@ static void check_refusals(const icoac_config_t *cfg)
     FZ_CHECK(icoac_reset(cfg, &blank) == ICOAC_ERR_NOT_INITIALISED, "icoac_reset on a zeroed state");
     FZ_CHECK(icoac_get_posterior(&blank, &posterior) == ICOAC_ERR_NOT_INITIALISED,
              "icoac_get_posterior on a zeroed state");
+    {
+        icoac_counters_t counters;
+        FZ_CHECK(icoac_get_counters(&blank, &counters) == ICOAC_ERR_NOT_INITIALISED,
+                 "icoac_get_counters on a zeroed state");
+    }
     memset(&out, 0xff, sizeof out);
     status = (int32_t)icoac_step(0, &blank, &in, &out);
     FZ_CHECK(status == ICOAC_ERR_NULL && out.status == status && out.force == ICOAC_R(0.0),
@@ -311,9 +443,16 @@ static int check_init(const icoac_config_t *cfg, icoac_state_t *state, const ico
     int32_t prior_status = ICOAC_OK;
     learned_t l;
     const char *field;
+    const char *bad_field = "not written";
     int32_t status;
     int i;
     FZ_CHECK(known_status(config_status), "icoac_config_check returned unknown status %d", (int)config_status);
+    FZ_CHECK((int32_t)icoac_config_check_field(cfg, &bad_field) == config_status,
+             "icoac_config_check_field disagrees with icoac_config_check (%d)", (int)config_status);
+    FZ_CHECK((config_status == ICOAC_OK) == (bad_field == 0) &&
+                 (bad_field == 0 || field_matches(cfg, bad_field, config_status)),
+             "icoac_config_check_field: status %d (%s) with field %s (mode %d)", (int)config_status,
+             status_name(config_status), bad_field != 0 ? bad_field : "NULL", (int)cfg->mode);
     FZ_CHECK(config_status != ICOAC_OK || config_documented(cfg),
              "icoac_config_check accepted a configuration outside the documented ranges");
     if (prior != 0) {
@@ -357,8 +496,8 @@ static void check_posterior(const icoac_state_t *state)
 {
     icoac_prior_t posterior;
     FZ_CHECK(icoac_get_posterior(state, &posterior) == ICOAC_OK, "icoac_get_posterior failed");
-    FZ_CHECK(memcmp(posterior.mean, state->w, sizeof posterior.mean) == 0 &&
-                 memcmp(posterior.cov, state->cov, sizeof posterior.cov) == 0,
+    FZ_CHECK(memcmp(posterior.mean, icoac_priv_state_c(state)->w, sizeof posterior.mean) == 0 &&
+                 memcmp(posterior.cov, icoac_priv_cov_c(icoac_priv_state_c(state)), sizeof posterior.cov) == 0,
              "icoac_get_posterior differs from the state");
 }
 

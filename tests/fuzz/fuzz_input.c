@@ -138,38 +138,51 @@ int64_t fz_i64(fz_reader_t *r)
     return k < 11 ? i64_table[k] : (int64_t)read_le(r, 8);
 }
 
-/* Config field index -> its int32 or real member (exactly one is set). Indices:
- * 0 mode, 1 reflex_mode, 2 ico_timing, 3 clip_inputs, 4-7 input_range, 8 gain,
- * 9 reflex_force, 10 zone_theta, 11 zone_x, 12 ico_rate, 13 critic_rate, 14 discount,
- * 15 td_clip, 16-19 critic_range, 20 critic_threshold, 21 noise_std, 22 actor_scale,
- * 23 forgetting, 24 rl_reflex, 25 act_with_sample. */
-static void config_field(icoac_config_t *cfg, int index, int32_t **int_field, icoac_real_t **real_field)
-{
-    *int_field = 0;
-    *real_field = 0;
-    switch (index) {
-    case 0: *int_field = &cfg->mode; break;
-    case 1: *int_field = &cfg->reflex_mode; break;
-    case 2: *int_field = &cfg->ico_timing; break;
-    case 3: *int_field = &cfg->clip_inputs; break;
-    case 4: case 5: case 6: case 7: *real_field = &cfg->input_range[index - 4]; break;
-    case 8: *real_field = &cfg->gain; break;
-    case 9: *real_field = &cfg->reflex_force; break;
-    case 10: *real_field = &cfg->zone_theta; break;
-    case 11: *real_field = &cfg->zone_x; break;
-    case 12: *real_field = &cfg->ico_rate; break;
-    case 13: *real_field = &cfg->critic_rate; break;
-    case 14: *real_field = &cfg->discount; break;
-    case 15: *real_field = &cfg->td_clip; break;
-    case 16: case 17: case 18: case 19: *real_field = &cfg->critic_range[index - 16]; break;
-    case 20: *real_field = &cfg->critic_threshold; break;
-    case 21: *real_field = &cfg->noise_std; break;
-    case 22: *real_field = &cfg->actor_scale; break;
-    case 23: *real_field = &cfg->forgetting; break;
-    case 24: *int_field = &cfg->rl_reflex; break;
-    default: *int_field = &cfg->act_with_sample; break;
-    }
-}
+/* Config fields by index, in struct order (the order icoac_config_check walks them): the
+ * member's offset and whether it is an int32 switch or a real. Indices:
+ * 0 mode, 1-4 policy.input_range, 5 policy.clip_inputs, 6 policy.gain, 7 policy.reflex_mode,
+ * 8 policy.reflex_force, 9 policy.zone_theta, 10 policy.zone_x, 11 ico.rate, 12 ico.timing,
+ * 13 critic.rate, 14 critic.discount, 15 critic.td_clip, 16-19 critic.range,
+ * 20 critic.threshold, 21 actor.noise_std, 22 actor.scale, 23 actor.forgetting,
+ * 24 actor.reflex, 25 actor.act_with_sample. */
+typedef struct {
+    size_t offset;
+    int is_int;
+} config_field_t;
+
+#define FZ_INT(member) {offsetof(icoac_config_t, member), 1}
+#define FZ_REAL(member) {offsetof(icoac_config_t, member), 0}
+
+static const config_field_t config_fields[] = {
+    FZ_INT(mode),
+    FZ_REAL(policy.input_range[0]),
+    FZ_REAL(policy.input_range[1]),
+    FZ_REAL(policy.input_range[2]),
+    FZ_REAL(policy.input_range[3]),
+    FZ_INT(policy.clip_inputs),
+    FZ_REAL(policy.gain),
+    FZ_INT(policy.reflex_mode),
+    FZ_REAL(policy.reflex_force),
+    FZ_REAL(policy.zone_theta),
+    FZ_REAL(policy.zone_x),
+    FZ_REAL(ico.rate),
+    FZ_INT(ico.timing),
+    FZ_REAL(critic.rate),
+    FZ_REAL(critic.discount),
+    FZ_REAL(critic.td_clip),
+    FZ_REAL(critic.range[0]),
+    FZ_REAL(critic.range[1]),
+    FZ_REAL(critic.range[2]),
+    FZ_REAL(critic.range[3]),
+    FZ_REAL(critic.threshold),
+    FZ_REAL(actor.noise_std),
+    FZ_REAL(actor.scale),
+    FZ_REAL(actor.forgetting),
+    FZ_INT(actor.reflex),
+    FZ_INT(actor.act_with_sample),
+};
+
+ICOAC_STATIC_ASSERT(sizeof config_fields / sizeof config_fields[0] == FZ_CONFIG_FIELDS, fz_config_field_count);
 
 void fz_config(fz_reader_t *r, icoac_config_t *cfg)
 {
@@ -181,13 +194,14 @@ void fz_config(fz_reader_t *r, icoac_config_t *cfg)
         return;
     }
     for (n = (c >> 1) % 8; n > 0; --n) {
-        int32_t *int_field;
-        icoac_real_t *real_field;
-        config_field(cfg, fz_u8(r) % FZ_CONFIG_FIELDS, &int_field, &real_field);
-        if (int_field != 0) {
-            *int_field = fz_i32(r);
+        const config_field_t *f = &config_fields[fz_u8(r) % FZ_CONFIG_FIELDS];
+        unsigned char *member = (unsigned char *)cfg + f->offset;
+        if (f->is_int) {
+            const int32_t v = fz_i32(r);
+            memcpy(member, &v, sizeof v);
         } else {
-            *real_field = fz_real(r);
+            const icoac_real_t v = fz_real(r);
+            memcpy(member, &v, sizeof v);
         }
     }
 }

@@ -25,22 +25,90 @@ BOUNDED_SCALES = [1e-3, 1e-2, 0.1, 1.0, 3.0, 10.0, 100.0, 1e4]
 INT32_TABLE = [0, 1, 2, -1, 2**31 - 1, -2**31, 3]
 INT64_TABLE = [0, 1, 2, 3, -1, 300, 1000, 100000, 2**63 - 1, -2**63, 10]
 
-CONFIG_FIELDS = (["mode", "reflex_mode", "ico_timing", "clip_inputs"]
-                 + [f"input_range{i}" for i in range(4)]
-                 + ["gain", "reflex_force", "zone_theta", "zone_x", "ico_rate", "critic_rate",
-                    "discount", "td_clip"]
-                 + [f"critic_range{i}" for i in range(4)]
-                 + ["critic_threshold", "noise_std", "actor_scale", "forgetting", "rl_reflex",
-                    "act_with_sample"])
-CONFIG_INTS = {"mode", "reflex_mode", "ico_timing", "clip_inputs", "rl_reflex", "act_with_sample"}
-CONFIG_DEFAULT = {"mode": 0, "reflex_mode": 0, "ico_timing": 0, "clip_inputs": 1,
-                  "input_range0": 2.4, "input_range1": 3.5, "input_range2": 0.2094384,
-                  "input_range3": 2.0, "gain": 10.0, "reflex_force": 1.0,
-                  "zone_theta": 0.20071286397934788, "zone_x": 2.35, "ico_rate": 1.0e-4,
-                  "critic_rate": 0.6, "discount": 0.95, "td_clip": 1.0, "critic_range0": 2.4,
-                  "critic_range1": 3.5, "critic_range2": 0.2094384, "critic_range3": 2.0,
-                  "critic_threshold": 0.001, "noise_std": 1.0, "actor_scale": 0.5,
-                  "forgetting": 1.0, "rl_reflex": 1, "act_with_sample": 0}
+# icoac_config_t (icoac.h), one group per concern: (member, kind) with kind "i" an int32
+# switch, "r" an icoac_real_t, "r4" an icoac_real_t[4], or a nested group.
+CONFIG_LAYOUT = [
+    ("mode", "i"),
+    ("policy", [("input_range", "r4"), ("clip_inputs", "i"), ("gain", "r"), ("reflex_mode", "i"),
+                ("reflex_force", "r"), ("zone_theta", "r"), ("zone_x", "r")]),
+    ("ico", [("rate", "r"), ("timing", "i")]),
+    ("critic", [("rate", "r"), ("discount", "r"), ("td_clip", "r"), ("range", "r4"), ("threshold", "r")]),
+    ("actor", [("noise_std", "r"), ("scale", "r"), ("forgetting", "r"), ("reflex", "i"),
+               ("act_with_sample", "i")]),
+]
+# sizeof(icoac_config_t) with float and with double reals (x86-64 and AArch64 alignment).
+CONFIG_SIZES = {"f": 104, "d": 200}
+
+
+def config_fields():
+    """Scalar fields of icoac_config_t in struct order: [(C designator, is_int)]."""
+    out = []
+
+    def walk(members, prefix):
+        for name, kind in members:
+            if isinstance(kind, list):
+                walk(kind, prefix + name + ".")
+            elif kind == "r4":
+                out.extend((f"{prefix}{name}[{i}]", False) for i in range(4))
+            else:
+                out.append((prefix + name, kind == "i"))
+
+    walk(CONFIG_LAYOUT, "")
+    return out
+
+
+# The mutation field indices of fuzz_input.c: struct order.
+CONFIG_FIELDS = [name for name, _ in config_fields()]
+CONFIG_INTS = {name for name, is_int in config_fields() if is_int}
+assert len(CONFIG_FIELDS) == 26
+CONFIG_DEFAULT = {"mode": 0,
+                  "policy.input_range[0]": 2.4, "policy.input_range[1]": 3.5,
+                  "policy.input_range[2]": 0.2094384, "policy.input_range[3]": 2.0,
+                  "policy.clip_inputs": 1, "policy.gain": 10.0, "policy.reflex_mode": 0,
+                  "policy.reflex_force": 1.0, "policy.zone_theta": 0.20071286397934788,
+                  "policy.zone_x": 2.35,
+                  "ico.rate": 1.0e-4, "ico.timing": 0,
+                  "critic.rate": 0.6, "critic.discount": 0.95, "critic.td_clip": 1.0,
+                  "critic.range[0]": 2.4, "critic.range[1]": 3.5, "critic.range[2]": 0.2094384,
+                  "critic.range[3]": 2.0, "critic.threshold": 0.001,
+                  "actor.noise_std": 1.0, "actor.scale": 0.5, "actor.forgetting": 1.0,
+                  "actor.reflex": 1, "actor.act_with_sample": 0}
+assert list(CONFIG_DEFAULT) == CONFIG_FIELDS
+
+
+def config_offsets(fmt):
+    """(sizeof(icoac_config_t), {designator: (offset, struct code)}) for real type fmt, by the C
+    rules: each member at a multiple of its alignment, a struct aligned like its widest
+    member and padded to a multiple of that."""
+    real = struct.calcsize("<" + fmt)
+
+    def place(members):
+        """(size, alignment, {designator: (offset, code)}) of one struct."""
+        fields, offset, align = {}, 0, 1
+        for name, kind in members:
+            if isinstance(kind, list):
+                size, sub_align, sub = place(kind)
+                offset = -(-offset // sub_align) * sub_align
+                fields.update({f"{name}.{key}": (offset + o, code) for key, (o, code) in sub.items()})
+                offset += size
+                align = max(align, sub_align)
+                continue
+            size, code = (4, "i") if kind == "i" else (real, fmt)
+            offset = -(-offset // size) * size
+            if kind == "r4":
+                fields.update({f"{name}[{i}]": (offset + i * size, code) for i in range(4)})
+                offset += 4 * size
+            else:
+                fields[name] = (offset, code)
+                offset += size
+            align = max(align, size)
+        return -(-offset // align) * align, align, fields
+
+    size, _, fields = place(CONFIG_LAYOUT)
+    assert list(fields) == CONFIG_FIELDS
+    return size, fields
+
+
 PLANT_FIELDS = ["gravity", "cart_mass", "pole_mass", "half_length", "dt", "x_limit",
                 "theta_limit", "integrator", "reserved"]
 RUN_FIELDS = ["max_trials", "success_steps", "init_velocity_noise"]
@@ -73,8 +141,9 @@ def int64(v):
     return bytes([INT64_TABLE.index(v)])
 
 
-def config(**fields):
-    """icoac_config_default with mutations (at most 7, applied in order)."""
+def config(fields=None):
+    """icoac_config_default with mutations {C designator: value} (at most 7, applied in order)."""
+    fields = fields or {}
     assert len(fields) <= 7
     out = bytes([len(fields) << 1])
     for name, v in fields.items():
@@ -82,13 +151,16 @@ def config(**fields):
     return out
 
 
-def config_raw(fmt, **fields):
-    """Raw icoac_config_t bytes (fmt 'f' float, 'd' double) over the default."""
-    cfg = dict(CONFIG_DEFAULT, **fields)
-    ints = [cfg[n] for n in CONFIG_FIELDS[:4]]
-    reals = [cfg[n] for n in CONFIG_FIELDS[4:24]]
-    return b"\x01" + struct.pack(f"<4i20{fmt}2i", *ints, *reals, cfg["rl_reflex"],
-                                 cfg["act_with_sample"])
+def config_raw(fmt, fields=None):
+    """Raw icoac_config_t bytes (fmt 'f' float, 'd' double) over the default; padding 0."""
+    cfg = dict(CONFIG_DEFAULT, **(fields or {}))
+    assert set(cfg) == set(CONFIG_FIELDS)
+    size, offsets = config_offsets(fmt)
+    assert size == CONFIG_SIZES[fmt], (fmt, size)
+    raw = bytearray(size)
+    for name, (offset, code) in offsets.items():
+        struct.pack_into("<" + code, raw, offset, cfg[name])
+    return b"\x01" + bytes(raw)
 
 
 def prior(*mutations):
@@ -145,35 +217,45 @@ def controller_seeds(fmt):
     rl = {"mode": 1}
     s = {
         "default-ico": config() + NO_PRIOR + seed(1) + EXERCISE,
-        "default-rl": config(**rl) + NO_PRIOR + seed(2) + EXERCISE + EXERCISE,
-        "rl-sample": config(act_with_sample=1, **rl) + NO_PRIOR + seed(3) + EXERCISE + RESET + EXERCISE,
-        "rl-dense-forgetting": config(critic_threshold="0", forgetting=0.9, **rl) + NO_PRIOR + seed(4) + EXERCISE,
-        "rl-no-reflex": config(rl_reflex=0, discount="1", **rl) + NO_PRIOR + seed(5) + EXERCISE,
-        "ico-literal": config(ico_timing=1) + NO_PRIOR + seed(6) + EXERCISE,
-        "ico-reflex-gain": config(reflex_mode=1) + NO_PRIOR + seed(7) + EXERCISE,
+        "default-rl": config(rl) + NO_PRIOR + seed(2) + EXERCISE + EXERCISE,
+        "rl-sample": config({**rl, "actor.act_with_sample": 1}) + NO_PRIOR + seed(3) + EXERCISE + RESET + EXERCISE,
+        "rl-dense-forgetting": (config({**rl, "critic.threshold": "0", "actor.forgetting": 0.9}) + NO_PRIOR
+                                + seed(4) + EXERCISE),
+        "rl-no-reflex": config({**rl, "actor.reflex": 0, "critic.discount": "1"}) + NO_PRIOR + seed(5) + EXERCISE,
+        "ico-literal": config({"ico.timing": 1}) + NO_PRIOR + seed(6) + EXERCISE,
+        "ico-reflex-gain": config({"policy.reflex_mode": 1}) + NO_PRIOR + seed(7) + EXERCISE,
         "ico-prior": config() + prior(("mean0", 1.0), ("mean2", 10.0), ((1, 1), 2.0)) + seed(8) + EXERCISE,
-        "rl-prior-correlated": config(**rl) + prior(("mean2", 5.0), ((0, 1), 0.5, True)) + seed(9) + EXERCISE,
-        "prior-asymmetric": config(**rl) + prior(((0, 1), 0.5)) + seed(10) + EXERCISE,
+        "rl-prior-correlated": config(rl) + prior(("mean2", 5.0), ((0, 1), 0.5, True)) + seed(9) + EXERCISE,
+        "prior-asymmetric": config(rl) + prior(((0, 1), 0.5)) + seed(10) + EXERCISE,
         "prior-mean-nan": config() + prior(("mean1", "nan")) + seed(11) + EXERCISE,
-        "config-bad-mode": config(mode=2) + NO_PRIOR + seed(12) + EXERCISE,
-        "config-bad-range": config(input_range1="-1") + NO_PRIOR + seed(13) + EXERCISE,
+        "config-bad-mode": config({"mode": 2}) + NO_PRIOR + seed(12) + EXERCISE,
+        "config-bad-range": config({"policy.input_range[1]": "-1"}) + NO_PRIOR + seed(13) + EXERCISE,
         "config-raw-default": config_raw(fmt) + NO_PRIOR + seed(14) + EXERCISE,
-        "config-raw-rl": config_raw(fmt, mode=1, noise_std=0.5) + prior() + seed(15) + EXERCISE,
-        "nonfinite-input": (config(**rl) + NO_PRIOR + seed(16) + steps(ZERO, 2)
+        "config-raw-rl": config_raw(fmt, {**rl, "actor.noise_std": 0.5}) + prior() + seed(15) + EXERCISE,
+        "nonfinite-input": (config(rl) + NO_PRIOR + seed(16) + steps(ZERO, 2)
                             + step(("nan", "0", "0", "0")) + step(("0", "inf", "0", "0"))
                             + step(("0", "0", "-inf", "0"), terminal=True) + steps(ZERO, 2)),
+        # Issue 9: a mode ignores the groups it does not use, even when they are bad.
+        "config-ico-ignores-rl-groups": (config({"critic.range[0]": "1e-39", "critic.threshold": "nan",
+                                                 "actor.noise_std": "1e-20", "actor.reflex": 2})
+                                         + NO_PRIOR + seed(17) + EXERCISE),
+        "config-rl-ignores-ico-group": (config({**rl, "ico.rate": "nan", "ico.timing": 2}) + NO_PRIOR + seed(18)
+                                        + EXERCISE),
         # Known reproducers (issue 8).
-        "repro-rl-critic-range0-1e-39": config(critic_range0="1e-39", **rl) + NO_PRIOR + seed(1) + step(ZERO),
-        "repro-rl-noise-std-1e-20": config(noise_std="1e-20", **rl) + NO_PRIOR + seed(1) + steps(ZERO, 3) + EXERCISE,
-        "repro-input-range0-1e-39": config(input_range0="1e-39") + NO_PRIOR + seed(1) + step(ZERO) + EXERCISE,
-        "repro-noclip-x-1e30": config(clip_inputs=0) + NO_PRIOR + seed(1) + steps(("1e30", "0", "0", "0"), 3),
+        "repro-rl-critic-range0-1e-39": config({**rl, "critic.range[0]": "1e-39"}) + NO_PRIOR + seed(1) + step(ZERO),
+        "repro-rl-noise-std-1e-20": (config({**rl, "actor.noise_std": "1e-20"}) + NO_PRIOR + seed(1) + steps(ZERO, 3)
+                                     + EXERCISE),
+        "repro-input-range0-1e-39": (config({"policy.input_range[0]": "1e-39"}) + NO_PRIOR + seed(1) + step(ZERO)
+                                     + EXERCISE),
+        "repro-noclip-x-1e30": (config({"policy.clip_inputs": 0}) + NO_PRIOR + seed(1)
+                                + steps(("1e30", "0", "0", "0"), 3)),
         # Found by fuzzing the fixed firmware: a finite prior mean whose |w| overflows.
         "repro-prior-mean-1e30": config() + prior(("mean0", "1e30")) + seed(1) + EXERCISE,
     }
-    for field, v in (("gain", "1e30"), ("reflex_force", "1e38"), ("ico_rate", "1e30"), ("noise_std", "1e30")):
-        name = field.replace("_", "-")
-        s[f"repro-ico-{name}-{v}"] = config(**{field: v}) + NO_PRIOR + seed(1) + EXERCISE
-        s[f"repro-rl-{name}-{v}"] = config(**{field: v}, **rl) + NO_PRIOR + seed(1) + EXERCISE
+    for label, field, v in (("gain", "policy.gain", "1e30"), ("reflex-force", "policy.reflex_force", "1e38"),
+                            ("ico-rate", "ico.rate", "1e30"), ("noise-std", "actor.noise_std", "1e30")):
+        s[f"repro-ico-{label}-{v}"] = config({field: v}) + NO_PRIOR + seed(1) + EXERCISE
+        s[f"repro-rl-{label}-{v}"] = config({**rl, field: v}) + NO_PRIOR + seed(1) + EXERCISE
     return s
 
 
@@ -226,7 +308,7 @@ SIM_OPS = (op_cell(0.5, 0.05, 1) + op_grid([(0.0, 0.02, 2, False), (-1.0, -0.1, 
 
 
 def sim_seeds():
-    rl = config(mode=1)
+    rl = config({"mode": 1})
     return {
         "default-ico": plant() + run() + config() + NO_PRIOR + SIM_OPS,
         "default-rl": plant() + run() + rl + NO_PRIOR + SIM_OPS,
@@ -240,17 +322,19 @@ def sim_seeds():
         "paper-grid": plant() + run() + config() + NO_PRIOR + op_paper(1225) + op_paper(1224) + op_paper(0, True),
         "bad-plant": plant(gravity="nan") + run() + config() + NO_PRIOR + SIM_OPS,
         "bad-run": plant() + run(max_trials=0, init_velocity_noise="-1") + config() + NO_PRIOR + SIM_OPS,
-        "bad-config-prior": plant() + run() + config(mode=2) + prior(((2, 2), "-1")) + SIM_OPS,
+        "bad-config-prior": plant() + run() + config({"mode": 2}) + prior(((2, 2), "-1")) + SIM_OPS,
         "bad-arguments": (plant() + run() + config() + NO_PRIOR + op_cell("inf", 0.0, 1)
                           + op_trajectory(0.0, 0.0, "nan", 1, 0) + op_trajectory(0.0, "nan", "0", 1, 10)),
         "plant-extremes": (plant() + run() + config() + NO_PRIOR + op_plant(("1e300", "-1e30", "2.4", "nan"), "max")
                            + op_plant(("0", "0", "3.2", "1e300"), "-max")),
-        "trajectory-fall": plant() + run() + config(gain="0") + NO_PRIOR + op_trajectory(0.0, 0.2, "0.01", 9, 64),
+        "trajectory-fall": (plant() + run() + config({"policy.gain": "0"}) + NO_PRIOR
+                            + op_trajectory(0.0, 0.2, "0.01", 9, 64)),
         # Known reproducer (issue 8): a subnormal dt passes the plant check.
         "repro-plant-dt-1e-310": plant(dt="1e-310") + run() + config() + NO_PRIOR + SIM_OPS,
         # Found by fuzzing the fixed engine: float subnormals in the configuration or prior are
         # checked as given, then flushed to 0 in the run (FTZ/DAZ), so the verdicts differ.
-        "repro-config-zone-theta-1e-39": plant() + run() + config(zone_theta="1e-39") + NO_PRIOR + SIM_OPS,
+        "repro-config-zone-theta-1e-39": (plant() + run() + config({"policy.zone_theta": "1e-39"}) + NO_PRIOR
+                                          + SIM_OPS),
         "repro-prior-cov-diag-1e-39": plant() + run() + config() + prior(((0, 0), "1e-39")) + SIM_OPS,
         "repro-prior-cov-asymmetric-1e-39": plant() + run() + config() + prior(((3, 0), "-1e-39")) + SIM_OPS,
     }

@@ -5,7 +5,9 @@ import numpy as np
 import pytest
 
 from harness import _binding as B
+from harness import geometry
 from harness.config import build_config
+from harness.errors import LibraryError
 
 
 def test_struct_sizes_match_c():
@@ -15,42 +17,140 @@ def test_struct_sizes_match_c():
     assert ctypes.sizeof(B.Run) == B.lib.icoac_sim_sizeof_run()
     assert B.CELL_DTYPE.itemsize == B.lib.icoac_sim_sizeof_cell()
     assert ctypes.sizeof(B.c_real) == B.lib.icoac_sizeof_real()
-    assert ctypes.sizeof(B.State) == B.lib.icoac_sizeof_state()
     assert ctypes.sizeof(B.Input) == B.lib.icoac_sizeof_input()
     assert ctypes.sizeof(B.Output) == B.lib.icoac_sizeof_output()
     for name, (py, c) in B.layout_report().items():
         assert py == c, name
 
 
+def test_state_is_opaque_aligned_storage():
+    assert ctypes.sizeof(B.State) == B.lib.icoac_sizeof_state() == B.STATE_SIZE == B.CONSTANTS["ICOAC_STATE_SIZE"]
+    assert ctypes.alignment(B.State) == 8
+    assert [name for name, _ in B.State._fields_] == ["opaque"]  # no internal layout mirrored
+
+
 def test_abi_versions():
-    assert B.lib.icoac_abi_version() == B.ABI_VERSION == 3
-    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == 1
+    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 4
+    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 2
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
+
+
+def test_every_mirror_matches_the_c_field_table():
+    assert set(B.MIRRORS) <= set(B.FIELDS)
+    for c_type, (mirror, _) in B.MIRRORS.items():
+        assert B.mirror_fields(mirror) == B.FIELDS[c_type], c_type
+    assert "policy.gain" in B.FIELDS["icoac_config_t"] and "actor.act_with_sample" in B.FIELDS["icoac_config_t"]
+
+
+class _WrongPolicy(ctypes.Structure):
+    """icoac_policy_config_t with gain and clip_inputs swapped: same fields and size, wrong offsets."""
+    _fields_ = [("input_range", B.c_real * B.N_INPUTS), ("gain", B.c_real), ("clip_inputs", ctypes.c_int32),
+                ("reflex_mode", ctypes.c_int32), ("reflex_force", B.c_real), ("zone_theta", B.c_real),
+                ("zone_x", B.c_real)]
+
+
+class _WrongConfig(ctypes.Structure):
+    _fields_ = [("mode", ctypes.c_int32), ("policy", _WrongPolicy), ("ico", B.IcoConfig),
+                ("critic", B.CriticConfig), ("actor", B.ActorConfig)]
+
+
+def test_field_check_catches_a_wrong_offset():
+    assert ctypes.sizeof(_WrongConfig) == ctypes.sizeof(B.Config)
+    with pytest.raises(LibraryError, match=r"icoac_config_t\.policy\.clip_inputs: C offset 20 size 4, "
+                                           r"binding offset 24"):
+        B.check_mirror("icoac_config_t", _WrongConfig, c_size=B.lib.icoac_sizeof_config())
+    B.check_mirror("icoac_config_t", B.Config, c_size=B.lib.icoac_sizeof_config())
+
+
+def test_field_check_catches_missing_extra_size_and_dtype():
+    class Missing(ctypes.Structure):
+        _fields_ = [("mean", B.c_real * B.N_INPUTS)]
+
+    with pytest.raises(LibraryError, match=r"icoac_prior_t\.cov is in the C layout but not in the binding"):
+        B.check_mirror("icoac_prior_t", Missing)
+
+    class Extra(ctypes.Structure):
+        _fields_ = B.Counters._fields_ + [("spare", ctypes.c_uint32)]
+
+    with pytest.raises(LibraryError, match=r"icoac_counters_t\.spare is in the binding but not in the C layout"):
+        B.check_mirror("icoac_counters_t", Extra)
+    with pytest.raises(LibraryError, match=r"sizeof\(icoac_sim_run_t\): C 32, binding 24"):
+        B.check_mirror("icoac_sim_run_t", B.Run, c_size=32)
+    names = list(B.CELL_DTYPE.names)
+    wrong = np.dtype([(n, B.CELL_DTYPE.fields[n][0]) if n != "outcome" else ("outcome", np.int64)
+                      for n in names], align=True)
+    with pytest.raises(LibraryError, match=r"icoac_sim_cell_t\.outcome: C offset 24 size 4, binding offset 24 size 8"):
+        B.check_mirror("icoac_sim_cell_t", wrong)
+    # a made-up table: the binding is checked against whatever C says
+    table = dict(B.FIELDS["icoac_sim_plant_t"], dt=(40, 8))
+    with pytest.raises(LibraryError, match=r"icoac_sim_plant_t\.dt: C offset 40"):
+        B.check_mirror("icoac_sim_plant_t", B.Plant, c_fields=table)
+
+
+def test_constants_from_c():
+    c = B.CONSTANTS
+    assert B.MODES == {"ico": c["ICOAC_MODE_ICO"], "rl": c["ICOAC_MODE_RL"]}
+    assert B.REFLEX_MODES == {"unit": c["ICOAC_REFLEX_UNIT"], "gain": c["ICOAC_REFLEX_GAIN"]}
+    assert B.ICO_TIMINGS == {"code": c["ICOAC_ICO_TIMING_CODE"], "literal": c["ICOAC_ICO_TIMING_LITERAL"]}
+    assert B.INTEGRATORS == {"euler": c["ICOAC_SIM_EULER"], "rk4": c["ICOAC_SIM_RK4"]}
+    assert B.ERR_NUMERIC == c["ICOAC_ERR_NUMERIC"] and B.SIM_CANCELLED == c["ICOAC_SIM_CANCELLED"]
+    assert B.OUTCOME_NAMES == {c["ICOAC_SIM_PENDING"]: "pending", c["ICOAC_SIM_SUCCESS"]: "success",
+                               c["ICOAC_SIM_FAILED"]: "failed", c["ICOAC_SIM_ERROR"]: "error"}
+    assert B.CONFIG_STATUSES == {v for k, v in c.items() if k.startswith(("ICOAC_ERR_BAD_", "ICOAC_SIM_ERR_BAD_"))}
+    assert geometry.CELLS == geometry.THETAS * geometry.XS == c["ICOAC_SIM_GRID_CELLS"]
+    assert geometry.N_INTERIOR == (geometry.THETAS - 2) * (geometry.XS - 2)
+    assert B.PI == math.pi
+    with pytest.raises(LibraryError, match="ICOAC_NO_SUCH"):
+        B.constant("ICOAC_NO_SUCH")
+
+
+def test_status_texts_from_both_libraries():
+    assert B.status_str(B.ERR_NUMERIC) == B.lib.icoac_status_str(B.ERR_NUMERIC).decode()
+    assert B.status_str(B.SIM_ERR_THREAD) == B.lib.icoac_sim_status_str(B.SIM_ERR_THREAD).decode()
+    assert B.status_name(B.ERR_NUMERIC) == "numeric failure"
+    assert B.status_name(B.SIM_CANCELLED) == "cancelled"
+
+
+def test_counters_and_posterior_accessors():
+    cfg = build_config()
+    state = B.State()
+    B.check_status(B.lib.icoac_init(ctypes.byref(cfg.controller), ctypes.byref(state), None, 1))
+    inp, out = B.Input(), B.Output()
+    for s in ([0.1, 0.0, 0.01, 0.0], [math.nan, 0.0, 0.0, 0.0], [0.1, 0.0, 0.02, 0.0]):
+        for i, v in enumerate(s):
+            inp.s[i] = v
+        B.lib.icoac_step(ctypes.byref(cfg.controller), ctypes.byref(state), ctypes.byref(inp), ctypes.byref(out))
+    counters = B.get_counters(state)
+    assert (counters.ticks, counters.nonfinite, counters.numeric_faults) == (3, 1, 0)
+    post = B.get_posterior(state)
+    assert list(post.mean) == [0.0] * 4 and [list(r) for r in post.cov] == np.eye(4).tolist()
 
 
 def test_cell_dtype_offsets():
     names = B.CELL_DTYPE.names
     assert names == ("x0", "theta0", "seed", "outcome", "status", "trials", "total_steps",
                      "last_trial_steps", "elapsed_time", "weights", "cov")
-    assert B.CELL_DTYPE.fields["weights"][1] == 64
-    assert B.CELL_DTYPE.fields["cov"][1] == 96
+    assert B.CELL_DTYPE.fields["weights"][1] == B.FIELDS["icoac_sim_cell_t"]["weights"][0]
+    assert B.CELL_DTYPE.fields["cov"][1] == B.FIELDS["icoac_sim_cell_t"]["cov"][0]
 
 
 def test_config_defaults_match_spec():
     d = build_config().to_dict()
     c, p, r = d["controller"], d["plant"], d["run"]
-    assert c["mode"] == "ico" and c["reflex_mode"] == "unit" and c["ico_timing"] == "code"
-    assert c["gain"] == 10.0
-    assert c["reflex_force"] == 1.0
-    assert c["ico_rate"] == pytest.approx(1e-4)
-    assert c["input_range"] == pytest.approx([2.4, 3.5, 0.2094384, 2.0])
-    assert c["zone_theta"] == pytest.approx(math.radians(11.5), rel=1e-6)
-    assert c["zone_x"] == pytest.approx(2.35)
-    assert c["critic_rate"] == pytest.approx(0.6)
-    assert c["discount"] == pytest.approx(0.95)
-    assert c["noise_std"] == 1.0 and c["actor_scale"] == 0.5 and c["forgetting"] == 1.0
-    assert c["clip_inputs"] is True
+    assert set(c) == {"mode", "policy", "ico", "critic", "actor"}
+    pol, ico, cri, act = c["policy"], c["ico"], c["critic"], c["actor"]
+    assert c["mode"] == "ico" and pol["reflex_mode"] == "unit" and ico["timing"] == "code"
+    assert pol["gain"] == 10.0
+    assert pol["reflex_force"] == 1.0
+    assert ico["rate"] == pytest.approx(1e-4)
+    assert pol["input_range"] == pytest.approx([2.4, 3.5, 0.2094384, 2.0])
+    assert pol["zone_theta"] == pytest.approx(math.radians(11.5), rel=1e-6)
+    assert pol["zone_x"] == pytest.approx(2.35)
+    assert cri["rate"] == pytest.approx(0.6)
+    assert cri["discount"] == pytest.approx(0.95)
+    assert act["noise_std"] == 1.0 and act["scale"] == 0.5 and act["forgetting"] == 1.0
+    assert pol["clip_inputs"] is True and act["reflex"] is True and act["act_with_sample"] is False
     assert p == {"gravity": 9.8, "cart_mass": 1.0, "pole_mass": 0.1, "half_length": 0.5, "dt": 0.01,
                  "x_limit": 2.4, "theta_limit": pytest.approx(math.radians(12)), "integrator": "euler",
                  "reserved": 0}
@@ -61,20 +161,24 @@ def test_config_defaults_match_spec():
 def test_overrides_by_name():
     cfg = build_config({"reflex_mode": "gain", "ico_timing": "literal", "integrator": "rk4", "max_trials": 2000,
                         "noise_std": 2.0, "input_range": [2.4, 3.5, 0.2094384, 2.0], "clip_inputs": "false"})
-    assert cfg.controller.reflex_mode == 1 and cfg.controller.ico_timing == 1
-    assert cfg.plant.integrator == 1 and cfg.run.max_trials == 2000
-    assert cfg.controller.noise_std == 2.0 and cfg.controller.clip_inputs == 0
+    c = cfg.controller
+    assert c.policy.reflex_mode == B.REFLEX_MODES["gain"] and c.ico.timing == B.ICO_TIMINGS["literal"]
+    assert cfg.plant.integrator == B.INTEGRATORS["rk4"] and cfg.run.max_trials == 2000
+    assert c.actor.noise_std == 2.0 and c.policy.clip_inputs == 0
     d = cfg.to_dict()
-    assert d["controller"]["reflex_mode"] == "gain" and d["plant"]["integrator"] == "rk4"
+    assert d["controller"]["policy"]["reflex_mode"] == "gain" and d["plant"]["integrator"] == "rk4"
 
 
 def test_paper_grid_layout():
     from harness.grid import paper_grid
     cells = paper_grid(0)
-    assert cells.size == 1225
+    assert cells.size == geometry.CELLS == 1225
     assert np.all(cells["outcome"] == B.PENDING)
     assert cells["x0"][0] == pytest.approx(-2.4) and cells["x0"][48] == pytest.approx(2.4)
     assert np.degrees(cells["theta0"][0]) == pytest.approx(-12) and np.degrees(cells["theta0"][-1]) == pytest.approx(12)
     assert np.degrees(cells["theta0"][49]) == pytest.approx(-11)
     assert len(set(cells["seed"].tolist())) == 1225
     assert not np.array_equal(paper_grid(1)["seed"], cells["seed"])
+    rows, cols = geometry.grid_index(cells)
+    assert np.array_equal(geometry.cell_index(rows, cols), np.arange(cells.size))
+    assert geometry.THETA_STEP_DEG == 1.0 and geometry.map_extent() == (-2.45, 2.45, -12.5, 12.5)

@@ -7,25 +7,48 @@ from harness import _binding as B
 from harness.config import build_config, make_prior
 
 
-@pytest.mark.parametrize("overrides, status, words", [
-    ({"gain": -1.0}, B.ERR_BAD_GAIN, "gain"),
-    ({"reflex_force": -2.0}, B.ERR_BAD_GAIN, "reflex_force"),
-    ({"input_range": [2.4, 0.0, 0.2, 2.0]}, B.ERR_BAD_SCALE, "input_range"),
-    ({"zone_x": 0.0}, B.ERR_BAD_ZONE, "zone"),
-    ({"ico_rate": -1e-4}, B.ERR_BAD_ICO_RATE, "ico_rate"),
-    ({"discount": 1.5}, B.ERR_BAD_CRITIC, "critic"),
-    ({"noise_std": 0.0}, B.ERR_BAD_ACTOR, "noise_std"),
-    ({"mode": 7}, B.ERR_BAD_MODE, "mode"),
-    ({"dt": 0.0}, B.SIM_ERR_BAD_PLANT, "plant"),
-    ({"max_trials": 0}, B.SIM_ERR_BAD_RUN, "max_trials"),
+@pytest.mark.parametrize("overrides, condition, status, words", [
+    ({"gain": -1.0}, "ico", B.ERR_BAD_GAIN, "rejected: policy.gain=-1.0"),
+    ({"reflex_force": -2.0}, "ico", B.ERR_BAD_GAIN, "rejected: policy.reflex_force=-2.0"),
+    ({"input_range": [2.4, 0.0, 0.2, 2.0]}, "ico", B.ERR_BAD_SCALE, "rejected: policy.input_range[1]=0.0"),
+    ({"zone_x": 0.0}, "ico", B.ERR_BAD_ZONE, "policy.zone_x"),
+    ({"ico_rate": -1e-4}, "ico", B.ERR_BAD_ICO_RATE, "rejected: ico.rate=-0.0001"),
+    ({"discount": 1.5}, "rl", B.ERR_BAD_CRITIC, "rejected: critic.discount=1.5"),
+    ({"critic.td_clip": 0.0}, "rl", B.ERR_BAD_CRITIC, "rejected: critic.td_clip=0.0"),
+    ({"noise_std": 0.0}, "rl", B.ERR_BAD_ACTOR, "rejected: actor.noise_std=0.0"),
+    ({"mode": 7}, None, B.ERR_BAD_MODE, "rejected: mode=7"),
+    ({"ico.timing": 2}, "ico", B.ERR_BAD_MODE, "rejected: ico.timing=2"),
+    ({"dt": 0.0}, None, B.SIM_ERR_BAD_PLANT, "plant"),
+    ({"max_trials": 0}, None, B.SIM_ERR_BAD_RUN, "max_trials"),
 ])
-def test_bad_values_raise_config_error_with_c_message(overrides, status, words):
+def test_bad_values_raise_config_error_with_c_message(overrides, condition, status, words):
     with pytest.raises(B.ConfigError) as info:
-        build_config(overrides)
+        build_config(overrides, condition=condition)
     assert info.value.status == status
     assert info.value.c_message == B.status_str(status)
     assert B.status_str(status) in str(info.value)
     assert words in str(info.value)
+
+
+def test_mode_checks_only_its_groups():
+    """icoac_config_check validates the groups the mode uses: a bad critic passes in ICO mode."""
+    build_config({"discount": 1.5}, condition="ico")
+    with pytest.raises(B.ConfigError):
+        build_config({"discount": 1.5}, condition="rl")
+    build_config({"ico_rate": -1.0}, condition="rl")
+    with pytest.raises(B.ConfigError):
+        build_config({"ico_rate": -1.0}, condition="ico")
+
+
+def test_python_side_rejection_carries_the_c_status():
+    """A value rejected before C sees it (NaN, subnormal, overflow) has the status C gives that field."""
+    for name, status in [("gain", B.ERR_BAD_GAIN), ("critic.range", B.ERR_BAD_CRITIC),
+                         ("actor.forgetting", B.ERR_BAD_ACTOR), ("ico_rate", B.ERR_BAD_ICO_RATE),
+                         ("gravity", B.SIM_ERR_BAD_PLANT), ("init_velocity_noise", B.SIM_ERR_BAD_RUN)]:
+        value = [float("nan")] * 4 if name == "critic.range" else float("nan")
+        with pytest.raises(B.ConfigError) as info:
+            build_config({name: value})
+        assert info.value.status == status, name
 
 
 @pytest.mark.parametrize("name", ["gain", "ico_rate", "zone_theta", "gravity", "init_velocity_noise"])
@@ -38,7 +61,8 @@ def test_nan_rejected(name):
 def test_unknown_name_lists_valid_names():
     with pytest.raises(B.ConfigError) as info:
         build_config({"gian": 10})
-    assert "gian" in str(info.value) and "gain" in str(info.value) and "max_trials" in str(info.value)
+    text = str(info.value)
+    assert "gian" in text and "policy.gain" in text and "max_trials" in text and "did you mean gain" in text
 
 
 def test_bad_symbolic_value():

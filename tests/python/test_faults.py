@@ -337,6 +337,12 @@ def test_sweep_and_bench_numbers(capsys, res, tmp_path):
          "--subset"),
         (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1",
           "--seeds", "18446744073709551616"], "--seeds"),
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1",
+          "--seeds", "0,1"], "for the seeds 0,1 write --seed 0 --seeds 2"),
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1",
+          "--seed", "18446744073709551615", "--seeds", "2"], "2^64"),
+        (["bench", "--out", tmp_path / "b", "--seeds", "0"], "--seeds"),
+        (["bench", "--out", tmp_path / "b", "--seeds", "1,2,3"], "--seed 1 --seeds 3"),
         (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "prior_ridge=abc"], "prior_ridge"),
         (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1", "--threads", "1e10"],
          "--threads"),
@@ -431,7 +437,7 @@ def test_error_cells_are_neither_success_nor_failure():
     assert s["error_statuses"] == {str(B.ERR_NONFINITE_INPUT): 1, str(B.ERR_NUMERIC): 2}
     assert np.isnan(metrics.trials_to_success(cells)[7:]).all()
     text = metrics.format_summary("ico", s)
-    assert "3 cells reported a controller ERROR" in text and "numeric (4): 2" in text
+    assert "3 cells reported a controller ERROR" in text and "numeric failure (4): 2" in text
     assert B.ERR_NUMERIC == 4 and B.lib.icoac_abi_version() == B.ABI_VERSION
 
 
@@ -440,9 +446,8 @@ def test_help_documents_bounds(capsys):
         cli.main(["grid", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "--overwrite" in text and f"max({grid.DEFAULT_CHECKPOINT_CELLS} cells" in text
-    assert cli.CHECKPOINT_CELLS == grid.DEFAULT_CHECKPOINT_CELLS
-    assert cli.CHECKPOINT_EVERY == grid.DEFAULT_CHECKPOINT_EVERY
-    assert float(cli.MAX_DURATION_STEPS) == grid.MAX_TRAJECTORY_STEPS and cli.MAX_THREADS == grid.MAX_THREADS
+    assert cli.O.DEFAULT_CHECKPOINT_CELLS is grid.DEFAULT_CHECKPOINT_CELLS  # defined once, in harness.options
+    assert cli.O.MAX_TRAJECTORY_STEPS is grid.MAX_TRAJECTORY_STEPS and cli.O.MAX_THREADS is grid.MAX_THREADS
     with pytest.raises(SystemExit):
         cli.main(["figures", "--help"])
     assert "1e6 plant steps" in " ".join(capsys.readouterr().out.split())

@@ -10,6 +10,7 @@ from harness.config import build_config, make_prior
 from conftest import SMALL, SMALL_CELLS
 
 RESULT_FIELDS = ("outcome", "status", "trials", "total_steps", "last_trial_steps", "elapsed_time", "weights", "cov")
+assert grid.RESULT_FIELDS == RESULT_FIELDS
 
 
 def same(a, b):

@@ -20,14 +20,14 @@ def test_save_load_round_trip(tmp_path, small_cfg, small_run):
     for key in ("condition", "seed", "config", "git", "abi", "timestamp", "wall_time", "threads", "summary"):
         assert key in record
     assert record["config"]["run"]["max_trials"] == SMALL["max_trials"]
-    assert record["config"]["controller"]["gain"] == 10.0
+    assert record["config"]["controller"]["policy"]["gain"] == 10.0
     assert set(record["git"]) == {"commit", "dirty"}
     assert record["abi"]["abi_version"] == B.ABI_VERSION and record["complete"] is True
     assert record["summary"]["n_success"] == int((small_run["outcome"] == B.SUCCESS).sum())
     cfg = results.load_config(record)
     assert cfg.to_dict() == small_cfg.to_dict()
     results.check_resumable(record, condition="ico", seed=7, cfg=cfg, cell_indices=SMALL_CELLS)
-    with pytest.raises(results.ResultsError, match="gain"):
+    with pytest.raises(results.ResultsError, match="policy.gain 10.0 != 5.0"):
         results.check_resumable(record, condition="ico", seed=7, cfg=build_config(dict(SMALL, gain=5)),
                                 cell_indices=SMALL_CELLS)
     with pytest.raises(results.ResultsError, match="seed"):

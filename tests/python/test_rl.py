@@ -113,7 +113,7 @@ def test_prior_from_results_records_provenance(ico_dir):
 def test_rl_grid_deterministic_records_posterior(ico_dir):
     info = P.from_results(ico_dir)
     cfg = build_config(TINY_RL, condition="ico-rl", prior=info.prior())
-    assert cfg.controller.mode == 1
+    assert cfg.controller.mode == B.MODE_RL
     a = grid.make_cells(5, [300, 611, 900])
     b = grid.make_cells(5, [300, 611, 900])
     grid.run_grid(cfg, a, threads=2, progress=False)
@@ -152,8 +152,7 @@ def tick(cfg, state, s, terminal=False):
 
 
 def posterior(state):
-    post = B.Prior()
-    B.check_status(B.lib.icoac_get_posterior(ctypes.byref(state), ctypes.byref(post)))
+    post = B.get_posterior(state)
     return np.array(post.mean, dtype=float), np.array([list(r) for r in post.cov], dtype=float)
 
 
@@ -166,10 +165,10 @@ S_T1 = np.array([0.31, -0.38, 0.052, 0.58])
 
 def closed_form(cfg, mu, sigma, s_t, delta, eps):
     c = cfg.controller
-    rng = np.array(c.input_range, dtype=float)
-    h = c.gain * np.clip(s_t / rng, -1.0, 1.0)
-    y = h @ mu + c.actor_scale * delta * eps  # u_ob = mu_u + alpha * delta * eps
-    S = h @ sigma @ h + c.noise_std ** 2
+    rng = np.array(c.policy.input_range, dtype=float)
+    h = c.policy.gain * np.clip(s_t / rng, -1.0, 1.0)
+    y = h @ mu + c.actor.scale * delta * eps  # u_ob = mu_u + alpha * delta * eps
+    S = h @ sigma @ h + c.actor.noise_std ** 2
     return mu + sigma @ h * (y - h @ mu) / S, sigma - np.outer(sigma @ h, sigma @ h) / S
 
 
@@ -213,6 +212,7 @@ def test_cli_grid_ico_rl_records_prior(ico_dir, tmp_path):
     record = json.loads((out / "run.json").read_text())
     pi = record["prior_info"]
     assert record["condition"] == "ico-rl" and record["config"]["controller"]["mode"] == "rl"
+    assert record["config"]["controller"]["actor"]["noise_std"] == 1.0
     assert pi["source"] == str(ico_dir.resolve()) and pi["n_cells"] >= 2 and pi["ico_phase_simulated_time"] > 0
     assert pi["frame"] == {"x0_abs_max": 1.2, "theta0_abs_max_deg": 6.0} and len(pi["cov"]) == 4
     res = run_cli("grid", "--out", str(out), "--resume", "--quiet")
@@ -244,13 +244,34 @@ def test_sweep_two_settings_resumable(ico_dir, tmp_path):
     assert res.returncode == 0, res.stderr
     with open(out / "sweep.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
-    assert len(rows) == 2 and [r["noise_std"] for r in rows] == ["0.5", "2"]
+    assert len(rows) == 2 and [r["actor.noise_std"] for r in rows] == ["0.5", "2"]
+    assert [json.loads(r["key"]) for r in rows] == [{"actor.noise_std": 0.5}, {"actor.noise_std": 2}]
     assert rows[0]["n_ico_failed"] == "1" and rows[0]["n_cells"] == "2"
     assert (out / "sweep.md").read_text().count("\n| ") >= 3
+    assert json.loads((out / "sweep.json").read_text())["seeds"] == [0]
     res = run_cli(*args)  # resumed: nothing rerun, still two rows
     assert res.returncode == 0 and res.stderr.count("skipped") == 2
+    # the canonical name is the same parameter
+    res = run_cli(*[a.replace("noise_std=", "actor.noise_std=") for a in args])
+    assert res.returncode == 0 and res.stderr.count("skipped") == 2, res.stderr
+    # a sweep table written by the ABI-3 harness (flat names in the header and the keys) resumes too
+    text = (out / "sweep.csv").read_text().replace("actor.noise_std", "noise_std")
+    (out / "sweep.csv").write_text(text)
+    res = run_cli(*args)
+    assert res.returncode == 0 and res.stderr.count("skipped") == 2, res.stderr
     with open(out / "sweep.csv", newline="") as fh:
         assert len(list(csv.DictReader(fh))) == 2
+
+
+def test_sweep_seed_and_seeds(ico_dir, tmp_path):
+    out = tmp_path / "sweep"
+    res = run_cli("sweep", "--prior-from", str(ico_dir), "--out", str(out), "--param", "actor.scale=0.5",
+                  "--cells", "611", "--max-trials", "5", "--success-steps", "100", "--seed", "3", "--seeds", "2",
+                  "--quiet")
+    assert res.returncode == 0, res.stderr
+    assert json.loads((out / "sweep.json").read_text())["seeds"] == [3, 4]
+    with open(out / "sweep.csv", newline="") as fh:
+        assert [r["n_seeds"] for r in csv.DictReader(fh)] == ["2"]
 
 
 def test_bench_quick_writes_comparison(tmp_path):

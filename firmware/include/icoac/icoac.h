@@ -115,9 +115,9 @@ typedef struct {
  * between releases: read it through icoac_get_posterior and icoac_get_counters. The size has
  * room for later learners. */
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
-#define ICOAC_STATE_SIZE 2560
+#define ICOAC_STATE_SIZE 3584
 #else
-#define ICOAC_STATE_SIZE 1280
+#define ICOAC_STATE_SIZE 1792
 #endif
 typedef struct {
     uint64_t opaque[ICOAC_STATE_SIZE / 8];
@@ -181,7 +181,8 @@ icoac_status_t icoac_reset(const icoac_config_t *cfg, icoac_state_t *state);
 /* One tick: learn from the transition into in->s, then act on it. The return value is the
  * tick's status; out->status holds the same value, for hosts that log the output. Contract: with a configuration icoac_config_check accepts and a
  * finite in->s, either ICOAC_OK with a finite output and a finite learned state (w, Sigma_w,
- * v), or an error status with force 0 and the state unchanged but for its tick counters:
+ * v), or an error status with force 0 and everything the state holds (learned values, caches, RNG)
+ * unchanged but for its counters:
  * ICOAC_ERR_NONFINITE_INPUT for a NaN/Inf observation, ICOAC_ERR_NUMERIC when a value the tick
  * derived (force, new weights, covariance or its trace, critic value or TD error) was not finite. */
 icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,

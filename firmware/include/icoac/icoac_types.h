@@ -54,14 +54,14 @@ typedef enum {
     ICOAC_ERR_NOT_INITIALISED = 2,  /* state not set up by icoac_init */
     ICOAC_ERR_NONFINITE_INPUT = 3,  /* observation had NaN/Inf: safe output, no learning */
     ICOAC_ERR_NUMERIC = 4,          /* a value derived in this tick was not finite: force 0, nothing learned */
-    ICOAC_ERR_BAD_MODE = 10,        /* mode, reflex_mode, ico_timing or another switch out of range */
-    ICOAC_ERR_BAD_SCALE = 11,       /* input_range not finite and > 0 */
-    ICOAC_ERR_BAD_GAIN = 12,        /* gain or reflex_force not finite and >= 0 */
-    ICOAC_ERR_BAD_ZONE = 13,        /* zone_theta / zone_x not finite and > 0 */
-    ICOAC_ERR_BAD_ICO_RATE = 14,    /* ico_rate not finite and >= 0 */
-    ICOAC_ERR_BAD_CRITIC = 15,      /* critic rate, discount, ranges, clip or threshold invalid */
-    ICOAC_ERR_BAD_ACTOR = 16,       /* noise_std, actor_scale or forgetting invalid */
-    ICOAC_ERR_BAD_PRIOR = 17        /* prior mean not finite or covariance not symmetric PD */
+    ICOAC_ERR_BAD_MODE = 10,        /* mode, policy.reflex_mode, ico.timing or a 0/1 flag out of range */
+    ICOAC_ERR_BAD_SCALE = 11,       /* policy.input_range out of range */
+    ICOAC_ERR_BAD_GAIN = 12,        /* policy.gain or policy.reflex_force out of range */
+    ICOAC_ERR_BAD_ZONE = 13,        /* policy.zone_theta or policy.zone_x out of range */
+    ICOAC_ERR_BAD_ICO_RATE = 14,    /* ico.rate out of range */
+    ICOAC_ERR_BAD_CRITIC = 15,      /* a critic field out of range */
+    ICOAC_ERR_BAD_ACTOR = 16,       /* an actor field out of range */
+    ICOAC_ERR_BAD_PRIOR = 17        /* prior out of range, subnormal, or covariance not symmetric PD */
 } icoac_status_t;
 
 /* Static, human-readable name of a status (never NULL). */

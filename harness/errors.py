@@ -1,0 +1,32 @@
+"""Exception types of the harness (no dependencies, so the command line can catch them before the
+shared library is loaded).
+
+Every error the harness reports is a HarnessError; the command line prints it as one line and
+exits with status 2. Errors carrying a C status (IcoacError, ConfigError, Cancelled) are defined
+by the binding, on top of HarnessError; the ones below are the harness's own.
+"""
+from __future__ import annotations
+
+
+class HarnessError(Exception):
+    """Base of every error the harness reports as one line (exit status 2)."""
+
+
+class UsageError(HarnessError):
+    """A mistake on the command line or in the options given to a command."""
+
+
+class LibraryError(HarnessError):
+    """The shared library is missing or does not match this binding."""
+
+
+class ResultsError(HarnessError):
+    """A missing, unreadable or mismatching results directory."""
+
+
+class PriorError(HarnessError):
+    """No (or too few) ICO-successful cells to build a prior from, or a bad prior option."""
+
+
+class SweepError(UsageError):
+    """A malformed sweep parameter list or sweep directory."""

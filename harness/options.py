@@ -1,0 +1,35 @@
+"""Harness-side names, limits and defaults, each defined once (pure Python: the command line
+builds its parser from them without loading the shared library). Everything the C library
+defines - enum values, statuses, sizes, grid geometry - comes from the binding instead."""
+from __future__ import annotations
+
+# Learning conditions, in the order of the benchmark and its tables.
+CONDITIONS = ("ico", "ico-rl", "rl")
+RL_CONDITIONS = ("ico-rl", "rl")         # the conditions that run the actor-critic from a prior
+CONDITION_LABELS = {"ico": "ICO", "ico-rl": "ICO->RL", "rl": "RL"}
+
+PROFILE_NAMES = ("default", "paper", "quick")   # bench profiles (harness.bench.PROFILES)
+
+# Integer limits of the command line and of the Python API.
+INT64_MAX = 2 ** 63 - 1
+SEED_LIMIT = 2 ** 64            # seeds are uint64: [0, 2^64)
+MAX_THREADS = 1024              # --threads: 0 (all cores) .. MAX_THREADS
+MAX_SEEDS = 1000                # --seeds: 1 .. MAX_SEEDS
+
+# Checkpoints of a grid run: after this many newly finished cells, or after this many seconds
+# with at least one newly finished cell.
+DEFAULT_CHECKPOINT_CELLS = 25
+DEFAULT_CHECKPOINT_EVERY = 2.0
+
+# Trajectories (Fig. 1g): default length and the bound of the C buffers (40 bytes per step).
+TRAJECTORY_DURATION = 30.0      # s
+MAX_TRAJECTORY_STEPS = 1_000_000
+
+# Priors of the RL conditions (spec 7, A15/A16).
+FRAME_NAMES = ("central", "all")
+PRIOR_FRAME = (1.2, 6.0)        # the central frame: |x0| <= 1.2 m, |theta0| <= 6 deg
+PRIOR_RIDGE = 1e-6              # added to the prior covariance (times I)
+RL_COV_NAMES = ("ico", "identity")  # RL-alone prior covariance: that of ICO->RL, or 1*I
+
+# sweep: trial cap of every setting unless --max-trials says otherwise.
+SWEEP_MAX_TRIALS = 2000

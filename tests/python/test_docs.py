@@ -1,0 +1,62 @@
+"""Every `python -m harness ...` command in README.md, docs/*.md and the Makefile still parses, and
+its --set / --param names and values build a configuration (nothing is run)."""
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+
+from harness import cli, sweep
+from harness.config import build_config, parse_sets
+
+REPO = Path(__file__).resolve().parents[2]
+# Placeholders the documents use, with a value each stands for.
+PLACEHOLDERS = {"NAME": "variant", "SETTING": "integrator=rk4", "$(BENCH_PROFILE)": "quick",
+                "$(BENCH_OUT)": "results/bench"}
+
+
+def _after(text: str):
+    """What follows 'python -m harness' in a command (None for other commands and harness.tools)."""
+    m = re.search(r"(?:python3?|\$\(VPY\)) -m harness(\s.*|$)", text, re.S)
+    return " ".join(m.group(1).split()) if m else None
+
+
+def documented_commands():
+    """(file, arguments) of every documented harness command: code-block lines (with '\\'
+    continuations), inline `...` spans (which may wrap), Makefile recipe lines."""
+    out = []
+    for path in [REPO / "README.md", REPO / "Makefile", *sorted((REPO / "docs").glob("*.md"))]:
+        text = path.read_text().replace("\\\n", " ")
+        if path.name == "Makefile":
+            lines, spans = text.splitlines(), []
+        else:
+            blocks = re.findall(r"```[^\n]*\n(.*?)```", text, re.S)
+            lines = [line for block in blocks for line in block.splitlines()]
+            spans = re.findall(r"`([^`]+)`", re.sub(r"```.*?```", "", text, flags=re.S))
+        for item in lines + spans:
+            args = _after(item)
+            if args is not None:
+                out.append((path.name, args))
+    return out
+
+
+COMMANDS = documented_commands()
+
+
+def test_commands_found():
+    assert len(COMMANDS) >= 8, COMMANDS
+    assert any("sweep" in c and "--seeds" in c for _, c in COMMANDS)
+
+
+@pytest.mark.parametrize("where, command", COMMANDS, ids=[f"{w}:{c[:50]}" for w, c in COMMANDS])
+def test_documented_command_parses(where, command):
+    words = [PLACEHOLDERS.get(w, w) for w in shlex.split(command)]
+    if words in ([], ["--help"]):
+        return
+    args = cli.build_parser().parse_args(words)
+    if getattr(args, "set", None):
+        build_config(parse_sets(args.set))
+    if args.command == "sweep":
+        params = sweep.parse_params(args.param)
+        for setting in sweep.settings(params, args.one_at_a_time):
+            build_config({k: v for k, v in setting.items() if k not in sweep.PRIOR_PARAMS}, condition=args.condition)
