@@ -26,7 +26,7 @@ LIBRARY_ENV = "ICOAC_SIM_LIBRARY"
 DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.so"
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
-ABI_VERSION = 4
+ABI_VERSION = 5
 SIM_ABI_VERSION = 2
 
 
@@ -267,6 +267,7 @@ class Config(ctypes.Structure):
     """icoac_config_t: the mode and one group per concern."""
     _fields_ = [
         ("mode", ctypes.c_int32),
+        ("learn", ctypes.c_int32),
         ("policy", PolicyConfig),
         ("ico", IcoConfig),
         ("critic", CriticConfig),

@@ -1,4 +1,5 @@
-"""The paper's comparison (Fig. 2b, 3): ICO grids per seed, priors, ICO->RL and RL grids, summary, figures.
+"""The paper's comparison (Fig. 2b, 3): ICO grids per seed, priors, ICO->RL and RL grids with their
+no-learning controls (spec L1), summary, figures.
 
 Layout: OUT/<condition>/seed-<n>/ (results directories), OUT/bench.json (wall time per stage),
 OUT/summary.md and OUT/summary.json (mean and sd over seeds next to the paper's numbers).
@@ -20,7 +21,7 @@ from . import prior as P
 from .conditions import run_condition
 from .config import build_config, parse_sets
 from .metrics import percent
-from .options import CONDITION_LABELS as LABELS, CONDITIONS, PROFILE_NAMES
+from .options import CONDITION_LABELS as LABELS, CONDITIONS, CONTROL_OF, PROFILE_NAMES
 
 # Paper (Fig. 1b, 2b, 3a): ~68 % ICO, ~84 % ICO->RL; RL alone only "smaller" and "very slow" (Fig. 3 bars).
 PAPER = {
@@ -92,6 +93,24 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, A
     return out
 
 
+def gain_over_control(cells: Mapping[int, np.ndarray], control: Mapping[int, np.ndarray]) -> dict[str, Any]:
+    """Per seed {seed: cell array} of a condition and of its no-learning control -> mean/sd of the
+    cells it gains (succeed, the control does not), loses, and the difference in points of
+    success rate (all cells)."""
+    gained, lost, points = [], [], []
+    for seed in sorted(set(cells) & set(control)):
+        a = metrics.success_mask(cells[seed])
+        b = metrics.success_mask(control[seed])
+        gained.append(float(np.count_nonzero(a & ~b)))
+        lost.append(float(np.count_nonzero(~a & b)))
+        points.append(100.0 * (float(a.mean()) - float(b.mean())))
+    out: dict[str, Any] = {}
+    for key, values in (("cells_gained", gained), ("cells_lost", lost), ("points", points)):
+        mean, sd, n = _mean_sd(values)
+        out[key] = {"mean": mean, "sd": sd, "n": n, "per_seed": values}
+    return out
+
+
 def _fmt(stat: Mapping[str, Any] | None, pct: bool = False) -> str:
     if not stat or stat.get("mean") is None:
         return "n/a"
@@ -101,7 +120,7 @@ def _fmt(stat: Mapping[str, Any] | None, pct: bool = False) -> str:
 
 
 def summary_markdown(agg: Mapping[str, Any]) -> str:
-    lines = ["# ICO, RL and ICO->RL: mean ± sd over seeds", "",
+    lines = ["# ICO, RL and ICO->RL with their no-learning controls: mean ± sd over seeds", "",
              "| condition | seeds | caps (trials / steps) | success (all) | success (interior) | "
              "median trials to success | mean elapsed sim. time of successes (s) | paper |",
              "|---|---|---|---|---|---|---|---|"]
@@ -115,6 +134,16 @@ def summary_markdown(agg: Mapping[str, Any]) -> str:
                      f"{_fmt(e['success_rate'], True)} of {e['n_cells']} | "
                      f"{_fmt(e['success_rate_interior'], True)} of {e['n_interior']} | "
                      f"{_fmt(e['median_trials_to_success'])} | {_fmt(e['mean_elapsed_time_success'])} | {ptxt} |")
+    gains = [(c, agg[c]["gain_over_control"]) for c in CONDITIONS if c in agg and "gain_over_control" in agg[c]]
+    if gains:
+        lines += ["", "Gain over the no-learning control (same prior, acting weights, noise stream, resets "
+                  "and caps, every update off), per seed, mean ± sd:", "",
+                  "| condition | control | points of success (all) | cells gained | cells lost |",
+                  "|---|---|---|---|---|"]
+        for cond, g in gains:
+            control = next(k for k, v in CONTROL_OF.items() if v == cond)
+            lines.append(f"| {LABELS[cond]} | {LABELS[control]} | {_fmt(g['points'])} | "
+                         f"{_fmt(g['cells_gained'])} | {_fmt(g['cells_lost'])} |")
     if "ico-rl" in agg and agg["ico-rl"].get("ico_phase_simulated_time", {}).get("mean") is not None:
         lines += ["", "ICO->RL counts RL-phase trials only (A17); the ICO phase that produced each prior took "
                   f"{_fmt(agg['ico-rl']['ico_phase_simulated_time'])} s of simulated time (whole ICO grid)."]
@@ -221,7 +250,8 @@ class BenchOptions:
 
 
 def stages(opt: BenchOptions) -> list[Stage]:
-    """ICO grid per seed, prior per seed, ICO->RL and RL grids per seed, summary, figures. Every
+    """ICO grid per seed, prior per seed, ICO->RL, its control, RL and its control per seed,
+    summary, figures. Every
     argument and override is validated here, before anything runs or is written."""
     profile = PROFILES[opt.profile]
     out = Path(opt.out)
@@ -258,6 +288,8 @@ def stages(opt: BenchOptions) -> list[Stage]:
             info = P.from_results(seed_dir(out, "ico", seed), opt.frame, opt.ridge)
             ctx[("prior", "ico-rl", seed)] = info
             ctx[("prior", "rl", seed)] = P.rl_prior(info, opt.rl_cov)
+            for control, condition in CONTROL_OF.items():
+                ctx[("prior", control, seed)] = ctx[("prior", condition, seed)]
             progress(f"  prior seed {seed}: {info.n_cells} cells, mean "
                      + ", ".join(f"{v:.4g}" for v in info.mean))
         return Stage(f"prior seed-{seed}", run)
@@ -275,6 +307,11 @@ def stages(opt: BenchOptions) -> list[Stage]:
     def summary_stage(ctx):
         recs = {c: [ctx[(c, s)][1] for s in seeds if (c, s) in ctx] for c in CONDITIONS}
         agg = aggregate(recs)
+        for control, condition in CONTROL_OF.items():
+            if condition in agg and control in agg:
+                agg[condition]["gain_over_control"] = gain_over_control(
+                    {s: ctx[(condition, s)][0] for s in seeds if (condition, s) in ctx},
+                    {s: ctx[(control, s)][0] for s in seeds if (control, s) in ctx})
         ctx["aggregate"] = agg
         md, js = write_summary(out, agg)
         print(md.read_text(), end="")
@@ -286,7 +323,9 @@ def stages(opt: BenchOptions) -> list[Stage]:
     out_stages = [grid_stage("ico", s) for s in seeds]
     out_stages += [prior_stage(s) for s in seeds]
     out_stages += [grid_stage("ico-rl", s) for s in seeds]
+    out_stages += [grid_stage("ico-rl-control", s) for s in seeds]
     out_stages += [grid_stage("rl", s) for s in seeds]
+    out_stages += [grid_stage("rl-control", s) for s in seeds]
     out_stages += [Stage("summary", summary_stage), Stage("figures", figures_stage)]
     return out_stages
 

@@ -16,7 +16,7 @@ from . import grid, results
 from . import prior as P
 from .config import RunConfig, build_config
 from .errors import ResultsError, UsageError
-from .options import CONDITIONS, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY
+from .options import CONDITIONS, CONTROL_OF, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY
 
 
 def check_condition(condition: Any) -> str:
@@ -26,8 +26,9 @@ def check_condition(condition: Any) -> str:
 
 
 def condition_prior(condition: str, prior_from, frame, ridge: float, rl_cov: str = "ico") -> P.PriorInfo | None:
-    """PriorInfo of a condition (None for ico): ico-rl from an ICO results dir, rl with mean 0 (A16)."""
-    check_condition(condition)
+    """PriorInfo of a condition (None for ico): ico-rl from an ICO results dir, rl with mean 0 (A16);
+    a no-learning control has the prior of its condition."""
+    condition = CONTROL_OF.get(check_condition(condition), condition)
     if condition == "ico":
         if prior_from is not None:
             raise UsageError("--prior-from applies to the conditions rl and ico-rl")

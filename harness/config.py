@@ -67,7 +67,7 @@ ENUMS: dict[str, dict[str, int]] = {
     "ico.timing": B.ICO_TIMINGS,
     "integrator": B.INTEGRATORS,
 }
-BOOLS = ("policy.clip_inputs", "actor.reflex", "actor.act_with_sample")
+BOOLS = ("learn", "policy.clip_inputs", "actor.reflex", "actor.act_with_sample")
 _BOOL_NAMES = {"true": 1, "false": 0, "on": 1, "off": 0, "yes": 1, "no": 0, "1": 1, "0": 0}
 
 # Overrides of each learning condition on top of the defaults.
@@ -75,6 +75,8 @@ CONDITION_OVERRIDES: dict[str, dict[str, Any]] = {
     "ico": {"mode": "ico"},
     "rl": {"mode": "rl"},       # prior mean 0 (spec A16)
     "ico-rl": {"mode": "rl"},   # prior from an ICO grid (spec 7)
+    "ico-rl-control": {"mode": "rl", "learn": 0},
+    "rl-control": {"mode": "rl", "learn": 0},
 }
 assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS)
 

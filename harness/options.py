@@ -4,9 +4,14 @@ defines - enum values, statuses, sizes, grid geometry - comes from the binding i
 from __future__ import annotations
 
 # Learning conditions, in the order of the benchmark and its tables.
-CONDITIONS = ("ico", "ico-rl", "rl")
-RL_CONDITIONS = ("ico-rl", "rl")         # the conditions that run the actor-critic from a prior
-CONDITION_LABELS = {"ico": "ICO", "ico-rl": "ICO->RL", "rl": "RL"}
+CONDITIONS = ("ico", "ico-rl", "ico-rl-control", "rl", "rl-control")
+# The conditions that run the actor-critic from a prior.
+RL_CONDITIONS = ("ico-rl", "ico-rl-control", "rl", "rl-control")
+# No-learning control (spec L1) -> its condition: the same prior, acting weights, noise stream,
+# resets and caps, with every update off (the controller's `learn = 0`).
+CONTROL_OF = {"ico-rl-control": "ico-rl", "rl-control": "rl"}
+CONDITION_LABELS = {"ico": "ICO", "ico-rl": "ICO->RL", "ico-rl-control": "ICO->RL control", "rl": "RL",
+                    "rl-control": "RL control"}
 
 PROFILE_NAMES = ("default", "paper", "quick")   # bench profiles (harness.bench.PROFILES)
 

@@ -80,6 +80,7 @@ void icoac_config_default(icoac_config_t *cfg)
         return;
     }
     cfg->mode = ICOAC_MODE_ICO;
+    cfg->learn = 1;
     icoac_policy_config_default(&cfg->policy);
     icoac_ico_config_default(&cfg->ico);
     icoac_critic_config_default(&cfg->critic);
@@ -203,6 +204,9 @@ static int config_ok(const icoac_config_t *cfg, bad_field_t *bad)
 {
     if (cfg->mode != ICOAC_MODE_ICO && cfg->mode != ICOAC_MODE_RL) {
         ICOAC_PRIV_FAIL("mode", ICOAC_ERR_BAD_MODE);
+    }
+    if (!is_flag(cfg->learn)) {
+        ICOAC_PRIV_FAIL("learn", ICOAC_ERR_BAD_MODE);
     }
     if (!policy_ok(&cfg->policy, bad)) {
         return 0;

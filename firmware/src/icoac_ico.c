@@ -4,8 +4,8 @@
 
 /* ICO weights after a penalty onset of size drop > 0 (Eq. 2-3), and their norm. */
 static icoac_real_t learn_weights(const icoac_config_t *cfg, const icoac_priv_state_t *st,
-                              const icoac_real_t trace[ICOAC_N_INPUTS], icoac_real_t drop,
-                              icoac_real_t w[ICOAC_N_INPUTS])
+                                  const icoac_real_t trace[ICOAC_N_INPUTS], icoac_real_t drop,
+                                  icoac_real_t w[ICOAC_N_INPUTS])
 {
     const icoac_real_t step = cfg->ico.rate * drop;
     int i;
@@ -25,10 +25,10 @@ static void commit_weights(icoac_priv_state_t *st, const icoac_real_t w[ICOAC_N_
  * states are not seen. The force and the new weights' norm (finite only if every w_i is) are
  * checked before anything is stored; returns 0, with the state untouched, when one is not. */
 static int code_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
-                           const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
-                           icoac_output_t *out)
+                       const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
+                       icoac_output_t *out)
 {
-    const icoac_real_t drop = st->penalty_prev - penalty;
+    const icoac_real_t drop = cfg->learn ? st->penalty_prev - penalty : ICOAC_R(0.0);
     icoac_real_t w[ICOAC_N_INPUTS];
     icoac_real_t norm = ICOAC_R(0.0);
     icoac_real_t z;
@@ -62,11 +62,11 @@ static int code_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
  * terminal tick learns and outputs no force. Checked like the code timing (z stands for the
  * force on a terminal tick). */
 static int literal_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
-                              const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty,
-                              int terminal, icoac_output_t *out)
+                          const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty,
+                          int terminal, icoac_output_t *out)
 {
     const icoac_real_t drop = st->penalty_prev - penalty;
-    const int learn = st->has_prev && drop > ICOAC_R(0.0);
+    const int learn = cfg->learn && st->has_prev && drop > ICOAC_R(0.0);
     icoac_real_t w[ICOAC_N_INPUTS];
     icoac_real_t norm = ICOAC_R(0.0);
     icoac_real_t z;

@@ -30,12 +30,15 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     icoac_real_t (*cov)[ICOAC_N_INPUTS] = st->cov_buffer[st->cov_slot ^ 1]; /* the spare */
     icoac_real_t checked[5]; /* V(s), delta, |w|, trace of Sigma_w, G z (+ reflex) */
     const int slot_prev = st->active_slot;
-    const int learn = st->has_prev;
-    const icoac_real_t *w_act = cfg->actor.act_with_sample ? st->w_act : (learn ? w : st->w);
+    const int learn = st->has_prev;         /* a transition into s exists: delta is defined */
+    const int update = learn && cfg->learn; /* ... and the critic and actor learn from it */
+    const icoac_real_t *w_act = cfg->actor.act_with_sample ? st->w_act : (update ? w : st->w);
     icoac_real_t z = ICOAC_R(0.0);
     icoac_real_t noise;
     int i;
     checked[0] = ICOAC_R(0.0);
+    checked[1] = ICOAC_R(0.0);
+    checked[2] = st->weight_norm;
     checked[4] = ICOAC_R(0.0);
     if (!terminal) {
         icoac_priv_critic_factors(&cfg->critic, s, factors);
@@ -44,9 +47,11 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     }
     if (learn) {
         const icoac_real_t reward = terminal ? ICOAC_R(-1.0) : ICOAC_R(0.0);
+        checked[1] = clip_td(reward + cfg->critic.discount * checked[0] - st->value_prev, cfg->critic.td_clip);
+    }
+    if (update) {
         icoac_real_t h[ICOAC_N_INPUTS];
         icoac_real_t innovation;
-        checked[1] = clip_td(reward + cfg->critic.discount * checked[0] - st->value_prev, cfg->critic.td_clip);
         for (i = 0; i < ICOAC_N_INPUTS; ++i) {
             h[i] = cfg->policy.gain * st->x_prev[i];
         }
@@ -60,8 +65,6 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
             return 0;
         }
     } else {
-        checked[1] = ICOAC_R(0.0);
-        checked[2] = st->weight_norm;
         checked[3] = icoac_priv_trace4(icoac_priv_cov_c(st));
     }
     if (!terminal) {
@@ -72,7 +75,7 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
         return 0;
     }
     /* commit */
-    if (learn) {
+    if (update) {
         icoac_priv_critic_update(st->v, &st->active[slot_prev], cfg->critic.rate * checked[1]);
         icoac_priv_copy4(st->w, w);
         st->cov_slot ^= 1;

@@ -66,6 +66,7 @@ static const icoac_sim_constant_t constants[] = {
 
 static const icoac_sim_field_t fields[] = {
     FIELD(icoac_config_t, mode),
+    FIELD(icoac_config_t, learn),
     FIELD(icoac_config_t, policy.input_range),
     FIELD(icoac_config_t, policy.clip_inputs),
     FIELD(icoac_config_t, policy.gain),

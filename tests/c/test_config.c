@@ -763,7 +763,7 @@ static void test_sizeof_functions(void **unused)
 {
     (void)unused;
     assert_int_equal(icoac_abi_version(), ICOAC_ABI_VERSION);
-    assert_int_equal(ICOAC_ABI_VERSION, 4);
+    assert_int_equal(ICOAC_ABI_VERSION, 5);
     assert_int_equal(icoac_sizeof_real(), sizeof(icoac_real_t));
     assert_int_equal(icoac_sizeof_real(), REAL_IS_FLOAT ? 4 : 8);
     assert_int_equal(icoac_sizeof_config(), sizeof(icoac_config_t));

@@ -38,7 +38,8 @@
  *           the counters count the tick and its rejection.
  *           OK: every real output written (out is NaN-filled before the call) and finite, the
  *           learned state finite, cov exactly symmetric, out.weight_norm = |w|; force and
- *           noise 0 on a terminal step; q 0 in RL; value, td_error, noise, cov_trace 0 in ICO.
+ *           noise 0 on a terminal step; q 0 in RL; value, td_error, noise, cov_trace 0 in ICO;
+ *           with learn = 0 (the no-learning control) w, |w|, cov and v unchanged.
  *           Not OK: every real output 0 but weight_norm = |w|, learned state bytewise
  *           unchanged (the spare kept-unit slot and covariance buffer are scratch, not learned).
  *   reset   OK or ICOAC_ERR_NUMERIC; w, |w|, cov, v unchanged; w_act = w unless acting with a
@@ -226,6 +227,9 @@ static int actor_documented(const icoac_actor_config_t *a)
 
 static int config_documented(const icoac_config_t *cfg)
 {
+    if (cfg->learn != 0 && cfg->learn != 1) {
+        return 0;
+    }
     if (cfg->mode == ICOAC_MODE_ICO) {
         return policy_documented(&cfg->policy) && ico_documented(&cfg->ico);
     }
@@ -243,6 +247,7 @@ typedef struct {
 
 static const named_field_t named_fields[] = {
     {"mode", ICOAC_ERR_BAD_MODE, -1},
+    {"learn", ICOAC_ERR_BAD_MODE, -1},
     {"policy.input_range[0]", ICOAC_ERR_BAD_SCALE, -1},
     {"policy.input_range[1]", ICOAC_ERR_BAD_SCALE, -1},
     {"policy.input_range[2]", ICOAC_ERR_BAD_SCALE, -1},
@@ -356,6 +361,8 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
                  field, (double)after.w[0], (double)after.w[1], (double)after.w[2], (double)after.w[3],
                  (double)after.weight_norm);
         FZ_CHECK(cov_symmetric(CONST_MAT(after.cov)), "op %d: covariance not exactly symmetric", op);
+        field = cfg->learn ? 0 : learned_changed(&before, &after, 0);
+        FZ_CHECK(field == 0, "op %d: learn = 0, but the tick changed the learned %s", op, field);
         FZ_CHECK((in->flags & ICOAC_INPUT_TERMINAL) == 0u || (out.force == ICOAC_R(0.0) && out.noise == ICOAC_R(0.0)),
                  "op %d: terminal step with force %g noise %g", op, (double)out.force, (double)out.noise);
         FZ_CHECK(out.weight_norm == after.weight_norm, "op %d: out.weight_norm %g, state |w| %g", op,

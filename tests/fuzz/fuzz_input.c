@@ -140,11 +140,11 @@ int64_t fz_i64(fz_reader_t *r)
 
 /* Config fields by index, in struct order (the order icoac_config_check walks them): the
  * member's offset and whether it is an int32 switch or a real. Indices:
- * 0 mode, 1-4 policy.input_range, 5 policy.clip_inputs, 6 policy.gain, 7 policy.reflex_mode,
- * 8 policy.reflex_force, 9 policy.zone_theta, 10 policy.zone_x, 11 ico.rate, 12 ico.timing,
- * 13 critic.rate, 14 critic.discount, 15 critic.td_clip, 16-19 critic.range,
- * 20 critic.threshold, 21 actor.noise_std, 22 actor.scale, 23 actor.forgetting,
- * 24 actor.reflex, 25 actor.act_with_sample. */
+ * 0 mode, 1 learn, 2-5 policy.input_range, 6 policy.clip_inputs, 7 policy.gain,
+ * 8 policy.reflex_mode, 9 policy.reflex_force, 10 policy.zone_theta, 11 policy.zone_x,
+ * 12 ico.rate, 13 ico.timing, 14 critic.rate, 15 critic.discount, 16 critic.td_clip,
+ * 17-20 critic.range, 21 critic.threshold, 22 actor.noise_std, 23 actor.scale,
+ * 24 actor.forgetting, 25 actor.reflex, 26 actor.act_with_sample. */
 typedef struct {
     size_t offset;
     int is_int;
@@ -155,6 +155,7 @@ typedef struct {
 
 static const config_field_t config_fields[] = {
     FZ_INT(mode),
+    FZ_INT(learn),
     FZ_REAL(policy.input_range[0]),
     FZ_REAL(policy.input_range[1]),
     FZ_REAL(policy.input_range[2]),

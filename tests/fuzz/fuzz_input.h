@@ -20,7 +20,7 @@ typedef struct {
 #define FZ_VALUE_RAW 4      /* 36..39: raw bits of the value, little endian */
 #define FZ_VALUE_KINDS (FZ_VALUE_TABLE + FZ_VALUE_BOUNDED + FZ_VALUE_RAW)
 
-#define FZ_CONFIG_FIELDS 26 /* config mutation field indices 0..25, struct order: fuzz_input.c */
+#define FZ_CONFIG_FIELDS 27 /* config mutation field indices 0..26, struct order: fuzz_input.c */
 #define FZ_PRIOR_FIELDS 20  /* 0..3 mean, 4 + 4i + j cov[i][j] */
 
 void fz_reader_init(fz_reader_t *r, const uint8_t *data, size_t size);

@@ -29,6 +29,7 @@ INT64_TABLE = [0, 1, 2, 3, -1, 300, 1000, 100000, 2**63 - 1, -2**63, 10]
 # switch, "r" an icoac_real_t, "r4" an icoac_real_t[4], or a nested group.
 CONFIG_LAYOUT = [
     ("mode", "i"),
+    ("learn", "i"),
     ("policy", [("input_range", "r4"), ("clip_inputs", "i"), ("gain", "r"), ("reflex_mode", "i"),
                 ("reflex_force", "r"), ("zone_theta", "r"), ("zone_x", "r")]),
     ("ico", [("rate", "r"), ("timing", "i")]),
@@ -37,7 +38,7 @@ CONFIG_LAYOUT = [
                ("act_with_sample", "i")]),
 ]
 # sizeof(icoac_config_t) with float and with double reals (x86-64 and AArch64 alignment).
-CONFIG_SIZES = {"f": 104, "d": 200}
+CONFIG_SIZES = {"f": 108, "d": 200}
 
 
 def config_fields():
@@ -60,8 +61,8 @@ def config_fields():
 # The mutation field indices of fuzz_input.c: struct order.
 CONFIG_FIELDS = [name for name, _ in config_fields()]
 CONFIG_INTS = {name for name, is_int in config_fields() if is_int}
-assert len(CONFIG_FIELDS) == 26
-CONFIG_DEFAULT = {"mode": 0,
+assert len(CONFIG_FIELDS) == 27
+CONFIG_DEFAULT = {"mode": 0, "learn": 1,
                   "policy.input_range[0]": 2.4, "policy.input_range[1]": 3.5,
                   "policy.input_range[2]": 0.2094384, "policy.input_range[3]": 2.0,
                   "policy.clip_inputs": 1, "policy.gain": 10.0, "policy.reflex_mode": 0,

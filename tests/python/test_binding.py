@@ -30,7 +30,7 @@ def test_state_is_opaque_aligned_storage():
 
 
 def test_abi_versions():
-    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 4
+    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 5
     assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 2
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
@@ -51,14 +51,14 @@ class _WrongPolicy(ctypes.Structure):
 
 
 class _WrongConfig(ctypes.Structure):
-    _fields_ = [("mode", ctypes.c_int32), ("policy", _WrongPolicy), ("ico", B.IcoConfig),
+    _fields_ = [("mode", ctypes.c_int32), ("learn", ctypes.c_int32), ("policy", _WrongPolicy), ("ico", B.IcoConfig),
                 ("critic", B.CriticConfig), ("actor", B.ActorConfig)]
 
 
 def test_field_check_catches_a_wrong_offset():
     assert ctypes.sizeof(_WrongConfig) == ctypes.sizeof(B.Config)
-    with pytest.raises(LibraryError, match=r"icoac_config_t\.policy\.clip_inputs: C offset 20 size 4, "
-                                           r"binding offset 24"):
+    with pytest.raises(LibraryError, match=r"icoac_config_t\.policy\.clip_inputs: C offset 24 size 4, "
+                                           r"binding offset 28"):
         B.check_mirror("icoac_config_t", _WrongConfig, c_size=B.lib.icoac_sizeof_config())
     B.check_mirror("icoac_config_t", B.Config, c_size=B.lib.icoac_sizeof_config())
 
@@ -138,7 +138,8 @@ def test_cell_dtype_offsets():
 def test_config_defaults_match_spec():
     d = build_config().to_dict()
     c, p, r = d["controller"], d["plant"], d["run"]
-    assert set(c) == {"mode", "policy", "ico", "critic", "actor"}
+    assert set(c) == {"mode", "learn", "policy", "ico", "critic", "actor"}
+    assert c["learn"] is True
     pol, ico, cri, act = c["policy"], c["ico"], c["critic"], c["actor"]
     assert c["mode"] == "ico" and pol["reflex_mode"] == "unit" and ico["timing"] == "code"
     assert pol["gain"] == 10.0

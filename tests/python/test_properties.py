@@ -90,7 +90,7 @@ def test_single_field_override(given_name, value, condition):
 
 
 INT_FIELDS = [n for n in ALL_FIELDS if n in ENUMS or n in BOOLS or n in ("max_trials", "success_steps")]
-assert len(INT_FIELDS) == 9
+assert len(INT_FIELDS) == 10
 
 
 # k + m * 2^32 (and 2^64) wraps to a valid small value if anything truncates to int32 (int64)

@@ -132,6 +132,42 @@ def test_rl_grid_deterministic_records_posterior(ico_dir):
     assert c["outcome"][0] != B.PENDING
 
 
+# -- the no-learning controls (spec L1) -----------------------------------------------------------------
+@pytest.mark.parametrize("condition", ["ico-rl-control", "rl-control"])
+def test_control_learns_nothing_and_equals_zero_rates(ico_dir, condition):
+    """A control keeps the prior exactly (mu_w and Sigma_w of every cell), and its outcomes equal
+    those of its condition with the learning rates at 0 (critic rate, actor scale alpha)."""
+    info = P.from_results(ico_dir)
+    if condition == "rl-control":
+        info = P.rl_prior(info)
+    prior = info.prior()
+    control = build_config(TINY_RL, condition=condition, prior=prior)
+    assert control.controller.learn == 0 and control.controller.mode == B.MODE_RL
+    base = condition.removesuffix("-control")
+    zero = build_config({**TINY_RL, "critic.rate": 0, "actor.scale": 0}, condition=base, prior=prior)
+    learning = build_config(TINY_RL, condition=base, prior=prior)
+    cells = {name: grid.make_cells(5, [300, 611, 612, 900]) for name in ("control", "zero", "learning")}
+    for name, cfg in (("control", control), ("zero", zero), ("learning", learning)):
+        grid.run_grid(cfg, cells[name], threads=2, progress=False)
+    mean = np.array(prior.mean, dtype=float)
+    cov = np.array([list(r) for r in prior.cov], dtype=float)
+    for w, c in zip(cells["control"]["weights"], cells["control"]["cov"]):
+        assert np.array_equal(w, mean) and np.array_equal(c, cov)
+    for f in ("outcome", "status", "trials", "total_steps", "last_trial_steps"):
+        assert np.array_equal(cells["control"][f], cells["zero"][f]), f
+    assert not np.array_equal(cells["learning"]["weights"], cells["control"]["weights"])
+
+
+def test_cli_control_condition_records_its_prior(ico_dir, tmp_path):
+    out = tmp_path / "control"
+    res = run_cli("grid", "--condition", "ico-rl-control", "--prior-from", str(ico_dir), "--out", str(out),
+                  "--cells", "611", "--max-trials", "5", "--success-steps", "300", "--quiet")
+    assert res.returncode == 0, res.stderr
+    record = json.loads((out / "run.json").read_text())
+    assert record["condition"] == "ico-rl-control" and record["config"]["controller"]["learn"] is False
+    assert record["prior_info"]["mean"] == P.from_results(ico_dir).to_dict()["mean"]
+
+
 # -- the Bayesian actor step against the closed-form posterior -----------------------------------------
 def controller(cfg, mean, cov, seed=1):
     state = B.State()
@@ -283,14 +319,24 @@ def test_bench_quick_writes_comparison(tmp_path):
                  "fig1b_success_map.png"):
         data = (fig / name).read_bytes()
         assert data[:8] == PNG and len(data) > 5000
-    for cond in ("ico", "ico-rl", "rl"):
+    conds = ("ico", "ico-rl", "ico-rl-control", "rl", "rl-control")
+    for cond in conds:
         for seed in (0, 1):
             assert results.exists(out / cond / f"seed-{seed}")
     summary = json.loads((out / "summary.json").read_text())
-    assert set(summary) == {"ico", "ico-rl", "rl"} and summary["ico"]["paper"]["success_rate"] == 0.68
-    assert "ICO->RL" in (out / "summary.md").read_text()
+    assert set(summary) == set(conds) and summary["ico"]["paper"]["success_rate"] == 0.68
+    text = (out / "summary.md").read_text()
+    assert "ICO->RL" in text and "| ICO->RL | ICO->RL control |" in text
+    # the gain over the control, recomputed from the cells
+    gain = summary["ico-rl"]["gain_over_control"]
+    for i, seed in enumerate((0, 1)):
+        a, _ = results.load(out / "ico-rl" / f"seed-{seed}")
+        b, _ = results.load(out / "ico-rl-control" / f"seed-{seed}")
+        sa, sb = a["outcome"] == B.SUCCESS, b["outcome"] == B.SUCCESS
+        assert gain["cells_gained"]["per_seed"][i] == np.count_nonzero(sa & ~sb)
+        assert gain["cells_lost"]["per_seed"][i] == np.count_nonzero(~sa & sb)
     bench = json.loads((out / "bench.json").read_text())
-    assert bench["complete"] and len(bench["stages"]) == 10
+    assert bench["complete"] and len(bench["stages"]) == 14
     icorl = json.loads((out / "ico-rl" / "seed-0" / "run.json").read_text())
     assert icorl["prior_info"]["source"] == str((out / "ico" / "seed-0").resolve())
     assert icorl["config"]["run"]["max_trials"] == 100

@@ -94,6 +94,9 @@ typedef struct {
 
 typedef struct {
     int32_t mode;                 /* icoac_mode_t */
+    int32_t learn;                /* 1: learn (default); 0: every update off (w, Sigma_w, v fixed): the
+                                     no-learning control of a condition, or a fixed-w evaluation.
+                                     Acting, exploration noise and its random stream are unchanged */
     icoac_policy_config_t policy;
     icoac_ico_config_t ico;
     icoac_critic_config_t critic;
