@@ -3,6 +3,10 @@ no-learning controls (spec L1), summary, figures.
 
 Layout: OUT/<condition>/seed-<n>/ (results directories), OUT/bench.json (wall time per stage),
 OUT/summary.md and OUT/summary.json (mean and sd over seeds next to the paper's numbers).
+
+The linear-policy ceiling (spec L5) is not a bench stage: `python -m harness ceiling --out
+OUT/ceiling` measures it, and the bench shows it (a section of summary.md, reference lines in
+Fig. 3a) when OUT/ceiling/ceiling.json exists or --ceiling names one.
 """
 from __future__ import annotations
 
@@ -16,10 +20,12 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
+from . import ceiling as C
 from . import figures, geometry, grid, metrics, results
 from . import prior as P
 from .conditions import run_condition
 from .config import build_config, parse_sets
+from .errors import ResultsError
 from .metrics import percent
 from .options import CONDITION_LABELS as LABELS, CONDITIONS, CONTROL_OF, PROFILE_NAMES
 
@@ -119,7 +125,25 @@ def _fmt(stat: Mapping[str, Any] | None, pct: bool = False) -> str:
     return f"{stat['mean']:.4g} ± {stat['sd']:.2g}"
 
 
-def summary_markdown(agg: Mapping[str, Any]) -> str:
+def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
+    """Lines of summary.md for a ceiling record (harness.ceiling)."""
+    st, best = record["settings"], record["best"]
+    parts = []
+    for p, s in best["protocols"].items():
+        cap = "one trial per cell" if p == "first" else f"retries up to {s.get('max_trials', st['max_trials']):g} trials"
+        parts.append(f"{cap}: {percent(s['success_rate'])} of {s['n_cells']} cells, "
+                     f"{percent(s['success_rate_interior'])} of {s['n_interior']} interior")
+    lines = ["", f"Linear-policy ceiling (spec L5; no learning, the best single w = {C.format_w(best['w'])} "
+             f"of `python -m harness ceiling`, seed {st['seed']}, horizon {st['success_steps']:g} steps): "
+             + "; ".join(parts) + "."]
+    b = record.get("first_step_bound") or {}
+    if b.get("computed"):
+        lines[-1] += (f" First-step bound: {b['n_lost']} cells fail at the first step whatever the force, so no "
+                      f"controller exceeds {percent(b['success_rate_bound'])} of {b['n_cells']} cells on its first trial.")
+    return lines
+
+
+def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> str:
     lines = ["# ICO, RL and ICO->RL with their no-learning controls: mean ± sd over seeds", "",
              "| condition | seeds | caps (trials / steps) | success (all) | success (interior) | "
              "median trials to success | mean elapsed sim. time of successes (s) | paper |",
@@ -147,24 +171,28 @@ def summary_markdown(agg: Mapping[str, Any]) -> str:
     if "ico-rl" in agg and agg["ico-rl"].get("ico_phase_simulated_time", {}).get("mean") is not None:
         lines += ["", "ICO->RL counts RL-phase trials only (A17); the ICO phase that produced each prior took "
                   f"{_fmt(agg['ico-rl']['ico_phase_simulated_time'])} s of simulated time (whole ICO grid)."]
+    if ceiling is not None:
+        lines += ceiling_markdown(ceiling)
     lines += ["", f"Success rates use the cells run as denominator ({geometry.CELLS} / {geometry.N_INTERIOR} on "
               f"the full grid). The paper's ~{percent(PAPER['ico']['success_rate'], 0)} / "
               f"~{percent(PAPER['ico-rl']['success_rate'], 0)} are read as fractions of all {geometry.CELLS} cells."]
     return "\n".join(lines) + "\n"
 
 
-def write_summary(out: Path, agg: Mapping[str, Any]) -> tuple[Path, Path]:
+def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> tuple[Path, Path]:
     out = Path(out)
     md = out / "summary.md"
     js = out / "summary.json"
-    md.write_text(summary_markdown(agg))
+    md.write_text(summary_markdown(agg, ceiling))
     js.write_text(json.dumps(agg, indent=2) + "\n")
     return md, js
 
 
 def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarray | None,
-                       icorl_cells: np.ndarray | None, frame=None) -> list[Path]:
-    """Fig. 2b (first ICO->RL seed, ICO success domain outlined), Fig. 3a, Fig. 3b."""
+                       icorl_cells: np.ndarray | None, frame=None,
+                       ceiling: Mapping[str, Any] | None = None) -> list[Path]:
+    """Fig. 2b (first ICO->RL seed, ICO success domain outlined), Fig. 3a (with the linear-policy
+    ceiling's reference lines when a ceiling record is given), Fig. 3b."""
     figdir = Path(figdir)
     written = []
     if icorl_cells is not None:
@@ -178,7 +206,8 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
         written.append(figures.plot_fig3a(figdir / "fig3a_success_rate.png", [LABELS[c] for c in conds],
                                           [agg[c]["success_rate"] for c in conds],
                                           [agg[c]["success_rate_interior"] for c in conds],
-                                          [(PAPER.get(c) or {}).get("success_rate") for c in conds]))
+                                          [(PAPER.get(c) or {}).get("success_rate") for c in conds],
+                                          ceiling=C.reference_lines(ceiling)))
         written.append(figures.plot_fig3b(figdir / "fig3b_elapsed_time.png", [LABELS[c] for c in conds],
                                           [agg[c]["mean_elapsed_time_success"] for c in conds]))
     return written
@@ -243,6 +272,7 @@ class BenchOptions:
     frame: tuple[float, float] | None = P.DEFAULT_FRAME
     ridge: float = P.DEFAULT_RIDGE
     rl_cov: str = "ico"
+    ceiling: Path | None = None   # a ceiling.json (or its directory); default OUT/ceiling/ceiling.json
 
     def seed_list(self) -> list[int]:
         n = self.seeds if self.seeds is not None else PROFILES[self.profile]["seeds"]
@@ -294,6 +324,17 @@ def stages(opt: BenchOptions) -> list[Stage]:
                      + ", ".join(f"{v:.4g}" for v in info.mean))
         return Stage(f"prior seed-{seed}", run)
 
+    def ceiling_record():
+        """The ceiling shown (--ceiling, else OUT/ceiling/ceiling.json if present); a damaged default
+        file is reported and skipped rather than failing the bench at its end."""
+        try:
+            return C.bench_ceiling(out, opt.ceiling)
+        except ResultsError as exc:
+            if opt.ceiling is not None:
+                raise
+            progress(f"  ceiling not shown: {exc}")
+            return None
+
     def figures_stage(ctx):
         if figdir is None:
             return
@@ -301,7 +342,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
         for path in figures.make_figures(cells, record, figdir):
             progress(f"  wrote {path}")
         for path in comparison_figures(ctx["aggregate"], figdir, cells, ctx[("ico-rl", seeds[0])][0],
-                                       frame=opt.frame):
+                                       frame=opt.frame, ceiling=ceiling_record()):
             progress(f"  wrote {path}")
 
     def summary_stage(ctx):
@@ -313,12 +354,14 @@ def stages(opt: BenchOptions) -> list[Stage]:
                     {s: ctx[(condition, s)][0] for s in seeds if (condition, s) in ctx},
                     {s: ctx[(control, s)][0] for s in seeds if (control, s) in ctx})
         ctx["aggregate"] = agg
-        md, js = write_summary(out, agg)
+        md, js = write_summary(out, agg, ceiling_record())
         print(md.read_text(), end="")
         progress(f"  wrote {md} and {js}")
 
     for condition in CONDITIONS:  # every override valid before the first grid runs
         build_config(overrides(condition), condition=condition)
+    if opt.ceiling is not None:
+        C.load_ceiling(opt.ceiling)
 
     out_stages = [grid_stage("ico", s) for s in seeds]
     out_stages += [prior_stage(s) for s in seeds]

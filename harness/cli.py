@@ -1,8 +1,8 @@
-"""Command line: `python -m harness grid|figures|bench|sweep ...`.
+"""Command line: `python -m harness grid|figures|bench|sweep|ceiling ...`.
 
 This module only parses arguments and reports; the work is done by harness.conditions (one
-condition's grid and prior), harness.bench (the benchmark stages), harness.sweep and
-harness.figures. Nothing imports this module. The parser is built without loading the shared
+condition's grid and prior), harness.bench (the benchmark stages), harness.sweep,
+harness.ceiling and harness.figures. Nothing imports this module. The parser is built without loading the shared
 library (names and limits come from harness.options), so `--help` works without it.
 
 Options have one meaning in every command: ``--seed S`` is the first (for `grid` the only) seed
@@ -125,7 +125,7 @@ def _add_seeds(parser, default_count: str) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog=PROG, description="icoac grid benchmarks, results and figures")
-    sub = p.add_subparsers(dest="command", metavar="{grid,figures,bench,sweep}", parser_class=_Parser)
+    sub = p.add_subparsers(dest="command", metavar="{grid,figures,bench,sweep,ceiling}", parser_class=_Parser)
     sub.required = True
     cells_, every = O.DEFAULT_CHECKPOINT_CELLS, O.DEFAULT_CHECKPOINT_EVERY
 
@@ -193,6 +193,9 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--set", action="append", metavar="NAME=VALUE", help=SET_HELP)
     b.add_argument("--resume", action="store_true", help="continue earlier results instead of starting over")
     b.add_argument("--quiet", action="store_true", help="no progress bars")
+    b.add_argument("--ceiling", default=None, metavar="CEILING",
+                   help="ceiling.json of `ceiling` (or its directory) shown in summary.md and Fig. 3a "
+                        f"(default OUT/{O.CEILING_DIR}/{O.CEILING_FILE} if it exists)")
     _add_prior_args(b)
     b.set_defaults(func=cmd_bench)
 
@@ -217,6 +220,43 @@ def build_parser() -> argparse.ArgumentParser:
     _add_rl_cov(w)
     w.add_argument("--quiet", action="store_true")
     w.set_defaults(func=cmd_sweep)
+
+    c = sub.add_parser(
+        "ceiling", help="the linear-policy ceiling (spec L5): fixed-w evaluation, search for the best w, "
+                        "first-step bound",
+        epilog="Without --w: a seeded search (typical ICO weights - the mean of --prior-from - and LQR gains "
+               "as starting points, random search over magnitudes and signs, local refinement), screened "
+               "with one trial per cell at --screen-steps steps; the best --confirm are run at the full "
+               "horizon and the best of them under every --protocol. Writes OUT/search.json (every screen; "
+               "rerunning the same command resumes), OUT/evals/*/ (results directories), "
+               "OUT/ceiling.json and OUT/ceiling.md. Ctrl-C keeps finished work and exits with status 130.")
+    c.add_argument("--out", required=True, help="ceiling directory; created if missing")
+    c.add_argument("--prior-from", default=None, metavar="ICO_DIR",
+                   help="ICO results directory whose central-frame mean weight starts the search "
+                        f"(default the typical ICO weights {','.join(f'{v:g}' for v in O.TYPICAL_ICO_WEIGHTS)})")
+    c.add_argument("--w", default=None, metavar="W1,W2,W3,W4",
+                   help="evaluate this w = (w_x, w_xdot, w_theta, w_thetadot) only, no search")
+    c.add_argument("--protocol", choices=O.CEILING_PROTOCOL_CHOICES, default="both",
+                   help="final evaluation: one trial per cell (first), fresh initial velocities up to "
+                        "--max-trials (retries), or both (default)")
+    c.add_argument("--max-trials", type=_positive_int, default=O.CEILING_MAX_TRIALS,
+                   help=f"trial cap of the retries protocol (default {O.CEILING_MAX_TRIALS})")
+    c.add_argument("--success-steps", type=_positive_int, default=None,
+                   help="full horizon: steps of a successful trial (default 1e5)")
+    c.add_argument("--cells", default=None, help="subset of the paper grid's cell indices, e.g. 0,5,600-610")
+    c.add_argument("--candidates", type=_int_in(1, O.CEILING_MAX_CANDIDATES, f"an integer in [1, {O.CEILING_MAX_CANDIDATES}]"),
+                   default=None, metavar="N", help=f"distinct w screened by the search (default {O.CEILING_CANDIDATES})")
+    c.add_argument("--screen-steps", type=_positive_int, default=None, metavar="N",
+                   help=f"horizon of the screening runs (default {O.CEILING_SCREEN_STEPS})")
+    c.add_argument("--confirm", type=_int_in(1, O.CEILING_MAX_CANDIDATES, "an integer >= 1"), default=None,
+                   metavar="N", help=f"best screened w run at the full horizon (default {O.CEILING_CONFIRM})")
+    c.add_argument("--seed", type=_seed, default=0,
+                   help="grid seed (initial velocities) and search seed, in [0, 2^64 - 1] (default 0)")
+    c.add_argument("--threads", type=_threads, default=0, help=f"C threads in [0, {O.MAX_THREADS}] (0: all cores)")
+    c.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help=SET_HELP + "; mode, learn, max_trials and success_steps are set by the command")
+    c.add_argument("--quiet", action="store_true", help="no progress output")
+    c.set_defaults(func=cmd_ceiling)
     return p
 
 
@@ -277,7 +317,7 @@ def cmd_bench(args) -> int:
         profile=args.profile, out=Path(args.out), figures=Path(args.figures) if args.figures else None,
         seed=args.seed, seeds=args.seeds, rl_max_trials=args.rl_max_trials, threads=args.threads,
         sets=args.set or [], resume=args.resume, quiet=args.quiet, frame=_frame(args), ridge=args.prior_ridge,
-        rl_cov=args.rl_cov)
+        rl_cov=args.rl_cov, ceiling=Path(args.ceiling) if args.ceiling else None)
     return bench.run_bench(opt, argv=sys.argv[1:])
 
 
@@ -290,6 +330,17 @@ def cmd_sweep(args) -> int:
         max_trials=args.max_trials, success_steps=args.success_steps, sets=args.set or [],
         one_at_a_time=args.one_at_a_time, threads=args.threads, rl_cov=args.rl_cov, quiet=args.quiet)
     return sweep.run_sweep(opt)
+
+
+def cmd_ceiling(args) -> int:
+    from . import ceiling
+
+    opt = ceiling.CeilingOptions(
+        out=Path(args.out), prior_from=Path(args.prior_from) if args.prior_from else None, w=args.w,
+        protocol=args.protocol, max_trials=args.max_trials, success_steps=args.success_steps, cells=args.cells,
+        candidates=args.candidates, screen_steps=args.screen_steps, confirm=args.confirm, seed=args.seed,
+        threads=args.threads, sets=args.set or [], quiet=args.quiet)
+    return ceiling.run_ceiling(opt, argv=sys.argv[1:])
 
 
 def main(argv=None) -> int:

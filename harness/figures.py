@@ -239,10 +239,19 @@ def make_figures(cells: np.ndarray, record: Mapping, out: str | Path, *, label: 
     return written
 
 
+# Reference lines of the linear-policy ceiling (harness.ceiling) in Fig. 3a, by protocol label.
+CEILING_STYLES = {"first trial": dict(colors="tab:green", linestyles="-."),
+                  "retries": dict(colors="tab:purple", linestyles=":")}
+
+
 def plot_fig3a(path: str | Path, labels: Sequence[str], all_stats: Sequence[Mapping],
-               interior_stats: Sequence[Mapping], paper: Sequence[float | None]) -> Path:
+               interior_stats: Sequence[Mapping], paper: Sequence[float | None],
+               ceiling: Mapping[str, float] | None = None) -> Path:
     """Fig. 3a: mean success rate per condition (+- sd over seeds), all cells and interior cells,
-    with the paper's values (e.g. ~68 % ICO, ~84 % ICO->RL) marked."""
+    with the paper's values (e.g. ~68 % ICO, ~84 % ICO->RL) marked. ``ceiling`` ({protocol label:
+    success rate over all cells}, e.g. {"first trial": 0.915, "retries": 0.967}, from
+    harness.ceiling.reference_lines) adds horizontal lines "linear-policy ceiling (label)" across
+    the plot; without it the figure is exactly the one without ceiling."""
     def mv(stats):
         m = [np.nan if s is None or s.get("mean") is None else 100 * s["mean"] for s in stats]
         e = [0.0 if s is None or s.get("sd") is None else 100 * s["sd"] for s in stats]
@@ -251,7 +260,7 @@ def plot_fig3a(path: str | Path, labels: Sequence[str], all_stats: Sequence[Mapp
     m_all, e_all = mv(all_stats)
     m_in, e_in = mv(interior_stats)
     with plt.rc_context(STYLE):
-        fig, ax = plt.subplots(figsize=(5.0, 3.4))
+        fig, ax = plt.subplots(figsize=(5.0, 4.0) if ceiling else (5.0, 3.4))
         pos = np.arange(len(labels))
         width = 0.36
         ax.bar(pos - width / 2, np.nan_to_num(m_all), width, yerr=e_all, capsize=3, color="tab:blue",
@@ -267,12 +276,21 @@ def plot_fig3a(path: str | Path, labels: Sequence[str], all_stats: Sequence[Mapp
             ax.annotate(f"paper ~{percent(value, 0)}", (p, 100 * value), textcoords="offset points",
                         xytext=(0, 3), ha="center", fontsize=7)
             first = False
+        for name, rate in (ceiling or {}).items():
+            style = dict(linewidth=1.0, **CEILING_STYLES.get(name, dict(colors="grey", linestyles="-.")))
+            ax.hlines(100 * rate, -0.5, len(labels) - 0.5, label=f"linear-policy ceiling ({name}) {percent(rate)}",
+                      **style)
+        if ceiling:
+            ax.set_xlim(-0.5, len(labels) - 0.5)
         ax.set_xticks(pos)
         ax.set_xticklabels(labels)
         ax.set_ylim(0, 105)
         ax.set_ylabel("success rate (%)")
         ax.set_title("(a) success rate, mean ± sd over seeds")
-        ax.legend(loc="upper left", frameon=False, fontsize=7)
+        if ceiling:  # below the axes: the reference lines run across the whole plot
+            ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2, frameon=False, fontsize=7)
+        else:
+            ax.legend(loc="upper left", frameon=False, fontsize=7)
         fig.tight_layout()
         return save_figure(fig, path)
 

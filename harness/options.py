@@ -38,3 +38,20 @@ RL_COV_NAMES = ("ico", "identity")  # RL-alone prior covariance: that of ICO->RL
 
 # sweep: trial cap of every setting unless --max-trials says otherwise.
 SWEEP_MAX_TRIALS = 2000
+
+# ceiling (spec L5): fixed-w evaluation of the policy class F = G * w^T x~ + U and the search for
+# the best single w. Protocols: one trial per cell ("first"), or fresh initial velocities every
+# trial up to a trial cap ("retries"); "both" runs the two.
+CEILING_PROTOCOLS = ("first", "retries")
+CEILING_PROTOCOL_CHOICES = CEILING_PROTOCOLS + ("both",)
+CEILING_MAX_TRIALS = 1000        # trial cap of the retries protocol
+CEILING_CANDIDATES = 1000        # distinct w screened by the search (starting points included)
+CEILING_SCREEN_STEPS = 1000      # horizon of the screening runs (first protocol)
+CEILING_CONFIRM = 5              # best screened w confirmed at the full horizon
+CEILING_MAX_CANDIDATES = 100_000
+# A typical ICO weight vector (w_x, w_xdot, w_theta, w_thetadot): the start of the search when no
+# ICO results directory is given (--prior-from).
+TYPICAL_ICO_WEIGHTS = (0.094, 0.066, 0.365, 0.080)
+# Where the bench looks for a ceiling to draw into Fig. 3a: OUT/<CEILING_DIR>/<CEILING_FILE>.
+CEILING_DIR = "ceiling"
+CEILING_FILE = "ceiling.json"
