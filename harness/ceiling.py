@@ -838,16 +838,7 @@ def load_ceiling(path: str | Path, what: str = "--ceiling") -> dict[str, Any]:
     path = Path(path)
     file = path / CEILING_FILE if path.is_dir() else path
     where = repr(str(file))
-    try:
-        if file.stat().st_size > results.MAX_JSON_BYTES:
-            raise ResultsError(f"{what}: {where} is too large for a ceiling record")
-        data = json.loads(file.read_bytes())
-    except ResultsError:
-        raise
-    except OSError as exc:
-        raise ResultsError(f"{what}: cannot read {where}: {exc.strerror or exc}") from None
-    except (ValueError, RecursionError) as exc:
-        raise ResultsError(f"{what}: {where} is not valid JSON ({str(exc):.80})") from None
+    data = results.read_json(file, f"{what}: ")
     try:
         if data["format_version"] != FORMAT_VERSION or data["command"] != "ceiling":
             raise ValueError("not a ceiling record")

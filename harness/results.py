@@ -256,21 +256,26 @@ def check_record(record: Any, where: str = RUN_FILE) -> dict[str, Any]:
     return record
 
 
-def read_record(file: str | Path) -> dict[str, Any]:
-    """A run.json, parsed and checked (check_record)."""
+def read_json(file: str | Path, lead: str = "") -> Any:
+    """A JSON file of the harness (at most MAX_JSON_BYTES), parsed; ResultsError, prefixed with
+    ``lead``, if it cannot be read or parsed."""
     file = Path(file)
     where = repr(str(file))
     try:
         if file.stat().st_size > MAX_JSON_BYTES:
-            raise _err(f"{where} is larger than {MAX_JSON_BYTES} bytes; not a run record")
-        record = json.loads(file.read_bytes())
+            raise _err(f"{lead}{where} is larger than {MAX_JSON_BYTES} bytes")
+        return json.loads(file.read_bytes())
     except ResultsError:
         raise
     except OSError as exc:
-        raise _err(f"cannot read {where}: {exc.strerror or exc}") from None
+        raise _err(f"{lead}cannot read {where}: {exc.strerror or exc}") from None
     except (ValueError, RecursionError) as exc:  # JSONDecodeError, UnicodeDecodeError, nesting
-        raise _err(f"{where} is not valid JSON ({str(exc):.100})") from None
-    return check_record(record, where)
+        raise _err(f"{lead}{where} is not valid JSON ({str(exc):.100})") from None
+
+
+def read_record(file: str | Path) -> dict[str, Any]:
+    """A run.json, parsed and checked (check_record)."""
+    return check_record(read_json(file), repr(str(file)))
 
 
 def check_results_dir(path: str | Path, what: str | None = None) -> Path:

@@ -66,8 +66,8 @@ void icoac_priv_actor_sample(icoac_priv_state_t *st)
  * A Sigma = Sigma - k (Sigma h)^T and (A Sigma) A^T = A Sigma - (A Sigma h) k^T; the upper
  * triangle is mirrored, so Sigma stays exactly symmetric. */
 void icoac_priv_actor_update(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
-                        const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
-                        icoac_real_t cov[N][N])
+                             const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
+                             icoac_real_t cov[N][N])
 {
     const icoac_real_t noise_var = actor->noise_std * actor->noise_std;
     const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);

@@ -72,7 +72,7 @@ static inline void dimension_factors(icoac_real_t value, icoac_real_t range, int
 }
 
 void icoac_priv_critic_factors(const icoac_critic_config_t *critic, const icoac_real_t s[ICOAC_N_INPUTS],
-                          icoac_real_t factors[ICOAC_CRITIC_FACTORS])
+                               icoac_real_t factors[ICOAC_CRITIC_FACTORS])
 {
     dimension_factors(s[ICOAC_IDX_X], critic->range[ICOAC_IDX_X], ICOAC_CRITIC_N_X, factors);
     factors += ICOAC_CRITIC_N_X;
@@ -146,8 +146,8 @@ static int sorted_cells(const icoac_real_t *gth, const icoac_real_t *gthd, icoac
 }
 
 icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic, const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                                const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
-                                icoac_priv_critic_active_t *active)
+                                     const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+                                     icoac_priv_critic_active_t *active)
 {
     const icoac_real_t threshold = kept_floor(critic);
     const icoac_real_t *gx = factors;

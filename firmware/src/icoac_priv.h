@@ -136,7 +136,7 @@ static inline void icoac_priv_copy4(icoac_real_t dst[ICOAC_N_INPUTS], const icoa
 
 /* Fixed pairwise order: the same result on every target. */
 static inline icoac_real_t icoac_priv_dot4(const icoac_real_t a[ICOAC_N_INPUTS],
-                                      const icoac_real_t b[ICOAC_N_INPUTS])
+                                           const icoac_real_t b[ICOAC_N_INPUTS])
 {
     return (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
 }

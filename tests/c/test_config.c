@@ -394,6 +394,7 @@ typedef struct {
 #define INT_FIELD(member, group, status) {#member, offsetof(icoac_config_t, member), 1, group, status}
 
 static const config_field_t config_fields[] = {
+    INT_FIELD(learn, G_POLICY, ICOAC_ERR_BAD_MODE), /* checked in both modes, like the policy */
     REAL_FIELD(policy.input_range[0], G_POLICY, ICOAC_ERR_BAD_SCALE),
     REAL_FIELD(policy.input_range[1], G_POLICY, ICOAC_ERR_BAD_SCALE),
     REAL_FIELD(policy.input_range[2], G_POLICY, ICOAC_ERR_BAD_SCALE),
