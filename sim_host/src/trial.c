@@ -52,15 +52,17 @@ static void store_posterior(const icoac_state_t *ctrl, icoac_sim_cell_t *cell)
     }
 }
 
-/* One trial; returns steps run (success_steps on success) or -1 on a controller error. */
+/* One trial; returns the steps run, or -1 on a controller error. *balanced is 1 when the trial
+ * lasted success_steps steps without failing (a failure at the last step is a failure). */
 static int64_t run_trial(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
                          const icoac_sim_run_t *run, icoac_state_t *ctrl, const icoac_sim_cell_t *cell,
-                         icoac_rng_t *rng, int32_t *status)
+                         icoac_rng_t *rng, int32_t *status, int *balanced)
 {
     double s[4];
     icoac_input_t in;
     icoac_output_t out;
     int64_t steps = 0;
+    *balanced = 0;
     sim_start_trial(cell, run->init_velocity_noise, rng, s);
     *status = (int32_t)icoac_reset(cfg, ctrl);
     while (*status == ICOAC_SIM_OK && steps < run->success_steps) {
@@ -82,7 +84,11 @@ static int64_t run_trial(const icoac_config_t *cfg, const icoac_sim_plant_t *pla
             return steps;
         }
     }
-    return *status == ICOAC_SIM_OK ? steps : -1;
+    if (*status != ICOAC_SIM_OK) {
+        return -1;
+    }
+    *balanced = 1;
+    return steps;
 }
 
 static int cancelled(const volatile int32_t *cancel)
@@ -108,6 +114,7 @@ int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t 
     int64_t trials = 0;
     int64_t total = 0;
     int64_t steps = 0;
+    int balanced = 0;
 
     status = (int32_t)icoac_init(cfg, &ctrl, prior, icoac_mix_seed(cell->seed, 1u));
     if (status != ICOAC_SIM_OK) {
@@ -118,7 +125,7 @@ int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t 
         if (cancelled(cancel)) {
             return ICOAC_SIM_CANCELLED;
         }
-        steps = run_trial(cfg, plant, run, &ctrl, cell, &rng, &status);
+        steps = run_trial(cfg, plant, run, &ctrl, cell, &rng, &status, &balanced);
         if (steps < 0) {
             break;
         }
@@ -126,7 +133,7 @@ int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t 
         total += steps;
         add_progress(progress, ICOAC_SIM_PROGRESS_TRIALS, 1);
         add_progress(progress, ICOAC_SIM_PROGRESS_STEPS, steps);
-        if (steps >= run->success_steps) {
+        if (balanced) {
             break;
         }
     }
@@ -138,8 +145,7 @@ int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t 
     cell->status = status;
     /* Outcome last, with release order: a reader that sees it non-PENDING sees the rest. */
     __atomic_store_n(&cell->outcome,
-                     steps < 0 ? ICOAC_SIM_ERROR
-                               : (steps >= run->success_steps ? ICOAC_SIM_SUCCESS : ICOAC_SIM_FAILED),
+                     steps < 0 ? ICOAC_SIM_ERROR : (balanced ? ICOAC_SIM_SUCCESS : ICOAC_SIM_FAILED),
                      __ATOMIC_RELEASE);
     add_progress(progress, ICOAC_SIM_PROGRESS_CELLS, 1);
     return ICOAC_SIM_OK;

@@ -43,7 +43,7 @@ static void check_accounting(const icoac_sim_cell_t *c, const icoac_sim_run_t *r
         assert_int_equal(c->last_trial_steps, run->success_steps);
     } else {
         assert_int_equal(c->trials, run->max_trials);
-        assert_true(c->last_trial_steps < run->success_steps);
+        assert_true(c->last_trial_steps <= run->success_steps); /* = when it fell at the last step */
     }
 }
 
@@ -125,6 +125,38 @@ static void test_numeric_fault_marks_cell_error(void **unused)
             }
         }
     }
+}
+
+/* Success is success_steps steps without a failure: a trial that fails at its last step has
+ * failed (it used to count as a success). A fixed controller (w = 0, no learning) and no
+ * initial-velocity noise make every trial the same, falling at step n. */
+static void test_failure_at_the_last_step(void **unused)
+{
+    const icoac_sim_plant_t plant = default_plant();
+    icoac_config_t cfg = test_default_config();
+    icoac_sim_run_t run = small_run(1, 100000);
+    icoac_sim_cell_t c = make_cell(0.0, DEG(11.9), 1u);
+    int64_t n;
+    (void)unused;
+    cfg.learn = 0;
+    run.init_velocity_noise = 0.0;
+    assert_int_equal(icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL), ICOAC_SIM_OK);
+    assert_int_equal(c.outcome, ICOAC_SIM_FAILED);
+    n = c.last_trial_steps;
+    assert_true(n > 1 && n < 1000);
+    run = small_run(2, n);
+    c = make_cell(0.0, DEG(11.9), 1u);
+    assert_int_equal(icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL), ICOAC_SIM_OK);
+    assert_int_equal(c.outcome, ICOAC_SIM_FAILED);
+    assert_int_equal(c.trials, 2);
+    assert_int_equal(c.last_trial_steps, n);
+    check_accounting(&c, &run);
+    run = small_run(2, n - 1);
+    c = make_cell(0.0, DEG(11.9), 1u);
+    assert_int_equal(icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL), ICOAC_SIM_OK);
+    assert_int_equal(c.outcome, ICOAC_SIM_SUCCESS);
+    assert_int_equal(c.trials, 1);
+    check_accounting(&c, &run);
 }
 
 static void run_grid_ok(const icoac_config_t *cfg, icoac_sim_cell_t *cells, int64_t n, int32_t threads,
@@ -382,6 +414,7 @@ int main(void)
         cmocka_unit_test(test_cancel_and_resume),
         cmocka_unit_test(test_bad_parameters),
         cmocka_unit_test(test_numeric_fault_marks_cell_error),
+        cmocka_unit_test(test_failure_at_the_last_step),
         cmocka_unit_test(test_trajectory_recorder),
         cmocka_unit_test(test_trajectory_falls),
         cmocka_unit_test(test_fpu_mode_restored),
