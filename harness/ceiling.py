@@ -50,8 +50,7 @@ draws are recomputed through the C API (``icoac_sim_trajectory`` with one step g
 state of the cell's first trial), stepped once by ``icoac_sim_plant_step`` under several forces
 from -1e4 N to 1e4 N and tested with ``icoac_sim_failed``; the cells failing under every force
 are lost, and failure must not depend on the force (checked). The same set is checked against
-the engine itself: one trial of 2 steps per cell (2, not 1: the engine counts a trial that fails
-on its success_steps-th step as a success). The bound - cells minus lost cells - is an upper
+the engine itself: one trial of 1 step per cell. The bound - cells minus lost cells - is an upper
 bound on the successes of ANY controller under the first-trial protocol with this seed's draws;
 with retries a boundary cell may still succeed on a later, inward draw. It is defined for the
 Euler integrator only (with RK4 the force enters x1 and theta1) and reported as not computed
@@ -491,11 +490,10 @@ def first_step_bound(cfg: RunConfig, cells: np.ndarray, threads: int = 0) -> dic
     if not np.array_equal(lost, failed.any(axis=0)):
         raise LibraryError("failure at the first Euler step depends on the force; the first-step bound's "
                            "premise does not hold for this plant")
-    # The engine itself: one trial of 2 steps (a trial failing on its success_steps-th step counts as
-    # a success in the engine, hence 2); lost cells fail with a first trial of 1 step.
+    # The engine itself: one trial of 1 step per cell; the lost cells are exactly its failures.
     probe = RunConfig(controller=B.Config.from_buffer_copy(cfg.controller), plant=B.Plant.from_buffer_copy(cfg.plant),
                       run=B.Run.from_buffer_copy(cfg.run), prior=cfg.prior)
-    probe.run.max_trials, probe.run.success_steps = 1, 2
+    probe.run.max_trials, probe.run.success_steps = 1, 1
     eng = cells.copy()
     run = grid.run_grid(probe, eng, threads=threads, progress=False)
     if run.cancelled:

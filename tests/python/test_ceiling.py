@@ -151,9 +151,9 @@ def test_first_step_bound_is_the_outward_boundary_draws():
     assert bound["n_lost"] == int(outward.sum()) > 40 and bound["n_lost_interior"] == 0
     assert bound["max_success"] == geometry.CELLS - bound["n_lost"]
     assert bound["max_success_interior"] == geometry.N_INTERIOR
-    # the engine agrees: one first trial of 2 steps (any controller) fails exactly there
+    # the engine agrees: one first trial of 1 step (any controller) fails exactly there
     probe = grid.make_cells(2)
-    grid.run_grid(ceiling.fixed_config(ceiling.TYPICAL_ICO_WEIGHTS, success_steps=2), probe, progress=False)
+    grid.run_grid(ceiling.fixed_config(ceiling.TYPICAL_ICO_WEIGHTS, success_steps=1), probe, progress=False)
     assert np.array_equal(probe["outcome"] == B.FAILED, outward)
     # ... and so does every controller's first trial at the full horizon: no lost cell succeeds
     first = ceiling.evaluate(W, "first", seed=2, success_steps=300, threads=2)
