@@ -262,7 +262,9 @@ static void check_finished_cell(const setup_t *su, const icoac_sim_cell_t *cell,
                  "%s: SUCCESS after %lld trials, last %lld steps", what, (long long)cell->trials,
                  (long long)cell->last_trial_steps);
     } else {
-        FZ_CHECK(cell->trials == su->run.max_trials && cell->last_trial_steps < su->run.success_steps,
+        /* a trial that fails at its last step is a failure: last_trial_steps may equal the cap */
+        FZ_CHECK(cell->trials == su->run.max_trials && cell->last_trial_steps >= 1 &&
+                     cell->last_trial_steps <= su->run.success_steps,
                  "%s: FAILED after %lld trials, last %lld steps", what, (long long)cell->trials,
                  (long long)cell->last_trial_steps);
     }
