@@ -26,7 +26,7 @@ LIBRARY_ENV = "ICOAC_SIM_LIBRARY"
 DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.so"
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
-ABI_VERSION = 5
+ABI_VERSION = 6
 SIM_ABI_VERSION = 2
 
 
@@ -156,11 +156,14 @@ STATE_SIZE = int(constant("ICOAC_STATE_SIZE"))
 INPUT_TERMINAL = int(constant("ICOAC_INPUT_TERMINAL"))
 
 # Switches: {symbolic name: value}.
-MODES = enum("ICOAC_MODE_")                       # ico, rl
+MODES = enum("ICOAC_MODE_")                       # ico, rl, search
 REFLEX_MODES = enum("ICOAC_REFLEX_")              # unit, gain
 ICO_TIMINGS = enum("ICOAC_ICO_TIMING_")           # code, literal
+ACTOR_UPDATES = enum("ICOAC_ACTOR_", ("POSTERIOR", "MEAN", "GRADIENT"))  # posterior, mean, gradient
 INTEGRATORS = enum("ICOAC_SIM_", ("EULER", "RK4"))  # euler, rk4
-MODE_ICO, MODE_RL = MODES["ico"], MODES["rl"]
+MODE_ICO, MODE_RL, MODE_SEARCH = MODES["ico"], MODES["rl"], MODES["search"]
+SEARCH_BATCH_MAX = int(constant("ICOAC_SEARCH_BATCH_MAX"))
+EXPLORE_TICKS_MAX = int(constant("ICOAC_EXPLORE_TICKS_MAX"))
 
 # Statuses (icoac_status_t, then icoac_sim_status_t).
 OK = int(constant("ICOAC_OK"))
@@ -176,6 +179,7 @@ ERR_BAD_ICO_RATE = int(constant("ICOAC_ERR_BAD_ICO_RATE"))
 ERR_BAD_CRITIC = int(constant("ICOAC_ERR_BAD_CRITIC"))
 ERR_BAD_ACTOR = int(constant("ICOAC_ERR_BAD_ACTOR"))
 ERR_BAD_PRIOR = int(constant("ICOAC_ERR_BAD_PRIOR"))
+ERR_BAD_SEARCH = int(constant("ICOAC_ERR_BAD_SEARCH"))
 SIM_OK = int(constant("ICOAC_SIM_OK"))
 SIM_ERR_BAD_PLANT = int(constant("ICOAC_SIM_ERR_BAD_PLANT"))
 SIM_ERR_BAD_RUN = int(constant("ICOAC_SIM_ERR_BAD_RUN"))
@@ -249,17 +253,34 @@ class CriticConfig(ctypes.Structure):
         ("td_clip", c_real),
         ("range", _R4),
         ("threshold", c_real),
+        ("quirks", ctypes.c_int32),
     ]
 
 
 class ActorConfig(ctypes.Structure):
-    """icoac_actor_config_t: the Bayesian actor and its exploration (RL mode)."""
+    """icoac_actor_config_t: the actor, its reading and its exploration (RL mode)."""
     _fields_ = [
         ("noise_std", c_real),
         ("scale", c_real),
         ("forgetting", c_real),
         ("reflex", ctypes.c_int32),
         ("act_with_sample", ctypes.c_int32),
+        ("update", ctypes.c_int32),
+        ("rate", c_real),
+        ("likelihood_std", c_real),
+        ("batch", ctypes.c_int32),
+        ("explore_ticks", ctypes.c_int32),
+    ]
+
+
+class SearchConfig(ctypes.Structure):
+    """icoac_search_config_t: the episodic search (search mode)."""
+    _fields_ = [
+        ("batch", ctypes.c_int32),
+        ("elite_fraction", c_real),
+        ("step", c_real),
+        ("floor", c_real),
+        ("cov_scale", c_real),
     ]
 
 
@@ -272,6 +293,7 @@ class Config(ctypes.Structure):
         ("ico", IcoConfig),
         ("critic", CriticConfig),
         ("actor", ActorConfig),
+        ("search", SearchConfig),
     ]
 
 

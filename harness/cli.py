@@ -205,7 +205,7 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2,...",
                    help="values of one parameter (repeatable; names as for --set); prior_frame=central,all "
                         "and prior_ridge allowed")
-    w.add_argument("--condition", choices=O.RL_CONDITIONS, default=O.RL_CONDITIONS[0])
+    w.add_argument("--condition", choices=O.RL_CONDITIONS + O.SEARCH_CONDITIONS, default=O.RL_CONDITIONS[0])
     sel = w.add_mutually_exclusive_group()
     sel.add_argument("--cells", default=None, help="cell indices, e.g. 0,5,600-610")
     sel.add_argument("--subset", type=_subset, default=None, help="N evenly spread cells, at most the grid's cell count")

@@ -26,18 +26,20 @@ def check_condition(condition: Any) -> str:
 
 
 def condition_prior(condition: str, prior_from, frame, ridge: float, rl_cov: str = "ico") -> P.PriorInfo | None:
-    """PriorInfo of a condition (None for ico): ico-rl from an ICO results dir, rl with mean 0 (A16);
-    a no-learning control has the prior of its condition."""
+    """PriorInfo of a condition (None for ico): ico-rl and ico-search from an ICO results dir, rl
+    with mean 0 (A16), search N(0, I) (L4); a no-learning control has the prior of its condition."""
     condition = CONTROL_OF.get(check_condition(condition), condition)
     if condition == "ico":
         if prior_from is not None:
             raise UsageError("--prior-from applies to the conditions rl and ico-rl")
         return None
     base = P.from_results(prior_from, frame, ridge) if prior_from is not None else None
-    if condition == "ico-rl":
+    if condition in ("ico-rl", "ico-search"):
         if base is None:
-            raise UsageError("condition ico-rl needs --prior-from ICO_RESULTS_DIR")
+            raise UsageError(f"condition {condition} needs --prior-from ICO_RESULTS_DIR")
         return base
+    if condition == "search":
+        return P.rl_prior(base, "identity")
     return P.rl_prior(base, rl_cov)
 
 

@@ -65,9 +65,10 @@ ENUMS: dict[str, dict[str, int]] = {
     "mode": B.MODES,
     "policy.reflex_mode": B.REFLEX_MODES,
     "ico.timing": B.ICO_TIMINGS,
+    "actor.update": B.ACTOR_UPDATES,
     "integrator": B.INTEGRATORS,
 }
-BOOLS = ("learn", "policy.clip_inputs", "actor.reflex", "actor.act_with_sample")
+BOOLS = ("learn", "policy.clip_inputs", "critic.quirks", "actor.reflex", "actor.act_with_sample", "actor.batch")
 _BOOL_NAMES = {"true": 1, "false": 0, "on": 1, "off": 0, "yes": 1, "no": 0, "1": 1, "0": 0}
 
 # Overrides of each learning condition on top of the defaults.
@@ -77,6 +78,8 @@ CONDITION_OVERRIDES: dict[str, dict[str, Any]] = {
     "ico-rl": {"mode": "rl"},   # prior from an ICO grid (spec 7)
     "ico-rl-control": {"mode": "rl", "learn": 0},
     "rl-control": {"mode": "rl", "learn": 0},
+    "ico-search": {"mode": "search"},  # prior from an ICO grid, Sigma0 = search.cov_scale * its covariance
+    "search": {"mode": "search"},      # prior N(0, I) (spec L4)
 }
 assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS)
 

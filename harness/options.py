@@ -4,14 +4,16 @@ defines - enum values, statuses, sizes, grid geometry - comes from the binding i
 from __future__ import annotations
 
 # Learning conditions, in the order of the benchmark and its tables.
-CONDITIONS = ("ico", "ico-rl", "ico-rl-control", "rl", "rl-control")
+CONDITIONS = ("ico", "ico-rl", "ico-rl-control", "rl", "rl-control", "ico-search", "search")
 # The conditions that run the actor-critic from a prior.
 RL_CONDITIONS = ("ico-rl", "ico-rl-control", "rl", "rl-control")
 # No-learning control (spec L1) -> its condition: the same prior, acting weights, noise stream,
 # resets and caps, with every update off (the controller's `learn = 0`).
 CONTROL_OF = {"ico-rl-control": "ico-rl", "rl-control": "rl"}
+# The conditions of the episodic search (spec L4): ico-search from the ICO prior, search from N(0, I).
+SEARCH_CONDITIONS = ("ico-search", "search")
 CONDITION_LABELS = {"ico": "ICO", "ico-rl": "ICO->RL", "ico-rl-control": "ICO->RL control", "rl": "RL",
-                    "rl-control": "RL control"}
+                    "rl-control": "RL control", "ico-search": "ICO->search", "search": "search"}
 
 PROFILE_NAMES = ("default", "paper", "quick")   # bench profiles (harness.bench.PROFILES)
 

@@ -23,7 +23,7 @@ from ._binding import ConfigError
 from .config import build_config, canonical, parse_sets, parse_value
 from .errors import SweepError, UsageError
 from .metrics import percent
-from .options import FRAME_NAMES, RL_COV_NAMES, SWEEP_MAX_TRIALS
+from .options import CONTROL_OF, FRAME_NAMES, RL_COV_NAMES, SWEEP_MAX_TRIALS
 
 PRIOR_PARAMS = ("prior_frame", "prior_ridge")
 DEFAULT_CELLS = list(range(0, geometry.CELLS, 25))  # 49 cells spread over the grid
@@ -238,7 +238,10 @@ def run_sweep(opt: SweepOptions) -> int:
         if k not in priors:
             priors[k] = P.from_results(ico_dir, frame, ridge)
         info = priors[k]
-        return info if opt.condition == "ico-rl" else P.rl_prior(info, opt.rl_cov)
+        condition = CONTROL_OF.get(opt.condition, opt.condition)
+        if condition in ("ico-rl", "ico-search"):
+            return info
+        return P.rl_prior(info, "identity" if condition == "search" else opt.rl_cov)
 
     def config_for(setting):
         over = dict(fixed)

@@ -1,75 +1,34 @@
-/* Bayesian actor (spec 7): rank-1 Gaussian posterior step on (mu_w, Sigma_w),
- * covariance in Joseph form so it stays symmetric positive definite. */
+/* Actor (spec 7, L2): the posterior, mean and gradient readings of one observation, per tick
+ * or summed over a trial (batch, A14), and the per-trial sample of w. */
 #include "icoac_priv.h"
 
 #define N ICOAC_N_INPUTS
 
-icoac_real_t icoac_priv_trace4(const icoac_real_t m[N][N])
-{
-    return (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
-}
-
-/* m = L L^T; returns 0 when m is not positive definite. */
-int icoac_priv_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
-{
-    int i;
-    int j;
-    int k;
-    for (i = 0; i < N; ++i) {
-        for (j = 0; j < N; ++j) {
-            lower[i][j] = ICOAC_R(0.0);
-        }
-    }
-    for (j = 0; j < N; ++j) {
-        icoac_real_t diag = m[j][j];
-        for (k = 0; k < j; ++k) {
-            diag -= lower[j][k] * lower[j][k];
-        }
-        if (!(diag > ICOAC_R(0.0))) {
-            return 0;
-        }
-        lower[j][j] = ICOAC_PRIV_SQRT(diag);
-        for (i = j + 1; i < N; ++i) {
-            icoac_real_t sum = m[i][j];
-            for (k = 0; k < j; ++k) {
-                sum -= lower[i][k] * lower[j][k];
-            }
-            lower[i][j] = sum / lower[j][j];
-        }
-    }
-    return 1;
-}
-
 void icoac_priv_actor_sample(icoac_priv_state_t *st)
 {
     icoac_real_t lower[N][N];
-    icoac_real_t normal[N];
-    int i;
-    int j;
-    for (i = 0; i < N; ++i) {
-        normal[i] = icoac_rng_normal(&st->rng);
-    }
+    icoac_real_t sample[N];
     if (!icoac_priv_cholesky4(icoac_priv_cov_c(st), lower)) {
+        /* the draw is made anyway, so the stream does not depend on the factor */
+        (void)icoac_rng_normal(&st->rng);
+        (void)icoac_rng_normal(&st->rng);
+        (void)icoac_rng_normal(&st->rng);
+        (void)icoac_rng_normal(&st->rng);
         icoac_priv_copy4(st->w_act, st->w);
         return;
     }
-    for (i = 0; i < N; ++i) {
-        icoac_real_t sum = st->w[i];
-        for (j = 0; j <= i; ++j) {
-            sum += lower[i][j] * normal[j];
-        }
-        st->w_act[i] = sum;
-    }
+    icoac_priv_sample_lower(&st->rng, st->w, ICOAC_PRIV_CONST_MAT4(lower), sample);
+    icoac_priv_copy4(st->w_act, sample);
 }
 
-/* Sigma' = A Sigma A^T + sigma_u^2 k k^T with A = I - k h^T (Joseph form), evaluated as
- * A Sigma = Sigma - k (Sigma h)^T and (A Sigma) A^T = A Sigma - (A Sigma h) k^T; the upper
- * triangle is mirrored, so Sigma stays exactly symmetric. */
-void icoac_priv_actor_update(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
-                             const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
-                             icoac_real_t cov[N][N])
+/* Posterior reading: Sigma' = A Sigma A^T + sigma_L^2 k k^T with A = I - k h^T (Joseph form),
+ * evaluated as A Sigma = Sigma - k (Sigma h)^T and (A Sigma) A^T = A Sigma - (A Sigma h) k^T;
+ * the upper triangle is mirrored, so Sigma stays exactly symmetric. */
+void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
+                                icoac_real_t cov[N][N])
 {
-    const icoac_real_t noise_var = actor->noise_std * actor->noise_std;
+    const icoac_real_t noise_var = actor->likelihood_std * actor->likelihood_std;
     const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
     icoac_real_t cov_h[N];
     icoac_real_t gain[N];
@@ -112,4 +71,168 @@ void icoac_priv_actor_update(const icoac_actor_config_t *actor, const icoac_priv
             cov[j][i] = value;
         }
     }
+}
+
+/* Mean reading: mu += Sigma0 h innovation / (h^T Sigma0 h + sigma_L^2), Sigma_w unchanged. */
+static void mean_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st, const icoac_real_t h[N],
+                      icoac_real_t innovation, icoac_real_t w[N])
+{
+    const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
+    icoac_real_t cov_h[N];
+    icoac_real_t step;
+    int i;
+    for (i = 0; i < N; ++i) {
+        cov_h[i] = icoac_priv_dot4(prior[i], h);
+    }
+    step = innovation / (icoac_priv_dot4(h, cov_h) + actor->likelihood_std * actor->likelihood_std);
+    for (i = 0; i < N; ++i) {
+        w[i] = st->w[i] + cov_h[i] * step;
+    }
+}
+
+/* sum += h h^T / sigma_L^2 */
+static void add_info(const icoac_actor_config_t *actor, const icoac_real_t h[N], icoac_real_t sum[N][N])
+{
+    const icoac_real_t inv_var = ICOAC_R(1.0) / (actor->likelihood_std * actor->likelihood_std);
+    int i;
+    int j;
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            sum[i][j] += h[i] * h[j] * inv_var;
+        }
+    }
+}
+
+/* The batch's closed form at a trial's end: with precision P = Sigma^-1 + sum h h^T / sigma_L^2,
+ * mu' = mu + P^-1 sum h innovation / sigma_L^2, Sigma' = P^-1 (posterior; the mean reading keeps
+ * Sigma); the gradient reading moves mu by beta / sigma_u^2 * sum delta eps h. The sums are the
+ * state's plus this tick's observation (h_last, or NULL) and shift, staged by the caller. */
+ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                          const icoac_real_t *h_last, const icoac_real_t shift[N],
+                                          icoac_real_t w[N], icoac_real_t cov[N][N])
+{
+    icoac_real_t precision[N][N];
+    int i;
+    int j;
+    if (actor->update == ICOAC_ACTOR_GRADIENT) {
+        const icoac_real_t step = actor->rate / (actor->noise_std * actor->noise_std);
+        for (i = 0; i < N; ++i) {
+            w[i] = st->w[i] + step * shift[i];
+        }
+        return 0;
+    }
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            cov[i][j] = icoac_priv_cov_c(st)[i][j];
+        }
+    }
+    if (actor->update == ICOAC_ACTOR_POSTERIOR && actor->forgetting < ICOAC_R(1.0)) {
+        const icoac_real_t inflate = ICOAC_R(1.0) / actor->forgetting;
+        for (i = 0; i < N; ++i) {
+            for (j = 0; j < N; ++j) {
+                cov[i][j] *= inflate;
+            }
+        }
+    }
+    if (!icoac_priv_spd_inverse4(ICOAC_PRIV_CONST_MAT4(cov), precision)) {
+        return -1;
+    }
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            precision[i][j] += st->batch.info[i][j];
+        }
+    }
+    if (h_last != 0) {
+        add_info(actor, h_last, precision);
+    }
+    if (!icoac_priv_spd_inverse4(ICOAC_PRIV_CONST_MAT4(precision), cov)) {
+        return -1;
+    }
+    for (i = 0; i < N; ++i) {
+        w[i] = st->w[i] + icoac_priv_dot4(cov[i], shift);
+    }
+    return actor->update == ICOAC_ACTOR_POSTERIOR;
+}
+
+/* The batch's shift after one more observation, and a value that is finite only when the
+ * sums stay finite (the new trace of the information plus |shift|^2 bound every entry). */
+ICOAC_PRIV_NOINLINE static icoac_real_t batch_shift(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                const icoac_real_t h[N], icoac_real_t observation, icoac_real_t shift[N])
+{
+    icoac_real_t trace = ICOAC_R(0.0);
+    icoac_real_t scale = ICOAC_R(1.0);
+    int i;
+    if (actor->update != ICOAC_ACTOR_GRADIENT) {
+        scale = ICOAC_R(1.0) / (actor->likelihood_std * actor->likelihood_std);
+        trace = icoac_priv_trace4(st->batch.info) + icoac_priv_dot4(h, h) * scale;
+    }
+    for (i = 0; i < N; ++i) {
+        shift[i] = st->batch.shift[i] + h[i] * (observation * scale);
+    }
+    return trace + icoac_priv_dot4(shift, shift);
+}
+
+int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t *st, const icoac_real_t h[N],
+                          icoac_real_t delta, int observed, int trial_end, icoac_real_t w[N],
+                          icoac_real_t cov[N][N])
+{
+    /* u_ob - h^T mu_w, with u_ob = h^T w_act + alpha * delta * eps (Eq. 7-8) */
+    const icoac_real_t innovation = icoac_priv_dot4(h, st->w_act) - icoac_priv_dot4(h, st->w) +
+                                    actor->scale * delta * st->noise_prev;
+    if (actor->batch) {
+        icoac_real_t *shift = st->batch.staged_shift;
+        icoac_priv_copy4(shift, st->batch.shift);
+        if (observed) {
+            const icoac_real_t observation =
+                actor->update == ICOAC_ACTOR_GRADIENT ? delta * st->noise_prev : innovation;
+            if (!icoac_priv_finite(batch_shift(actor, st, h, observation, shift))) {
+                return -1;
+            }
+        }
+        if (!trial_end) {
+            icoac_priv_copy4(w, st->w);
+            return 0;
+        }
+        return batch_end(actor, st, observed ? h : 0, shift, w, cov);
+    }
+    if (!observed) {
+        icoac_priv_copy4(w, st->w);
+        return 0;
+    }
+    switch (actor->update) {
+    case ICOAC_ACTOR_MEAN:
+        mean_step(actor, st, h, innovation, w);
+        return 0;
+    case ICOAC_ACTOR_GRADIENT: {
+        const icoac_real_t step = actor->rate * delta * st->noise_prev / (actor->noise_std * actor->noise_std);
+        int i;
+        for (i = 0; i < N; ++i) {
+            w[i] = st->w[i] + step * h[i];
+        }
+        return 0;
+    }
+    default:
+        icoac_priv_actor_posterior(actor, st, h, innovation, w, cov);
+        return 1;
+    }
+}
+
+void icoac_priv_actor_commit_batch(const icoac_actor_config_t *actor, icoac_priv_state_t *st,
+                                   const icoac_real_t h[N], int observed, int trial_end)
+{
+    int i;
+    int j;
+    if (trial_end) {
+        for (i = 0; i < N; ++i) {
+            for (j = 0; j < N; ++j) {
+                st->batch.info[i][j] = ICOAC_R(0.0);
+            }
+            st->batch.shift[i] = ICOAC_R(0.0);
+        }
+        return;
+    }
+    if (observed && actor->update != ICOAC_ACTOR_GRADIENT) {
+        add_info(actor, h, st->batch.info);
+    }
+    icoac_priv_copy4(st->batch.shift, st->batch.staged_shift);
 }

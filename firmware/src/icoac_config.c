@@ -9,13 +9,14 @@ const char *icoac_status_str(icoac_status_t status)
     case ICOAC_ERR_NOT_INITIALISED: return "state not initialised (call icoac_init)";
     case ICOAC_ERR_NONFINITE_INPUT: return "non-finite observation (ignored, no learning)";
     case ICOAC_ERR_NUMERIC: return "numeric failure: a value derived in this tick was not finite (force 0, nothing learned)";
-    case ICOAC_ERR_BAD_MODE: return "invalid switch (mode, policy.reflex_mode, ico.timing or a 0/1 flag)";
+    case ICOAC_ERR_BAD_MODE: return "invalid switch (mode, policy.reflex_mode, ico.timing, actor.update or a 0/1 flag)";
     case ICOAC_ERR_BAD_SCALE: return "invalid policy.input_range (must be in [1e-6, 1e6])";
     case ICOAC_ERR_BAD_GAIN: return "invalid policy.gain or policy.reflex_force (must be in [0, 1e4])";
     case ICOAC_ERR_BAD_ZONE: return "invalid policy.zone_theta or policy.zone_x (must be in [1e-6, pi] rad and [1e-6, 1e6] m)";
     case ICOAC_ERR_BAD_ICO_RATE: return "invalid ico.rate (must be in [0, 1])";
     case ICOAC_ERR_BAD_CRITIC: return "invalid critic parameter (rate [0, 10], discount [0, 1], td_clip [1e-6, 1e3], range [1e-6, 1e6], threshold [0, 1))";
-    case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std [1e-3, 1e3], scale [0, 1e3], forgetting [0.5, 1])";
+    case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std [1e-3, 1e3], scale [0, 1e3], forgetting [0.5, 1], update 0-2, rate [0, 1e3], likelihood_std [1e-3, 1e3], explore_ticks [0, 1e8])";
+    case ICOAC_ERR_BAD_SEARCH: return "invalid search parameter (batch [1, 16], elite_fraction (0, 1], step (0, 1], floor [1e-6, 1e3], cov_scale [1, 1e3])";
     case ICOAC_ERR_BAD_PRIOR: return "invalid prior (|mean| <= 1e6, covariance entries |c| <= 1e12, zero or normal, symmetric positive definite)";
     default: return "unknown status";
     }
@@ -60,6 +61,7 @@ void icoac_critic_config_default(icoac_critic_config_t *critic)
     critic->range[ICOAC_IDX_THETA] = ICOAC_R(0.2094384);
     critic->range[ICOAC_IDX_THETA_DOT] = ICOAC_R(2.0);
     critic->threshold = ICOAC_R(0.001);
+    critic->quirks = 0;
 }
 
 void icoac_actor_config_default(icoac_actor_config_t *actor)
@@ -72,6 +74,23 @@ void icoac_actor_config_default(icoac_actor_config_t *actor)
     actor->forgetting = ICOAC_R(1.0);
     actor->reflex = 1;
     actor->act_with_sample = 0;
+    actor->update = ICOAC_ACTOR_POSTERIOR;
+    actor->rate = ICOAC_R(0.01);
+    actor->likelihood_std = ICOAC_R(1.0);
+    actor->batch = 0;
+    actor->explore_ticks = 0;
+}
+
+void icoac_search_config_default(icoac_search_config_t *search)
+{
+    if (search == 0) {
+        return;
+    }
+    search->batch = 4;
+    search->elite_fraction = ICOAC_R(0.5);
+    search->step = ICOAC_R(0.5);
+    search->floor = ICOAC_R(0.1);
+    search->cov_scale = ICOAC_R(1.0);
 }
 
 void icoac_config_default(icoac_config_t *cfg)
@@ -85,6 +104,7 @@ void icoac_config_default(icoac_config_t *cfg)
     icoac_ico_config_default(&cfg->ico);
     icoac_critic_config_default(&cfg->critic);
     icoac_actor_config_default(&cfg->actor);
+    icoac_search_config_default(&cfg->search);
 }
 
 /* lo <= v <= hi and v not subnormal; false for NaN. */
@@ -176,6 +196,9 @@ static int critic_ok(const icoac_critic_config_t *c, bad_field_t *bad)
     if (!within(c->threshold, ICOAC_R(0.0), ICOAC_R(1.0)) || !(c->threshold < ICOAC_R(1.0))) {
         ICOAC_PRIV_FAIL("critic.threshold", ICOAC_ERR_BAD_CRITIC);
     }
+    if (!is_flag(c->quirks)) {
+        ICOAC_PRIV_FAIL("critic.quirks", ICOAC_ERR_BAD_MODE);
+    }
     return 1;
 }
 
@@ -196,13 +219,48 @@ static int actor_ok(const icoac_actor_config_t *a, bad_field_t *bad)
     if (!is_flag(a->act_with_sample)) {
         ICOAC_PRIV_FAIL("actor.act_with_sample", ICOAC_ERR_BAD_MODE);
     }
+    if (a->update != ICOAC_ACTOR_POSTERIOR && a->update != ICOAC_ACTOR_MEAN && a->update != ICOAC_ACTOR_GRADIENT) {
+        ICOAC_PRIV_FAIL("actor.update", ICOAC_ERR_BAD_MODE);
+    }
+    if (!within(a->rate, ICOAC_R(0.0), ICOAC_ACTOR_RATE_MAX)) {
+        ICOAC_PRIV_FAIL("actor.rate", ICOAC_ERR_BAD_ACTOR);
+    }
+    if (!within(a->likelihood_std, ICOAC_NOISE_STD_MIN, ICOAC_NOISE_STD_MAX)) {
+        ICOAC_PRIV_FAIL("actor.likelihood_std", ICOAC_ERR_BAD_ACTOR);
+    }
+    if (!is_flag(a->batch)) {
+        ICOAC_PRIV_FAIL("actor.batch", ICOAC_ERR_BAD_MODE);
+    }
+    if (a->explore_ticks < 0 || a->explore_ticks > ICOAC_EXPLORE_TICKS_MAX) {
+        ICOAC_PRIV_FAIL("actor.explore_ticks", ICOAC_ERR_BAD_ACTOR);
+    }
+    return 1;
+}
+
+static int search_ok(const icoac_search_config_t *s, bad_field_t *bad)
+{
+    if (s->batch < 1 || s->batch > ICOAC_SEARCH_BATCH_MAX) {
+        ICOAC_PRIV_FAIL("search.batch", ICOAC_ERR_BAD_SEARCH);
+    }
+    if (!within(s->elite_fraction, ICOAC_R(0.0), ICOAC_R(1.0)) || !(s->elite_fraction > ICOAC_R(0.0))) {
+        ICOAC_PRIV_FAIL("search.elite_fraction", ICOAC_ERR_BAD_SEARCH);
+    }
+    if (!within(s->step, ICOAC_R(0.0), ICOAC_R(1.0)) || !(s->step > ICOAC_R(0.0))) {
+        ICOAC_PRIV_FAIL("search.step", ICOAC_ERR_BAD_SEARCH);
+    }
+    if (!within(s->floor, ICOAC_SEARCH_FLOOR_MIN, ICOAC_SEARCH_FLOOR_MAX)) {
+        ICOAC_PRIV_FAIL("search.floor", ICOAC_ERR_BAD_SEARCH);
+    }
+    if (!within(s->cov_scale, ICOAC_R(1.0), ICOAC_SEARCH_COV_SCALE_MAX)) {
+        ICOAC_PRIV_FAIL("search.cov_scale", ICOAC_ERR_BAD_SEARCH);
+    }
     return 1;
 }
 
 /* The mode, then the groups it uses, in struct order. */
 static int config_ok(const icoac_config_t *cfg, bad_field_t *bad)
 {
-    if (cfg->mode != ICOAC_MODE_ICO && cfg->mode != ICOAC_MODE_RL) {
+    if (cfg->mode != ICOAC_MODE_ICO && cfg->mode != ICOAC_MODE_RL && cfg->mode != ICOAC_MODE_SEARCH) {
         ICOAC_PRIV_FAIL("mode", ICOAC_ERR_BAD_MODE);
     }
     if (!is_flag(cfg->learn)) {
@@ -213,6 +271,9 @@ static int config_ok(const icoac_config_t *cfg, bad_field_t *bad)
     }
     if (cfg->mode == ICOAC_MODE_ICO) {
         return ico_ok(&cfg->ico, bad);
+    }
+    if (cfg->mode == ICOAC_MODE_SEARCH) {
+        return search_ok(&cfg->search, bad);
     }
     return critic_ok(&cfg->critic, bad) && actor_ok(&cfg->actor, bad);
 }

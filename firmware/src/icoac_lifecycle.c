@@ -9,6 +9,8 @@ static void clear_trial(icoac_priv_state_t *st)
     memset(st->x_prev, 0, sizeof st->x_prev);
     st->active[0].pairs = 0u;
     st->active[1].pairs = 0u;
+    st->trial_ticks = 0u;
+    memset(&st->batch, 0, sizeof st->batch);
 }
 
 icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const icoac_prior_t *prior,
@@ -39,6 +41,10 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
         st->inv_range[i] = ICOAC_R(1.0) / cfg->policy.input_range[i];
     }
+    if (cfg->mode == ICOAC_MODE_SEARCH && !icoac_priv_search_init(&cfg->search, st)) {
+        memset(state, 0, sizeof *state);
+        return ICOAC_ERR_BAD_PRIOR;
+    }
     st->weight_norm = ICOAC_PRIV_SQRT(icoac_priv_dot4(st->w, st->w));
     icoac_rng_seed(&st->rng, seed, 0x1C0ACu);
     st->magic = ICOAC_PRIV_STATE_MAGIC;
@@ -57,6 +63,8 @@ icoac_status_t icoac_reset(const icoac_config_t *cfg, icoac_state_t *state)
     clear_trial(st);
     if (cfg->mode == ICOAC_MODE_RL && cfg->actor.act_with_sample) {
         icoac_priv_actor_sample(st);
+    } else if (cfg->mode == ICOAC_MODE_SEARCH) {
+        icoac_priv_search_sample(st);
     } else {
         icoac_priv_copy4(st->w_act, st->w);
     }

@@ -22,6 +22,13 @@
 #define ICOAC_PRIV_LIBM_EXP expf
 #endif
 
+/* Kept out of line: a per-trial path whose frame should not add to the per-tick one. */
+#if defined(__GNUC__)
+#define ICOAC_PRIV_NOINLINE __attribute__((__noinline__))
+#else
+#define ICOAC_PRIV_NOINLINE
+#endif
+
 /* C99 will not pass T[4][4] to const T[4][4] implicitly. */
 #define ICOAC_PRIV_CONST_MAT4(m) ((const icoac_real_t(*)[ICOAC_N_INPUTS])(m))
 
@@ -172,17 +179,41 @@ icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic, const 
 void icoac_priv_critic_update(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_active_t *active,
                               icoac_real_t step);
 
-/* Actor (icoac_actor.c). The update reads mu_w, Sigma_w from st and writes the candidate
- * posterior to w, cov (which may be st's own w, cov). */
-void icoac_priv_actor_update(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
-                             const icoac_real_t h[ICOAC_N_INPUTS], icoac_real_t innovation,
-                             icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+/* Actor (icoac_actor.c). The step reads mu_w, Sigma_w and the batch sums from st and stages
+ * the candidate mu_w in w, Sigma_w in cov (the spare buffer) and the batch's shift in its
+ * scratch; h = G x~(t); observed: the transition's tick explored (L3); trial_end: a terminal
+ * tick. Returns 1 when cov holds a new Sigma_w, 0 when Sigma_w stays, -1 when the batch sums
+ * or its closed form failed. icoac_priv_actor_commit_batch follows the tick's checks. */
+int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t *st,
+                          const icoac_real_t h[ICOAC_N_INPUTS], icoac_real_t delta, int observed, int trial_end,
+                          icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+void icoac_priv_actor_commit_batch(const icoac_actor_config_t *actor, icoac_priv_state_t *st,
+                                   const icoac_real_t h[ICOAC_N_INPUTS], int observed, int trial_end);
+/* The posterior reading's step for innovation (in place allowed: w, cov may be st's own). */
+void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                const icoac_real_t h[ICOAC_N_INPUTS], icoac_real_t innovation,
+                                icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
 /* w_act = mu_w + L n (L L^T = Sigma_w), or mu_w when Sigma_w is not positive definite. Always
  * finite: |L_ij| <= sqrt(Sigma_ii) <= sqrt(REAL_MAX) and the polar normals are below 1e8. */
 void icoac_priv_actor_sample(icoac_priv_state_t *st);
+
+/* Episodic search (icoac_search.c): the tick, the trial's draw, and the setup at init. */
+int icoac_priv_search_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
+                           const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out);
+void icoac_priv_search_sample(icoac_priv_state_t *st);
+int icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st);
+
+/* Gaussian helpers (icoac_gauss.c). */
 icoac_real_t icoac_priv_trace4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
 /* m = L L^T; returns 0 when m is not positive definite. */
 int icoac_priv_cholesky4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS],
                          icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+/* inverse = m^-1 (exactly symmetric) through the Cholesky factor; 0 when m is not PD. */
+int icoac_priv_spd_inverse4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS],
+                            icoac_real_t inverse[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+/* sample = mean + L n, n four standard normals drawn from rng. */
+void icoac_priv_sample_lower(icoac_rng_t *rng, const icoac_real_t mean[ICOAC_N_INPUTS],
+                             const icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS],
+                             icoac_real_t sample[ICOAC_N_INPUTS]);
 
 #endif /* ICOAC_PRIV_H */

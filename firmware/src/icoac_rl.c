@@ -15,54 +15,64 @@ static int off_diagonal_finite(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPU
 }
 
 /* Actor-critic tick: learn from the transition s_t -> s (spec 8b steps 5-8), then act on s.
- * V(s), delta, the actor's candidate posterior and the force are staged; the critic and the
- * actor are updated, and the caches advanced, only when they are finite. Returns 0, with the
- * state untouched, otherwise. Checked: V(s), delta, |w| (covers every w_i), the trace of
- * Sigma_w (covers its diagonal) and its off-diagonal, and G z (+ reflex). Not checked, as
- * finite by the configuration's bounds: the noise (|eps| < 1e8 sigma_u), hence the force
- * G z + eps + reflex; and the critic weights, which move by at most critic_rate * td_clip
- * <= 1e4 per tick. Writes every output field but reflex, penalty, weight_norm and status. */
+ * V(s), delta, the actor's candidate mu_w and Sigma_w and the force are staged; the critic and
+ * the actor are updated, and the caches advanced, only when they are finite. Returns 0, with
+ * the state untouched, otherwise. Checked: V(s), delta, |w| (covers every w_i), the trace of
+ * Sigma_w (covers its diagonal) and its off-diagonal when it changed, the batch sums, and
+ * G z (+ reflex). Not checked, as finite by the configuration's bounds: the noise
+ * (|eps| < 1e8 sigma_u), hence the force G z + eps + reflex; and the critic weights, which move
+ * by at most critic_rate * td_clip <= 1e4 per tick. Writes every output field but reflex,
+ * penalty, weight_norm and status. */
 int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_N_INPUTS],
                        const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out)
 {
     icoac_real_t factors[ICOAC_CRITIC_FACTORS];
     icoac_real_t w[ICOAC_N_INPUTS];
+    icoac_real_t h[ICOAC_N_INPUTS];
     icoac_real_t (*cov)[ICOAC_N_INPUTS] = st->cov_buffer[st->cov_slot ^ 1]; /* the spare */
     icoac_real_t checked[5]; /* V(s), delta, |w|, trace of Sigma_w, G z (+ reflex) */
     const int slot_prev = st->active_slot;
     const int learn = st->has_prev;         /* a transition into s exists: delta is defined */
     const int update = learn && cfg->learn; /* ... and the critic and actor learn from it */
+    /* the transition's first tick explored (L3): its noise is the actor's observation */
+    const int observed = cfg->actor.explore_ticks == 0 || st->trial_ticks <= (uint32_t)cfg->actor.explore_ticks;
     const icoac_real_t *w_act = cfg->actor.act_with_sample ? st->w_act : (update ? w : st->w);
+    int cov_changed = 0;
     icoac_real_t z = ICOAC_R(0.0);
-    icoac_real_t noise;
+    icoac_real_t noise = ICOAC_R(0.0);
     int i;
     checked[0] = ICOAC_R(0.0);
     checked[1] = ICOAC_R(0.0);
     checked[2] = st->weight_norm;
     checked[4] = ICOAC_R(0.0);
-    if (!terminal) {
+    if (!terminal || cfg->critic.quirks) {
         icoac_priv_critic_factors(&cfg->critic, s, factors);
         /* fills the spare slot: the current one stays the eligibility of this update */
         checked[0] = icoac_priv_critic_value(&cfg->critic, st->v, factors, &st->active[slot_prev ^ 1]);
+        if (terminal) {
+            checked[0] = ICOAC_R(0.0); /* quirks: only the kept units of s_t+1 were wanted */
+        }
     }
     if (learn) {
         const icoac_real_t reward = terminal ? ICOAC_R(-1.0) : ICOAC_R(0.0);
         checked[1] = clip_td(reward + cfg->critic.discount * checked[0] - st->value_prev, cfg->critic.td_clip);
     }
     if (update) {
-        icoac_real_t h[ICOAC_N_INPUTS];
-        icoac_real_t innovation;
         for (i = 0; i < ICOAC_N_INPUTS; ++i) {
             h[i] = cfg->policy.gain * st->x_prev[i];
         }
-        /* u_ob - h^T mu_w, with u_ob = h^T w_act + alpha * delta * eps (Eq. 7-8). */
-        innovation = icoac_priv_dot4(h, st->w_act) - icoac_priv_dot4(h, st->w) +
-                     cfg->actor.scale * checked[1] * st->noise_prev;
-        icoac_priv_actor_update(&cfg->actor, st, h, innovation, w, cov);
-        checked[2] = ICOAC_PRIV_SQRT(icoac_priv_dot4(w, w));
-        checked[3] = icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov));
-        if (!off_diagonal_finite(ICOAC_PRIV_CONST_MAT4(cov))) {
+        cov_changed = icoac_priv_actor_step(&cfg->actor, st, h, checked[1], observed, terminal, w, cov);
+        if (cov_changed < 0) {
             return 0;
+        }
+        checked[2] = ICOAC_PRIV_SQRT(icoac_priv_dot4(w, w));
+        if (cov_changed) {
+            checked[3] = icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov));
+            if (!off_diagonal_finite(ICOAC_PRIV_CONST_MAT4(cov))) {
+                return 0;
+            }
+        } else {
+            checked[3] = icoac_priv_trace4(icoac_priv_cov_c(st));
         }
     } else {
         checked[3] = icoac_priv_trace4(icoac_priv_cov_c(st));
@@ -76,12 +86,16 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     }
     /* commit */
     if (update) {
-        icoac_priv_critic_update(st->v, &st->active[slot_prev], cfg->critic.rate * checked[1]);
+        icoac_priv_critic_update(st->v, &st->active[cfg->critic.quirks ? slot_prev ^ 1 : slot_prev],
+                                 cfg->critic.rate * checked[1]);
         icoac_priv_copy4(st->w, w);
-        st->cov_slot ^= 1;
+        st->cov_slot ^= cov_changed;
         st->weight_norm = checked[2];
         if (!cfg->actor.act_with_sample) {
             icoac_priv_copy4(st->w_act, w);
+        }
+        if (cfg->actor.batch) {
+            icoac_priv_actor_commit_batch(&cfg->actor, st, h, observed, terminal);
         }
     }
     out->q = ICOAC_R(0.0);
@@ -95,7 +109,9 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
         st->has_prev = 0;
         return 1;
     }
-    noise = cfg->actor.noise_std * icoac_rng_normal(&st->rng);
+    if (cfg->actor.explore_ticks == 0 || st->trial_ticks < (uint32_t)cfg->actor.explore_ticks) {
+        noise = cfg->actor.noise_std * icoac_rng_normal(&st->rng);
+    }
     out->z = z;
     out->noise = noise;
     out->force = checked[4] + noise;
@@ -103,9 +119,9 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
         out->force += icoac_priv_reflex_force(&cfg->policy, out->reflex);
     }
     st->active_slot = slot_prev ^ 1;
-    st->value_prev = checked[0];
+    /* quirks: V_old = 0 at a reset, so the trial's first delta is gamma V(s_1) */
+    st->value_prev = (cfg->critic.quirks && !st->has_prev) ? ICOAC_R(0.0) : checked[0];
     st->noise_prev = noise;
     icoac_priv_cache_tick(st, scaled);
     return 1;
 }
-

@@ -27,6 +27,22 @@ typedef struct {
     uint8_t cells;                                     /* cells listed */
 } icoac_priv_critic_active_t;
 
+/* Per-trial sums of the actor's batch granularity (actor.batch), over the explored ticks. */
+typedef struct {
+    icoac_real_t info[ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* sum h h^T / sigma_L^2 (posterior, mean) */
+    icoac_real_t shift[ICOAC_N_INPUTS];                /* sum h * innovation / sigma_L^2; gradient: sum delta eps h */
+    icoac_real_t staged_shift[ICOAC_N_INPUTS];         /* scratch: shift after this tick, until its commit */
+} icoac_priv_actor_batch_t;
+
+/* Episodic search (ICOAC_MODE_SEARCH): the batch of trials since the last update. */
+typedef struct {
+    icoac_real_t w[ICOAC_SEARCH_BATCH_MAX][ICOAC_N_INPUTS]; /* each trial's sampled weights */
+    uint32_t ticks[ICOAC_SEARCH_BATCH_MAX];                 /* its length (the return) */
+    icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS];     /* Cholesky factor of Sigma_w */
+    icoac_real_t floor[ICOAC_N_INPUTS];                     /* search.floor * Sigma0_ii */
+    int32_t count;                                          /* trials recorded */
+} icoac_priv_search_t;
+
 /* Everything the controller owns. */
 typedef struct ICOAC_PRIV_MAY_ALIAS {
     uint32_t magic;                                   /* set by icoac_init */
@@ -44,7 +60,10 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
     icoac_real_t penalty_prev;                        /* r of the previous ICO observation */
     icoac_real_t value_prev;                          /* V(s_t) */
     icoac_real_t noise_prev;                          /* exploration noise eps_t (N) */
-    icoac_rng_t rng;                                  /* exploration noise */
+    uint32_t trial_ticks;                             /* non-terminal ticks of this trial so far (wraps at 2^32) */
+    icoac_priv_actor_batch_t batch;                   /* RL, actor.batch: this trial's sums */
+    icoac_priv_search_t search;                       /* search mode */
+    icoac_rng_t rng;                                  /* exploration noise; search: the samples */
     icoac_counters_t counters;
 } icoac_priv_state_t;
 

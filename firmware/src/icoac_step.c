@@ -60,12 +60,18 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state, const
     zone = icoac_priv_zone(&cfg->policy, in->s);
     out->reflex = zone.reflex;
     out->penalty = zone.penalty;
-    ok = cfg->mode == ICOAC_MODE_RL ? icoac_priv_rl_tick(cfg, st, in->s, scaled, terminal, out)
-                                    : icoac_priv_ico_tick(cfg, st, scaled, zone.penalty, terminal, out);
+    if (cfg->mode == ICOAC_MODE_RL) {
+        ok = icoac_priv_rl_tick(cfg, st, in->s, scaled, terminal, out);
+    } else if (cfg->mode == ICOAC_MODE_SEARCH) {
+        ok = icoac_priv_search_tick(cfg, st, scaled, terminal, out);
+    } else {
+        ok = icoac_priv_ico_tick(cfg, st, scaled, zone.penalty, terminal, out);
+    }
     if (!ok) {
         st->counters.numeric_faults++;
         return rejected(st, out, ICOAC_ERR_NUMERIC);
     }
+    st->trial_ticks += (uint32_t)!terminal;
     out->weight_norm = st->weight_norm;
     out->status = ICOAC_OK;
     return ICOAC_OK;

@@ -12,7 +12,7 @@ static void actor_update_in_place(const icoac_config_t *cfg, icoac_state_t *stat
                                   icoac_real_t innovation)
 {
     icoac_priv_state_t *st = icoac_priv_state(state);
-    icoac_priv_actor_update(&cfg->actor, st, h, innovation, st->w, icoac_priv_cov(st));
+    icoac_priv_actor_posterior(&cfg->actor, st, h, innovation, st->w, icoac_priv_cov(st));
 }
 
 /* The state's mean and covariance. */
@@ -245,7 +245,7 @@ static void test_update_staged_into_spare(void **unused)
         }
         in_place = state;
         before = state;
-        icoac_priv_actor_update(&cfg.actor, st, h, innovation, w, st->cov_buffer[spare]);
+        icoac_priv_actor_posterior(&cfg.actor, st, h, innovation, w, st->cov_buffer[spare]);
         actor_update_in_place(&cfg, &in_place, h, innovation);
         /* the state's posterior and slot are untouched ... */
         assert_int_equal(st->cov_slot, icoac_priv_state_c(&before)->cov_slot);

@@ -15,11 +15,20 @@
 extern "C" {
 #endif
 
-/* Learning condition. ICO->RL is ICOAC_MODE_RL with an ICO-derived prior. */
+/* Learning condition. ICO->RL is ICOAC_MODE_RL with an ICO-derived prior, ICO->search
+ * ICOAC_MODE_SEARCH with one. */
 typedef enum {
-    ICOAC_MODE_ICO = 0, /* ICO rule on w (Eq. 2-3) */
-    ICOAC_MODE_RL = 1   /* NGnet critic + Bayesian actor on (mu_w, Sigma_w) (Eq. 6-8) */
+    ICOAC_MODE_ICO = 0,   /* ICO rule on w (Eq. 2-3) */
+    ICOAC_MODE_RL = 1,    /* NGnet critic + Bayesian actor on (mu_w, Sigma_w) (Eq. 6-8) */
+    ICOAC_MODE_SEARCH = 2 /* episodic search on (mu_w, Sigma_w): one sample per trial (spec L4) */
 } icoac_mode_t;
+
+/* How the actor moves mu_w (and Sigma_w) per observation (spec L2). */
+typedef enum {
+    ICOAC_ACTOR_POSTERIOR = 0, /* sequential Bayesian posterior (literal Eq. 6-8): Sigma_w shrinks */
+    ICOAC_ACTOR_MEAN = 1,      /* posterior-mean step with Sigma_w held at the prior */
+    ICOAC_ACTOR_GRADIENT = 2   /* Gaussian-policy gradient step beta * delta * eps * h / sigma_u^2 */
+} icoac_actor_update_t;
 
 /* How the reflex U in {-1, 0, +1} enters the force (spec A2). */
 typedef enum {
@@ -52,10 +61,16 @@ typedef enum {
 #define ICOAC_NOISE_STD_MAX ICOAC_R(1.0e3)
 #define ICOAC_ACTOR_SCALE_MAX ICOAC_R(1.0e3)  /* actor.scale, >= 0 */
 #define ICOAC_FORGETTING_MIN ICOAC_R(0.5)     /* actor.forgetting, <= 1 */
+#define ICOAC_ACTOR_RATE_MAX ICOAC_R(1.0e3)   /* actor.rate, >= 0 */
+#define ICOAC_EXPLORE_TICKS_MAX 100000000     /* actor.explore_ticks, >= 0 */
+#define ICOAC_SEARCH_BATCH_MAX 16             /* search.batch, >= 1: trials per update */
+#define ICOAC_SEARCH_FLOOR_MIN ICOAC_R(1.0e-6) /* search.floor */
+#define ICOAC_SEARCH_FLOOR_MAX ICOAC_R(1.0e3)
+#define ICOAC_SEARCH_COV_SCALE_MAX ICOAC_R(1.0e3) /* search.cov_scale, >= 1 */
 
 /* Configuration, one group per concern; a mode validates and uses only its groups (ICO:
- * policy, ico; RL: policy, critic, actor). Integer switches are int32_t so the layout is the
- * same on every ABI. Ranges: the ICOAC_*_MIN / _MAX bounds above. */
+ * policy, ico; RL: policy, critic, actor; search: policy, search). Integer switches are int32_t so the layout is the
+ * same on every ABI. Ranges: the ICOAC_*_MIN / _MAX bounds above (search: its own group). */
 
 /* Policy: how the state becomes the feature z = w^T x~ and the force (every mode). */
 typedef struct {
@@ -81,16 +96,34 @@ typedef struct {
     icoac_real_t td_clip;               /* |delta| limit, [1e-6, 1e3]. 1 */
     icoac_real_t range[ICOAC_N_INPUTS]; /* grid half-widths (SI), [1e-6, 1e6]. 2.4, 3.5, 0.2094, 2.0 */
     icoac_real_t threshold;             /* drop normalized activations below this, [0, 1). 0.001 (code); 0 = dense */
+    int32_t quirks;                     /* 1: the authors' code (A10): TD update on b(s_t+1), V_old = 0 at a
+                                           reset; 0: TD(0) on b(s_t), V(s_0) (default) */
 } icoac_critic_config_t;
 
-/* Bayesian actor and exploration (ICOAC_MODE_RL). */
+/* Actor and exploration (ICOAC_MODE_RL). Every reading observes u_ob = mu_u + alpha*delta*eps. */
 typedef struct {
-    icoac_real_t noise_std;  /* sigma_u (N), [1e-3, 1e3]. 1 */
-    icoac_real_t scale;      /* alpha, [0, 1e3]. 0.5 */
-    icoac_real_t forgetting; /* lambda_f, [0.5, 1]. 1 (none) */
-    int32_t reflex;          /* 1: reflex added to the executed force; 0: off */
-    int32_t act_with_sample; /* 1: act with a posterior sample of w per trial; 0: with mu_w */
+    icoac_real_t noise_std;      /* sigma_u (N), [1e-3, 1e3]. 1 */
+    icoac_real_t scale;          /* alpha, [0, 1e3]. 0.5 */
+    icoac_real_t forgetting;     /* lambda_f, [0.5, 1]. 1 (none); posterior reading only */
+    int32_t reflex;              /* 1: reflex added to the executed force; 0: off */
+    int32_t act_with_sample;     /* 1: act with a posterior sample of w per trial; 0: with mu_w */
+    int32_t update;              /* icoac_actor_update_t. posterior (literal) */
+    icoac_real_t rate;           /* beta of the gradient reading, [0, 1e3]. 0.01 */
+    icoac_real_t likelihood_std; /* sigma_L (N) of the posterior and mean readings, [1e-3, 1e3]. 1 (= sigma_u, literal) */
+    int32_t batch;               /* 1: accumulate over a trial, one update at its terminal tick (A14); 0: per tick */
+    int32_t explore_ticks;       /* N: eps = 0 and no actor update from tick N of a trial on; 0: always explore */
 } icoac_actor_config_t;
+
+/* Episodic search over N(mu_w, Sigma_w) (ICOAC_MODE_SEARCH, spec L4): each trial acts with one
+ * sample w (F = G w^T x~ + reflex, no noise); after `batch` failed trials the best
+ * round(elite_fraction * batch) (at least 1) by length move mu_w and Sigma_w by `step`. */
+typedef struct {
+    int32_t batch;               /* K, trials per update, [1, ICOAC_SEARCH_BATCH_MAX]. 4 */
+    icoac_real_t elite_fraction; /* rho, (0, 1]. 0.5 */
+    icoac_real_t step;           /* a, (0, 1]. 0.5 */
+    icoac_real_t floor;          /* f: Sigma_ii >= f * Sigma0_ii after each update, [1e-6, 1e3]. 0.1 */
+    icoac_real_t cov_scale;      /* c: Sigma0 = c * prior covariance, [1, 1e3]. 1 */
+} icoac_search_config_t;
 
 typedef struct {
     int32_t mode;                 /* icoac_mode_t */
@@ -101,6 +134,7 @@ typedef struct {
     icoac_ico_config_t ico;
     icoac_critic_config_t critic;
     icoac_actor_config_t actor;
+    icoac_search_config_t search;
 } icoac_config_t;
 
 /* Gaussian prior / posterior of the feature weights, (w_x, w_xdot, w_theta, w_thetadot).
@@ -134,7 +168,8 @@ typedef struct {
 } icoac_counters_t;
 
 /* Flags of icoac_input_t. */
-#define ICOAC_INPUT_TERMINAL 1u /* s is a failure state: learn from it, output no action */
+#define ICOAC_INPUT_TERMINAL 1u /* s is a failure state: learn from it, output no action; ends a trial
+                                   (batch updates and the search's trial record happen here) */
 
 /* One tick's observation, SI units, theta > 0 leans toward +x. */
 typedef struct {
@@ -163,6 +198,7 @@ void icoac_policy_config_default(icoac_policy_config_t *policy);
 void icoac_ico_config_default(icoac_ico_config_t *ico);
 void icoac_critic_config_default(icoac_critic_config_t *critic);
 void icoac_actor_config_default(icoac_actor_config_t *actor);
+void icoac_search_config_default(icoac_search_config_t *search);
 
 /* Validate the mode and the groups it uses; ICOAC_OK or the status of the first bad field's
  * group. icoac_config_check_field also names that field ("critic.range[0]", a static string;
@@ -178,7 +214,8 @@ icoac_status_t icoac_prior_check(const icoac_prior_t *prior);
 icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state,
                           const icoac_prior_t *prior, uint64_t seed);
 
-/* Start a new trial: forget the previous tick, keep everything learned. */
+/* Start a new trial: forget the previous tick, keep everything learned. A per-trial batch
+ * (actor.batch) not ended by a terminal tick is dropped. Search mode draws the trial's w. */
 icoac_status_t icoac_reset(const icoac_config_t *cfg, icoac_state_t *state);
 
 /* One tick: learn from the transition into in->s, then act on it. The return value is the

@@ -9,7 +9,7 @@ extern "C" {
 #endif
 
 /* Bump when a public struct layout or an enum value changes. */
-#define ICOAC_ABI_VERSION 5
+#define ICOAC_ABI_VERSION 6
 
 /* Real-number type: float by default; define ICOAC_REAL_DOUBLE=1 for double. */
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
@@ -54,14 +54,15 @@ typedef enum {
     ICOAC_ERR_NOT_INITIALISED = 2,  /* state not set up by icoac_init */
     ICOAC_ERR_NONFINITE_INPUT = 3,  /* observation had NaN/Inf: safe output, no learning */
     ICOAC_ERR_NUMERIC = 4,          /* a value derived in this tick was not finite: force 0, nothing learned */
-    ICOAC_ERR_BAD_MODE = 10,        /* mode, policy.reflex_mode, ico.timing or a 0/1 flag out of range */
+    ICOAC_ERR_BAD_MODE = 10,        /* mode, policy.reflex_mode, ico.timing, actor.update or a 0/1 flag out of range */
     ICOAC_ERR_BAD_SCALE = 11,       /* policy.input_range out of range */
     ICOAC_ERR_BAD_GAIN = 12,        /* policy.gain or policy.reflex_force out of range */
     ICOAC_ERR_BAD_ZONE = 13,        /* policy.zone_theta or policy.zone_x out of range */
     ICOAC_ERR_BAD_ICO_RATE = 14,    /* ico.rate out of range */
     ICOAC_ERR_BAD_CRITIC = 15,      /* a critic field out of range */
     ICOAC_ERR_BAD_ACTOR = 16,       /* an actor field out of range */
-    ICOAC_ERR_BAD_PRIOR = 17        /* prior out of range, subnormal, or covariance not symmetric PD */
+    ICOAC_ERR_BAD_PRIOR = 17,       /* prior out of range, subnormal, or covariance not symmetric PD */
+    ICOAC_ERR_BAD_SEARCH = 18       /* a search field out of range */
 } icoac_status_t;
 
 /* Static, human-readable name of a status (never NULL). */

@@ -1,0 +1,97 @@
+/* Gaussian helpers shared by the actor and the search: trace, Cholesky factor, SPD inverse,
+ * and a draw through the factor. */
+#include "icoac_priv.h"
+
+#define N ICOAC_N_INPUTS
+
+icoac_real_t icoac_priv_trace4(const icoac_real_t m[N][N])
+{
+    return (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
+}
+
+int icoac_priv_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
+{
+    int i;
+    int j;
+    int k;
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            lower[i][j] = ICOAC_R(0.0);
+        }
+    }
+    for (j = 0; j < N; ++j) {
+        icoac_real_t diag = m[j][j];
+        for (k = 0; k < j; ++k) {
+            diag -= lower[j][k] * lower[j][k];
+        }
+        if (!(diag > ICOAC_R(0.0))) {
+            return 0;
+        }
+        lower[j][j] = ICOAC_PRIV_SQRT(diag);
+        for (i = j + 1; i < N; ++i) {
+            icoac_real_t sum = m[i][j];
+            for (k = 0; k < j; ++k) {
+                sum -= lower[i][k] * lower[j][k];
+            }
+            lower[i][j] = sum / lower[j][j];
+        }
+    }
+    return 1;
+}
+
+int icoac_priv_spd_inverse4(const icoac_real_t m[N][N], icoac_real_t inverse[N][N])
+{
+    icoac_real_t lower[N][N];
+    icoac_real_t column[N];
+    int i;
+    int j;
+    int k;
+    if (!icoac_priv_cholesky4(m, lower)) {
+        return 0;
+    }
+    for (k = 0; k < N; ++k) {
+        /* L y = e_k, then L^T x = y: x is column k of the inverse */
+        for (i = 0; i < N; ++i) {
+            icoac_real_t sum = i == k ? ICOAC_R(1.0) : ICOAC_R(0.0);
+            for (j = 0; j < i; ++j) {
+                sum -= lower[i][j] * column[j];
+            }
+            column[i] = sum / lower[i][i];
+        }
+        for (i = N - 1; i >= 0; --i) {
+            icoac_real_t sum = column[i];
+            for (j = i + 1; j < N; ++j) {
+                sum -= lower[j][i] * column[j];
+            }
+            column[i] = sum / lower[i][i];
+        }
+        for (i = 0; i < N; ++i) {
+            inverse[i][k] = column[i];
+        }
+    }
+    /* exactly symmetric */
+    for (i = 0; i < N; ++i) {
+        for (j = i + 1; j < N; ++j) {
+            inverse[j][i] = inverse[i][j];
+        }
+    }
+    return 1;
+}
+
+void icoac_priv_sample_lower(icoac_rng_t *rng, const icoac_real_t mean[N], const icoac_real_t lower[N][N],
+                             icoac_real_t sample[N])
+{
+    icoac_real_t normal[N];
+    int i;
+    int j;
+    for (i = 0; i < N; ++i) {
+        normal[i] = icoac_rng_normal(rng);
+    }
+    for (i = 0; i < N; ++i) {
+        icoac_real_t sum = mean[i];
+        for (j = 0; j <= i; ++j) {
+            sum += lower[i][j] * normal[j];
+        }
+        sample[i] = sum;
+    }
+}

@@ -1,0 +1,185 @@
+/* Episodic search over N(mu_w, Sigma_w) (spec L4): each trial acts with one sample of w, like
+ * the ICO policy and without exploration noise; each failed trial's length is its return; every
+ * search.batch trials the elite moves mu_w and Sigma_w (cross-entropy step with a floor). */
+#include "icoac_features.h"
+
+#define N ICOAC_N_INPUTS
+
+int icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st)
+{
+    icoac_real_t (*cov)[N] = icoac_priv_cov(st);
+    int i;
+    int j;
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            cov[i][j] *= search->cov_scale;
+        }
+        st->search.floor[i] = search->floor * cov[i][i];
+    }
+    st->search.count = 0;
+    return icoac_priv_all_finite(&cov[0][0], N * N) && icoac_priv_all_finite(st->search.floor, N) &&
+           icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov), st->search.lower);
+}
+
+void icoac_priv_search_sample(icoac_priv_state_t *st)
+{
+    icoac_real_t sample[N];
+    icoac_priv_sample_lower(&st->rng, st->w, ICOAC_PRIV_CONST_MAT4(st->search.lower), sample);
+    icoac_priv_copy4(st->w_act, sample);
+}
+
+/* The batch being closed: the recorded trials 0..count-1, then the trial ending now. */
+typedef struct {
+    const icoac_priv_search_t *recorded;
+    const icoac_real_t *last_w;
+    uint32_t last_ticks;
+    int size;
+} closing_batch_t;
+
+static const icoac_real_t *trial_w(const closing_batch_t *b, int k)
+{
+    return k < b->recorded->count ? b->recorded->w[k] : b->last_w;
+}
+
+static uint32_t trial_ticks(const closing_batch_t *b, int k)
+{
+    return k < b->recorded->count ? b->recorded->ticks[k] : b->last_ticks;
+}
+
+/* The n_elite longest trials, longest first; ties go to the earlier trial. */
+static void choose_elite(const closing_batch_t *b, int n_elite, uint8_t elite[ICOAC_SEARCH_BATCH_MAX])
+{
+    uint32_t taken = 0u;
+    int e;
+    int k;
+    for (e = 0; e < n_elite; ++e) {
+        int best = -1;
+        for (k = 0; k < b->size; ++k) {
+            if (((taken >> k) & 1u) == 0u && (best < 0 || trial_ticks(b, k) > trial_ticks(b, best))) {
+                best = k;
+            }
+        }
+        taken |= 1u << best;
+        elite[e] = (uint8_t)best;
+    }
+}
+
+/* Elite size n_e = max(1, round(rho K)). */
+static int elite_size(const icoac_search_config_t *search)
+{
+    const int n = (int)(search->elite_fraction * (icoac_real_t)search->batch + ICOAC_R(0.5));
+    return n < 1 ? 1 : (n > search->batch ? search->batch : n);
+}
+
+/* The update after a full batch, staged into w, cov and lower: mu' = (1-a) mu + a mean_elite;
+ * Sigma' = (1-a) Sigma + a Cov_elite about mu' (upper triangle mirrored), then
+ * Sigma'_ii >= floor_i. Returns 0 when a value is not finite or Sigma' not positive definite. */
+static int search_update(const icoac_search_config_t *search, const icoac_priv_state_t *st,
+                         const closing_batch_t *b, icoac_real_t w[N], icoac_real_t cov[N][N],
+                         icoac_real_t lower[N][N])
+{
+    const icoac_real_t (*sigma)[N] = icoac_priv_cov_c(st);
+    const icoac_real_t a = search->step;
+    const int n_elite = elite_size(search);
+    const icoac_real_t inv_n = ICOAC_R(1.0) / (icoac_real_t)n_elite;
+    uint8_t elite[ICOAC_SEARCH_BATCH_MAX];
+    int e;
+    int i;
+    int j;
+    choose_elite(b, n_elite, elite);
+    for (i = 0; i < N; ++i) {
+        icoac_real_t sum = ICOAC_R(0.0);
+        for (e = 0; e < n_elite; ++e) {
+            sum += trial_w(b, elite[e])[i];
+        }
+        w[i] = (ICOAC_R(1.0) - a) * st->w[i] + a * (sum * inv_n);
+    }
+    for (i = 0; i < N; ++i) {
+        for (j = i; j < N; ++j) {
+            icoac_real_t sum = ICOAC_R(0.0);
+            icoac_real_t value;
+            for (e = 0; e < n_elite; ++e) {
+                const icoac_real_t *we = trial_w(b, elite[e]);
+                sum += (we[i] - w[i]) * (we[j] - w[j]);
+            }
+            value = (ICOAC_R(1.0) - a) * sigma[i][j] + a * (sum * inv_n);
+            if (i == j && !(value >= st->search.floor[i])) {
+                value = st->search.floor[i];
+            }
+            cov[i][j] = value;
+            cov[j][i] = value;
+        }
+    }
+    return icoac_priv_all_finite(w, N) && icoac_priv_all_finite(&cov[0][0], N * N) &&
+           icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov), lower) &&
+           icoac_priv_all_finite(&lower[0][0], N * N);
+}
+
+/* A terminal tick ends the trial: record (w_act, length); a full batch updates (staged: on a
+ * failure nothing is recorded and 0 is returned). */
+ICOAC_PRIV_NOINLINE static int end_trial(const icoac_config_t *cfg, icoac_priv_state_t *st)
+{
+    icoac_priv_search_t *recorded = &st->search;
+    closing_batch_t b;
+    icoac_real_t w[N];
+    icoac_real_t lower[N][N];
+    icoac_real_t (*cov)[N] = st->cov_buffer[st->cov_slot ^ 1]; /* the spare */
+    int i;
+    int j;
+    if (!cfg->learn) {
+        return 1;
+    }
+    if (recorded->count + 1 < cfg->search.batch) {
+        icoac_priv_copy4(recorded->w[recorded->count], st->w_act);
+        recorded->ticks[recorded->count] = st->trial_ticks;
+        recorded->count++;
+        return 1;
+    }
+    b.recorded = recorded;
+    b.last_w = st->w_act;
+    b.last_ticks = st->trial_ticks;
+    b.size = recorded->count + 1;
+    if (!search_update(&cfg->search, st, &b, w, cov, lower)) {
+        return 0;
+    }
+    icoac_priv_copy4(st->w, w);
+    st->cov_slot ^= 1;
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            recorded->lower[i][j] = lower[i][j];
+        }
+    }
+    st->weight_norm = ICOAC_PRIV_SQRT(icoac_priv_dot4(w, w));
+    recorded->count = 0;
+    return 1;
+}
+
+/* Writes every output field but reflex, penalty, weight_norm and status. */
+int icoac_priv_search_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
+                           const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out)
+{
+    icoac_real_t z;
+    icoac_real_t force;
+    out->q = ICOAC_R(0.0);
+    out->value = ICOAC_R(0.0);
+    out->td_error = ICOAC_R(0.0);
+    out->noise = ICOAC_R(0.0);
+    if (terminal) {
+        if (!end_trial(cfg, st)) {
+            return 0;
+        }
+        out->z = ICOAC_R(0.0);
+        out->force = ICOAC_R(0.0);
+        out->cov_trace = icoac_priv_trace4(icoac_priv_cov_c(st));
+        return 1;
+    }
+    z = icoac_priv_dot4(st->w_act, scaled);
+    force = cfg->policy.gain * z + icoac_priv_reflex_force(&cfg->policy, out->reflex);
+    if (!icoac_priv_finite(force)) {
+        return 0;
+    }
+    out->z = z;
+    out->force = force;
+    out->cov_trace = icoac_priv_trace4(icoac_priv_cov_c(st));
+    return 1;
+}

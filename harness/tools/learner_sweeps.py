@@ -1,0 +1,87 @@
+"""The sweeps that chose the learners' defaults (issue 10, spec L2-L4), as one command:
+
+    python -m harness.tools.learner_sweeps --prior-from results/bench/ico/seed-0 --out results/sweeps
+
+Each sweep runs on two cell selections, 2 seeds each: `spread` (49 cells evenly over the grid)
+and `ico-failed` (every cell where the ICO run of --prior-from failed). Stage 1 compares the actor
+readings and their rates (with the no-learning control), and the search's parameters one at a
+time; stage 2 (``--stage 2 --base NAME=VALUE ...``) varies the exploration schedule, the batch
+granularity, the critic quirks and the exploration scale around the stage-1 choice. Every sweep
+resumes (finished settings are skipped), so an interrupted run loses nothing.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .. import results
+from ..sweep import SweepOptions, run_sweep
+
+SEEDS = 2
+MAX_TRIALS = 1000
+SPREAD_CELLS = 49
+
+# (name, condition, parameters, one at a time)
+STAGE_1 = (
+    ("ico-rl-control", "ico-rl-control", ["actor.update=posterior"], False),
+    ("ico-rl-posterior", "ico-rl", ["actor.update=posterior", "actor.likelihood_std=0.3,1,3,10"], False),
+    ("ico-rl-mean", "ico-rl", ["actor.update=mean", "actor.likelihood_std=0.3,1,3,10"], False),
+    ("ico-rl-gradient", "ico-rl", ["actor.update=gradient", "actor.rate=0.001,0.003,0.01,0.03,0.1"], False),
+    ("rl-control", "rl-control", ["actor.update=posterior"], False),
+    ("rl-posterior", "rl", ["actor.update=posterior", "actor.likelihood_std=1,10"], False),
+    ("rl-mean", "rl", ["actor.update=mean", "actor.likelihood_std=1,10"], False),
+    ("rl-gradient", "rl", ["actor.update=gradient", "actor.rate=0.003,0.01,0.03,0.1"], False),
+    ("ico-search", "ico-search", ["search.batch=2,4,8", "search.elite_fraction=0.25,0.5",
+                                  "search.step=0.5,1", "search.floor=0.01,0.1,1",
+                                  "search.cov_scale=1,4,16"], True),
+    ("search", "search", ["search.batch=2,4,8", "search.elite_fraction=0.25,0.5",
+                          "search.step=0.5,1", "search.floor=0.01,0.1,1",
+                          "search.cov_scale=1,4,16"], True),
+)
+STAGE_2 = (
+    ("ico-rl-stage2", "ico-rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
+                                 "actor.noise_std=0.3,1,3", "actor.scale=0.5,2"], True),
+    ("rl-stage2", "rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
+                         "actor.noise_std=0.3,1,3", "actor.scale=0.5,2"], True),
+)
+
+
+def ico_failed_cells(prior_from: Path) -> str:
+    """Cell indices (a --cells spec) where the ICO run failed."""
+    cells, _ = results.load(prior_from, what="--prior-from")
+    failed = np.nonzero(cells["outcome"] != 1)[0]
+    return ",".join(str(int(i)) for i in failed)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m harness.tools.learner_sweeps", description=__doc__.split("\n")[0])
+    ap.add_argument("--prior-from", required=True, type=Path, help="ICO results directory (one seed)")
+    ap.add_argument("--out", required=True, type=Path, help="one subdirectory per sweep and selection")
+    ap.add_argument("--stage", type=int, choices=(1, 2), default=1)
+    ap.add_argument("--base", action="append", default=[], metavar="NAME=VALUE",
+                    help="stage 2: the stage-1 choice, fixed in every setting (repeatable)")
+    ap.add_argument("--only", action="append", default=[], help="run only the sweeps of these names")
+    ap.add_argument("--threads", type=int, default=0)
+    args = ap.parse_args(argv)
+    selections = {"spread": dict(subset=SPREAD_CELLS), "ico-failed": dict(cells=ico_failed_cells(args.prior_from))}
+    plan = STAGE_1 if args.stage == 1 else STAGE_2
+    for name, condition, params, one_at_a_time in plan:
+        if args.only and name not in args.only:
+            continue
+        for label, selection in selections.items():
+            print(f"[learner_sweeps] {name} on {label} cells", file=sys.stderr, flush=True)
+            code = run_sweep(SweepOptions(prior_from=args.prior_from, out=args.out / f"{name}-{label}",
+                                          params=params, condition=condition, seeds=SEEDS,
+                                          max_trials=MAX_TRIALS, sets=list(args.base),
+                                          one_at_a_time=one_at_a_time, threads=args.threads, quiet=True,
+                                          **selection))
+            if code:
+                return code
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
