@@ -1,5 +1,5 @@
-"""The paper's comparison (Fig. 2b, 3): ICO grids per seed, priors, ICO->RL and RL grids with their
-no-learning controls (spec L1), summary, figures.
+"""The paper's comparison (Fig. 2b, 3): ICO grids per seed, priors, ICO->RL, RL, ICO->search and
+search grids with their no-learning controls (spec L1), summary, figures.
 
 Layout: OUT/<condition>/seed-<n>/ (results directories), OUT/bench.json (wall time per stage),
 OUT/summary.md and OUT/summary.json (mean and sd over seeds next to the paper's numbers).
@@ -35,6 +35,8 @@ PAPER = {
     "ico-rl": {"success_rate": 0.84, "note": "Fig. 2b; most cells 5-2000 trials, a few > 2000"},
     "rl": {"success_rate": None, "note": "Fig. 3: smaller domain than ICO, very slow; no number in the text"},
 }
+# The learners after ICO and its prior, in stage order.
+LEARNERS = tuple(c for c in CONDITIONS if c != "ico")
 
 # Spread subset for smoke tests: rows (theta0 + 12 deg) x columns ((x0 + 2.4) / 0.1); includes
 # Fig. 1g's start (row 8, column 19) and enough central cells for a prior.
@@ -144,7 +146,7 @@ def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
 
 
 def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> str:
-    lines = ["# ICO, RL and ICO->RL with their no-learning controls: mean ± sd over seeds", "",
+    lines = ["# ICO and the learners with their no-learning controls: mean ± sd over seeds", "",
              "| condition | seeds | caps (trials / steps) | success (all) | success (interior) | "
              "median trials to success | mean elapsed sim. time of successes (s) | paper |",
              "|---|---|---|---|---|---|---|---|"]
@@ -280,9 +282,9 @@ class BenchOptions:
 
 
 def stages(opt: BenchOptions) -> list[Stage]:
-    """ICO grid per seed, prior per seed, ICO->RL, its control, RL and its control per seed,
-    summary, figures. Every
-    argument and override is validated here, before anything runs or is written."""
+    """ICO grid per seed, prior per seed, then each learner and its control per seed (ICO->RL, RL,
+    ICO->search, search), summary, figures. Every argument and override is validated here, before
+    anything runs or is written."""
     profile = PROFILES[opt.profile]
     out = Path(opt.out)
     figdir = Path(opt.figures) if opt.figures else None
@@ -318,6 +320,8 @@ def stages(opt: BenchOptions) -> list[Stage]:
             info = P.from_results(seed_dir(out, "ico", seed), opt.frame, opt.ridge)
             ctx[("prior", "ico-rl", seed)] = info
             ctx[("prior", "rl", seed)] = P.rl_prior(info, opt.rl_cov)
+            ctx[("prior", "ico-search", seed)] = info
+            ctx[("prior", "search", seed)] = P.rl_prior(info, "identity")
             for control, condition in CONTROL_OF.items():
                 ctx[("prior", control, seed)] = ctx[("prior", condition, seed)]
             progress(f"  prior seed {seed}: {info.n_cells} cells, mean "
@@ -365,10 +369,8 @@ def stages(opt: BenchOptions) -> list[Stage]:
 
     out_stages = [grid_stage("ico", s) for s in seeds]
     out_stages += [prior_stage(s) for s in seeds]
-    out_stages += [grid_stage("ico-rl", s) for s in seeds]
-    out_stages += [grid_stage("ico-rl-control", s) for s in seeds]
-    out_stages += [grid_stage("rl", s) for s in seeds]
-    out_stages += [grid_stage("rl-control", s) for s in seeds]
+    for condition in LEARNERS:
+        out_stages += [grid_stage(condition, s) for s in seeds]
     out_stages += [Stage("summary", summary_stage), Stage("figures", figures_stage)]
     return out_stages
 

@@ -152,6 +152,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="trials before a cell fails, in [1, 2^63 - 1] (default 1e5)")
     g.add_argument("--success-steps", type=_positive_int, default=None,
                    help="steps of a successful trial, in [1, 2^63 - 1] (default 1e5)")
+    g.add_argument("--configuration", choices=O.CONFIGURATION_NAMES, default=O.CONFIGURATION_NAMES[0],
+                   help="named configuration applied before --set: the defaults, or the paper's literal "
+                        "reading of the actor-critic (posterior actor, exploration always on, per-tick updates)")
     g.add_argument("--set", action="append", metavar="NAME=VALUE", help=SET_HELP)
     g.add_argument("--cells", default=None, help="subset of the paper grid's cell indices (row-major, from 0), e.g. 0,5,600-610")
     again = g.add_mutually_exclusive_group()
@@ -190,6 +193,9 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--rl-max-trials", type=_positive_int, default=None,
                    help="trial cap of the RL and ICO->RL grids (overrides the profile)")
     b.add_argument("--threads", type=_threads, default=0, help=f"C threads in [0, {O.MAX_THREADS}] (0: all cores)")
+    b.add_argument("--configuration", choices=O.CONFIGURATION_NAMES, default=O.CONFIGURATION_NAMES[0],
+                   help="named configuration applied before --set: the defaults, or the paper's literal "
+                        "reading of the actor-critic (posterior actor, exploration always on, per-tick updates)")
     b.add_argument("--set", action="append", metavar="NAME=VALUE", help=SET_HELP)
     b.add_argument("--resume", action="store_true", help="continue earlier results instead of starting over")
     b.add_argument("--quiet", action="store_true", help="no progress bars")
@@ -213,6 +219,9 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--max-trials", type=_positive_int, default=O.SWEEP_MAX_TRIALS,
                    help=f"trials before a cell fails (default {O.SWEEP_MAX_TRIALS})")
     w.add_argument("--success-steps", type=_positive_int, default=None)
+    w.add_argument("--configuration", choices=O.CONFIGURATION_NAMES, default=O.CONFIGURATION_NAMES[0],
+                   help="named configuration applied before --set: the defaults, or the paper's literal "
+                        "reading of the actor-critic (posterior actor, exploration always on, per-tick updates)")
     w.add_argument("--set", action="append", metavar="NAME=VALUE", help="fixed override for every setting")
     w.add_argument("--one-at-a-time", action="store_true",
                    help="vary one parameter at a time around the first value of each")
@@ -261,9 +270,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 # -- commands: arguments in, report out ----------------------------------------------------------------
+def _sets(args) -> list[str]:
+    """--configuration's items, then --set's."""
+    from .config import named_sets
+    return named_sets(args.configuration, args.set)
+
+
 def _overrides(args) -> dict:
     from .config import parse_sets
-    over = parse_sets(args.set)
+    over = parse_sets(_sets(args))
     if args.max_trials is not None:
         over["max_trials"] = args.max_trials
     if args.success_steps is not None:
@@ -280,7 +295,7 @@ def cmd_grid(args) -> int:
     from . import conditions, metrics
 
     explicit = any(v is not None for v in (args.condition, args.seed, args.max_trials, args.success_steps,
-                                            args.cells, args.prior_from)) or bool(args.set)
+                                            args.cells, args.prior_from)) or bool(_sets(args))
     condition = args.condition or O.CONDITIONS[0]
     info = None
     if explicit or not args.resume:
@@ -316,7 +331,7 @@ def cmd_bench(args) -> int:
     opt = bench.BenchOptions(
         profile=args.profile, out=Path(args.out), figures=Path(args.figures) if args.figures else None,
         seed=args.seed, seeds=args.seeds, rl_max_trials=args.rl_max_trials, threads=args.threads,
-        sets=args.set or [], resume=args.resume, quiet=args.quiet, frame=_frame(args), ridge=args.prior_ridge,
+        sets=_sets(args), resume=args.resume, quiet=args.quiet, frame=_frame(args), ridge=args.prior_ridge,
         rl_cov=args.rl_cov, ceiling=Path(args.ceiling) if args.ceiling else None)
     return bench.run_bench(opt, argv=sys.argv[1:])
 
@@ -327,7 +342,7 @@ def cmd_sweep(args) -> int:
     opt = sweep.SweepOptions(
         prior_from=Path(args.prior_from), out=Path(args.out), params=args.param, condition=args.condition,
         cells=args.cells, subset=args.subset, seed=args.seed, seeds=1 if args.seeds is None else args.seeds,
-        max_trials=args.max_trials, success_steps=args.success_steps, sets=args.set or [],
+        max_trials=args.max_trials, success_steps=args.success_steps, sets=_sets(args),
         one_at_a_time=args.one_at_a_time, threads=args.threads, rl_cov=args.rl_cov, quiet=args.quiet)
     return sweep.run_sweep(opt)
 

@@ -79,9 +79,28 @@ CONDITION_OVERRIDES: dict[str, dict[str, Any]] = {
     "ico-rl-control": {"mode": "rl", "learn": 0},
     "rl-control": {"mode": "rl", "learn": 0},
     "ico-search": {"mode": "search"},  # prior from an ICO grid, Sigma0 = search.cov_scale * its covariance
+    "ico-search-control": {"mode": "search", "learn": 0},
     "search": {"mode": "search"},      # prior N(0, I) (spec L4)
+    "search-control": {"mode": "search", "learn": 0},
 }
 assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS)
+
+
+# Named configurations: --set items applied before the command's own --set. "literal" restores the
+# paper's literal reading where the defaults were chosen by the learner sweeps (docs/results.md).
+NAMED_CONFIGURATIONS: dict[str, tuple[str, ...]] = {
+    "default": (),
+    "literal": ("actor.update=posterior", "actor.likelihood_std=1", "actor.batch=0", "actor.explore_ticks=0",
+                "critic.quirks=0"),
+}
+assert tuple(NAMED_CONFIGURATIONS) == options.CONFIGURATION_NAMES
+
+
+def named_sets(name: str, sets: Iterable[str] | None = None) -> list[str]:
+    """The --set items of a named configuration, then ``sets``."""
+    if name not in NAMED_CONFIGURATIONS:
+        raise UsageError(f"unknown configuration {_short(name)}; valid: {', '.join(NAMED_CONFIGURATIONS)}")
+    return list(NAMED_CONFIGURATIONS[name]) + list(sets or [])
 
 
 def _short(value: Any, limit: int = 60) -> str:

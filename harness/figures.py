@@ -192,7 +192,7 @@ def plot_bars(path: str | Path, labels: Sequence[str], values: Sequence[float],
         pos = np.arange(len(labels))
         ax.bar(pos, values, yerr=errors, color="tab:blue", capsize=3, width=0.6)
         ax.set_xticks(pos)
-        ax.set_xticklabels(labels)
+        ax.set_xticklabels(labels, rotation=30, ha="right")
         ax.set_ylabel(ylabel)
         if title:
             ax.set_title(title)
@@ -260,7 +260,8 @@ def plot_fig3a(path: str | Path, labels: Sequence[str], all_stats: Sequence[Mapp
     m_all, e_all = mv(all_stats)
     m_in, e_in = mv(interior_stats)
     with plt.rc_context(STYLE):
-        fig, ax = plt.subplots(figsize=(5.0, 4.0) if ceiling else (5.0, 3.4))
+        width = max(5.0, 0.75 * len(labels) + 1.0)
+        fig, ax = plt.subplots(figsize=(width, 4.6) if ceiling else (width, 4.0))
         pos = np.arange(len(labels))
         width = 0.36
         ax.bar(pos - width / 2, np.nan_to_num(m_all), width, yerr=e_all, capsize=3, color="tab:blue",
@@ -283,7 +284,7 @@ def plot_fig3a(path: str | Path, labels: Sequence[str], all_stats: Sequence[Mapp
         if ceiling:
             ax.set_xlim(-0.5, len(labels) - 0.5)
         ax.set_xticks(pos)
-        ax.set_xticklabels(labels)
+        ax.set_xticklabels(labels, rotation=30, ha="right")
         ax.set_ylim(0, 105)
         ax.set_ylabel("success rate (%)")
         ax.set_title("(a) success rate, mean ± sd over seeds")
@@ -300,7 +301,7 @@ def plot_fig3b(path: str | Path, labels: Sequence[str], stats: Sequence[Mapping]
     m = np.array([np.nan if s is None or s.get("mean") is None else s["mean"] for s in stats], dtype=float)
     e = np.array([0.0 if s is None or s.get("sd") is None else s["sd"] for s in stats], dtype=float)
     with plt.rc_context(STYLE):
-        fig, ax = plt.subplots(figsize=(4.4, 3.4))
+        fig, ax = plt.subplots(figsize=(max(4.4, 0.7 * len(labels) + 1.0), 4.0))
         pos = np.arange(len(labels))
         ok = np.isfinite(m) & (m > 0)
         # Asymmetric error bars clipped above zero so the log axis can show them.
@@ -314,7 +315,7 @@ def plot_fig3b(path: str | Path, labels: Sequence[str], stats: Sequence[Mapping]
             hi = 10.0 ** math.ceil(math.log10(np.max(m[ok] + e[ok]) * 1.01))
             ax.set_ylim(lo, hi)
         ax.set_xticks(pos)
-        ax.set_xticklabels(labels)
+        ax.set_xticklabels(labels, rotation=30, ha="right")
         ax.set_ylabel("elapsed simulated time (s)")
         ax.set_title("(b) time to success, mean ± sd over seeds")
         fig.tight_layout()

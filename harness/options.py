@@ -4,18 +4,24 @@ defines - enum values, statuses, sizes, grid geometry - comes from the binding i
 from __future__ import annotations
 
 # Learning conditions, in the order of the benchmark and its tables.
-CONDITIONS = ("ico", "ico-rl", "ico-rl-control", "rl", "rl-control", "ico-search", "search")
+CONDITIONS = ("ico", "ico-rl", "ico-rl-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
+              "search-control")
 # The conditions that run the actor-critic from a prior.
 RL_CONDITIONS = ("ico-rl", "ico-rl-control", "rl", "rl-control")
 # No-learning control (spec L1) -> its condition: the same prior, acting weights, noise stream,
 # resets and caps, with every update off (the controller's `learn = 0`).
-CONTROL_OF = {"ico-rl-control": "ico-rl", "rl-control": "rl"}
+CONTROL_OF = {"ico-rl-control": "ico-rl", "rl-control": "rl", "ico-search-control": "ico-search",
+              "search-control": "search"}
 # The conditions of the episodic search (spec L4): ico-search from the ICO prior, search from N(0, I).
-SEARCH_CONDITIONS = ("ico-search", "search")
+SEARCH_CONDITIONS = ("ico-search", "ico-search-control", "search", "search-control")
 CONDITION_LABELS = {"ico": "ICO", "ico-rl": "ICO->RL", "ico-rl-control": "ICO->RL control", "rl": "RL",
-                    "rl-control": "RL control", "ico-search": "ICO->search", "search": "search"}
+                    "rl-control": "RL control", "ico-search": "ICO->search", "ico-search-control": "ICO->search control",
+                    "search": "search", "search-control": "search control"}
 
 PROFILE_NAMES = ("default", "paper", "quick")   # bench profiles (harness.bench.PROFILES)
+# Named configurations (harness.config.NAMED_CONFIGURATIONS): the defaults, or the paper's literal
+# reading of the actor-critic (spec 7, A10, A14; L2, L3), one option away (--configuration literal).
+CONFIGURATION_NAMES = ("default", "literal")
 
 # Integer limits of the command line and of the Python API.
 INT64_MAX = 2 ** 63 - 1

@@ -24,9 +24,9 @@ void icoac_priv_actor_sample(icoac_priv_state_t *st)
 /* Posterior reading: Sigma' = A Sigma A^T + sigma_L^2 k k^T with A = I - k h^T (Joseph form),
  * evaluated as A Sigma = Sigma - k (Sigma h)^T and (A Sigma) A^T = A Sigma - (A Sigma h) k^T;
  * the upper triangle is mirrored, so Sigma stays exactly symmetric. */
-void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
-                                const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
-                                icoac_real_t cov[N][N])
+static inline void posterior_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                  const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
+                                  icoac_real_t cov[N][N])
 {
     const icoac_real_t noise_var = actor->likelihood_std * actor->likelihood_std;
     const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
@@ -73,8 +73,15 @@ void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_p
     }
 }
 
+void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
+                                icoac_real_t cov[N][N])
+{
+    posterior_step(actor, st, h, innovation, w, cov);
+}
+
 /* Mean reading: mu += Sigma0 h innovation / (h^T Sigma0 h + sigma_L^2), Sigma_w unchanged. */
-static void mean_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st, const icoac_real_t h[N],
+ICOAC_PRIV_NOINLINE static void mean_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st, const icoac_real_t h[N],
                       icoac_real_t innovation, icoac_real_t w[N])
 {
     const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
@@ -212,7 +219,7 @@ int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t 
         return 0;
     }
     default:
-        icoac_priv_actor_posterior(actor, st, h, innovation, w, cov);
+        posterior_step(actor, st, h, innovation, w, cov);
         return 1;
     }
 }

@@ -35,7 +35,8 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     const int learn = st->has_prev;         /* a transition into s exists: delta is defined */
     const int update = learn && cfg->learn; /* ... and the critic and actor learn from it */
     /* the transition's first tick explored (L3): its noise is the actor's observation */
-    const int observed = cfg->actor.explore_ticks == 0 || st->trial_ticks <= (uint32_t)cfg->actor.explore_ticks;
+    const uint32_t explore_ticks = (uint32_t)cfg->actor.explore_ticks;
+    const int observed = explore_ticks == 0u || st->trial_ticks <= explore_ticks;
     const icoac_real_t *w_act = cfg->actor.act_with_sample ? st->w_act : (update ? w : st->w);
     int cov_changed = 0;
     icoac_real_t z = ICOAC_R(0.0);
@@ -109,7 +110,7 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
         st->has_prev = 0;
         return 1;
     }
-    if (cfg->actor.explore_ticks == 0 || st->trial_ticks < (uint32_t)cfg->actor.explore_ticks) {
+    if (explore_ticks == 0u || st->trial_ticks < explore_ticks) {
         noise = cfg->actor.noise_std * icoac_rng_normal(&st->rng);
     }
     out->z = z;
@@ -122,6 +123,7 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     /* quirks: V_old = 0 at a reset, so the trial's first delta is gamma V(s_1) */
     st->value_prev = (cfg->critic.quirks && !st->has_prev) ? ICOAC_R(0.0) : checked[0];
     st->noise_prev = noise;
+    st->trial_ticks++;
     icoac_priv_cache_tick(st, scaled);
     return 1;
 }

@@ -181,5 +181,6 @@ int icoac_priv_search_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
     out->z = z;
     out->force = force;
     out->cov_trace = icoac_priv_trace4(icoac_priv_cov_c(st));
+    st->trial_ticks++;
     return 1;
 }

@@ -60,7 +60,7 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
     icoac_real_t penalty_prev;                        /* r of the previous ICO observation */
     icoac_real_t value_prev;                          /* V(s_t) */
     icoac_real_t noise_prev;                          /* exploration noise eps_t (N) */
-    uint32_t trial_ticks;                             /* non-terminal ticks of this trial so far (wraps at 2^32) */
+    uint32_t trial_ticks;                             /* RL and search: non-terminal ticks of this trial so far (wraps at 2^32) */
     icoac_priv_actor_batch_t batch;                   /* RL, actor.batch: this trial's sums */
     icoac_priv_search_t search;                       /* search mode */
     icoac_rng_t rng;                                  /* exploration noise; search: the samples */

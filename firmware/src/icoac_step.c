@@ -71,7 +71,6 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state, const
         st->counters.numeric_faults++;
         return rejected(st, out, ICOAC_ERR_NUMERIC);
     }
-    st->trial_ticks += (uint32_t)!terminal;
     out->weight_norm = st->weight_norm;
     out->status = ICOAC_OK;
     return ICOAC_OK;

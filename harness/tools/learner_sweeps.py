@@ -5,7 +5,7 @@
 Each sweep runs on two cell selections, 2 seeds each: `spread` (49 cells evenly over the grid)
 and `ico-failed` (every cell where the ICO run of --prior-from failed). Stage 1 compares the actor
 readings and their rates (with the no-learning control), and the search's parameters one at a
-time; stage 2 (``--stage 2 --base NAME=VALUE ...``) varies the exploration schedule, the batch
+time, then small factorial grids of the search's breadth (cov_scale x floor x batch); stage 2 (``--stage 2 --base NAME=VALUE ...``) varies the exploration schedule, the batch
 granularity, the critic quirks and the exploration scale around the stage-1 choice. Every sweep
 resumes (finished settings are skipped), so an interrupted run loses nothing.
 """
@@ -28,15 +28,22 @@ SPREAD_CELLS = 49
 STAGE_1 = (
     ("ico-rl-control", "ico-rl-control", ["actor.update=posterior"], False),
     ("ico-rl-posterior", "ico-rl", ["actor.update=posterior", "actor.likelihood_std=0.3,1,3,10"], False),
-    ("ico-rl-mean", "ico-rl", ["actor.update=mean", "actor.likelihood_std=0.3,1,3,10"], False),
-    ("ico-rl-gradient", "ico-rl", ["actor.update=gradient", "actor.rate=0.001,0.003,0.01,0.03,0.1"], False),
+    ("ico-rl-mean", "ico-rl", ["actor.update=mean", "actor.likelihood_std=0.03,0.1,0.3,1,3,10"], False),
+    ("ico-rl-gradient", "ico-rl", ["actor.update=gradient",
+                                     "actor.rate=0.0001,0.0003,0.001,0.003,0.01,0.03,0.1"], False),
     ("rl-control", "rl-control", ["actor.update=posterior"], False),
     ("rl-posterior", "rl", ["actor.update=posterior", "actor.likelihood_std=1,10"], False),
-    ("rl-mean", "rl", ["actor.update=mean", "actor.likelihood_std=1,10"], False),
-    ("rl-gradient", "rl", ["actor.update=gradient", "actor.rate=0.003,0.01,0.03,0.1"], False),
+    ("rl-mean", "rl", ["actor.update=mean", "actor.likelihood_std=0.1,0.3,1,10"], False),
+    ("rl-gradient", "rl", ["actor.update=gradient", "actor.rate=0.001,0.003,0.01,0.03,0.1"], False),
+    ("ico-search-control", "ico-search-control", ["search.cov_scale=1,16,256"], False),
     ("ico-search", "ico-search", ["search.batch=2,4,8", "search.elite_fraction=0.25,0.5",
                                   "search.step=0.5,1", "search.floor=0.01,0.1,1",
-                                  "search.cov_scale=1,4,16"], True),
+                                  "search.cov_scale=1,4,16,64,256"], True),
+    ("ico-search-grid", "ico-search", ["search.cov_scale=16,64,256", "search.floor=0.1,1", "search.batch=4,8",
+                                       "search.elite_fraction=0.25"], False),
+    ("search-control", "search-control", ["search.cov_scale=1,4"], False),
+    ("search-grid", "search", ["search.cov_scale=1,4", "search.floor=0.1,1", "search.batch=4,8",
+                               "search.elite_fraction=0.25"], False),
     ("search", "search", ["search.batch=2,4,8", "search.elite_fraction=0.25,0.5",
                           "search.step=0.5,1", "search.floor=0.01,0.1,1",
                           "search.cov_scale=1,4,16"], True),
