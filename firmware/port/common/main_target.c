@@ -46,10 +46,13 @@ static uint32_t timer_elapsed(uint32_t from, uint32_t to)
     return (from - to) & 0x00FFFFFFu;
 }
 
+/* The paint stores are volatile so that GCC does not turn the loop into a memset call, whose own
+ * frame would lie in the painted area (newlib-nano's ARMv6-M memset pushes 20 bytes and would
+ * restore a clobbered r4). */
 void port_ticks_begin(uintptr_t sp)
 {
-    uint32_t *p = __stack_bottom;
-    uint32_t *end = (uint32_t *)(port_read_sp() - 16u);
+    volatile uint32_t *p = __stack_bottom;
+    volatile uint32_t *end = (volatile uint32_t *)(port_read_sp() - 16u);
     (void)sp;
     while (p < end) {
         *p++ = STACK_PAINT;
