@@ -1,4 +1,4 @@
-/* icoac port example: replays the recorded closed-loop ICO and RL sequences through
+/* icoac port example: replays the recorded closed-loop ICO, RL and search sequences through
  * icoac_step, measures instructions (SysTick under QEMU -icount shift=0) and peak stack
  * (painting), and prints every tick's outputs over semihosting.
  *
@@ -62,10 +62,16 @@ void port_ticks_begin(uintptr_t sp)
     t_last = t_begin;
 }
 
-void port_tick_done(void)
+void port_tick_start(uint32_t kind)
+{
+    (void)kind;
+}
+
+void port_tick_done(uint32_t kind)
 {
     uint32_t now = timer_now();
     uint32_t d = timer_elapsed(t_last, now);
+    (void)kind;
     if (d > t_max) {
         t_max = d;
     }
@@ -160,7 +166,8 @@ int main(void)
         return 1;
     }
     if (replay_run(&ctrl, ICOAC_MODE_ICO, icoac_step, 1) == 0u ||
-        replay_run(&ctrl, ICOAC_MODE_RL, icoac_step, 1) == 0u) {
+        replay_run(&ctrl, ICOAC_MODE_RL, icoac_step, 1) == 0u ||
+        replay_run(&ctrl, ICOAC_MODE_SEARCH, icoac_step, 1) == 0u) {
         return 1;
     }
     port_puts("END\n");
