@@ -5,7 +5,7 @@
   run     <preset> <out>                   run the example under QEMU (-icount shift=0), save output
   nm      <preset>                         no heap allocator in the library or the example
   compare <host-exe|out> <target-out>      ICO bit-exact, RL and search within tolerance of the host build
-  stack   <target-out> <budget>            peak stack of the tick loop within budget (bytes)
+  stack   <target-out> <budget>            peak stack of the tick loops (and of the search update) within budget (bytes)
 """
 import os
 import re
@@ -133,13 +133,22 @@ def cmd_compare(host_path, target_path):
         sys.exit("\n".join(fail[:20]))
 
 
+def measurements(text):
+    """{mode: {key: int}} from the target's "M <mode> key=value ..." lines."""
+    return {m.group(1): {k: int(v) for k, v in (kv.split("=") for kv in m.group(2).split())}
+            for m in re.finditer(r"^M (\w+) (.*)$", text, re.M)}
+
+
 def cmd_stack(target_path, budget):
-    text = open(target_path).read()
-    peaks = [int(m) for m in re.findall(r"^M \w+ .*stack=(\d+)", text, re.M)]
-    if len(peaks) != 2:
-        sys.exit("no stack measurements in " + target_path)
-    print("peak stack below the tick loop: ICO %d B, RL %d B (budget %d B)" % (peaks[0], peaks[1], budget))
-    if max(peaks) > budget:
+    meas = measurements(open(target_path).read())
+    peaks = [("ICO", meas.get("ico", {}).get("stack")), ("RL", meas.get("rl", {}).get("stack")),
+             ("search", meas.get("search", {}).get("stack")),
+             ("search update", meas.get("search", {}).get("stack_update"))]
+    if any(v is None for _, v in peaks):
+        sys.exit("stack measurements missing in " + target_path)
+    print("peak stack below the tick loop: %s (budget %d B)"
+          % (", ".join("%s %d B" % p for p in peaks), budget))
+    if max(v for _, v in peaks) > budget:
         sys.exit("stack budget exceeded")
 
 
