@@ -3,7 +3,8 @@
 
 Builds the cortex-m4f and cortex-m0plus presets, runs the port example under QEMU with
 -icount shift=0 (1 instruction = 1 ns of virtual time) and tabulates flash/RAM
-(arm-none-eabi-size), struct sizes, peak stack and instructions per tick.
+(arm-none-eabi-size), struct sizes, peak stack and instructions per tick (and, for the search
+learner, per update and per trial start).
 
   python3 firmware/port/report.py                      # print the table
   python3 firmware/port/report.py --update docs/porting.md   # rewrite the table between markers
@@ -20,6 +21,15 @@ import target_check  # noqa: E402
 
 BEGIN, END = "<!-- target-report:begin -->", "<!-- target-report:end -->"
 GOALS = {"cortex-m4f": 3000, "cortex-m0plus": 100000}
+
+
+def search_batch():
+    """REPLAY_SEARCH_BATCH of the recorded inputs (search.batch of the replay)."""
+    path = os.path.join(ROOT, "firmware", "port", "common", "recorded_inputs.h")
+    return int(re.search(r"^#define REPLAY_SEARCH_BATCH (\d+)", open(path).read(), re.M).group(1))
+
+
+BATCH = search_batch()
 
 
 def size_of(path):
@@ -78,20 +88,35 @@ def measure(preset):
     z = dict(kv.split("=") for kv in re.search(r"^Z (.*)$", out, re.M).group(1).split())
     cal = dict(kv.split("=") for kv in re.search(r"^C (.*)$", out, re.M).group(1).split())
     insn_per_count = int(cal["insns"]) / int(cal["systick"])
+    meas = target_check.measurements(out)
     ticks = {}
-    for m in re.finditer(r"^M (\w+) (.*)$", out, re.M):
-        kv = dict(x.split("=") for x in m.group(2).split())
-        n = int(kv["ticks"])
-        net = (int(kv["systick_total"]) - int(kv["systick_base"])) * insn_per_count / n
-        worst = (int(kv["systick_max"]) - int(kv["systick_base_max"])) * insn_per_count
-        ticks[m.group(1)] = (net, int(kv["stack"]), worst)
+    for mode in ("ico", "rl"):
+        kv = meas[mode]
+        net = (kv["systick_total"] - kv["systick_base"]) * insn_per_count / kv["ticks"]
+        worst = (kv["systick_max"] - kv["systick_base_max"]) * insn_per_count
+        ticks[mode] = (net, kv["stack"], worst)
+    # Search: the update ticks (terminal ticks that close a batch) apart from the others; every
+    # SysTick sum is over `phases` runs.
+    kv = meas["search"]
+    phases, updates = kv["phases"], kv["updates"]
+    update = kv["systick_update"] - kv["systick_update_base"]
+    search = {
+        "ticks": kv["ticks"], "updates": updates, "phases": phases,
+        "tick": (kv["systick_total"] - kv["systick_base"] - update) * insn_per_count
+                / (phases * (kv["ticks"] - updates)),
+        "update": update * insn_per_count / (phases * updates),
+        "resets": kv["resets"],
+        "reset": (kv["systick_reset"] - kv["systick_reset_base"]) * insn_per_count / kv["resets"],
+        "stack": kv["stack"], "stack_update": kv["stack_update"],
+    }
     return {
         "lib": size_of(target_check.lib(preset)),
         "linked": linked_sizes(target_check.elf(preset)[:-4] + ".map"),
         "elf": size_of(target_check.elf(preset)),
         "frame": step_frame(preset),
         "config": int(z["config"]), "state": int(z["state"]),
-        "ico": ticks["ico"], "rl": ticks["rl"], "board": target_check.BOARDS[preset],
+        "ico": ticks["ico"], "rl": ticks["rl"], "search": search, "board": target_check.BOARDS[preset],
+        "recorded": sum(kv["ticks"] for kv in meas.values()),
         "insn_per_count": insn_per_count,
     }
 
@@ -110,7 +135,8 @@ def table(results):
     row("libm/libc/libgcc flash in the example (float math for the library, memcpy)", "",
         lambda r, k: "%d B" % r["linked"]["runtime"])
     row("library RAM: data + bss", "", lambda r, k: "%d B" % (r["lib"][1] + r["lib"][2]))
-    row("example flash: text + data (incl. %s recorded ticks)" % "800", "",
+    first = results[p[0]]
+    row("example flash: text + data (incl. %d recorded ticks)" % first["recorded"], "",
         lambda r, k: "%d B" % (r["elf"][0] + r["elf"][1]))
     row("example RAM: data + bss (excl. stack)", "", lambda r, k: "%d B" % (r["elf"][1] + r["elf"][2]))
     row("`sizeof(icoac_config_t)`", "", lambda r, k: "%d B" % r["config"])
@@ -121,11 +147,24 @@ def table(results):
         lambda r, k: "%d B %s" % (r["ico"][1], "ok" if r["ico"][1] <= 512 else "**over**"))
     row("peak stack of a tick, RL (painted)", "<= 512 B",
         lambda r, k: "%d B %s" % (r["rl"][1], "ok" if r["rl"][1] <= 512 else "**over**"))
+    row("peak stack of a search tick (painted; update ticks excluded)", "<= 512 B",
+        lambda r, k: "%d B %s" % (r["search"]["stack"], "ok" if r["search"]["stack"] <= 512 else "**over**"))
+    row("peak stack of a search update tick (painted)", "<= 512 B",
+        lambda r, k: "%d B %s" % (r["search"]["stack_update"],
+                                  "ok" if r["search"]["stack_update"] <= 512 else "**over**"))
     row("`icoac_step` own frame (`-fstack-usage`)", "",
         lambda r, k: "%d B" % r["frame"])
     row("instructions per ICO tick (mean of 400)", "", lambda r, k: "%.0f" % r["ico"][0])
     row("instructions per RL tick (mean of 400)", "M4F <= 3,000; M0+ <= 100,000",
         lambda r, k: "%.0f %s" % (r["rl"][0], "ok" if r["rl"][0] <= GOALS[k] else "**over goal**"))
+    sr = first["search"]
+    row("instructions per search tick (mean of the %d that do not close a batch)"
+        % (sr["ticks"] - sr["updates"]), "", lambda r, k: "%.0f" % r["search"]["tick"])
+    row("instructions per search update (terminal tick closing a batch of %d trials; mean of %d x %d runs)"
+        % (BATCH, sr["updates"], sr["phases"]), "",
+        lambda r, k: "%.0f +- %.0f" % (r["search"]["update"], 2 * r["insn_per_count"] / r["search"]["phases"]))
+    row("instructions per search trial start (`icoac_reset`: the draw of w; mean of %d)" % sr["resets"], "",
+        lambda r, k: "%.0f" % r["search"]["reset"])
     row("slowest ICO tick (instructions, approx.)", "",
         lambda r, k: "%.0f +- %.0f" % (r["ico"][2], 2 * r["insn_per_count"]))
     row("slowest RL tick (instructions, approx.)", "",

@@ -122,39 +122,66 @@ static void print_posterior(const icoac_state_t *state)
 
 uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step, int verbose)
 {
-    const replay_tick_t *seq = mode == ICOAC_MODE_RL ? replay_rl : replay_ico;
-    uint32_t n = mode == ICOAC_MODE_RL ? REPLAY_RL_N : REPLAY_ICO_N;
-    uint64_t seed = mode == ICOAC_MODE_RL ? REPLAY_RL_SEED : REPLAY_ICO_SEED;
+    const replay_tick_t *seq;
+    uint32_t n;
+    uint64_t seed;
+    const char *section;
     icoac_input_t in;
     icoac_output_t out;
     uint32_t i;
+    uint32_t trials = 0u;
     uintptr_t sp;
 
+    if (mode == ICOAC_MODE_SEARCH) {
+        seq = replay_search;
+        n = REPLAY_SEARCH_N;
+        seed = REPLAY_SEARCH_SEED;
+        section = "S search\n";
+    } else if (mode == ICOAC_MODE_RL) {
+        seq = replay_rl;
+        n = REPLAY_RL_N;
+        seed = REPLAY_RL_SEED;
+        section = "S rl\n";
+    } else {
+        seq = replay_ico;
+        n = REPLAY_ICO_N;
+        seed = REPLAY_ICO_SEED;
+        section = "S ico\n";
+    }
     icoac_config_default(&ctrl->cfg);
     ctrl->cfg.mode = mode;
+    ctrl->cfg.search.batch = REPLAY_SEARCH_BATCH; /* as gen_inputs.c; search mode only */
     if (icoac_config_check(&ctrl->cfg) != ICOAC_OK ||
         icoac_init(&ctrl->cfg, &ctrl->state, NULL, seed) != ICOAC_OK) {
         port_puts("E init\n");
         return 0u;
     }
     if (verbose) {
-        port_puts(mode == ICOAC_MODE_RL ? "S rl\n" : "S ico\n");
+        port_puts(section);
     }
     sp = port_read_sp();
     if (!verbose) {
         port_ticks_begin(sp);
     }
     for (i = 0u; i < n; ++i) {
+        const int terminal = (seq[i].flags & REPLAY_FLAG_TERMINAL) != 0u;
+        uint32_t kind = REPLAY_TICK_PLAIN;
+        if (mode == ICOAC_MODE_SEARCH && terminal && ++trials % (uint32_t)REPLAY_SEARCH_BATCH == 0u) {
+            kind = REPLAY_TICK_UPDATE;
+        }
+        if (!verbose) {
+            port_tick_start(kind);
+        }
         if ((seq[i].flags & REPLAY_FLAG_RESET) != 0u) {
             (void)icoac_reset(&ctrl->cfg, &ctrl->state);
         }
         memcpy(in.s, seq[i].s, sizeof in.s);
-        in.flags = (seq[i].flags & REPLAY_FLAG_TERMINAL) != 0u ? ICOAC_INPUT_TERMINAL : 0u;
+        in.flags = terminal ? ICOAC_INPUT_TERMINAL : 0u;
         (void)step(&ctrl->cfg, &ctrl->state, &in, &out);
         if (verbose) {
             print_tick(i, &out);
         } else {
-            port_tick_done();
+            port_tick_done(kind);
         }
     }
     if (!verbose) {

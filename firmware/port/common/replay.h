@@ -21,14 +21,21 @@ typedef struct {
 typedef icoac_status_t (*replay_step_fn)(const icoac_config_t *cfg, icoac_state_t *state,
                                          const icoac_input_t *in, icoac_output_t *out);
 
+/* Kind of a tick, passed to the per-tick hooks of a non-verbose run. */
+#define REPLAY_TICK_PLAIN 0u  /* every tick but the next kind (trial starts included) */
+#define REPLAY_TICK_UPDATE 1u /* search: the terminal tick that closes a batch of
+                                 REPLAY_SEARCH_BATCH trials and runs the update */
+
 /* Provided by the platform (target: semihosting; host: stdout). */
 void port_puts(const char *s);
 /* Called right before and after the tick loop with the stack pointer of the loop's frame
  * (0 on the host). The target paints the stack and reads its timer here. */
 void port_ticks_begin(uintptr_t sp);
 void port_ticks_end(uintptr_t sp);
-/* Called after every tick of a non-verbose run (timing of the slowest tick). */
-void port_tick_done(void);
+/* Called before every tick of a non-verbose run (before its icoac_reset, if any) and after it
+ * (timing of the slowest tick and of the update ticks; stack of the update ticks). */
+void port_tick_start(uint32_t kind);
+void port_tick_done(uint32_t kind);
 uintptr_t port_read_sp(void);
 
 /* One controller instance, owned by the caller (the library keeps no state of its own). */
@@ -37,8 +44,9 @@ typedef struct {
     icoac_state_t state;
 } replay_controller_t;
 
-/* Run sequence mode (ICOAC_MODE_ICO / ICOAC_MODE_RL) with step on ctrl (re-initialised);
- * print each tick when verbose. Returns the number of ticks, or 0 on an init error. */
+/* Run sequence mode (ICOAC_MODE_ICO / ICOAC_MODE_RL / ICOAC_MODE_SEARCH) with step on ctrl
+ * (re-initialised; default configuration but search.batch = REPLAY_SEARCH_BATCH); print each
+ * tick and then the posterior when verbose. Returns the number of ticks, or 0 on an init error. */
 uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step, int verbose);
 
 /* Formatting helpers (no printf: newlib's float printf allocates). */
