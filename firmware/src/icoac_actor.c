@@ -183,9 +183,12 @@ int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t 
                           icoac_real_t delta, int observed, int trial_end, icoac_real_t w[N],
                           icoac_real_t cov[N][N])
 {
-    /* u_ob - h^T mu_w, with u_ob = h^T w_act + alpha * delta * eps (Eq. 7-8) */
-    const icoac_real_t innovation = icoac_priv_dot4(h, st->w_act) - icoac_priv_dot4(h, st->w) +
-                                    actor->scale * delta * st->noise_prev;
+    /* u_ob - h^T mu_w, with u_ob = h^T w_act + alpha * delta * eps (Eq. 7-8); acting with mu_w,
+     * w_act is mu_w bit for bit and the first term is exactly 0 */
+    icoac_real_t innovation = actor->scale * delta * st->noise_prev;
+    if (actor->act_with_sample) {
+        innovation += icoac_priv_dot4(h, st->w_act) - icoac_priv_dot4(h, st->w);
+    }
     if (actor->batch) {
         icoac_real_t *shift = st->batch.staged_shift;
         icoac_priv_copy4(shift, st->batch.shift);

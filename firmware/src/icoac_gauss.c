@@ -1,13 +1,8 @@
-/* Gaussian helpers shared by the actor and the search: trace, Cholesky factor, SPD inverse,
- * and a draw through the factor. */
+/* Gaussian helpers shared by the actor and the search: Cholesky factor, SPD inverse, and a
+ * draw through the factor. */
 #include "icoac_priv.h"
 
 #define N ICOAC_N_INPUTS
-
-icoac_real_t icoac_priv_trace4(const icoac_real_t m[N][N])
-{
-    return (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
-}
 
 int icoac_priv_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
 {

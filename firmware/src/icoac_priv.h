@@ -32,9 +32,10 @@
 /* C99 will not pass T[4][4] to const T[4][4] implicitly. */
 #define ICOAC_PRIV_CONST_MAT4(m) ((const icoac_real_t(*)[ICOAC_N_INPUTS])(m))
 
-/* exp(a) for the critic. Default: the C library's expf/exp. With ICOAC_FAST_EXP=1 (float
- * builds; the microcontroller presets turn it on): Cody-Waite reduction a = n ln2 + r,
- * |r| <= ln2/2, a degree-6 Taylor polynomial for e^r and 2^n from the exponent bits.
+/* exp(a) for the critic and ln(a) for the exploration noise. Default: the C library's. With
+ * ICOAC_FAST_EXP=1 (float builds; the microcontroller presets turn it on), icoac's own. exp:
+ * Cody-Waite reduction a = n ln2 + r, |r| <= ln2/2, a degree-6 Taylor polynomial for e^r and
+ * 2^n from the exponent bits.
  * Relative error < 1e-6 on [-87, 88] (tests/c/test_fast_exp.c); 0 below -87, NaN for NaN. */
 #if defined(ICOAC_FAST_EXP) && ICOAC_FAST_EXP && !(defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE)
 static inline float icoac_priv_exp(float a)
@@ -65,10 +66,44 @@ static inline float icoac_priv_exp(float a)
     scale.u = (uint32_t)(n + 127) << 23;
     return p * scale.f;
 }
+
+/* ln(a) for the polar method's s in (0, 1), positive normal a (ICOAC_FAST_EXP=1): a = m 2^e with
+ * m in [sqrt(1/2), sqrt(2)), ln m = 2 atanh(t), t = (m - 1)/(m + 1), |t| <= 0.1716, by its odd
+ * series to t^9 (truncation < 3e-9 relative); e ln 2 in two parts. Max error a few ulp
+ * (tests/c/test_fast_exp.c); not for 0, subnormal, negative or non-finite a. */
+static inline float icoac_priv_log(float a)
+{
+    const float ln2_hi = 0.693145751953125f;
+    const float ln2_lo = 1.42860676533018704e-06f;
+    union {
+        float f;
+        uint32_t u;
+    } m;
+    int32_t e;
+    float t;
+    float t2;
+    float series;
+    m.f = a;
+    e = (int32_t)(m.u >> 23) - 127;
+    m.u = (m.u & 0x007FFFFFu) | 0x3F800000u; /* [1, 2) */
+    if (m.u > 0x3FB504F3u) {                  /* above sqrt(2): halve */
+        m.u -= 0x00800000u;
+        ++e;
+    }
+    t = (m.f - 1.0f) / (m.f + 1.0f);
+    t2 = t * t;
+    series = t * (2.0f + t2 * (2.0f / 3.0f + t2 * (2.0f / 5.0f + t2 * (2.0f / 7.0f + t2 * (2.0f / 9.0f)))));
+    return ((float)e * ln2_hi + series) + (float)e * ln2_lo;
+}
 #else
 static inline icoac_real_t icoac_priv_exp(icoac_real_t a)
 {
     return ICOAC_PRIV_LIBM_EXP(a);
+}
+
+static inline icoac_real_t icoac_priv_log(icoac_real_t a)
+{
+    return ICOAC_PRIV_LOG(a);
 }
 #endif
 
@@ -148,6 +183,11 @@ static inline icoac_real_t icoac_priv_dot4(const icoac_real_t a[ICOAC_N_INPUTS],
     return (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
 }
 
+static inline icoac_real_t icoac_priv_trace4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS])
+{
+    return (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
+}
+
 /* The tick's per-trial cache: this tick's scaled observation is the next one's previous. */
 static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_real_t scaled[ICOAC_N_INPUTS])
 {
@@ -204,7 +244,6 @@ void icoac_priv_search_sample(icoac_priv_state_t *st);
 int icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st);
 
 /* Gaussian helpers (icoac_gauss.c). */
-icoac_real_t icoac_priv_trace4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
 /* m = L L^T; returns 0 when m is not positive definite. */
 int icoac_priv_cholesky4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS],
                          icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);

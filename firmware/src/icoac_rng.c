@@ -52,7 +52,7 @@ icoac_real_t icoac_rng_normal(icoac_rng_t *rng)
         v = ICOAC_R(2.0) * icoac_rng_uniform(rng) - ICOAC_R(1.0);
         s = u * u + v * v;
     } while (s >= ICOAC_R(1.0) || s == ICOAC_R(0.0));
-    f = ICOAC_PRIV_SQRT(ICOAC_R(-2.0) * ICOAC_PRIV_LOG(s) / s);
+    f = ICOAC_PRIV_SQRT(ICOAC_R(-2.0) * icoac_priv_log(s) / s);
     rng->spare_normal = v * f;
     rng->has_spare = 1;
     return u * f;

@@ -43,28 +43,30 @@ typedef struct {
     int32_t count;                                          /* trials recorded */
 } icoac_priv_search_t;
 
-/* Everything the controller owns. */
+/* Everything the controller owns. The small per-tick fields come first: a Cortex-M load or
+ * store reaches 1020 bytes past the base, so fields behind the large arrays cost an address
+ * computation per access. */
 typedef struct ICOAC_PRIV_MAY_ALIAS {
     uint32_t magic;                                   /* set by icoac_init */
     int32_t has_prev;                                 /* a previous tick of this trial is cached */
     icoac_real_t inv_range[ICOAC_N_INPUTS];           /* 1 / policy.input_range, derived by icoac_init */
     icoac_real_t w[ICOAC_N_INPUTS];                   /* ICO weights, or actor mean mu_w */
     icoac_real_t weight_norm;                         /* |w|, refreshed when w changes */
-    icoac_real_t cov_buffer[2][ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* Sigma_w, and the spare the RL tick stages into */
-    int32_t cov_slot;                                 /* index of Sigma_w in cov_buffer */
     icoac_real_t w_act[ICOAC_N_INPUTS];               /* weights used to act (mu_w or a sample) */
-    icoac_real_t v[ICOAC_CRITIC_UNITS];               /* critic weights */
-    icoac_priv_critic_active_t active[2];             /* kept critic units of s_t and of s */
+    int32_t cov_slot;                                 /* index of Sigma_w in cov_buffer */
     int32_t active_slot;                              /* index of s_t's entry in active */
     icoac_real_t x_prev[ICOAC_N_INPUTS];              /* scaled observation of the previous tick */
     icoac_real_t penalty_prev;                        /* r of the previous ICO observation */
     icoac_real_t value_prev;                          /* V(s_t) */
     icoac_real_t noise_prev;                          /* exploration noise eps_t (N) */
     uint32_t trial_ticks;                             /* RL and search: non-terminal ticks of this trial so far (wraps at 2^32) */
-    icoac_priv_actor_batch_t batch;                   /* RL, actor.batch: this trial's sums */
-    icoac_priv_search_t search;                       /* search mode */
     icoac_rng_t rng;                                  /* exploration noise; search: the samples */
     icoac_counters_t counters;
+    icoac_real_t cov_buffer[2][ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* Sigma_w, and the spare the RL tick stages into */
+    icoac_priv_critic_active_t active[2];             /* kept critic units of s_t and of s */
+    icoac_real_t v[ICOAC_CRITIC_UNITS];               /* critic weights */
+    icoac_priv_actor_batch_t batch;                   /* RL, actor.batch: this trial's sums */
+    icoac_priv_search_t search;                       /* search mode */
 } icoac_priv_state_t;
 
 ICOAC_STATIC_ASSERT(sizeof(icoac_priv_state_t) <= sizeof(icoac_state_t), state_fits_its_storage);

@@ -48,11 +48,14 @@ STAGE_1 = (
                           "search.step=0.5,1", "search.floor=0.01,0.1,1",
                           "search.cov_scale=1,4,16"], True),
 )
+# One at a time: the first value of each list is the base (the defaults around the stage-1 choice).
 STAGE_2 = (
     ("ico-rl-stage2", "ico-rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
-                                 "actor.noise_std=0.3,1,3", "actor.scale=0.5,2"], True),
+                                 "actor.noise_std=1,0.3,0.5,2", "actor.scale=0.5,0.25,2"], True),
+    ("ico-rl-schedule-grid", "ico-rl", ["actor.explore_ticks=30,100,300", "actor.rate=0.0003,0.001,0.003"], False),
     ("rl-stage2", "rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
-                         "actor.noise_std=0.3,1,3", "actor.scale=0.5,2"], True),
+                         "actor.noise_std=1,0.3,0.5,2", "actor.scale=0.5,0.25,2"], True),
+    ("rl-schedule-grid", "rl", ["actor.explore_ticks=30,100,300", "actor.likelihood_std=0.03,0.1,0.3"], False),
 )
 
 

@@ -142,6 +142,7 @@ def measurements(text):
 def cmd_stack(target_path, budget):
     meas = measurements(open(target_path).read())
     peaks = [("ICO", meas.get("ico", {}).get("stack")), ("RL", meas.get("rl", {}).get("stack")),
+             ("RL literal", meas.get("rl_literal", {}).get("stack")),
              ("search", meas.get("search", {}).get("stack")),
              ("search update", meas.get("search", {}).get("stack_update"))]
     if any(v is None for _, v in peaks):

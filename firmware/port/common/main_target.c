@@ -273,6 +273,7 @@ int main(void)
     port_puts("\n");
     count_insns = (200000u + (c2 - c1) / 2u) / (c2 - c1); /* instructions per count, rounded */
     if (measure(&ctrl, ICOAC_MODE_ICO, "ico", count_insns) || measure(&ctrl, ICOAC_MODE_RL, "rl", count_insns) ||
+        measure(&ctrl, REPLAY_RL_LITERAL, "rl_literal", count_insns) ||
         measure(&ctrl, ICOAC_MODE_SEARCH, "search", count_insns)) {
         return 1;
     }

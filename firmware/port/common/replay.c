@@ -137,11 +137,11 @@ uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step
         n = REPLAY_SEARCH_N;
         seed = REPLAY_SEARCH_SEED;
         section = "S search\n";
-    } else if (mode == ICOAC_MODE_RL) {
+    } else if (mode == ICOAC_MODE_RL || mode == REPLAY_RL_LITERAL) {
         seq = replay_rl;
         n = REPLAY_RL_N;
         seed = REPLAY_RL_SEED;
-        section = "S rl\n";
+        section = mode == REPLAY_RL_LITERAL ? "S rl_literal\n" : "S rl\n";
     } else {
         seq = replay_ico;
         n = REPLAY_ICO_N;
@@ -149,7 +149,12 @@ uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step
         section = "S ico\n";
     }
     icoac_config_default(&ctrl->cfg);
-    ctrl->cfg.mode = mode;
+    ctrl->cfg.mode = mode == REPLAY_RL_LITERAL ? ICOAC_MODE_RL : mode;
+    if (mode == REPLAY_RL_LITERAL) {
+        ctrl->cfg.actor.update = ICOAC_ACTOR_POSTERIOR;
+        ctrl->cfg.actor.explore_ticks = 0;
+        ctrl->cfg.actor.batch = 0;
+    }
     ctrl->cfg.search.batch = REPLAY_SEARCH_BATCH; /* as gen_inputs.c; search mode only */
     if (icoac_config_check(&ctrl->cfg) != ICOAC_OK ||
         icoac_init(&ctrl->cfg, &ctrl->state, NULL, seed) != ICOAC_OK) {

@@ -44,9 +44,14 @@ typedef struct {
     icoac_state_t state;
 } replay_controller_t;
 
-/* Run sequence mode (ICOAC_MODE_ICO / ICOAC_MODE_RL / ICOAC_MODE_SEARCH) with step on ctrl
- * (re-initialised; default configuration but search.batch = REPLAY_SEARCH_BATCH); print each
- * tick and then the posterior when verbose. Returns the number of ticks, or 0 on an init error. */
+/* Not a controller mode: the RL sequence with the paper's literal actor reading (posterior
+ * update, exploration always on, per tick), whatever the defaults are. */
+#define REPLAY_RL_LITERAL 0x100
+
+/* Run sequence mode (ICOAC_MODE_ICO / ICOAC_MODE_RL / ICOAC_MODE_SEARCH / REPLAY_RL_LITERAL)
+ * with step on ctrl (re-initialised; default configuration but search.batch =
+ * REPLAY_SEARCH_BATCH); print each tick and then the posterior when verbose. Returns the
+ * number of ticks, or 0 on an init error. */
 uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step, int verbose);
 
 /* Formatting helpers (no printf: newlib's float printf allocates). */
