@@ -1,4 +1,4 @@
-/* Bayesian actor (spec 7): icoac_actor_update against the closed-form Gaussian posterior,
+/* Bayesian actor (spec 7): icoac_priv_actor_posterior against the closed-form Gaussian posterior,
  * long-run symmetry / positive definiteness, forgetting, and the Eq. 7-8 wiring in icoac_step. */
 #include "test_common.h"
 
@@ -126,7 +126,8 @@ static void compare_with_closed_form(const icoac_config_t *cfg, test_rng_t *rng,
         hd[i] = (double)h[i];
     }
     innovation = (double)(icoac_real_t)test_uniform(rng, -3, 3);
-    r = (double)cfg->actor.noise_std * (double)cfg->actor.noise_std;
+    /* the likelihood variance is sigma_L^2 (spec L2), whatever the exploration std sigma_u */
+    r = (double)cfg->actor.likelihood_std * (double)cfg->actor.likelihood_std;
     closed_form(&prior, hd, innovation, r, &post);
     actor_update_in_place(cfg, &state, h, (icoac_real_t)innovation);
     /* float: a few hundred ulps of the largest prior entry (the update subtracts nearly equal terms) */
@@ -148,7 +149,9 @@ static void test_update_matches_closed_form(void **unused)
     (void)unused;
     (void)rl_state(&cfg);
     for (n = 0; n < 300; ++n) {
-        cfg.actor.noise_std = (icoac_real_t)(n % 3 == 0 ? 1.0 : (n % 3 == 1 ? 0.5 : 3.0));
+        cfg.actor.likelihood_std = (icoac_real_t)(n % 3 == 0 ? 1.0 : (n % 3 == 1 ? 0.5 : 3.0));
+        /* sigma_u differs from sigma_L in most cases: it must not enter the posterior step */
+        cfg.actor.noise_std = (icoac_real_t)(n % 5 == 0 ? 1.0 : (n % 5 < 3 ? 0.25 : 7.0));
         compare_with_closed_form(&cfg, &rng, n % 2 ? 10.0 : 1.0);
     }
 }

@@ -15,6 +15,7 @@ static void test_defaults_match_spec(void **unused)
     icoac_ico_config_t ico;
     icoac_critic_config_t critic;
     icoac_actor_config_t actor;
+    icoac_search_config_t search;
     const double tol = 4.0 * REAL_EPS;
     (void)unused;
     assert_int_equal(cfg.mode, ICOAC_MODE_ICO);
@@ -43,32 +44,52 @@ static void test_defaults_match_spec(void **unused)
     assert_close(cfg.actor.forgetting, 1.0, 0.0);
     assert_int_equal(cfg.actor.reflex, 1);
     assert_int_equal(cfg.actor.act_with_sample, 0);
+    /* spec L2-L4, A10: the literal readings by default */
+    assert_int_equal(cfg.learn, 1);
+    assert_int_equal(cfg.critic.quirks, 0);
+    assert_int_equal(cfg.actor.update, ICOAC_ACTOR_POSTERIOR);
+    assert_close(cfg.actor.rate, 0.01, tol * 0.01);
+    assert_close(cfg.actor.likelihood_std, 1.0, 0.0);
+    assert_true(cfg.actor.likelihood_std == cfg.actor.noise_std); /* sigma_L = sigma_u (literal) */
+    assert_int_equal(cfg.actor.batch, 0);
+    assert_int_equal(cfg.actor.explore_ticks, 0);
+    assert_int_equal(cfg.search.batch, 4);
+    assert_close(cfg.search.elite_fraction, 0.5, 0.0);
+    assert_close(cfg.search.step, 0.5, 0.0);
+    assert_close(cfg.search.floor, 0.1, tol * 0.1);
+    assert_close(cfg.search.cov_scale, 1.0, 0.0);
     /* Each group's default is the configuration default's group (same fill: padding agrees). */
     memset(&filled, 0xA5, sizeof filled);
     memset(&policy, 0xA5, sizeof policy);
     memset(&ico, 0xA5, sizeof ico);
     memset(&critic, 0xA5, sizeof critic);
     memset(&actor, 0xA5, sizeof actor);
+    memset(&search, 0xA5, sizeof search);
     icoac_config_default(&filled);
     icoac_policy_config_default(&policy);
     icoac_ico_config_default(&ico);
     icoac_critic_config_default(&critic);
     icoac_actor_config_default(&actor);
+    icoac_search_config_default(&search);
     assert_int_equal(filled.mode, ICOAC_MODE_ICO);
     assert_memory_equal(&policy, &filled.policy, sizeof policy);
     assert_memory_equal(&ico, &filled.ico, sizeof ico);
     assert_memory_equal(&critic, &filled.critic, sizeof critic);
     assert_memory_equal(&actor, &filled.actor, sizeof actor);
+    assert_memory_equal(&search, &filled.search, sizeof search);
     /* and the default over a 0xA5 fill equals the default over zeros, field by field */
     assert_true(memcmp(filled.policy.input_range, cfg.policy.input_range, sizeof cfg.policy.input_range) == 0);
     assert_true(filled.policy.gain == cfg.policy.gain && filled.policy.zone_x == cfg.policy.zone_x);
     assert_true(filled.critic.threshold == cfg.critic.threshold && filled.actor.reflex == cfg.actor.reflex);
+    assert_true(filled.actor.likelihood_std == cfg.actor.likelihood_std && filled.search.floor == cfg.search.floor);
+    assert_true(filled.search.batch == cfg.search.batch && filled.actor.explore_ticks == cfg.actor.explore_ticks);
     /* must not crash */
     icoac_config_default(NULL);
     icoac_policy_config_default(NULL);
     icoac_ico_config_default(NULL);
     icoac_critic_config_default(NULL);
     icoac_actor_config_default(NULL);
+    icoac_search_config_default(NULL);
 }
 
 /* One mutation of the default configuration, the status it must produce and the field
@@ -81,7 +102,8 @@ typedef struct {
     const char *field;
 } config_case_t;
 
-/* MUT: on the default (ICO) configuration; RLMUT: in RL mode, which validates critic and actor. */
+/* MUT: on the default (ICO) configuration; RLMUT: in RL mode, which validates critic and actor;
+ * SMUT: in search mode, which validates the search group. */
 #define MUT(fname, body) \
     static void fname(icoac_config_t *c) { body; }
 #define RLMUT(fname, body)           \
@@ -90,8 +112,14 @@ typedef struct {
         c->mode = ICOAC_MODE_RL;     \
         body;                        \
     }
+#define SMUT(fname, body)            \
+    static void fname(icoac_config_t *c) \
+    {                                \
+        c->mode = ICOAC_MODE_SEARCH; \
+        body;                        \
+    }
 
-MUT(m_mode_2, c->mode = 2)
+MUT(m_mode_3, c->mode = 3)
 MUT(m_mode_neg, c->mode = -1)
 MUT(m_reflex_mode_2, c->policy.reflex_mode = 2)
 MUT(m_reflex_mode_neg, c->policy.reflex_mode = -1)
@@ -165,10 +193,62 @@ MUT(m_zone_theta_subnormal, c->policy.zone_theta = (icoac_real_t)(REAL_IS_FLOAT 
 MUT(m_zone_x_tiny, c->policy.zone_x = (icoac_real_t)9e-7)
 MUT(m_gain_subnormal, c->policy.gain = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
 RLMUT(m_threshold_subnormal, c->critic.threshold = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
+/* The learners' fields (spec L2-L4, A10), each bound from both sides. */
+RLMUT(m_quirks_2, c->critic.quirks = 2)
+RLMUT(m_quirks_neg, c->critic.quirks = -1)
+RLMUT(m_update_3, c->actor.update = 3)
+RLMUT(m_update_neg, c->actor.update = -1)
+RLMUT(m_rate_neg, c->actor.rate = (icoac_real_t)-1e-6)
+RLMUT(m_rate_big, c->actor.rate = (icoac_real_t)1001)
+RLMUT(m_rate_nan, c->actor.rate = NAN_R)
+RLMUT(m_rate_inf, c->actor.rate = INF_R)
+RLMUT(m_rate_subnormal, c->actor.rate = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
+RLMUT(m_lik_zero, c->actor.likelihood_std = 0)
+RLMUT(m_lik_tiny, c->actor.likelihood_std = (icoac_real_t)9e-4)
+RLMUT(m_lik_big, c->actor.likelihood_std = (icoac_real_t)1001)
+RLMUT(m_lik_nan, c->actor.likelihood_std = NAN_R)
+RLMUT(m_lik_inf, c->actor.likelihood_std = INF_R)
+RLMUT(m_lik_neg, c->actor.likelihood_std = -1)
+RLMUT(m_abatch_2, c->actor.batch = 2)
+RLMUT(m_abatch_neg, c->actor.batch = -1)
+RLMUT(m_explore_neg, c->actor.explore_ticks = -1)
+RLMUT(m_explore_big, c->actor.explore_ticks = ICOAC_EXPLORE_TICKS_MAX + 1)
+RLMUT(m_explore_min, c->actor.explore_ticks = INT32_MIN)
+SMUT(m_sbatch_zero, c->search.batch = 0)
+SMUT(m_sbatch_neg, c->search.batch = -1)
+SMUT(m_sbatch_big, c->search.batch = ICOAC_SEARCH_BATCH_MAX + 1)
+SMUT(m_elite_zero, c->search.elite_fraction = 0)
+SMUT(m_elite_neg, c->search.elite_fraction = (icoac_real_t)-0.5)
+SMUT(m_elite_big, c->search.elite_fraction = (icoac_real_t)1.001)
+SMUT(m_elite_nan, c->search.elite_fraction = NAN_R)
+SMUT(m_elite_subnormal, c->search.elite_fraction = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
+SMUT(m_step_zero, c->search.step = 0)
+SMUT(m_step_neg, c->search.step = (icoac_real_t)-0.5)
+SMUT(m_step_big, c->search.step = (icoac_real_t)1.001)
+SMUT(m_step_nan, c->search.step = NAN_R)
+SMUT(m_floor_zero, c->search.floor = 0)
+SMUT(m_floor_tiny, c->search.floor = (icoac_real_t)9e-7)
+SMUT(m_floor_big, c->search.floor = (icoac_real_t)1001)
+SMUT(m_floor_nan, c->search.floor = NAN_R)
+SMUT(m_floor_inf, c->search.floor = INF_R)
+SMUT(m_cov_scale_below_one, c->search.cov_scale = (icoac_real_t)0.999)
+SMUT(m_cov_scale_zero, c->search.cov_scale = 0)
+SMUT(m_cov_scale_big, c->search.cov_scale = (icoac_real_t)1001)
+SMUT(m_cov_scale_nan, c->search.cov_scale = NAN_R)
+SMUT(m_cov_scale_inf, c->search.cov_scale = INF_R)
+SMUT(m_search_learn_2, c->learn = 2)
+SMUT(m_search_gain_nan, c->policy.gain = NAN_R)
 /* Several bad fields: the first in struct order (mode, policy, then the mode's groups) is named. */
 MUT(m_two_policy_fields, { c->policy.zone_x = INF_R; c->policy.input_range[2] = NAN_R; })
 RLMUT(m_policy_before_critic, { c->critic.rate = NAN_R; c->policy.gain = -1.0f; })
 RLMUT(m_critic_before_actor, { c->actor.noise_std = 0; c->critic.threshold = 1.0f; })
+SMUT(m_policy_before_search, { c->search.batch = 0; c->policy.zone_x = INF_R; })
+SMUT(m_search_in_order, { c->search.cov_scale = 0; c->search.floor = 0; c->search.step = 0;
+                          c->search.elite_fraction = 0; })
+SMUT(m_search_batch_first, { c->search.cov_scale = 0; c->search.batch = 0; })
+RLMUT(m_actor_new_in_order, { c->actor.explore_ticks = -1; c->actor.batch = 2; c->actor.likelihood_std = 0;
+                              c->actor.rate = -1; c->actor.update = 3; })
+RLMUT(m_quirks_before_actor, { c->actor.update = 3; c->critic.quirks = 2; })
 MUT(m_mode_before_all, { c->mode = 7; c->policy.gain = NAN_R; c->ico.rate = NAN_R; })
 /* Boundary values that are valid. */
 RLMUT(ok_range_bounds, { c->policy.input_range[0] = (icoac_real_t)1e-6; c->policy.input_range[1] = (icoac_real_t)1e6;
@@ -179,6 +259,21 @@ RLMUT(ok_upper_bounds_rl, { c->policy.gain = (icoac_real_t)1e4; c->policy.reflex
                             c->critic.td_clip = (icoac_real_t)1e3; c->actor.noise_std = (icoac_real_t)1e3;
                             c->actor.scale = (icoac_real_t)1e3; })
 RLMUT(ok_lower_bounds, { c->critic.td_clip = (icoac_real_t)1e-6; c->actor.noise_std = (icoac_real_t)1e-3; })
+MUT(ok_mode_search, c->mode = ICOAC_MODE_SEARCH)
+RLMUT(ok_rl_learner_lower, { c->critic.quirks = 1; c->actor.update = ICOAC_ACTOR_GRADIENT; c->actor.rate = 0;
+                             c->actor.likelihood_std = ICOAC_NOISE_STD_MIN; c->actor.batch = 1;
+                             c->actor.explore_ticks = 0; })
+RLMUT(ok_rl_learner_upper, { c->actor.update = ICOAC_ACTOR_MEAN; c->actor.rate = ICOAC_ACTOR_RATE_MAX;
+                             c->actor.likelihood_std = ICOAC_NOISE_STD_MAX;
+                             c->actor.explore_ticks = ICOAC_EXPLORE_TICKS_MAX; })
+RLMUT(ok_explore_one, c->actor.explore_ticks = 1)
+SMUT(ok_search_lower, { c->search.batch = 1; c->search.elite_fraction = (icoac_real_t)1e-6;
+                        c->search.step = (icoac_real_t)1e-6; c->search.floor = ICOAC_SEARCH_FLOOR_MIN;
+                        c->search.cov_scale = 1; })
+SMUT(ok_search_upper, { c->search.batch = ICOAC_SEARCH_BATCH_MAX; c->search.elite_fraction = 1;
+                        c->search.step = 1; c->search.floor = ICOAC_SEARCH_FLOOR_MAX;
+                        c->search.cov_scale = ICOAC_SEARCH_COV_SCALE_MAX; })
+SMUT(ok_search_no_learning, { c->learn = 0; c->policy.reflex_mode = ICOAC_REFLEX_GAIN; c->policy.clip_inputs = 0; })
 MUT(ok_gain_zero, c->policy.gain = 0)
 MUT(ok_reflex_force_zero, c->policy.reflex_force = 0)
 MUT(ok_ico_rate_zero, c->ico.rate = 0)
@@ -194,7 +289,7 @@ MUT(ok_ico_gain_literal, { c->policy.reflex_mode = ICOAC_REFLEX_GAIN; c->ico.tim
                            c->policy.clip_inputs = 0; })
 
 static const config_case_t config_cases[] = {
-    {"mode=2", m_mode_2, ICOAC_ERR_BAD_MODE, "mode"},
+    {"mode=3", m_mode_3, ICOAC_ERR_BAD_MODE, "mode"},
     {"mode=-1", m_mode_neg, ICOAC_ERR_BAD_MODE, "mode"},
     {"policy.reflex_mode=2", m_reflex_mode_2, ICOAC_ERR_BAD_MODE, "policy.reflex_mode"},
     {"policy.reflex_mode=-1", m_reflex_mode_neg, ICOAC_ERR_BAD_MODE, "policy.reflex_mode"},
@@ -267,14 +362,70 @@ static const config_case_t config_cases[] = {
     {"policy.zone_x=9e-7", m_zone_x_tiny, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
     {"policy.gain subnormal", m_gain_subnormal, ICOAC_ERR_BAD_GAIN, "policy.gain"},
     {"RL, critic.threshold subnormal", m_threshold_subnormal, ICOAC_ERR_BAD_CRITIC, "critic.threshold"},
+    {"RL, critic.quirks=2", m_quirks_2, ICOAC_ERR_BAD_MODE, "critic.quirks"},
+    {"RL, critic.quirks=-1", m_quirks_neg, ICOAC_ERR_BAD_MODE, "critic.quirks"},
+    {"RL, actor.update=3", m_update_3, ICOAC_ERR_BAD_MODE, "actor.update"},
+    {"RL, actor.update=-1", m_update_neg, ICOAC_ERR_BAD_MODE, "actor.update"},
+    {"RL, actor.rate<0", m_rate_neg, ICOAC_ERR_BAD_ACTOR, "actor.rate"},
+    {"RL, actor.rate>1e3", m_rate_big, ICOAC_ERR_BAD_ACTOR, "actor.rate"},
+    {"RL, actor.rate=NaN", m_rate_nan, ICOAC_ERR_BAD_ACTOR, "actor.rate"},
+    {"RL, actor.rate=Inf", m_rate_inf, ICOAC_ERR_BAD_ACTOR, "actor.rate"},
+    {"RL, actor.rate subnormal", m_rate_subnormal, ICOAC_ERR_BAD_ACTOR, "actor.rate"},
+    {"RL, actor.likelihood_std=0", m_lik_zero, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
+    {"RL, actor.likelihood_std=9e-4", m_lik_tiny, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
+    {"RL, actor.likelihood_std>1e3", m_lik_big, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
+    {"RL, actor.likelihood_std=NaN", m_lik_nan, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
+    {"RL, actor.likelihood_std=Inf", m_lik_inf, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
+    {"RL, actor.likelihood_std<0", m_lik_neg, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
+    {"RL, actor.batch=2", m_abatch_2, ICOAC_ERR_BAD_MODE, "actor.batch"},
+    {"RL, actor.batch=-1", m_abatch_neg, ICOAC_ERR_BAD_MODE, "actor.batch"},
+    {"RL, actor.explore_ticks=-1", m_explore_neg, ICOAC_ERR_BAD_ACTOR, "actor.explore_ticks"},
+    {"RL, actor.explore_ticks>1e8", m_explore_big, ICOAC_ERR_BAD_ACTOR, "actor.explore_ticks"},
+    {"RL, actor.explore_ticks=INT32_MIN", m_explore_min, ICOAC_ERR_BAD_ACTOR, "actor.explore_ticks"},
+    {"search, search.batch=0", m_sbatch_zero, ICOAC_ERR_BAD_SEARCH, "search.batch"},
+    {"search, search.batch=-1", m_sbatch_neg, ICOAC_ERR_BAD_SEARCH, "search.batch"},
+    {"search, search.batch=17", m_sbatch_big, ICOAC_ERR_BAD_SEARCH, "search.batch"},
+    {"search, search.elite_fraction=0", m_elite_zero, ICOAC_ERR_BAD_SEARCH, "search.elite_fraction"},
+    {"search, search.elite_fraction<0", m_elite_neg, ICOAC_ERR_BAD_SEARCH, "search.elite_fraction"},
+    {"search, search.elite_fraction>1", m_elite_big, ICOAC_ERR_BAD_SEARCH, "search.elite_fraction"},
+    {"search, search.elite_fraction=NaN", m_elite_nan, ICOAC_ERR_BAD_SEARCH, "search.elite_fraction"},
+    {"search, search.elite_fraction subnormal", m_elite_subnormal, ICOAC_ERR_BAD_SEARCH, "search.elite_fraction"},
+    {"search, search.step=0", m_step_zero, ICOAC_ERR_BAD_SEARCH, "search.step"},
+    {"search, search.step<0", m_step_neg, ICOAC_ERR_BAD_SEARCH, "search.step"},
+    {"search, search.step>1", m_step_big, ICOAC_ERR_BAD_SEARCH, "search.step"},
+    {"search, search.step=NaN", m_step_nan, ICOAC_ERR_BAD_SEARCH, "search.step"},
+    {"search, search.floor=0", m_floor_zero, ICOAC_ERR_BAD_SEARCH, "search.floor"},
+    {"search, search.floor=9e-7", m_floor_tiny, ICOAC_ERR_BAD_SEARCH, "search.floor"},
+    {"search, search.floor>1e3", m_floor_big, ICOAC_ERR_BAD_SEARCH, "search.floor"},
+    {"search, search.floor=NaN", m_floor_nan, ICOAC_ERR_BAD_SEARCH, "search.floor"},
+    {"search, search.floor=Inf", m_floor_inf, ICOAC_ERR_BAD_SEARCH, "search.floor"},
+    {"search, search.cov_scale=0.999", m_cov_scale_below_one, ICOAC_ERR_BAD_SEARCH, "search.cov_scale"},
+    {"search, search.cov_scale=0", m_cov_scale_zero, ICOAC_ERR_BAD_SEARCH, "search.cov_scale"},
+    {"search, search.cov_scale>1e3", m_cov_scale_big, ICOAC_ERR_BAD_SEARCH, "search.cov_scale"},
+    {"search, search.cov_scale=NaN", m_cov_scale_nan, ICOAC_ERR_BAD_SEARCH, "search.cov_scale"},
+    {"search, search.cov_scale=Inf", m_cov_scale_inf, ICOAC_ERR_BAD_SEARCH, "search.cov_scale"},
+    {"search, learn=2", m_search_learn_2, ICOAC_ERR_BAD_MODE, "learn"},
+    {"search, policy.gain=NaN", m_search_gain_nan, ICOAC_ERR_BAD_GAIN, "policy.gain"},
     {"policy.zone_x and policy.input_range[2]", m_two_policy_fields, ICOAC_ERR_BAD_SCALE, "policy.input_range[2]"},
     {"RL, critic.rate and policy.gain", m_policy_before_critic, ICOAC_ERR_BAD_GAIN, "policy.gain"},
     {"RL, actor.noise_std and critic.threshold", m_critic_before_actor, ICOAC_ERR_BAD_CRITIC, "critic.threshold"},
+    {"search, search.batch and policy.zone_x", m_policy_before_search, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
+    {"search, four search fields", m_search_in_order, ICOAC_ERR_BAD_SEARCH, "search.elite_fraction"},
+    {"search, search.cov_scale and search.batch", m_search_batch_first, ICOAC_ERR_BAD_SEARCH, "search.batch"},
+    {"RL, five new actor fields", m_actor_new_in_order, ICOAC_ERR_BAD_MODE, "actor.update"},
+    {"RL, actor.update and critic.quirks", m_quirks_before_actor, ICOAC_ERR_BAD_MODE, "critic.quirks"},
     {"mode=7 and more", m_mode_before_all, ICOAC_ERR_BAD_MODE, "mode"},
     {"RL, ranges at their bounds", ok_range_bounds, ICOAC_OK, NULL},
     {"ICO upper bounds", ok_upper_bounds_ico, ICOAC_OK, NULL},
     {"RL upper bounds", ok_upper_bounds_rl, ICOAC_OK, NULL},
     {"RL lower bounds", ok_lower_bounds, ICOAC_OK, NULL},
+    {"mode=search", ok_mode_search, ICOAC_OK, NULL},
+    {"RL, learner fields at their lower bounds", ok_rl_learner_lower, ICOAC_OK, NULL},
+    {"RL, learner fields at their upper bounds", ok_rl_learner_upper, ICOAC_OK, NULL},
+    {"RL, actor.explore_ticks=1", ok_explore_one, ICOAC_OK, NULL},
+    {"search lower bounds", ok_search_lower, ICOAC_OK, NULL},
+    {"search upper bounds", ok_search_upper, ICOAC_OK, NULL},
+    {"search, no learning, switches at their alternative", ok_search_no_learning, ICOAC_OK, NULL},
     {"policy.gain=0", ok_gain_zero, ICOAC_OK, NULL},
     {"policy.reflex_force=0", ok_reflex_force_zero, ICOAC_OK, NULL},
     {"ico.rate=0", ok_ico_rate_zero, ICOAC_OK, NULL},
@@ -298,7 +449,7 @@ static int starts_with(const char *s, const char *prefix)
 static void test_bad_configs_rejected_state_untouched(void **unused)
 {
     size_t n;
-    int seen[ICOAC_ERR_BAD_PRIOR + 1] = {0};
+    int seen[ICOAC_ERR_BAD_SEARCH + 1] = {0};
     int s;
     (void)unused;
     for (n = 0; n < N_CONFIG_CASES; ++n) {
@@ -335,6 +486,7 @@ static void test_bad_configs_rejected_state_untouched(void **unused)
     for (s = ICOAC_ERR_BAD_MODE; s <= ICOAC_ERR_BAD_ACTOR; ++s) {
         assert_true(seen[s]);
     }
+    assert_true(seen[ICOAC_ERR_BAD_SEARCH]);
 }
 
 /* icoac_config_check_field names the first bad field of every case, agrees with
@@ -380,21 +532,29 @@ static void test_config_cases_name_their_field(void **unused)
 }
 
 /* Every field of the configuration, in struct order, with the group that validates it: the
- * policy in both modes, ico in ICO mode only, critic and actor in RL mode only. */
-typedef enum { G_POLICY, G_ICO, G_RL } group_t;
+ * policy in every mode, ico in ICO mode only, critic and actor in RL mode only, search in
+ * search mode only; and a value that is invalid in that field (NaN for a real). */
+typedef enum { G_POLICY, G_ICO, G_RL, G_SEARCH } group_t;
 typedef struct {
     const char *name;
     size_t offset;
+    size_t size;
     int is_int;
     group_t group;
     icoac_status_t status;
+    int32_t bad_int; /* for an int field */
 } config_field_t;
 
-#define REAL_FIELD(member, group, status) {#member, offsetof(icoac_config_t, member), 0, group, status}
-#define INT_FIELD(member, group, status) {#member, offsetof(icoac_config_t, member), 1, group, status}
+#define MEMBER_SIZE(member) sizeof(((icoac_config_t *)0)->member)
+#define REAL_FIELD(member, group, status) \
+    {#member, offsetof(icoac_config_t, member), MEMBER_SIZE(member), 0, group, status, 0}
+#define INT_FIELD_BAD(member, group, status, bad) \
+    {#member, offsetof(icoac_config_t, member), MEMBER_SIZE(member), 1, group, status, bad}
+/* 7 is out of range of every switch and 0/1 flag */
+#define INT_FIELD(member, group, status) INT_FIELD_BAD(member, group, status, 7)
 
 static const config_field_t config_fields[] = {
-    INT_FIELD(learn, G_POLICY, ICOAC_ERR_BAD_MODE), /* checked in both modes, like the policy */
+    INT_FIELD(learn, G_POLICY, ICOAC_ERR_BAD_MODE), /* checked in every mode, like the policy */
     REAL_FIELD(policy.input_range[0], G_POLICY, ICOAC_ERR_BAD_SCALE),
     REAL_FIELD(policy.input_range[1], G_POLICY, ICOAC_ERR_BAD_SCALE),
     REAL_FIELD(policy.input_range[2], G_POLICY, ICOAC_ERR_BAD_SCALE),
@@ -415,22 +575,35 @@ static const config_field_t config_fields[] = {
     REAL_FIELD(critic.range[2], G_RL, ICOAC_ERR_BAD_CRITIC),
     REAL_FIELD(critic.range[3], G_RL, ICOAC_ERR_BAD_CRITIC),
     REAL_FIELD(critic.threshold, G_RL, ICOAC_ERR_BAD_CRITIC),
+    INT_FIELD(critic.quirks, G_RL, ICOAC_ERR_BAD_MODE),
     REAL_FIELD(actor.noise_std, G_RL, ICOAC_ERR_BAD_ACTOR),
     REAL_FIELD(actor.scale, G_RL, ICOAC_ERR_BAD_ACTOR),
     REAL_FIELD(actor.forgetting, G_RL, ICOAC_ERR_BAD_ACTOR),
     INT_FIELD(actor.reflex, G_RL, ICOAC_ERR_BAD_MODE),
     INT_FIELD(actor.act_with_sample, G_RL, ICOAC_ERR_BAD_MODE),
+    INT_FIELD(actor.update, G_RL, ICOAC_ERR_BAD_MODE),
+    REAL_FIELD(actor.rate, G_RL, ICOAC_ERR_BAD_ACTOR),
+    REAL_FIELD(actor.likelihood_std, G_RL, ICOAC_ERR_BAD_ACTOR),
+    INT_FIELD(actor.batch, G_RL, ICOAC_ERR_BAD_MODE),
+    INT_FIELD_BAD(actor.explore_ticks, G_RL, ICOAC_ERR_BAD_ACTOR, -1), /* 7 ticks is valid */
+    INT_FIELD_BAD(search.batch, G_SEARCH, ICOAC_ERR_BAD_SEARCH, ICOAC_SEARCH_BATCH_MAX + 1),
+    REAL_FIELD(search.elite_fraction, G_SEARCH, ICOAC_ERR_BAD_SEARCH),
+    REAL_FIELD(search.step, G_SEARCH, ICOAC_ERR_BAD_SEARCH),
+    REAL_FIELD(search.floor, G_SEARCH, ICOAC_ERR_BAD_SEARCH),
+    REAL_FIELD(search.cov_scale, G_SEARCH, ICOAC_ERR_BAD_SEARCH),
 };
 
 #define N_CONFIG_FIELDS ((int)(sizeof config_fields / sizeof config_fields[0]))
 
-/* NaN for a real, 7 for a switch: invalid in every field. */
+/* The modes, and the first value past them. */
+#define N_MODES (ICOAC_MODE_SEARCH + 1)
+
+/* NaN for a real, the field's bad value for a switch or count. */
 static void spoil(icoac_config_t *cfg, const config_field_t *f)
 {
     unsigned char *bytes = (unsigned char *)cfg;
     if (f->is_int) {
-        const int32_t bad = 7;
-        memcpy(bytes + f->offset, &bad, sizeof bad);
+        memcpy(bytes + f->offset, &f->bad_int, sizeof f->bad_int);
     } else {
         const icoac_real_t bad = NAN_R;
         memcpy(bytes + f->offset, &bad, sizeof bad);
@@ -439,7 +612,42 @@ static void spoil(icoac_config_t *cfg, const config_field_t *f)
 
 static int validated(const config_field_t *f, int32_t mode)
 {
-    return f->group == G_POLICY || (f->group == G_ICO) == (mode == ICOAC_MODE_ICO);
+    switch (f->group) {
+    case G_POLICY: return 1;
+    case G_ICO: return mode == ICOAC_MODE_ICO;
+    case G_RL: return mode == ICOAC_MODE_RL;
+    default: return mode == ICOAC_MODE_SEARCH;
+    }
+}
+
+/* The table above lists every member of icoac_config_t: with `mode` it covers each byte that
+ * is not padding, in struct order, without overlap (a new field the table misses fails here). */
+static void test_field_table_covers_config(void **unused)
+{
+    size_t end = sizeof(int32_t); /* mode, at offset 0 */
+    size_t covered = sizeof(int32_t);
+    int i;
+    (void)unused;
+    assert_int_equal(offsetof(icoac_config_t, mode), 0);
+    for (i = 0; i < N_CONFIG_FIELDS; ++i) {
+        const config_field_t *f = &config_fields[i];
+        assert_int_equal(f->size, f->is_int ? sizeof(int32_t) : sizeof(icoac_real_t));
+        if (f->offset < end) {
+            print_error("%s at %u overlaps the field before (end %u)\n", f->name, (unsigned)f->offset, (unsigned)end);
+            fail();
+        }
+        /* a gap is alignment padding only: shorter than the member's alignment */
+        if (f->offset - end >= f->size) {
+            print_error("%u bytes before %s are not listed\n", (unsigned)(f->offset - end), f->name);
+            fail();
+        }
+        end = f->offset + f->size;
+        covered += f->size;
+    }
+    assert_true(sizeof(icoac_config_t) - end < sizeof(icoac_real_t));
+    if (REAL_IS_FLOAT) {
+        assert_int_equal(covered, sizeof(icoac_config_t)); /* no padding with float reals */
+    }
 }
 
 /* One bad field at a time: named with its group's status where the mode uses the group,
@@ -449,7 +657,7 @@ static void test_each_field_named_or_ignored(void **unused)
     int32_t mode;
     int i;
     (void)unused;
-    for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
+    for (mode = ICOAC_MODE_ICO; mode < N_MODES; ++mode) {
         for (i = 0; i < N_CONFIG_FIELDS; ++i) {
             const config_field_t *f = &config_fields[i];
             icoac_config_t cfg = test_default_config();
@@ -489,7 +697,7 @@ static void test_check_order_is_struct_order(void **unused)
     int32_t mode;
     int i;
     (void)unused;
-    for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
+    for (mode = ICOAC_MODE_ICO; mode < N_MODES; ++mode) {
         icoac_config_t cfg = test_default_config();
         const char *field = NULL;
         cfg.mode = mode;
@@ -503,20 +711,24 @@ static void test_check_order_is_struct_order(void **unused)
             assert_non_null(field);
             assert_string_equal(field, f->name);
         }
-        cfg.mode = 2;
+        cfg.mode = N_MODES;
+        assert_int_equal(icoac_config_check_field(&cfg, &field), ICOAC_ERR_BAD_MODE);
+        assert_string_equal(field, "mode");
+        cfg.mode = -1;
         assert_int_equal(icoac_config_check_field(&cfg, &field), ICOAC_ERR_BAD_MODE);
         assert_string_equal(field, "mode");
     }
 }
 
 /* A mode ignores the groups it does not use, even when every field of them is bad: ICO runs
- * with a spoilt critic and actor, RL with a spoilt ico group (new with issue 9). The
- * controller behaves exactly as with valid unused groups. */
+ * with a spoilt critic, actor and search, RL with a spoilt ico and search group (new with
+ * issue 9), search with a spoilt ico, critic and actor. The controller behaves exactly as with
+ * valid unused groups. */
 static void test_unused_groups_ignored(void **unused)
 {
     int32_t mode;
     (void)unused;
-    for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
+    for (mode = ICOAC_MODE_ICO; mode < N_MODES; ++mode) {
         icoac_config_t cfg = test_default_config();
         icoac_config_t clean;
         icoac_state_t state, twin;
@@ -551,26 +763,42 @@ static void test_unused_groups_ignored(void **unused)
         }
         assert_memory_equal(&state, &twin, sizeof state);
     }
-    /* the case table's rejections of unused groups, in the other mode */
+    /* the case table's rejections of a mode's own group, in every other mode */
     {
         size_t n;
+        int32_t other;
+        int tried = 0;
         for (n = 0; n < N_CONFIG_CASES; ++n) {
             const config_case_t *c = &config_cases[n];
-            icoac_config_t cfg = test_default_config();
-            icoac_state_t state;
-            const char *field = "not written";
-            const int rl_group = starts_with(c->field, "critic.") || starts_with(c->field, "actor.");
-            if (!rl_group && !starts_with(c->field, "ico.")) {
+            int32_t owner;
+            if (starts_with(c->field, "critic.") || starts_with(c->field, "actor.")) {
+                owner = ICOAC_MODE_RL;
+            } else if (starts_with(c->field, "ico.")) {
+                owner = ICOAC_MODE_ICO;
+            } else if (starts_with(c->field, "search.")) {
+                owner = ICOAC_MODE_SEARCH;
+            } else {
                 continue;
             }
-            c->mutate(&cfg);
-            cfg.mode = rl_group ? ICOAC_MODE_ICO : ICOAC_MODE_RL;
-            if (icoac_config_check_field(&cfg, &field) != ICOAC_OK || field != NULL) {
-                print_error("case %s in the other mode: not ignored (field %s)\n", c->name, field ? field : "NULL");
-                fail();
+            for (other = ICOAC_MODE_ICO; other < N_MODES; ++other) {
+                icoac_config_t cfg = test_default_config();
+                icoac_state_t state;
+                const char *field = "not written";
+                if (other == owner) {
+                    continue;
+                }
+                c->mutate(&cfg);
+                cfg.mode = other;
+                if (icoac_config_check_field(&cfg, &field) != ICOAC_OK || field != NULL) {
+                    print_error("case %s in mode %d: not ignored (field %s)\n", c->name, (int)other,
+                                field ? field : "NULL");
+                    fail();
+                }
+                assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
+                ++tried;
             }
-            assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
         }
+        assert_true(tried > 100);
     }
 }
 
@@ -582,7 +810,7 @@ static void expect_bad_prior(const icoac_prior_t *prior, const char *name)
     icoac_status_t got;
     int mode;
     assert_int_equal(icoac_prior_check(prior), ICOAC_ERR_BAD_PRIOR);
-    for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
+    for (mode = ICOAC_MODE_ICO; mode < N_MODES; ++mode) {
         cfg.mode = mode;
         memset(&state, 0x5A, sizeof state);
         memset(&sentinel, 0x5A, sizeof sentinel);
@@ -737,7 +965,8 @@ static void test_status_strings(void **unused)
     static const icoac_status_t all[] = {
         ICOAC_OK, ICOAC_ERR_NULL, ICOAC_ERR_NOT_INITIALISED, ICOAC_ERR_NONFINITE_INPUT, ICOAC_ERR_NUMERIC,
         ICOAC_ERR_BAD_MODE, ICOAC_ERR_BAD_SCALE, ICOAC_ERR_BAD_GAIN, ICOAC_ERR_BAD_ZONE,
-        ICOAC_ERR_BAD_ICO_RATE, ICOAC_ERR_BAD_CRITIC, ICOAC_ERR_BAD_ACTOR, ICOAC_ERR_BAD_PRIOR};
+        ICOAC_ERR_BAD_ICO_RATE, ICOAC_ERR_BAD_CRITIC, ICOAC_ERR_BAD_ACTOR, ICOAC_ERR_BAD_PRIOR,
+        ICOAC_ERR_BAD_SEARCH};
     const size_t n = sizeof all / sizeof all[0];
     const char *unknown;
     size_t i, j;
@@ -764,7 +993,12 @@ static void test_sizeof_functions(void **unused)
 {
     (void)unused;
     assert_int_equal(icoac_abi_version(), ICOAC_ABI_VERSION);
-    assert_int_equal(ICOAC_ABI_VERSION, 5);
+    assert_int_equal(ICOAC_ABI_VERSION, 6);
+    assert_int_equal(ICOAC_ERR_BAD_SEARCH, 18);
+    assert_int_equal(ICOAC_MODE_SEARCH, 2);
+    assert_int_equal(ICOAC_ACTOR_POSTERIOR, 0);
+    assert_int_equal(ICOAC_ACTOR_MEAN, 1);
+    assert_int_equal(ICOAC_ACTOR_GRADIENT, 2);
     assert_int_equal(icoac_sizeof_real(), sizeof(icoac_real_t));
     assert_int_equal(icoac_sizeof_real(), REAL_IS_FLOAT ? 4 : 8);
     assert_int_equal(icoac_sizeof_config(), sizeof(icoac_config_t));
@@ -785,6 +1019,7 @@ int main(void)
         cmocka_unit_test(test_defaults_match_spec),
         cmocka_unit_test(test_bad_configs_rejected_state_untouched),
         cmocka_unit_test(test_config_cases_name_their_field),
+        cmocka_unit_test(test_field_table_covers_config),
         cmocka_unit_test(test_each_field_named_or_ignored),
         cmocka_unit_test(test_check_order_is_struct_order),
         cmocka_unit_test(test_unused_groups_ignored),

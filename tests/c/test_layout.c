@@ -85,7 +85,7 @@ static void test_constants_table(void **unused)
     }
     /* spot checks against the headers */
     assert_true(constant("ICOAC_ABI_VERSION") == ICOAC_ABI_VERSION);
-    assert_true(constant("ICOAC_ABI_VERSION") == 5);
+    assert_true(constant("ICOAC_ABI_VERSION") == 6);
     assert_true(constant("ICOAC_SIM_ABI_VERSION") == ICOAC_SIM_ABI_VERSION);
     assert_true(constant("ICOAC_SIM_ABI_VERSION") == 2);
     assert_true(constant("ICOAC_N_INPUTS") == ICOAC_N_INPUTS);
@@ -95,6 +95,15 @@ static void test_constants_table(void **unused)
     assert_true(constant("ICOAC_INPUT_TERMINAL") == ICOAC_INPUT_TERMINAL);
     assert_true(constant("ICOAC_MODE_ICO") == ICOAC_MODE_ICO);
     assert_true(constant("ICOAC_MODE_RL") == ICOAC_MODE_RL);
+    assert_true(constant("ICOAC_MODE_SEARCH") == ICOAC_MODE_SEARCH);
+    assert_true(constant("ICOAC_MODE_SEARCH") == 2);
+    assert_true(constant("ICOAC_ACTOR_POSTERIOR") == ICOAC_ACTOR_POSTERIOR);
+    assert_true(constant("ICOAC_ACTOR_MEAN") == ICOAC_ACTOR_MEAN);
+    assert_true(constant("ICOAC_ACTOR_GRADIENT") == ICOAC_ACTOR_GRADIENT);
+    assert_true(constant("ICOAC_SEARCH_BATCH_MAX") == ICOAC_SEARCH_BATCH_MAX);
+    assert_true(constant("ICOAC_EXPLORE_TICKS_MAX") == ICOAC_EXPLORE_TICKS_MAX);
+    assert_true(constant("ICOAC_ERR_BAD_SEARCH") == ICOAC_ERR_BAD_SEARCH);
+    assert_true(constant("ICOAC_ERR_BAD_SEARCH") == 18);
     assert_true(constant("ICOAC_REFLEX_GAIN") == ICOAC_REFLEX_GAIN);
     assert_true(constant("ICOAC_ICO_TIMING_LITERAL") == ICOAC_ICO_TIMING_LITERAL);
     assert_true(constant("ICOAC_ERR_NUMERIC") == ICOAC_ERR_NUMERIC);
@@ -204,6 +213,17 @@ static void test_fields_spot_checks(void **unused)
     SPOT(icoac_config_t, critic.threshold);
     SPOT(icoac_config_t, actor.noise_std);
     SPOT(icoac_config_t, actor.act_with_sample);
+    SPOT(icoac_config_t, critic.quirks);
+    SPOT(icoac_config_t, actor.update);
+    SPOT(icoac_config_t, actor.rate);
+    SPOT(icoac_config_t, actor.likelihood_std);
+    SPOT(icoac_config_t, actor.batch);
+    SPOT(icoac_config_t, actor.explore_ticks);
+    SPOT(icoac_config_t, search.batch);
+    SPOT(icoac_config_t, search.elite_fraction);
+    SPOT(icoac_config_t, search.step);
+    SPOT(icoac_config_t, search.floor);
+    SPOT(icoac_config_t, search.cov_scale);
     SPOT(icoac_prior_t, cov);
     SPOT(icoac_counters_t, numeric_faults);
     SPOT(icoac_input_t, flags);
@@ -219,6 +239,11 @@ static void test_fields_spot_checks(void **unused)
     assert_true(find_field("icoac_config_t", "ico.rate")->offset >= offsetof(icoac_config_t, ico));
     assert_true(find_field("icoac_config_t", "actor.act_with_sample")->offset <
                 offsetof(icoac_config_t, actor) + sizeof(icoac_actor_config_t));
+    assert_int_equal(find_field("icoac_config_t", "search.batch")->offset, offsetof(icoac_config_t, search));
+    /* the search group is the last: its last member ends the struct (no tail padding with float) */
+    assert_true(find_field("icoac_config_t", "search.cov_scale")->offset + sizeof(icoac_real_t) +
+                    (REAL_IS_FLOAT ? 0 : sizeof(icoac_real_t) - 1) >=
+                sizeof(icoac_config_t));
 }
 
 int main(void)

@@ -6,12 +6,15 @@
  *   config  mode byte c. c odd: sizeof(icoac_config_t) raw bytes laid over
  *           icoac_config_default (fewer when the input ends; the nested layout of icoac.h,
  *           padding included). c even: the default with (c >> 1) % 8 mutations, each a field
- *           byte (% 26; indices in struct order, table in fuzz_input.c: 0 mode,
- *           1-4 policy.input_range, 5 policy.clip_inputs, 6 policy.gain, 7 policy.reflex_mode,
- *           8 policy.reflex_force, 9 policy.zone_theta, 10 policy.zone_x, 11 ico.rate,
- *           12 ico.timing, 13 critic.rate, 14 critic.discount, 15 critic.td_clip,
- *           16-19 critic.range, 20 critic.threshold, 21 actor.noise_std, 22 actor.scale,
- *           23 actor.forgetting, 24 actor.reflex, 25 actor.act_with_sample) and a value.
+ *           byte (% 38; indices in struct order, table in fuzz_input.c: 0 mode, 1 learn,
+ *           2-5 policy.input_range, 6 policy.clip_inputs, 7 policy.gain, 8 policy.reflex_mode,
+ *           9 policy.reflex_force, 10 policy.zone_theta, 11 policy.zone_x, 12 ico.rate,
+ *           13 ico.timing, 14 critic.rate, 15 critic.discount, 16 critic.td_clip,
+ *           17-20 critic.range, 21 critic.threshold, 22 critic.quirks, 23 actor.noise_std,
+ *           24 actor.scale, 25 actor.forgetting, 26 actor.reflex, 27 actor.act_with_sample,
+ *           28 actor.update, 29 actor.rate, 30 actor.likelihood_std, 31 actor.batch,
+ *           32 actor.explore_ticks, 33 search.batch, 34 search.elite_fraction, 35 search.step,
+ *           36 search.floor, 37 search.cov_scale) and a value.
  *   prior   byte p. p % 3: 0 NULL, 1 mean 0 and cov I, 2 that with (p / 3) % 8 mutations,
  *           each a field byte b ((b & 127) % 20: 0-3 mean[i], 4 + 4i + j cov[i][j];
  *           b & 128 also sets cov[j][i]) and a value.
@@ -30,20 +33,31 @@
  *
  * Contract, checked after every call (abort on violation):
  *   init    status = icoac_config_check when that fails, else icoac_prior_check when that
- *           fails, else OK or ICOAC_ERR_NUMERIC; icoac_config_check_field agrees and names a
- *           field exactly when the check fails; the checks accept only documented ranges of
- *           the groups the mode uses (ICO: policy, ico; RL: policy, critic, actor); after OK
- *           the learned state (w, |w|, cov, w_act, v) is finite and holds the prior.
+ *           fails, else OK or ICOAC_ERR_NUMERIC (search mode: or ICOAC_ERR_BAD_PRIOR, when
+ *           cov_scale * the prior covariance is not positive definite); icoac_config_check_field
+ *           agrees and names a field exactly when the check fails; the checks accept only
+ *           documented ranges of the groups the mode uses (ICO: policy, ico; RL: policy,
+ *           critic, actor; search: policy, search); after OK the learned state (w, |w|, cov,
+ *           w_act, v) is finite and holds the prior (search: cov = cov_scale * the prior's,
+ *           the floor search.floor * its diagonal, no trial recorded).
  *   step    returned status = out.status, a known status; non-finite s <=> NONFINITE_INPUT;
  *           the counters count the tick and its rejection.
  *           OK: every real output written (out is NaN-filled before the call) and finite, the
  *           learned state finite, cov exactly symmetric, out.weight_norm = |w|; force and
- *           noise 0 on a terminal step; q 0 in RL; value, td_error, noise, cov_trace 0 in ICO;
- *           with learn = 0 (the no-learning control) w, |w|, cov and v unchanged.
- *           Not OK: every real output 0 but weight_norm = |w|, learned state bytewise
- *           unchanged (the spare kept-unit slot and covariance buffer are scratch, not learned).
- *   reset   OK or ICOAC_ERR_NUMERIC; w, |w|, cov, v unchanged; w_act = w unless acting with a
- *           sample (and always after ICOAC_ERR_NUMERIC); w_act finite after OK.
+ *           noise 0 on a terminal step; q 0 in RL and search; value, td_error, noise,
+ *           cov_trace 0 in ICO; value, td_error, noise 0 and cov_trace = trace(cov) in search;
+ *           with learn = 0 (the no-learning control) w, |w|, cov, v, the actor's batch sums
+ *           and the search's trial record unchanged. RL: the mean and gradient readings never
+ *           change cov; per-trial batches (actor.batch) change w and cov only at a terminal
+ *           step; noise 0 from tick actor.explore_ticks of a trial on. Search: w, cov and the
+ *           record change only at a terminal step, which records the trial (count + 1) or,
+ *           with the batch full, updates (count 0, every cov_ii >= its floor).
+ *           Not OK: every real output 0 but weight_norm = |w|, learned state (batch sums,
+ *           trial record and the trial's tick count included) bytewise unchanged (the spare
+ *           kept-unit slot, covariance buffer and staged batch shift are scratch, not learned).
+ *   reset   OK or ICOAC_ERR_NUMERIC; w, |w|, cov, v and the search's record unchanged, the
+ *           actor's batch sums cleared; w_act = w unless acting with a sample (RL with
+ *           act_with_sample, search) (and always after ICOAC_ERR_NUMERIC); w_act finite after OK.
  */
 #include <math.h>
 #include <stdint.h>
@@ -62,23 +76,64 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-/* Everything the controller learns; compared bytewise around each call (no padding). */
+/* Everything the controller learns; compared bytewise around each call (no padding). The
+ * actor's batch sums (actor.batch) and the search's record of the trials of its batch are
+ * learned too, but per trial or per batch; trial_ticks is the trial's tick count. */
 typedef struct {
     icoac_real_t w[N];
     icoac_real_t weight_norm;
     icoac_real_t cov[N][N];
     icoac_real_t v[ICOAC_CRITIC_UNITS];
     icoac_real_t w_act[N];
+    icoac_real_t batch_info[N][N];
+    icoac_real_t batch_shift[N];
+    icoac_real_t search_w[ICOAC_SEARCH_BATCH_MAX][N];
+    uint32_t search_ticks[ICOAC_SEARCH_BATCH_MAX];
+    icoac_real_t search_lower[N][N];
+    icoac_real_t search_floor[N];
+    int32_t search_count;
+    uint32_t trial_ticks;
 } learned_t;
+
+/* What learned_changed compares besides w, |w|, cov and v. */
+#define FZ_W_ACT 1      /* the acting weights */
+#define FZ_BATCH 2      /* the actor's batch sums */
+#define FZ_RECORD 4     /* the search's record, factor and floor */
+#define FZ_TRIAL 8      /* the trial's tick count */
 
 static void learned_take(const icoac_state_t *state, learned_t *l)
 {
     const icoac_priv_state_t *st = icoac_priv_state_c(state);
+    memset(l, 0, sizeof *l);
     memcpy(l->w, st->w, sizeof l->w);
     l->weight_norm = st->weight_norm;
     memcpy(l->cov, icoac_priv_cov_c(st), sizeof l->cov);
     memcpy(l->v, st->v, sizeof l->v);
     memcpy(l->w_act, st->w_act, sizeof l->w_act);
+    memcpy(l->batch_info, st->batch.info, sizeof l->batch_info);
+    memcpy(l->batch_shift, st->batch.shift, sizeof l->batch_shift);
+    memcpy(l->search_w, st->search.w, sizeof l->search_w);
+    memcpy(l->search_ticks, st->search.ticks, sizeof l->search_ticks);
+    memcpy(l->search_lower, st->search.lower, sizeof l->search_lower);
+    memcpy(l->search_floor, st->search.floor, sizeof l->search_floor);
+    l->search_count = st->search.count;
+    l->trial_ticks = st->trial_ticks;
+}
+
+static int all_zero(const icoac_real_t *p, int n)
+{
+    int i;
+    for (i = 0; i < n; ++i) {
+        if (p[i] != ICOAC_R(0.0)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+static icoac_real_t trace4(const icoac_real_t m[N][N])
+{
+    return (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]); /* the library's order */
 }
 
 static icoac_counters_t counters_of(const icoac_state_t *state)
@@ -123,8 +178,9 @@ static const char *learned_nonfinite(const learned_t *l, int with_w_act)
     return 0;
 }
 
-/* Name of the first learned field that differs, or NULL (w_act only if with_w_act). */
-static const char *learned_changed(const learned_t *a, const learned_t *b, int with_w_act)
+/* Name of the first learned field that differs, or NULL (w, |w|, cov, v, and the FZ_* parts
+ * in what). */
+static const char *learned_changed(const learned_t *a, const learned_t *b, int what)
 {
     if (memcmp(a->w, b->w, sizeof a->w) != 0) {
         return "w";
@@ -138,8 +194,24 @@ static const char *learned_changed(const learned_t *a, const learned_t *b, int w
     if (memcmp(a->v, b->v, sizeof a->v) != 0) {
         return "v";
     }
-    if (with_w_act && memcmp(a->w_act, b->w_act, sizeof a->w_act) != 0) {
+    if ((what & FZ_W_ACT) && memcmp(a->w_act, b->w_act, sizeof a->w_act) != 0) {
         return "w_act";
+    }
+    if ((what & FZ_BATCH) && (memcmp(a->batch_info, b->batch_info, sizeof a->batch_info) != 0 ||
+                              memcmp(a->batch_shift, b->batch_shift, sizeof a->batch_shift) != 0)) {
+        return "actor batch sums";
+    }
+    if ((what & FZ_RECORD) && (memcmp(a->search_w, b->search_w, sizeof a->search_w) != 0 ||
+                               memcmp(a->search_ticks, b->search_ticks, sizeof a->search_ticks) != 0 ||
+                               a->search_count != b->search_count)) {
+        return "search record";
+    }
+    if ((what & FZ_RECORD) && (memcmp(a->search_lower, b->search_lower, sizeof a->search_lower) != 0 ||
+                               memcmp(a->search_floor, b->search_floor, sizeof a->search_floor) != 0)) {
+        return "search factor or floor";
+    }
+    if ((what & FZ_TRIAL) && a->trial_ticks != b->trial_ticks) {
+        return "trial tick count";
     }
     return 0;
 }
@@ -222,7 +294,18 @@ static int critic_documented(const icoac_critic_config_t *c)
 static int actor_documented(const icoac_actor_config_t *a)
 {
     return finite_positive(a->noise_std) && finite_non_negative(a->scale) && finite_positive(a->forgetting) &&
-           a->forgetting <= ICOAC_R(1.0) && is_flag(a->reflex) && is_flag(a->act_with_sample);
+           a->forgetting <= ICOAC_R(1.0) && is_flag(a->reflex) && is_flag(a->act_with_sample) &&
+           (a->update == ICOAC_ACTOR_POSTERIOR || a->update == ICOAC_ACTOR_MEAN ||
+            a->update == ICOAC_ACTOR_GRADIENT) &&
+           finite_non_negative(a->rate) && finite_positive(a->likelihood_std) && is_flag(a->batch) &&
+           a->explore_ticks >= 0;
+}
+
+static int search_documented(const icoac_search_config_t *s)
+{
+    return s->batch >= 1 && s->batch <= ICOAC_SEARCH_BATCH_MAX && finite_positive(s->elite_fraction) &&
+           s->elite_fraction <= ICOAC_R(1.0) && finite_positive(s->step) && s->step <= ICOAC_R(1.0) &&
+           finite_positive(s->floor) && isfinite(s->cov_scale) && s->cov_scale >= ICOAC_R(1.0);
 }
 
 static int config_documented(const icoac_config_t *cfg)
@@ -233,8 +316,11 @@ static int config_documented(const icoac_config_t *cfg)
     if (cfg->mode == ICOAC_MODE_ICO) {
         return policy_documented(&cfg->policy) && ico_documented(&cfg->ico);
     }
+    if (cfg->mode == ICOAC_MODE_SEARCH) {
+        return policy_documented(&cfg->policy) && search_documented(&cfg->search);
+    }
     return cfg->mode == ICOAC_MODE_RL && policy_documented(&cfg->policy) && critic_documented(&cfg->critic) &&
-           actor_documented(&cfg->actor);
+           actor_documented(&cfg->actor) && is_flag(cfg->critic.quirks);
 }
 
 /* The fields icoac_config_check_field may name, with their group's status and the mode that
@@ -268,11 +354,22 @@ static const named_field_t named_fields[] = {
     {"critic.range[2]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
     {"critic.range[3]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
     {"critic.threshold", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.quirks", ICOAC_ERR_BAD_MODE, ICOAC_MODE_RL},
     {"actor.noise_std", ICOAC_ERR_BAD_ACTOR, ICOAC_MODE_RL},
     {"actor.scale", ICOAC_ERR_BAD_ACTOR, ICOAC_MODE_RL},
     {"actor.forgetting", ICOAC_ERR_BAD_ACTOR, ICOAC_MODE_RL},
     {"actor.reflex", ICOAC_ERR_BAD_MODE, ICOAC_MODE_RL},
     {"actor.act_with_sample", ICOAC_ERR_BAD_MODE, ICOAC_MODE_RL},
+    {"actor.update", ICOAC_ERR_BAD_MODE, ICOAC_MODE_RL},
+    {"actor.rate", ICOAC_ERR_BAD_ACTOR, ICOAC_MODE_RL},
+    {"actor.likelihood_std", ICOAC_ERR_BAD_ACTOR, ICOAC_MODE_RL},
+    {"actor.batch", ICOAC_ERR_BAD_MODE, ICOAC_MODE_RL},
+    {"actor.explore_ticks", ICOAC_ERR_BAD_ACTOR, ICOAC_MODE_RL},
+    {"search.batch", ICOAC_ERR_BAD_SEARCH, ICOAC_MODE_SEARCH},
+    {"search.elite_fraction", ICOAC_ERR_BAD_SEARCH, ICOAC_MODE_SEARCH},
+    {"search.step", ICOAC_ERR_BAD_SEARCH, ICOAC_MODE_SEARCH},
+    {"search.floor", ICOAC_ERR_BAD_SEARCH, ICOAC_MODE_SEARCH},
+    {"search.cov_scale", ICOAC_ERR_BAD_SEARCH, ICOAC_MODE_SEARCH},
 };
 
 /* field is a known name with this status, of a group cfg's mode checks. */
@@ -316,6 +413,77 @@ static int output_cleared(const icoac_output_t *out, icoac_real_t weight_norm)
            out->cov_trace == ICOAC_R(0.0);
 }
 
+/* An OK RL step: q 0; the mean and gradient readings keep cov; a per-trial batch moves w and
+ * cov only at the trial's end; no exploration noise from tick explore_ticks of a trial on. */
+static void check_rl_step(const icoac_config_t *cfg, const learned_t *before, const learned_t *after,
+                          const icoac_output_t *out, int terminal, int op)
+{
+    const icoac_actor_config_t *a = &cfg->actor;
+    FZ_CHECK(out->q == ICOAC_R(0.0), "op %d: RL step with q %g", op, (double)out->q);
+    FZ_CHECK(a->update == ICOAC_ACTOR_POSTERIOR || memcmp(before->cov, after->cov, sizeof before->cov) == 0,
+             "op %d: actor reading %d changed cov", op, (int)a->update);
+    FZ_CHECK(!a->batch || terminal ||
+                 (memcmp(before->w, after->w, sizeof before->w) == 0 &&
+                  memcmp(before->cov, after->cov, sizeof before->cov) == 0),
+             "op %d: a per-trial batch changed w or cov before the trial's end", op);
+    FZ_CHECK(!a->batch || !terminal || !cfg->learn ||
+                 (all_zero(after->batch_shift, N) && all_zero(&after->batch_info[0][0], N * N)),
+             "op %d: the batch sums were not cleared at the trial's end", op);
+    FZ_CHECK(a->explore_ticks == 0 || before->trial_ticks < (uint32_t)a->explore_ticks ||
+                 out->noise == ICOAC_R(0.0),
+             "op %d: noise %g at tick %u of a trial, explore_ticks %d", op, (double)out->noise,
+             (unsigned)before->trial_ticks, (int)a->explore_ticks);
+    FZ_CHECK(!(a->explore_ticks > 0 && before->trial_ticks > (uint32_t)a->explore_ticks) || a->batch ||
+                 memcmp(before->w, after->w, sizeof before->w) == 0,
+             "op %d: the actor learned from an unexplored tick (tick %u, explore_ticks %d)", op,
+             (unsigned)before->trial_ticks, (int)a->explore_ticks);
+}
+
+/* An OK search step: no critic or noise outputs, cov_trace the trace of cov; w, cov and the
+ * record change only at a terminal step (learning), which records the trial or, with the batch
+ * full, updates w and cov with the floor held and empties the record. */
+static void check_search_step(const icoac_config_t *cfg, const learned_t *before, const learned_t *after,
+                              const icoac_output_t *out, int terminal, int op)
+{
+    const char *field;
+    int i;
+    FZ_CHECK(out->q == ICOAC_R(0.0) && out->value == ICOAC_R(0.0) && out->td_error == ICOAC_R(0.0) &&
+                 out->noise == ICOAC_R(0.0) && out->cov_trace == trace4(CONST_MAT(after->cov)),
+             "op %d: search step with q %g value %g td %g noise %g trace %g (cov trace %g)", op, (double)out->q,
+             (double)out->value, (double)out->td_error, (double)out->noise, (double)out->cov_trace,
+             (double)trace4(CONST_MAT(after->cov)));
+    FZ_CHECK(memcmp(before->w_act, after->w_act, sizeof before->w_act) == 0,
+             "op %d: a search step changed the trial's weights", op);
+    FZ_CHECK(memcmp(before->search_floor, after->search_floor, sizeof before->search_floor) == 0,
+             "op %d: a search step changed the floor", op);
+    FZ_CHECK(after->search_count >= 0 && after->search_count < cfg->search.batch,
+             "op %d: %d trials recorded, batch %d", op, (int)after->search_count, (int)cfg->search.batch);
+    if (!terminal || !cfg->learn) {
+        field = learned_changed(before, after, FZ_RECORD);
+        FZ_CHECK(field == 0, "op %d: a non-learning search step changed the learned %s", op, field);
+        return;
+    }
+    if (before->search_count + 1 < cfg->search.batch) {
+        FZ_CHECK(after->search_count == before->search_count + 1 &&
+                     memcmp(after->search_w[before->search_count], before->w_act, sizeof before->w_act) == 0 &&
+                     after->search_ticks[before->search_count] == before->trial_ticks,
+                 "op %d: the trial (%u ticks) was not recorded as trial %d", op, (unsigned)before->trial_ticks,
+                 (int)before->search_count);
+        FZ_CHECK(memcmp(before->w, after->w, sizeof before->w) == 0 &&
+                     memcmp(before->cov, after->cov, sizeof before->cov) == 0,
+                 "op %d: the search moved w or cov before its batch was full", op);
+        return;
+    }
+    FZ_CHECK(after->search_count == 0, "op %d: the batch is full, but %d trials remain recorded", op,
+             (int)after->search_count);
+    for (i = 0; i < N; ++i) {
+        FZ_CHECK(after->cov[i][i] >= after->search_floor[i], "op %d: cov[%d][%d] = %g below its floor %g", op, i, i,
+                 (double)after->cov[i][i], (double)after->search_floor[i]);
+        FZ_CHECK(after->search_lower[i][i] > ICOAC_R(0.0), "op %d: Cholesky factor with L[%d][%d] = %g", op, i, i,
+                 (double)after->search_lower[i][i]);
+    }
+}
+
 static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in, int op)
 {
     learned_t before;
@@ -325,6 +493,7 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
     icoac_counters_t counted_after;
     const char *field;
     int32_t status;
+    const int terminal = (in->flags & ICOAC_INPUT_TERMINAL) != 0u;
     int finite_in = 1;
     int i;
     learned_take(state, &before);
@@ -361,14 +530,19 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
                  field, (double)after.w[0], (double)after.w[1], (double)after.w[2], (double)after.w[3],
                  (double)after.weight_norm);
         FZ_CHECK(cov_symmetric(CONST_MAT(after.cov)), "op %d: covariance not exactly symmetric", op);
-        field = cfg->learn ? 0 : learned_changed(&before, &after, 0);
+        field = cfg->learn ? 0 : learned_changed(&before, &after, FZ_BATCH | FZ_RECORD);
         FZ_CHECK(field == 0, "op %d: learn = 0, but the tick changed the learned %s", op, field);
-        FZ_CHECK((in->flags & ICOAC_INPUT_TERMINAL) == 0u || (out.force == ICOAC_R(0.0) && out.noise == ICOAC_R(0.0)),
+        FZ_CHECK(!terminal || (out.force == ICOAC_R(0.0) && out.noise == ICOAC_R(0.0)),
                  "op %d: terminal step with force %g noise %g", op, (double)out.force, (double)out.noise);
         FZ_CHECK(out.weight_norm == after.weight_norm, "op %d: out.weight_norm %g, state |w| %g", op,
                  (double)out.weight_norm, (double)after.weight_norm);
+        FZ_CHECK(after.trial_ticks == before.trial_ticks + (terminal ? 0u : 1u),
+                 "op %d: trial tick count %u -> %u (terminal %d)", op, (unsigned)before.trial_ticks,
+                 (unsigned)after.trial_ticks, terminal);
         if (cfg->mode == ICOAC_MODE_RL) {
-            FZ_CHECK(out.q == ICOAC_R(0.0), "op %d: RL step with q %g", op, (double)out.q);
+            check_rl_step(cfg, &before, &after, &out, terminal, op);
+        } else if (cfg->mode == ICOAC_MODE_SEARCH) {
+            check_search_step(cfg, &before, &after, &out, terminal, op);
         } else {
             FZ_CHECK(out.value == ICOAC_R(0.0) && out.td_error == ICOAC_R(0.0) && out.noise == ICOAC_R(0.0) &&
                          out.cov_trace == ICOAC_R(0.0),
@@ -382,7 +556,7 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
                  op, (int)status, status_name(status), (double)out.force, (double)out.z, (double)out.reflex,
                  (double)out.penalty, (double)out.q, (double)out.weight_norm, (double)after.weight_norm,
                  (double)out.value, (double)out.td_error, (double)out.noise, (double)out.cov_trace);
-        field = learned_changed(&before, &after, 1);
+        field = learned_changed(&before, &after, FZ_W_ACT | FZ_BATCH | FZ_RECORD | FZ_TRIAL);
         FZ_CHECK(field == 0, "op %d: status %d (%s) changed the learned %s", op, (int)status,
                  status_name(status), field);
     }
@@ -390,7 +564,7 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
 
 static void check_reset(const icoac_config_t *cfg, icoac_state_t *state, int op)
 {
-    const int sampled = cfg->mode == ICOAC_MODE_RL && cfg->actor.act_with_sample;
+    const int sampled = (cfg->mode == ICOAC_MODE_RL && cfg->actor.act_with_sample) || cfg->mode == ICOAC_MODE_SEARCH;
     learned_t before;
     learned_t after;
     const char *field;
@@ -400,8 +574,11 @@ static void check_reset(const icoac_config_t *cfg, icoac_state_t *state, int op)
     learned_take(state, &after);
     FZ_CHECK(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC, "op %d: icoac_reset returned %d (%s)", op,
              (int)status, status_name(status));
-    field = learned_changed(&before, &after, 0);
+    /* a batch not ended by a terminal step is dropped */
+    field = learned_changed(&before, &after, FZ_RECORD);
     FZ_CHECK(field == 0, "op %d: icoac_reset changed the learned %s", op, field);
+    FZ_CHECK(all_zero(after.batch_shift, N) && all_zero(&after.batch_info[0][0], N * N) && after.trial_ticks == 0u,
+             "op %d: icoac_reset kept the trial's batch sums or tick count (%u)", op, (unsigned)after.trial_ticks);
     if (status == ICOAC_OK) {
         FZ_CHECK(finite_n(after.w_act, N), "op %d: icoac_reset OK with a non-finite w_act", op);
     }
@@ -481,6 +658,10 @@ static int check_init(const icoac_config_t *cfg, icoac_state_t *state, const ico
                  (int)prior_status);
         return 0;
     }
+    if (status == ICOAC_ERR_BAD_PRIOR && cfg->mode == ICOAC_MODE_SEARCH) {
+        /* cov_scale * the prior covariance lost positive definiteness in rounding */
+        return 0;
+    }
     FZ_CHECK(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC, "icoac_init returned %d (%s) for a valid setup",
              (int)status, status_name(status));
     learned_take(state, &l);
@@ -492,10 +673,23 @@ static int check_init(const icoac_config_t *cfg, icoac_state_t *state, const ico
         FZ_CHECK(l.w[i] == (prior != 0 ? prior->mean[i] : ICOAC_R(0.0)), "icoac_init: w[%d] is not the prior mean",
                  i);
         for (j = 0; j < N; ++j) {
-            const icoac_real_t expect = prior != 0 ? prior->cov[i][j] : (i == j ? ICOAC_R(1.0) : ICOAC_R(0.0));
-            FZ_CHECK(l.cov[i][j] == expect, "icoac_init: cov[%d][%d] is not the prior's", i, j);
+            icoac_real_t expect = prior != 0 ? prior->cov[i][j] : (i == j ? ICOAC_R(1.0) : ICOAC_R(0.0));
+            if (cfg->mode == ICOAC_MODE_SEARCH) {
+                expect *= cfg->search.cov_scale; /* Sigma0 = c * the prior covariance */
+            }
+            FZ_CHECK(l.cov[i][j] == expect, "icoac_init: cov[%d][%d] = %g is not the prior's (%g)", i, j,
+                     (double)l.cov[i][j], (double)expect);
+        }
+        if (cfg->mode == ICOAC_MODE_SEARCH) {
+            FZ_CHECK(l.search_floor[i] == cfg->search.floor * l.cov[i][i] && l.search_lower[i][i] > ICOAC_R(0.0),
+                     "icoac_init: search floor[%d] %g (expected %g), factor %g", i, (double)l.search_floor[i],
+                     (double)(cfg->search.floor * l.cov[i][i]), (double)l.search_lower[i][i]);
         }
     }
+    FZ_CHECK(l.search_count == 0 && l.trial_ticks == 0u && all_zero(l.batch_shift, N) &&
+                 all_zero(&l.batch_info[0][0], N * N),
+             "icoac_init: a trial record (%d), tick count (%u) or batch sums not empty", (int)l.search_count,
+             (unsigned)l.trial_ticks);
     return 1;
 }
 

@@ -139,12 +139,15 @@ int64_t fz_i64(fz_reader_t *r)
 }
 
 /* Config fields by index, in struct order (the order icoac_config_check walks them): the
- * member's offset and whether it is an int32 switch or a real. Indices:
+ * member's offset and whether it is an int32 (switch or count) or a real. Indices:
  * 0 mode, 1 learn, 2-5 policy.input_range, 6 policy.clip_inputs, 7 policy.gain,
  * 8 policy.reflex_mode, 9 policy.reflex_force, 10 policy.zone_theta, 11 policy.zone_x,
  * 12 ico.rate, 13 ico.timing, 14 critic.rate, 15 critic.discount, 16 critic.td_clip,
- * 17-20 critic.range, 21 critic.threshold, 22 actor.noise_std, 23 actor.scale,
- * 24 actor.forgetting, 25 actor.reflex, 26 actor.act_with_sample. */
+ * 17-20 critic.range, 21 critic.threshold, 22 critic.quirks, 23 actor.noise_std,
+ * 24 actor.scale, 25 actor.forgetting, 26 actor.reflex, 27 actor.act_with_sample,
+ * 28 actor.update, 29 actor.rate, 30 actor.likelihood_std, 31 actor.batch,
+ * 32 actor.explore_ticks, 33 search.batch, 34 search.elite_fraction, 35 search.step,
+ * 36 search.floor, 37 search.cov_scale. */
 typedef struct {
     size_t offset;
     int is_int;
@@ -176,11 +179,22 @@ static const config_field_t config_fields[] = {
     FZ_REAL(critic.range[2]),
     FZ_REAL(critic.range[3]),
     FZ_REAL(critic.threshold),
+    FZ_INT(critic.quirks),
     FZ_REAL(actor.noise_std),
     FZ_REAL(actor.scale),
     FZ_REAL(actor.forgetting),
     FZ_INT(actor.reflex),
     FZ_INT(actor.act_with_sample),
+    FZ_INT(actor.update),
+    FZ_REAL(actor.rate),
+    FZ_REAL(actor.likelihood_std),
+    FZ_INT(actor.batch),
+    FZ_INT(actor.explore_ticks),
+    FZ_INT(search.batch),
+    FZ_REAL(search.elite_fraction),
+    FZ_REAL(search.step),
+    FZ_REAL(search.floor),
+    FZ_REAL(search.cov_scale),
 };
 
 ICOAC_STATIC_ASSERT(sizeof config_fields / sizeof config_fields[0] == FZ_CONFIG_FIELDS, fz_config_field_count);

@@ -20,7 +20,7 @@ typedef struct {
 #define FZ_VALUE_RAW 4      /* 36..39: raw bits of the value, little endian */
 #define FZ_VALUE_KINDS (FZ_VALUE_TABLE + FZ_VALUE_BOUNDED + FZ_VALUE_RAW)
 
-#define FZ_CONFIG_FIELDS 27 /* config mutation field indices 0..26, struct order: fuzz_input.c */
+#define FZ_CONFIG_FIELDS 38 /* config mutation field indices 0..37, struct order: fuzz_input.c */
 #define FZ_PRIOR_FIELDS 20  /* 0..3 mean, 4 + 4i + j cov[i][j] */
 
 void fz_reader_init(fz_reader_t *r, const uint8_t *data, size_t size);
@@ -37,7 +37,7 @@ int64_t fz_i64(fz_reader_t *r);       /* selector (mod 12): see fuzz_input.c, 11
 
 /* Config section: a mode byte c; c odd: the raw bytes of icoac_config_t (the nested layout,
  * padding included) over the default; c even: the default with (c >> 1) % 8 mutations (field
- * byte % 26, value). */
+ * byte % FZ_CONFIG_FIELDS, value). */
 void fz_config(fz_reader_t *r, icoac_config_t *cfg);
 
 /* Prior section: a byte p; p % 3 == 0: NULL, 1: mean 0 and cov I, 2: that with (p / 3) % 8

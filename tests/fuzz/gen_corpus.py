@@ -26,19 +26,22 @@ INT32_TABLE = [0, 1, 2, -1, 2**31 - 1, -2**31, 3]
 INT64_TABLE = [0, 1, 2, 3, -1, 300, 1000, 100000, 2**63 - 1, -2**63, 10]
 
 # icoac_config_t (icoac.h), one group per concern: (member, kind) with kind "i" an int32
-# switch, "r" an icoac_real_t, "r4" an icoac_real_t[4], or a nested group.
+# (switch or count), "r" an icoac_real_t, "r4" an icoac_real_t[4], or a nested group.
 CONFIG_LAYOUT = [
     ("mode", "i"),
     ("learn", "i"),
     ("policy", [("input_range", "r4"), ("clip_inputs", "i"), ("gain", "r"), ("reflex_mode", "i"),
                 ("reflex_force", "r"), ("zone_theta", "r"), ("zone_x", "r")]),
     ("ico", [("rate", "r"), ("timing", "i")]),
-    ("critic", [("rate", "r"), ("discount", "r"), ("td_clip", "r"), ("range", "r4"), ("threshold", "r")]),
+    ("critic", [("rate", "r"), ("discount", "r"), ("td_clip", "r"), ("range", "r4"), ("threshold", "r"),
+                ("quirks", "i")]),
     ("actor", [("noise_std", "r"), ("scale", "r"), ("forgetting", "r"), ("reflex", "i"),
-               ("act_with_sample", "i")]),
+               ("act_with_sample", "i"), ("update", "i"), ("rate", "r"), ("likelihood_std", "r"),
+               ("batch", "i"), ("explore_ticks", "i")]),
+    ("search", [("batch", "i"), ("elite_fraction", "r"), ("step", "r"), ("floor", "r"), ("cov_scale", "r")]),
 ]
 # sizeof(icoac_config_t) with float and with double reals (x86-64 and AArch64 alignment).
-CONFIG_SIZES = {"f": 108, "d": 200}
+CONFIG_SIZES = {"f": 152, "d": 280}
 
 
 def config_fields():
@@ -61,7 +64,7 @@ def config_fields():
 # The mutation field indices of fuzz_input.c: struct order.
 CONFIG_FIELDS = [name for name, _ in config_fields()]
 CONFIG_INTS = {name for name, is_int in config_fields() if is_int}
-assert len(CONFIG_FIELDS) == 27
+assert len(CONFIG_FIELDS) == 38
 CONFIG_DEFAULT = {"mode": 0, "learn": 1,
                   "policy.input_range[0]": 2.4, "policy.input_range[1]": 3.5,
                   "policy.input_range[2]": 0.2094384, "policy.input_range[3]": 2.0,
@@ -71,9 +74,12 @@ CONFIG_DEFAULT = {"mode": 0, "learn": 1,
                   "ico.rate": 1.0e-4, "ico.timing": 0,
                   "critic.rate": 0.6, "critic.discount": 0.95, "critic.td_clip": 1.0,
                   "critic.range[0]": 2.4, "critic.range[1]": 3.5, "critic.range[2]": 0.2094384,
-                  "critic.range[3]": 2.0, "critic.threshold": 0.001,
+                  "critic.range[3]": 2.0, "critic.threshold": 0.001, "critic.quirks": 0,
                   "actor.noise_std": 1.0, "actor.scale": 0.5, "actor.forgetting": 1.0,
-                  "actor.reflex": 1, "actor.act_with_sample": 0}
+                  "actor.reflex": 1, "actor.act_with_sample": 0, "actor.update": 0, "actor.rate": 0.01,
+                  "actor.likelihood_std": 1.0, "actor.batch": 0, "actor.explore_ticks": 0,
+                  "search.batch": 4, "search.elite_fraction": 0.5, "search.step": 0.5, "search.floor": 0.1,
+                  "search.cov_scale": 1.0}
 assert list(CONFIG_DEFAULT) == CONFIG_FIELDS
 
 
@@ -115,8 +121,15 @@ PLANT_FIELDS = ["gravity", "cart_mass", "pole_mass", "half_length", "dt", "x_lim
 RUN_FIELDS = ["max_trials", "success_steps", "init_velocity_noise"]
 
 
-def value(v, table):
-    """A real or double: a table name (str) or an ordinary number as a bounded int16."""
+class Exact(float):
+    """A real given by its raw bits (selector 36), e.g. a documented bound exactly."""
+
+
+def value(v, table, fmt="f"):
+    """A real or double: a table name (str), an Exact value as raw bits of struct code fmt, or an
+    ordinary number as a bounded int16."""
+    if isinstance(v, Exact):
+        return bytes([len(REAL_TABLE) + len(BOUNDED_SCALES)]) + struct.pack("<" + fmt, v)
     if isinstance(v, str):
         return bytes([table.index(v)])
     for k, scale in enumerate(BOUNDED_SCALES):
@@ -126,29 +139,33 @@ def value(v, table):
     raise ValueError(f"{v} is outside the bounded range; use a table name")
 
 
-def real(v):
-    return value(v, REAL_TABLE)
+def real(v, fmt="f"):
+    return value(v, REAL_TABLE, fmt)
 
 
 def double(v):
-    return value(v, DOUBLE_TABLE)
+    return value(v, DOUBLE_TABLE, "d")
 
 
 def int32(v):
-    return bytes([INT32_TABLE.index(v)])
+    """A table value by its selector, any other int32 as selector 7 and its 4 raw bytes."""
+    if v in INT32_TABLE:
+        return bytes([INT32_TABLE.index(v)])
+    return bytes([len(INT32_TABLE)]) + struct.pack("<i", v)
 
 
 def int64(v):
     return bytes([INT64_TABLE.index(v)])
 
 
-def config(fields=None):
-    """icoac_config_default with mutations {C designator: value} (at most 7, applied in order)."""
+def config(fields=None, fmt="f"):
+    """icoac_config_default with mutations {C designator: value} (at most 7, applied in order);
+    fmt: the real type's struct code (for Exact values)."""
     fields = fields or {}
     assert len(fields) <= 7
     out = bytes([len(fields) << 1])
     for name, v in fields.items():
-        out += bytes([CONFIG_FIELDS.index(name)]) + (int32(v) if name in CONFIG_INTS else real(v))
+        out += bytes([CONFIG_FIELDS.index(name)]) + (int32(v) if name in CONFIG_INTS else real(v, fmt))
     return out
 
 
@@ -213,9 +230,16 @@ EXERCISE = (steps(ZERO, 2) + steps((0.5, 0.3, 0.05, 0.2), 4) + steps((2.5, 1.0, 
             + RESET + steps((0.1, 0.0, 0.01, 0.0), 8) + steps((-0.3, 0.2, -0.1, 0.5), 8))
 
 
+# Six trials of different lengths, each ended by a failure and a reset: a search batch of 4
+# updates once (and a batch of 2 three times).
+SEARCH_TRIALS = b"".join(steps((0.1 * k, -0.2, 0.02 * k, 0.3), 2 + 3 * k) + step((2.5, 1.0, "0.25", 1.0), terminal=True)
+                         + RESET for k in range(6))
+
+
 def controller_seeds(fmt):
     """Seeds of the controller targets; fmt is the real type's struct code."""
     rl = {"mode": 1}
+    search = {"mode": 2}
     s = {
         "default-ico": config() + NO_PRIOR + seed(1) + EXERCISE,
         "default-rl": config(rl) + NO_PRIOR + seed(2) + EXERCISE + EXERCISE,
@@ -229,7 +253,7 @@ def controller_seeds(fmt):
         "rl-prior-correlated": config(rl) + prior(("mean2", 5.0), ((0, 1), 0.5, True)) + seed(9) + EXERCISE,
         "prior-asymmetric": config(rl) + prior(((0, 1), 0.5)) + seed(10) + EXERCISE,
         "prior-mean-nan": config() + prior(("mean1", "nan")) + seed(11) + EXERCISE,
-        "config-bad-mode": config({"mode": 2}) + NO_PRIOR + seed(12) + EXERCISE,
+        "config-bad-mode": config({"mode": 3}) + NO_PRIOR + seed(12) + EXERCISE,
         "config-bad-range": config({"policy.input_range[1]": "-1"}) + NO_PRIOR + seed(13) + EXERCISE,
         "config-raw-default": config_raw(fmt) + NO_PRIOR + seed(14) + EXERCISE,
         "config-raw-rl": config_raw(fmt, {**rl, "actor.noise_std": 0.5}) + prior() + seed(15) + EXERCISE,
@@ -242,6 +266,50 @@ def controller_seeds(fmt):
                                          + NO_PRIOR + seed(17) + EXERCISE),
         "config-rl-ignores-ico-group": (config({**rl, "ico.rate": "nan", "ico.timing": 2}) + NO_PRIOR + seed(18)
                                         + EXERCISE),
+        # The learners (spec L2-L4, A10): actor readings, per-trial batches, the exploration
+        # schedule, the critic quirks, and the episodic search over several batches.
+        "rl-mean": config({**rl, "actor.update": 1, "actor.likelihood_std": 0.25}) + NO_PRIOR + seed(19) + EXERCISE * 2,
+        "rl-gradient": config({**rl, "actor.update": 2, "actor.rate": 0.1}) + NO_PRIOR + seed(20) + EXERCISE * 2,
+        "rl-batch-posterior": (config({**rl, "actor.batch": 1, "actor.forgetting": 0.9}) + NO_PRIOR + seed(21)
+                               + EXERCISE * 2),
+        "rl-batch-mean": config({**rl, "actor.batch": 1, "actor.update": 1}) + NO_PRIOR + seed(22) + EXERCISE * 2,
+        "rl-batch-gradient": (config({**rl, "actor.batch": 1, "actor.update": 2, "actor.rate": 1.0}) + NO_PRIOR
+                              + seed(23) + EXERCISE * 2),
+        "rl-explore-ticks": (config({**rl, "actor.explore_ticks": 5, "actor.act_with_sample": 1}) + NO_PRIOR
+                             + seed(24) + EXERCISE * 2),
+        "rl-batch-explore-quirks": (config({**rl, "actor.batch": 1, "actor.explore_ticks": 3, "critic.quirks": 1})
+                                    + NO_PRIOR + seed(25) + EXERCISE * 2),
+        "rl-quirks": config({**rl, "critic.quirks": 1, "critic.threshold": "0"}) + NO_PRIOR + seed(26) + EXERCISE,
+        "rl-learner-extremes": (config({**rl, "actor.update": 2, "actor.rate": Exact(1000.0),
+                                        "actor.noise_std": Exact(0.001), "actor.likelihood_std": Exact(1000.0),
+                                        "actor.explore_ticks": 100000000}, fmt)
+                                + NO_PRIOR + seed(27) + EXERCISE),
+        "rl-mean-likelihood-min": (config({**rl, "actor.update": 1, "actor.likelihood_std": Exact(0.001),
+                                           "actor.scale": Exact(1000.0)}, fmt) + NO_PRIOR + seed(40) + EXERCISE),
+        "rl-ignores-search-group": (config({**rl, "search.batch": 0, "search.floor": "nan", "search.cov_scale": "0"})
+                                    + NO_PRIOR + seed(28) + EXERCISE),
+        "search-default": config(search) + NO_PRIOR + seed(29) + SEARCH_TRIALS,
+        "search-batch-1": config({**search, "search.batch": 1, "search.step": "1"}) + NO_PRIOR + seed(30) + SEARCH_TRIALS,
+        "search-step-1": (config({**search, "search.step": "1", "search.elite_fraction": "0.5", "search.floor": 1.0})
+                          + NO_PRIOR + seed(31) + SEARCH_TRIALS),
+        "search-max-batch": (config({**search, "search.batch": 16, "search.elite_fraction": "0.25"}) + NO_PRIOR
+                             + seed(32) + SEARCH_TRIALS * 3),
+        "search-prior-scaled": (config({**search, "search.cov_scale": 16.0, "search.floor": "1e-5"})
+                                + prior(("mean2", 5.0), ((0, 1), 0.5, True), ((2, 2), 4.0)) + seed(33) + SEARCH_TRIALS),
+        "search-floor-max": (config({**search, "search.floor": Exact(1000.0), "search.cov_scale": Exact(1000.0),
+                                     "search.batch": 2}, fmt) + NO_PRIOR + seed(34) + SEARCH_TRIALS),
+        "search-floor-min": (config({**search, "search.floor": Exact(1e-6), "search.elite_fraction": Exact(1e-6),
+                                     "search.step": Exact(1e-6), "search.batch": 3}, fmt) + NO_PRIOR + seed(41)
+                             + SEARCH_TRIALS),
+        "search-no-learning": config({**search, "learn": 0}) + NO_PRIOR + seed(35) + SEARCH_TRIALS,
+        "search-ignores-other-groups": (config({**search, "ico.rate": "nan", "critic.range[0]": "1e-39",
+                                                "actor.noise_std": "0", "actor.update": 7, "critic.quirks": 2})
+                                        + NO_PRIOR + seed(36) + SEARCH_TRIALS),
+        "search-bad-batch": config({**search, "search.batch": 17}) + NO_PRIOR + seed(37) + SEARCH_TRIALS,
+        "search-nonfinite-terminal": (config({**search, "search.batch": 2}) + NO_PRIOR + seed(38) + steps(ZERO, 3)
+                                      + step(("nan", "0", "0", "0"), terminal=True) + SEARCH_TRIALS),
+        "config-raw-search": config_raw(fmt, {**search, "search.batch": 2, "search.step": 0.25}) + prior() + seed(39)
+                             + SEARCH_TRIALS,
         # Known reproducers (issue 8).
         "repro-rl-critic-range0-1e-39": config({**rl, "critic.range[0]": "1e-39"}) + NO_PRIOR + seed(1) + step(ZERO),
         "repro-rl-noise-std-1e-20": (config({**rl, "actor.noise_std": "1e-20"}) + NO_PRIOR + seed(1) + steps(ZERO, 3)
@@ -323,7 +391,12 @@ def sim_seeds():
         "paper-grid": plant() + run() + config() + NO_PRIOR + op_paper(1225) + op_paper(1224) + op_paper(0, True),
         "bad-plant": plant(gravity="nan") + run() + config() + NO_PRIOR + SIM_OPS,
         "bad-run": plant() + run(max_trials=0, init_velocity_noise="-1") + config() + NO_PRIOR + SIM_OPS,
-        "bad-config-prior": plant() + run() + config({"mode": 2}) + prior(((2, 2), "-1")) + SIM_OPS,
+        "bad-config-prior": plant() + run() + config({"mode": 3}) + prior(((2, 2), "-1")) + SIM_OPS,
+        "default-search": plant() + run() + config({"mode": 2, "search.batch": 2}) + NO_PRIOR + SIM_OPS,
+        "search-prior": (plant() + run(max_trials=3) + config({"mode": 2, "search.batch": 1, "search.cov_scale": 4.0})
+                         + prior(("mean2", 5.0), ("mean3", 1.0)) + SIM_OPS),
+        "rl-learners": (plant() + run() + config({"mode": 1, "actor.update": 1, "actor.batch": 1,
+                                                  "actor.explore_ticks": 50, "critic.quirks": 1}) + NO_PRIOR + SIM_OPS),
         "bad-arguments": (plant() + run() + config() + NO_PRIOR + op_cell("inf", 0.0, 1)
                           + op_trajectory(0.0, 0.0, "nan", 1, 0) + op_trajectory(0.0, "nan", "0", 1, 10)),
         "plant-extremes": (plant() + run() + config() + NO_PRIOR + op_plant(("1e300", "-1e30", "2.4", "nan"), "max")

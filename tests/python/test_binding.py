@@ -30,7 +30,7 @@ def test_state_is_opaque_aligned_storage():
 
 
 def test_abi_versions():
-    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 5
+    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 6
     assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 2
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
@@ -41,6 +41,16 @@ def test_every_mirror_matches_the_c_field_table():
     for c_type, (mirror, _) in B.MIRRORS.items():
         assert B.mirror_fields(mirror) == B.FIELDS[c_type], c_type
     assert "policy.gain" in B.FIELDS["icoac_config_t"] and "actor.act_with_sample" in B.FIELDS["icoac_config_t"]
+    for name in ("critic.quirks", "actor.update", "actor.rate", "actor.likelihood_std", "actor.batch",
+                 "actor.explore_ticks", "search.batch", "search.elite_fraction", "search.step", "search.floor",
+                 "search.cov_scale"):
+        assert name in B.FIELDS["icoac_config_t"], name
+    # the C field table covers icoac_config_t: every byte (float reals: no padding) or all but padding
+    ends = sorted((off, off + size) for off, size in B.FIELDS["icoac_config_t"].values())
+    covered = sum(e - o for o, e in ends)
+    assert all(ends[i][1] <= ends[i + 1][0] for i in range(len(ends) - 1))
+    assert covered == B.lib.icoac_sizeof_config() or (B.real_dtype == np.float64 and
+                                                      covered < B.lib.icoac_sizeof_config())
 
 
 class _WrongPolicy(ctypes.Structure):
@@ -52,7 +62,7 @@ class _WrongPolicy(ctypes.Structure):
 
 class _WrongConfig(ctypes.Structure):
     _fields_ = [("mode", ctypes.c_int32), ("learn", ctypes.c_int32), ("policy", _WrongPolicy), ("ico", B.IcoConfig),
-                ("critic", B.CriticConfig), ("actor", B.ActorConfig)]
+                ("critic", B.CriticConfig), ("actor", B.ActorConfig), ("search", B.SearchConfig)]
 
 
 def test_field_check_catches_a_wrong_offset():
@@ -90,7 +100,12 @@ def test_field_check_catches_missing_extra_size_and_dtype():
 
 def test_constants_from_c():
     c = B.CONSTANTS
-    assert B.MODES == {"ico": c["ICOAC_MODE_ICO"], "rl": c["ICOAC_MODE_RL"]}
+    assert B.MODES == {"ico": c["ICOAC_MODE_ICO"], "rl": c["ICOAC_MODE_RL"], "search": c["ICOAC_MODE_SEARCH"]}
+    assert B.MODE_SEARCH == c["ICOAC_MODE_SEARCH"] == 2
+    assert B.ACTOR_UPDATES == {"posterior": c["ICOAC_ACTOR_POSTERIOR"], "mean": c["ICOAC_ACTOR_MEAN"],
+                               "gradient": c["ICOAC_ACTOR_GRADIENT"]}
+    assert B.ERR_BAD_SEARCH == c["ICOAC_ERR_BAD_SEARCH"] == 18 and B.ERR_BAD_SEARCH in B.CONFIG_STATUSES
+    assert B.SEARCH_BATCH_MAX == c["ICOAC_SEARCH_BATCH_MAX"] and B.EXPLORE_TICKS_MAX == c["ICOAC_EXPLORE_TICKS_MAX"]
     assert B.REFLEX_MODES == {"unit": c["ICOAC_REFLEX_UNIT"], "gain": c["ICOAC_REFLEX_GAIN"]}
     assert B.ICO_TIMINGS == {"code": c["ICOAC_ICO_TIMING_CODE"], "literal": c["ICOAC_ICO_TIMING_LITERAL"]}
     assert B.INTEGRATORS == {"euler": c["ICOAC_SIM_EULER"], "rk4": c["ICOAC_SIM_RK4"]}
@@ -138,9 +153,9 @@ def test_cell_dtype_offsets():
 def test_config_defaults_match_spec():
     d = build_config().to_dict()
     c, p, r = d["controller"], d["plant"], d["run"]
-    assert set(c) == {"mode", "learn", "policy", "ico", "critic", "actor"}
+    assert set(c) == {"mode", "learn", "policy", "ico", "critic", "actor", "search"}
     assert c["learn"] is True
-    pol, ico, cri, act = c["policy"], c["ico"], c["critic"], c["actor"]
+    pol, ico, cri, act, sea = c["policy"], c["ico"], c["critic"], c["actor"], c["search"]
     assert c["mode"] == "ico" and pol["reflex_mode"] == "unit" and ico["timing"] == "code"
     assert pol["gain"] == 10.0
     assert pol["reflex_force"] == 1.0
@@ -152,6 +167,11 @@ def test_config_defaults_match_spec():
     assert cri["discount"] == pytest.approx(0.95)
     assert act["noise_std"] == 1.0 and act["scale"] == 0.5 and act["forgetting"] == 1.0
     assert pol["clip_inputs"] is True and act["reflex"] is True and act["act_with_sample"] is False
+    # spec L2-L4, A10: the literal readings by default
+    assert cri["quirks"] is False
+    assert act["update"] == "posterior" and act["rate"] == pytest.approx(0.01) and act["likelihood_std"] == 1.0
+    assert act["batch"] is False and act["explore_ticks"] == 0
+    assert sea == {"batch": 4, "elite_fraction": 0.5, "step": 0.5, "floor": pytest.approx(0.1), "cov_scale": 1.0}
     assert p == {"gravity": 9.8, "cart_mass": 1.0, "pole_mass": 0.1, "half_length": 0.5, "dt": 0.01,
                  "x_limit": 2.4, "theta_limit": pytest.approx(math.radians(12)), "integrator": "euler",
                  "reserved": 0}

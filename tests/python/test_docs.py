@@ -60,3 +60,18 @@ def test_documented_command_parses(where, command):
         params = sweep.parse_params(args.param)
         for setting in sweep.settings(params, args.one_at_a_time):
             build_config({k: v for k, v in setting.items() if k not in sweep.PRIOR_PARAMS}, condition=args.condition)
+
+
+def test_learner_sweep_plans_build():
+    """Every setting of the learner sweeps (harness.tools.learner_sweeps, spec L2-L4) builds a
+    configuration of its condition, in the mode of that condition."""
+    from harness import _binding as B
+    from harness.tools import learner_sweeps
+
+    n = 0
+    for name, condition, params, one_at_a_time in learner_sweeps.STAGE_1 + learner_sweeps.STAGE_2:
+        for setting in sweep.settings(sweep.parse_params(params), one_at_a_time):
+            cfg = build_config({k: v for k, v in setting.items() if k not in sweep.PRIOR_PARAMS}, condition=condition)
+            assert cfg.controller.mode == (B.MODE_SEARCH if "search" in condition else B.MODE_RL), name
+            n += 1
+    assert n > 20

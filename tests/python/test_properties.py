@@ -1,6 +1,7 @@
 """Property tests (hypothesis): configuration building, `--set` parsing, cell lists and results
 loading accept an input and round-trip it, or reject it with the harness's own error type - never
 another exception. Profile (examples, derandomized) in conftest.py."""
+import ctypes
 import io
 import json
 import math
@@ -66,7 +67,7 @@ def test_build_config_accepts_and_round_trips_or_rejects(overrides):
         assert_round_trip(cfg)
 
 
-@given(st.sampled_from(ALL_FIELDS + tuple(ALIASES)), field_values, st.sampled_from(["ico", "rl"]))
+@given(st.sampled_from(ALL_FIELDS + tuple(ALIASES)), field_values, st.sampled_from(["ico", "rl", "search"]))
 def test_single_field_override(given_name, value, condition):
     cfg = total(build_config, {given_name: value}, condition=condition)
     if cfg is None:
@@ -89,8 +90,11 @@ def test_single_field_override(given_name, value, condition):
         assert kind(got) == kind(value) and math.isfinite(got)
 
 
-INT_FIELDS = [n for n in ALL_FIELDS if n in ENUMS or n in BOOLS or n in ("max_trials", "success_steps")]
-assert len(INT_FIELDS) == 10
+# switches, flags and counts: every integer field (explore_ticks and search.batch are plain int32 counts)
+INT_FIELDS = [n for n in ALL_FIELDS if n in ENUMS or n in BOOLS
+              or n in ("max_trials", "success_steps", "actor.explore_ticks", "search.batch")]
+assert len(INT_FIELDS) == 15
+assert {n for n in config.CONTROLLER_FIELDS if config._ctype(B.Config(), n) is ctypes.c_int32} <= set(INT_FIELDS)
 
 
 # k + m * 2^32 (and 2^64) wraps to a valid small value if anything truncates to int32 (int64)

@@ -204,13 +204,18 @@ def closed_form(cfg, mu, sigma, s_t, delta, eps):
     rng = np.array(c.policy.input_range, dtype=float)
     h = c.policy.gain * np.clip(s_t / rng, -1.0, 1.0)
     y = h @ mu + c.actor.scale * delta * eps  # u_ob = mu_u + alpha * delta * eps
-    S = h @ sigma @ h + c.actor.noise_std ** 2
+    S = h @ sigma @ h + c.actor.likelihood_std ** 2  # the likelihood std sigma_L (spec L2), not sigma_u
     return mu + sigma @ h * (y - h @ mu) / S, sigma - np.outer(sigma @ h, sigma @ h) / S
 
 
-@pytest.mark.parametrize("noise_std, actor_scale", [(1.0, 0.5), (2.0, 1.0)])
-def test_bayes_step_terminal_matches_closed_form(noise_std, actor_scale):
-    cfg = build_config({"noise_std": noise_std, "actor_scale": actor_scale}, condition="rl")
+@pytest.mark.parametrize("noise_std, actor_scale, likelihood_std",
+                         [(1.0, 0.5, None), (2.0, 1.0, None), (2.0, 1.0, 2.0), (1.0, 0.5, 3.0)])
+def test_bayes_step_terminal_matches_closed_form(noise_std, actor_scale, likelihood_std):
+    over = {"noise_std": noise_std, "actor_scale": actor_scale}
+    if likelihood_std is not None:
+        over["actor.likelihood_std"] = likelihood_std
+    cfg = build_config(over, condition="rl")
+    assert cfg.controller.actor.likelihood_std == (likelihood_std or 1.0)  # default sigma_L = 1 N
     state = controller(cfg, MU, SIGMA, seed=11)
     out1 = tick(cfg, state, S_T)
     assert out1.status == 0 and out1.value == 0.0 and out1.noise != 0.0

@@ -1,0 +1,76 @@
+"""Driving one controller tick by tick through the binding (icoac_init / icoac_reset / icoac_step),
+shared by test_readings.py and test_search.py; the numpy side of those tests is in them."""
+import ctypes
+
+import numpy as np
+
+from harness import _binding as B
+from harness.config import make_prior
+
+REAL = B.real_dtype.type  # np.float32 for the float library
+
+
+def controller(cfg, mean=None, cov=None, seed=1):
+    """An initialised state for cfg (a RunConfig), prior (mean, cov) or NULL."""
+    state = B.State()
+    prior = None if mean is None else ctypes.byref(make_prior(mean, cov))
+    B.check_status(B.lib.icoac_init(ctypes.byref(cfg.controller), ctypes.byref(state), prior, seed))
+    return state
+
+
+def reset(cfg, state):
+    B.check_status(B.lib.icoac_reset(ctypes.byref(cfg.controller), ctypes.byref(state)))
+
+
+def tick(cfg, state, s, terminal=False, expect=B.OK):
+    """One icoac_step on s; the output (its status must be `expect`)."""
+    inp = B.Input()
+    for i in range(B.N_INPUTS):
+        inp.s[i] = float(s[i])
+    inp.flags = B.INPUT_TERMINAL if terminal else 0
+    out = B.Output()
+    status = B.lib.icoac_step(ctypes.byref(cfg.controller), ctypes.byref(state), ctypes.byref(inp), ctypes.byref(out))
+    assert status == expect == out.status, (status, out.status)
+    return out
+
+
+def posterior(state):
+    """(mu_w, Sigma_w) as float64 arrays."""
+    post = B.get_posterior(state)
+    return np.array(post.mean, dtype=float), np.array([list(r) for r in post.cov], dtype=float)
+
+
+def stored(s):
+    """The state as the controller stores it (icoac_real_t)."""
+    return np.asarray(s, dtype=float).astype(REAL).astype(float)
+
+
+def scaled(cfg, s):
+    """x~ = clip(s / input_range, -1, 1), in the real type like the library (s * (1 / range))."""
+    c = cfg.controller.policy
+    inv = (REAL(1.0) / np.array(c.input_range, dtype=REAL)).astype(REAL)
+    x = (np.asarray(s, dtype=float).astype(REAL) * inv).astype(float)
+    return np.clip(x, -1.0, 1.0) if c.clip_inputs else x
+
+
+def features(cfg, s):
+    """h = G x~(s)."""
+    return float(cfg.controller.policy.gain) * scaled(cfg, s)
+
+
+def random_state(rng, n=None):
+    """States inside the failure limits, velocities beyond the scaling ranges now and then."""
+    size = (4,) if n is None else (n, 4)
+    lo, hi = np.array([-2.3, -4.0, -0.2, -2.5]), np.array([2.3, 4.0, 0.2, 2.5])
+    return stored(rng.uniform(lo, hi, size=size))
+
+
+FAILED = np.array([0.1, 0.2, 0.25, 0.3])  # theta beyond 12 deg: a failure state
+
+
+def random_prior(rng, scale=0.5):
+    """(mean, cov) of a random Gaussian with a full, well-conditioned covariance."""
+    a = rng.uniform(-1, 1, size=(4, 4))
+    cov = scale * (a @ a.T + 0.05 * np.eye(4))
+    cov = stored((cov + cov.T) / 2)
+    return stored(rng.uniform(-0.5, 0.5, size=4)), cov
