@@ -80,8 +80,9 @@ CONDITION_OVERRIDES: dict[str, dict[str, Any]] = {
     "rl-control": {"mode": "rl", "learn": 0},
     "ico-search": {"mode": "search"},  # prior from an ICO grid, Sigma0 = search.cov_scale * its covariance
     "ico-search-control": {"mode": "search", "learn": 0},
-    "search": {"mode": "search"},      # prior N(0, I) (spec L4)
-    "search-control": {"mode": "search", "learn": 0},
+    # prior N(0, I) (spec L4); Sigma0 = 4 I, chosen by the learner sweeps like the C defaults
+    "search": {"mode": "search", "search.cov_scale": 4},
+    "search-control": {"mode": "search", "search.cov_scale": 4, "learn": 0},
 }
 assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS)
 
@@ -90,7 +91,7 @@ assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS)
 # paper's literal reading where the defaults were chosen by the learner sweeps (docs/results.md).
 NAMED_CONFIGURATIONS: dict[str, tuple[str, ...]] = {
     "default": (),
-    "literal": ("actor.update=posterior", "actor.likelihood_std=1", "actor.batch=0", "actor.explore_ticks=0",
+    "literal": ("actor.update=posterior", "actor.likelihood_std=0", "actor.batch=0", "actor.explore_ticks=0",
                 "critic.quirks=0"),
 }
 assert tuple(NAMED_CONFIGURATIONS) == options.CONFIGURATION_NAMES

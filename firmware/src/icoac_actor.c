@@ -4,6 +4,13 @@
 
 #define N ICOAC_N_INPUTS
 
+/* sigma_L^2: actor.likelihood_std, or sigma_u^2 when it is 0 (the literal reading). */
+static inline icoac_real_t likelihood_var(const icoac_actor_config_t *actor)
+{
+    const icoac_real_t std = actor->likelihood_std > ICOAC_R(0.0) ? actor->likelihood_std : actor->noise_std;
+    return std * std;
+}
+
 void icoac_priv_actor_sample(icoac_priv_state_t *st)
 {
     icoac_real_t lower[N][N];
@@ -28,7 +35,7 @@ static inline void posterior_step(const icoac_actor_config_t *actor, const icoac
                                   const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
                                   icoac_real_t cov[N][N])
 {
-    const icoac_real_t noise_var = actor->likelihood_std * actor->likelihood_std;
+    const icoac_real_t noise_var = likelihood_var(actor);
     const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
     icoac_real_t cov_h[N];
     icoac_real_t gain[N];
@@ -81,8 +88,8 @@ void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_p
 }
 
 /* Mean reading: mu += Sigma0 h innovation / (h^T Sigma0 h + sigma_L^2), Sigma_w unchanged. */
-ICOAC_PRIV_NOINLINE static void mean_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st, const icoac_real_t h[N],
-                      icoac_real_t innovation, icoac_real_t w[N])
+ICOAC_PRIV_NOINLINE static void mean_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                          const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N])
 {
     const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
     icoac_real_t cov_h[N];
@@ -91,7 +98,7 @@ ICOAC_PRIV_NOINLINE static void mean_step(const icoac_actor_config_t *actor, con
     for (i = 0; i < N; ++i) {
         cov_h[i] = icoac_priv_dot4(prior[i], h);
     }
-    step = innovation / (icoac_priv_dot4(h, cov_h) + actor->likelihood_std * actor->likelihood_std);
+    step = innovation / (icoac_priv_dot4(h, cov_h) + likelihood_var(actor));
     for (i = 0; i < N; ++i) {
         w[i] = st->w[i] + cov_h[i] * step;
     }
@@ -100,7 +107,7 @@ ICOAC_PRIV_NOINLINE static void mean_step(const icoac_actor_config_t *actor, con
 /* sum += h h^T / sigma_L^2 */
 static void add_info(const icoac_actor_config_t *actor, const icoac_real_t h[N], icoac_real_t sum[N][N])
 {
-    const icoac_real_t inv_var = ICOAC_R(1.0) / (actor->likelihood_std * actor->likelihood_std);
+    const icoac_real_t inv_var = ICOAC_R(1.0) / likelihood_var(actor);
     int i;
     int j;
     for (i = 0; i < N; ++i) {
@@ -163,14 +170,15 @@ ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, cons
 
 /* The batch's shift after one more observation, and a value that is finite only when the
  * sums stay finite (the new trace of the information plus |shift|^2 bound every entry). */
-ICOAC_PRIV_NOINLINE static icoac_real_t batch_shift(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
-                                const icoac_real_t h[N], icoac_real_t observation, icoac_real_t shift[N])
+ICOAC_PRIV_NOINLINE static icoac_real_t batch_shift(const icoac_actor_config_t *actor,
+                                                    const icoac_priv_state_t *st, const icoac_real_t h[N],
+                                                    icoac_real_t observation, icoac_real_t shift[N])
 {
     icoac_real_t trace = ICOAC_R(0.0);
     icoac_real_t scale = ICOAC_R(1.0);
     int i;
     if (actor->update != ICOAC_ACTOR_GRADIENT) {
-        scale = ICOAC_R(1.0) / (actor->likelihood_std * actor->likelihood_std);
+        scale = ICOAC_R(1.0) / likelihood_var(actor);
         trace = icoac_priv_trace4(st->batch.info) + icoac_priv_dot4(h, h) * scale;
     }
     for (i = 0; i < N; ++i) {

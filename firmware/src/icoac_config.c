@@ -15,7 +15,7 @@ const char *icoac_status_str(icoac_status_t status)
     case ICOAC_ERR_BAD_ZONE: return "invalid policy.zone_theta or policy.zone_x (must be in [1e-6, pi] rad and [1e-6, 1e6] m)";
     case ICOAC_ERR_BAD_ICO_RATE: return "invalid ico.rate (must be in [0, 1])";
     case ICOAC_ERR_BAD_CRITIC: return "invalid critic parameter (rate [0, 10], discount [0, 1], td_clip [1e-6, 1e3], range [1e-6, 1e6], threshold [0, 1))";
-    case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std [1e-3, 1e3], scale [0, 1e3], forgetting [0.5, 1], update 0-2, rate [0, 1e3], likelihood_std [1e-3, 1e3], explore_ticks [0, 1e8])";
+    case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std [1e-3, 1e3], scale [0, 1e3], forgetting [0.5, 1], update 0-2, rate [0, 1e3], likelihood_std 0 or [1e-3, 1e3], explore_ticks [0, 1e8])";
     case ICOAC_ERR_BAD_SEARCH: return "invalid search parameter (batch [1, 16], elite_fraction (0, 1], step (0, 1], floor [1e-6, 1e3], cov_scale [1, 1e3])";
     case ICOAC_ERR_BAD_PRIOR: return "invalid prior (|mean| <= 1e6, covariance entries |c| <= 1e12, zero or normal, symmetric positive definite)";
     default: return "unknown status";
@@ -74,11 +74,12 @@ void icoac_actor_config_default(icoac_actor_config_t *actor)
     actor->forgetting = ICOAC_R(1.0);
     actor->reflex = 1;
     actor->act_with_sample = 0;
-    actor->update = ICOAC_ACTOR_POSTERIOR;
+    /* chosen by the learner sweeps (docs/results.md); the literal reading is posterior, 0 */
+    actor->update = ICOAC_ACTOR_GRADIENT;
     actor->rate = ICOAC_R(0.01);
-    actor->likelihood_std = ICOAC_R(1.0);
+    actor->likelihood_std = ICOAC_R(0.0);
     actor->batch = 0;
-    actor->explore_ticks = 0;
+    actor->explore_ticks = 1000;
 }
 
 void icoac_search_config_default(icoac_search_config_t *search)
@@ -86,11 +87,12 @@ void icoac_search_config_default(icoac_search_config_t *search)
     if (search == 0) {
         return;
     }
-    search->batch = 4;
-    search->elite_fraction = ICOAC_R(0.5);
+    /* chosen by the learner sweeps for ICO->search (docs/results.md) */
+    search->batch = 8;
+    search->elite_fraction = ICOAC_R(0.25);
     search->step = ICOAC_R(0.5);
-    search->floor = ICOAC_R(0.1);
-    search->cov_scale = ICOAC_R(1.0);
+    search->floor = ICOAC_R(1.0);
+    search->cov_scale = ICOAC_R(64.0);
 }
 
 void icoac_config_default(icoac_config_t *cfg)
@@ -225,7 +227,7 @@ static int actor_ok(const icoac_actor_config_t *a, bad_field_t *bad)
     if (!within(a->rate, ICOAC_R(0.0), ICOAC_ACTOR_RATE_MAX)) {
         ICOAC_PRIV_FAIL("actor.rate", ICOAC_ERR_BAD_ACTOR);
     }
-    if (!within(a->likelihood_std, ICOAC_NOISE_STD_MIN, ICOAC_NOISE_STD_MAX)) {
+    if (!(a->likelihood_std == ICOAC_R(0.0)) && !within(a->likelihood_std, ICOAC_NOISE_STD_MIN, ICOAC_NOISE_STD_MAX)) {
         ICOAC_PRIV_FAIL("actor.likelihood_std", ICOAC_ERR_BAD_ACTOR);
     }
     if (!is_flag(a->batch)) {

@@ -26,6 +26,15 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const
     if (status == ICOAC_OK && prior != 0) {
         status = icoac_prior_check(prior);
     }
+    if (status == ICOAC_OK && cfg->mode == ICOAC_MODE_SEARCH) {
+        icoac_real_t identity[ICOAC_N_INPUTS][ICOAC_N_INPUTS] = {{ICOAC_R(0.0)}};
+        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+            identity[i][i] = ICOAC_R(1.0);
+        }
+        if (!icoac_priv_search_prior_ok(&cfg->search, prior != 0 ? prior->cov : ICOAC_PRIV_CONST_MAT4(identity))) {
+            status = ICOAC_ERR_BAD_PRIOR;
+        }
+    }
     if (status != ICOAC_OK) {
         return status;
     }
@@ -41,9 +50,8 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
         st->inv_range[i] = ICOAC_R(1.0) / cfg->policy.input_range[i];
     }
-    if (cfg->mode == ICOAC_MODE_SEARCH && !icoac_priv_search_init(&cfg->search, st)) {
-        memset(state, 0, sizeof *state);
-        return ICOAC_ERR_BAD_PRIOR;
+    if (cfg->mode == ICOAC_MODE_SEARCH) {
+        icoac_priv_search_init(&cfg->search, st);
     }
     st->weight_norm = ICOAC_PRIV_SQRT(icoac_priv_dot4(st->w, st->w));
     icoac_rng_seed(&st->rng, seed, 0x1C0ACu);

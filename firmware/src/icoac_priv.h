@@ -241,7 +241,11 @@ void icoac_priv_actor_sample(icoac_priv_state_t *st);
 int icoac_priv_search_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
                            const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out);
 void icoac_priv_search_sample(icoac_priv_state_t *st);
-int icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st);
+/* Sigma0 = search.cov_scale * cov finite and positive definite (checked before icoac_init
+ * clears the state), then the setup of a cleared state holding the prior. */
+int icoac_priv_search_prior_ok(const icoac_search_config_t *search,
+                               const icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+void icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st);
 
 /* Gaussian helpers (icoac_gauss.c). */
 /* m = L L^T; returns 0 when m is not positive definite. */

@@ -5,20 +5,35 @@
 
 #define N ICOAC_N_INPUTS
 
-int icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st)
+/* Sigma0 = c * cov, its floors and its Cholesky factor; 0 when not finite or not PD. */
+static int scaled_prior(const icoac_search_config_t *search, const icoac_real_t cov[N][N], icoac_real_t sigma0[N][N],
+                        icoac_real_t floor[N], icoac_real_t lower[N][N])
 {
-    icoac_real_t (*cov)[N] = icoac_priv_cov(st);
     int i;
     int j;
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
-            cov[i][j] *= search->cov_scale;
+            sigma0[i][j] = cov[i][j] * search->cov_scale;
         }
-        st->search.floor[i] = search->floor * cov[i][i];
+        floor[i] = search->floor * sigma0[i][i];
     }
+    return icoac_priv_all_finite(&sigma0[0][0], N * N) && icoac_priv_all_finite(floor, N) &&
+           icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(sigma0), lower);
+}
+
+int icoac_priv_search_prior_ok(const icoac_search_config_t *search, const icoac_real_t cov[N][N])
+{
+    icoac_real_t sigma0[N][N];
+    icoac_real_t floor[N];
+    icoac_real_t lower[N][N];
+    return scaled_prior(search, cov, sigma0, floor, lower);
+}
+
+void icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st)
+{
+    icoac_real_t (*cov)[N] = icoac_priv_cov(st);
     st->search.count = 0;
-    return icoac_priv_all_finite(&cov[0][0], N * N) && icoac_priv_all_finite(st->search.floor, N) &&
-           icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov), st->search.lower);
+    (void)scaled_prior(search, ICOAC_PRIV_CONST_MAT4(cov), cov, st->search.floor, st->search.lower);
 }
 
 void icoac_priv_search_sample(icoac_priv_state_t *st)
@@ -110,9 +125,21 @@ static int search_update(const icoac_search_config_t *search, const icoac_priv_s
             cov[j][i] = value;
         }
     }
-    return icoac_priv_all_finite(w, N) && icoac_priv_all_finite(&cov[0][0], N * N) &&
-           icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov), lower) &&
-           icoac_priv_all_finite(&lower[0][0], N * N);
+    if (!icoac_priv_all_finite(w, N) || !icoac_priv_all_finite(&cov[0][0], N * N)) {
+        return 0;
+    }
+    if (!icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov), lower)) {
+        /* A rank-deficient elite (n_e <= 4) with a step near 1 leaves Sigma' singular, which a
+         * diagonal floor need not repair: add the floor to the diagonal instead, a positive
+         * definite bound below Sigma' (Sigma' is positive semidefinite up to rounding). */
+        for (i = 0; i < N; ++i) {
+            cov[i][i] += st->search.floor[i];
+        }
+        if (!icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov), lower)) {
+            return 0;
+        }
+    }
+    return icoac_priv_all_finite(&lower[0][0], N * N);
 }
 
 /* A terminal tick ends the trial: record (w_act, length); a full batch updates (staged: on a

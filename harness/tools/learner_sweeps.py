@@ -53,9 +53,12 @@ STAGE_2 = (
     ("ico-rl-stage2", "ico-rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
                                  "actor.noise_std=1,0.3,0.5,2", "actor.scale=0.5,0.25,2"], True),
     ("ico-rl-schedule-grid", "ico-rl", ["actor.explore_ticks=30,100,300", "actor.rate=0.0003,0.001,0.003"], False),
+    ("ico-rl-schedule-grid2", "ico-rl", ["actor.explore_ticks=100,300,1000", "actor.rate=0.003,0.01,0.03"], False),
     ("rl-stage2", "rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
                          "actor.noise_std=1,0.3,0.5,2", "actor.scale=0.5,0.25,2"], True),
     ("rl-schedule-grid", "rl", ["actor.explore_ticks=30,100,300", "actor.likelihood_std=0.03,0.1,0.3"], False),
+    ("rl-noise-grid", "rl", ["actor.noise_std=1,2,3", "actor.scale=0.5,2,8"], False),
+    ("rl-noise-grid2", "rl", ["actor.noise_std=3,5", "actor.scale=0.25,0.5", "actor.explore_ticks=0,1000"], False),
 )
 
 

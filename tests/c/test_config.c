@@ -203,7 +203,7 @@ RLMUT(m_rate_big, c->actor.rate = (icoac_real_t)1001)
 RLMUT(m_rate_nan, c->actor.rate = NAN_R)
 RLMUT(m_rate_inf, c->actor.rate = INF_R)
 RLMUT(m_rate_subnormal, c->actor.rate = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
-RLMUT(m_lik_zero, c->actor.likelihood_std = 0)
+RLMUT(m_lik_subnormal, c->actor.likelihood_std = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
 RLMUT(m_lik_tiny, c->actor.likelihood_std = (icoac_real_t)9e-4)
 RLMUT(m_lik_big, c->actor.likelihood_std = (icoac_real_t)1001)
 RLMUT(m_lik_nan, c->actor.likelihood_std = NAN_R)
@@ -246,7 +246,7 @@ SMUT(m_policy_before_search, { c->search.batch = 0; c->policy.zone_x = INF_R; })
 SMUT(m_search_in_order, { c->search.cov_scale = 0; c->search.floor = 0; c->search.step = 0;
                           c->search.elite_fraction = 0; })
 SMUT(m_search_batch_first, { c->search.cov_scale = 0; c->search.batch = 0; })
-RLMUT(m_actor_new_in_order, { c->actor.explore_ticks = -1; c->actor.batch = 2; c->actor.likelihood_std = 0;
+RLMUT(m_actor_new_in_order, { c->actor.explore_ticks = -1; c->actor.batch = 2; c->actor.likelihood_std = -1;
                               c->actor.rate = -1; c->actor.update = 3; })
 RLMUT(m_quirks_before_actor, { c->actor.update = 3; c->critic.quirks = 2; })
 MUT(m_mode_before_all, { c->mode = 7; c->policy.gain = NAN_R; c->ico.rate = NAN_R; })
@@ -267,6 +267,7 @@ RLMUT(ok_rl_learner_upper, { c->actor.update = ICOAC_ACTOR_MEAN; c->actor.rate =
                              c->actor.likelihood_std = ICOAC_NOISE_STD_MAX;
                              c->actor.explore_ticks = ICOAC_EXPLORE_TICKS_MAX; })
 RLMUT(ok_explore_one, c->actor.explore_ticks = 1)
+RLMUT(ok_likelihood_follows_noise, c->actor.likelihood_std = 0)
 SMUT(ok_search_lower, { c->search.batch = 1; c->search.elite_fraction = (icoac_real_t)1e-6;
                         c->search.step = (icoac_real_t)1e-6; c->search.floor = ICOAC_SEARCH_FLOOR_MIN;
                         c->search.cov_scale = 1; })
@@ -371,7 +372,7 @@ static const config_case_t config_cases[] = {
     {"RL, actor.rate=NaN", m_rate_nan, ICOAC_ERR_BAD_ACTOR, "actor.rate"},
     {"RL, actor.rate=Inf", m_rate_inf, ICOAC_ERR_BAD_ACTOR, "actor.rate"},
     {"RL, actor.rate subnormal", m_rate_subnormal, ICOAC_ERR_BAD_ACTOR, "actor.rate"},
-    {"RL, actor.likelihood_std=0", m_lik_zero, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
+    {"RL, actor.likelihood_std subnormal", m_lik_subnormal, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
     {"RL, actor.likelihood_std=9e-4", m_lik_tiny, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
     {"RL, actor.likelihood_std>1e3", m_lik_big, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
     {"RL, actor.likelihood_std=NaN", m_lik_nan, ICOAC_ERR_BAD_ACTOR, "actor.likelihood_std"},
@@ -423,6 +424,7 @@ static const config_case_t config_cases[] = {
     {"RL, learner fields at their lower bounds", ok_rl_learner_lower, ICOAC_OK, NULL},
     {"RL, learner fields at their upper bounds", ok_rl_learner_upper, ICOAC_OK, NULL},
     {"RL, actor.explore_ticks=1", ok_explore_one, ICOAC_OK, NULL},
+    {"RL, actor.likelihood_std=0 (sigma_u)", ok_likelihood_follows_noise, ICOAC_OK, NULL},
     {"search lower bounds", ok_search_lower, ICOAC_OK, NULL},
     {"search upper bounds", ok_search_upper, ICOAC_OK, NULL},
     {"search, no learning, switches at their alternative", ok_search_no_learning, ICOAC_OK, NULL},

@@ -107,22 +107,25 @@ typedef struct {
     icoac_real_t forgetting;     /* lambda_f, [0.5, 1]. 1 (none); posterior reading only */
     int32_t reflex;              /* 1: reflex added to the executed force; 0: off */
     int32_t act_with_sample;     /* 1: act with a posterior sample of w per trial; 0: with mu_w */
-    int32_t update;              /* icoac_actor_update_t. posterior (literal) */
+    int32_t update;              /* icoac_actor_update_t. gradient (chosen by a sweep; literal: posterior) */
     icoac_real_t rate;           /* beta of the gradient reading, [0, 1e3]. 0.01 */
-    icoac_real_t likelihood_std; /* sigma_L (N) of the posterior and mean readings, [1e-3, 1e3]. 1 (= sigma_u, literal) */
+    icoac_real_t likelihood_std; /* sigma_L (N) of the posterior and mean readings, [1e-3, 1e3], or 0: sigma_u
+                                    (literal). 0 */
     int32_t batch;               /* 1: accumulate over a trial, one update at its terminal tick (A14); 0: per tick */
-    int32_t explore_ticks;       /* N: eps = 0 and no actor update from tick N of a trial on; 0: always explore */
+    int32_t explore_ticks;       /* N: eps = 0 and no actor update from tick N of a trial on; 0: always explore
+                                    (literal). 1000 (10 s) */
 } icoac_actor_config_t;
 
 /* Episodic search over N(mu_w, Sigma_w) (ICOAC_MODE_SEARCH, spec L4): each trial acts with one
  * sample w (F = G w^T x~ + reflex, no noise); after `batch` failed trials the best
- * round(elite_fraction * batch) (at least 1) by length move mu_w and Sigma_w by `step`. */
+ * round(elite_fraction * batch) (at least 1) by length move mu_w and Sigma_w by `step`.
+ * Defaults chosen by a sweep for the ICO prior (docs/results.md). */
 typedef struct {
-    int32_t batch;               /* K, trials per update, [1, ICOAC_SEARCH_BATCH_MAX]. 4 */
-    icoac_real_t elite_fraction; /* rho, (0, 1]. 0.5 */
+    int32_t batch;               /* K, trials per update, [1, ICOAC_SEARCH_BATCH_MAX]. 8 */
+    icoac_real_t elite_fraction; /* rho, (0, 1]; n_e = max(1, round half up(rho K)). 0.25 */
     icoac_real_t step;           /* a, (0, 1]. 0.5 */
-    icoac_real_t floor;          /* f: Sigma_ii >= f * Sigma0_ii after each update, [1e-6, 1e3]. 0.1 */
-    icoac_real_t cov_scale;      /* c: Sigma0 = c * prior covariance, [1, 1e3]. 1 */
+    icoac_real_t floor;          /* f: Sigma_ii >= f * Sigma0_ii after each update, [1e-6, 1e3]. 1 */
+    icoac_real_t cov_scale;      /* c: Sigma0 = c * prior covariance, [1, 1e3]. 64 */
 } icoac_search_config_t;
 
 typedef struct {
@@ -188,7 +191,7 @@ typedef struct {
     icoac_real_t value;       /* V(s) (RL) */
     icoac_real_t td_error;    /* clipped delta of the transition into s (RL) */
     icoac_real_t noise;       /* exploration noise eps (N) (RL) */
-    icoac_real_t cov_trace;   /* trace of Sigma_w (RL) */
+    icoac_real_t cov_trace;   /* trace of Sigma_w (RL, search) */
     int32_t status;           /* icoac_status_t of this tick */
 } icoac_output_t;
 
