@@ -17,6 +17,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from . import _binding as B
 from . import geometry, grid, metrics, results
 from . import prior as P
 from ._binding import ConfigError
@@ -214,6 +215,7 @@ def run_sweep(opt: SweepOptions) -> int:
             "success_steps": opt.success_steps, "set": list(opt.sets), "rl_cov": opt.rl_cov}
     meta_path = out / "sweep.json"
     csv_path = out / "sweep.csv"
+    runs: list = []  # provenance of each invocation that ran settings (not compared on resume)
     if meta_path.is_file() and csv_path.is_file():
         try:
             old = json.loads(meta_path.read_bytes())
@@ -224,6 +226,7 @@ def run_sweep(opt: SweepOptions) -> int:
         diff = [k for k in meta if old.get(k) != meta[k]]
         if diff:
             raise UsageError(f"{str(out)!r} holds a sweep with other {', '.join(diff)}; use another --out")
+        runs = old.get("runs") if isinstance(old.get("runs"), list) else []
     header, rows = _read_table(csv_path)
     if header is not None:
         missing = [n for n in names if n not in _param_columns(header)]
@@ -251,7 +254,10 @@ def run_sweep(opt: SweepOptions) -> int:
     for setting in todo:  # every setting valid before the first grid runs (and before any write)
         config_for(setting)
     results.check_writable(out)
-    meta_path.write_text(json.dumps(meta, indent=2) + "\n")
+    pending = [key_of(st) for st in todo if key_of(st) not in done]
+    if pending or not runs:
+        runs = runs + [{"git": results.git_info(), "library": str(B.LIBRARY_PATH), "settings": pending}]
+    meta_path.write_text(json.dumps({**meta, "runs": runs}, indent=2) + "\n")
 
     t_all = time.monotonic()
     for i, setting in enumerate(todo, 1):

@@ -2,7 +2,9 @@
 
     python -m harness.tools.learner_sweeps --prior-from results/bench/ico/seed-0 --out results/sweeps
 
-Each sweep runs on two cell selections, 2 seeds each: `spread` (49 cells evenly over the grid)
+Every sweep starts from the literal configuration (`--configuration literal`: the defaults before
+these sweeps chose new ones), so it reproduces at any later commit. Each sweep runs on two cell
+selections, 2 seeds each: `spread` (49 cells evenly over the grid)
 and `ico-failed` (every cell where the ICO run of --prior-from failed). Stage 1 compares the actor
 readings and their rates (with the no-learning control), and the search's parameters one at a
 time, then small factorial grids of the search's breadth (cov_scale x floor x batch); stage 2 (``--stage 2 --base NAME=VALUE ...``) varies the exploration schedule, the batch
@@ -12,12 +14,15 @@ resumes (finished settings are skipped), so an interrupted run loses nothing.
 from __future__ import annotations
 
 import argparse
+import csv
+import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from .. import results
+from ..config import named_sets
 from ..sweep import SweepOptions, run_sweep
 
 SEEDS = 2
@@ -54,11 +59,15 @@ STAGE_2 = (
                                  "actor.noise_std=1,0.3,0.5,2", "actor.scale=0.5,0.25,2"], True),
     ("ico-rl-schedule-grid", "ico-rl", ["actor.explore_ticks=30,100,300", "actor.rate=0.0003,0.001,0.003"], False),
     ("ico-rl-schedule-grid2", "ico-rl", ["actor.explore_ticks=100,300,1000", "actor.rate=0.003,0.01,0.03"], False),
+    ("ico-rl-noise-grid", "ico-rl", ["actor.explore_ticks=1000", "actor.noise_std=1,2,3,5",
+                                        "actor.rate=0.0003,0.001,0.003,0.01"],
+     False),
     ("rl-stage2", "rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
                          "actor.noise_std=1,0.3,0.5,2", "actor.scale=0.5,0.25,2"], True),
     ("rl-schedule-grid", "rl", ["actor.explore_ticks=30,100,300", "actor.likelihood_std=0.03,0.1,0.3"], False),
     ("rl-noise-grid", "rl", ["actor.noise_std=1,2,3", "actor.scale=0.5,2,8"], False),
     ("rl-noise-grid2", "rl", ["actor.noise_std=3,5", "actor.scale=0.25,0.5", "actor.explore_ticks=0,1000"], False),
+    ("rl-noise-grid3", "rl", ["actor.explore_ticks=1000", "actor.noise_std=5,8", "actor.scale=0.1,0.25"], False),
 )
 
 
@@ -67,6 +76,47 @@ def ico_failed_cells(prior_from: Path) -> str:
     cells, _ = results.load(prior_from, what="--prior-from")
     failed = np.nonzero(cells["outcome"] != 1)[0]
     return ",".join(str(int(i)) for i in failed)
+
+
+SELECTIONS = ("spread", "ico-failed")
+
+
+def _pct(row: dict | None, key: str) -> str:
+    if not row or row.get(key) in (None, ""):
+        return "n/a"
+    return f"{100 * float(row[key]):.1f}"
+
+
+def report(out: Path) -> str:
+    """One markdown table per sweep of OUT: each setting on the spread and the ICO-failed cells
+    (success mean ± sd over the seeds, %; median trials to success), in run order."""
+    lines = [f"# Learner sweeps ({out})", ""]
+    for name, condition, _params, _one in STAGE_1 + STAGE_2:
+        tables = {}
+        for sel in SELECTIONS:
+            path = out / f"{name}-{sel}" / "sweep.csv"
+            if path.is_file():
+                with open(path, newline="") as fh:
+                    tables[sel] = {r["key"]: r for r in csv.DictReader(fh)}
+        if not tables:
+            continue
+        meta = json.loads((out / f"{name}-{next(iter(tables))}" / "sweep.json").read_text())
+        keys = list(dict.fromkeys(k for t in tables.values() for k in t))
+        n_failed = next((r["n_ico_failed"] for r in tables.get("ico-failed", {}).values()), "?")
+        lines += [f"## {name} ({condition}; seeds {meta['seeds']}, cap {meta['max_trials']} trials; "
+                  f"fixed: {', '.join(meta['set']) or 'defaults'})", "",
+                  f"| setting | spread 49 cells: success % (± sd) | median trials | ICO-failed {n_failed} cells: "
+                  "success % (± sd) | median trials |", "|---|---|---|---|---|"]
+        for k in keys:
+            setting = ", ".join(f"{a}={b}" for a, b in json.loads(k).items())
+            cols = []
+            for sel in SELECTIONS:
+                r = tables.get(sel, {}).get(k)
+                cols += [f"{_pct(r, 'success_rate_mean')} ± {_pct(r, 'success_rate_sd')}",
+                         (r or {}).get("median_trials") or "n/a"]
+            lines.append(f"| {setting} | " + " | ".join(cols) + " |")
+        lines.append("")
+    return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -78,7 +128,13 @@ def main(argv: list[str] | None = None) -> int:
                     help="stage 2: the stage-1 choice, fixed in every setting (repeatable)")
     ap.add_argument("--only", action="append", default=[], help="run only the sweeps of these names")
     ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--report", action="store_true", help="only write OUT/summary.md from the finished sweeps")
     args = ap.parse_args(argv)
+    if args.report:
+        path = args.out / "summary.md"
+        path.write_text(report(args.out))
+        print(path)
+        return 0
     selections = {"spread": dict(subset=SPREAD_CELLS), "ico-failed": dict(cells=ico_failed_cells(args.prior_from))}
     plan = STAGE_1 if args.stage == 1 else STAGE_2
     for name, condition, params, one_at_a_time in plan:
@@ -88,7 +144,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"[learner_sweeps] {name} on {label} cells", file=sys.stderr, flush=True)
             code = run_sweep(SweepOptions(prior_from=args.prior_from, out=args.out / f"{name}-{label}",
                                           params=params, condition=condition, seeds=SEEDS,
-                                          max_trials=MAX_TRIALS, sets=list(args.base),
+                                          max_trials=MAX_TRIALS, sets=named_sets("literal", args.base),
                                           one_at_a_time=one_at_a_time, threads=args.threads, quiet=True,
                                           **selection))
             if code:

@@ -102,13 +102,13 @@ typedef struct {
 
 /* Actor and exploration (ICOAC_MODE_RL). Every reading observes u_ob = mu_u + alpha*delta*eps. */
 typedef struct {
-    icoac_real_t noise_std;      /* sigma_u (N), [1e-3, 1e3]. 1 */
+    icoac_real_t noise_std;      /* sigma_u (N), [1e-3, 1e3]. 3 (chosen by a sweep; literal: 1) */
     icoac_real_t scale;          /* alpha, [0, 1e3]. 0.5 */
     icoac_real_t forgetting;     /* lambda_f, [0.5, 1]. 1 (none); posterior reading only */
     int32_t reflex;              /* 1: reflex added to the executed force; 0: off */
     int32_t act_with_sample;     /* 1: act with a posterior sample of w per trial; 0: with mu_w */
     int32_t update;              /* icoac_actor_update_t. gradient (chosen by a sweep; literal: posterior) */
-    icoac_real_t rate;           /* beta of the gradient reading, [0, 1e3]. 0.01 */
+    icoac_real_t rate;           /* beta of the gradient reading, [0, 1e3]. 0.001 */
     icoac_real_t likelihood_std; /* sigma_L (N) of the posterior and mean readings, [1e-3, 1e3], or 0: sigma_u
                                     (literal). 0 */
     int32_t batch;               /* 1: accumulate over a trial, one update at its terminal tick (A14); 0: per tick */
