@@ -18,7 +18,7 @@ FUZZ_FLAGS ?=
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_sim
 
 .PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz bench \
-  bench-speed clean target-report
+  bench-speed clean target-report sweeps
 
 all: build
 
@@ -79,6 +79,19 @@ bench-speed: build
 bench: build venv bench-speed
 	$(VPY) -m harness ceiling --out $(BENCH_OUT)/ceiling --quiet
 	$(VPY) -m harness bench --profile $(BENCH_PROFILE) --out $(BENCH_OUT) --figures docs/figures
+
+# The learner sweeps that chose the defaults (docs/results.md), on the ICO grid of seed 0 of a
+# bench (make bench first); resumable, summary in $(SWEEP_OUT)/summary.md.
+SWEEP_OUT ?= results/sweeps
+SWEEP_ICO ?= $(BENCH_OUT)/ico/seed-0
+SWEEP = $(VPY) -m harness.tools.learner_sweeps --prior-from $(SWEEP_ICO) --out $(SWEEP_OUT)
+sweeps: build venv
+	$(SWEEP)
+	$(SWEEP) --stage 2 --only ico-rl-stage2 --only ico-rl-schedule-grid --only ico-rl-schedule-grid2 \
+	  --only ico-rl-noise-grid --base actor.update=gradient --base actor.rate=0.001
+	$(SWEEP) --stage 2 --only rl-stage2 --only rl-schedule-grid --only rl-noise-grid --only rl-noise-grid2 \
+	  --only rl-noise-grid3 --base actor.update=mean --base actor.likelihood_std=0.1
+	$(SWEEP) --report
 
 # Microcontroller resource report: cross builds, QEMU runs, table in docs/porting.md.
 target-report: deps
