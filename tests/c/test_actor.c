@@ -90,11 +90,13 @@ static void load_state(icoac_state_t *state, gauss_t *g)
     }
 }
 
+/* RL with the posterior reading (the file's subject; the default reading is the gradient). */
 static icoac_state_t rl_state(icoac_config_t *cfg)
 {
     icoac_state_t state;
     *cfg = test_default_config();
     cfg->mode = ICOAC_MODE_RL;
+    test_literal_reading(cfg);
     assert_int_equal(icoac_init(cfg, &state, NULL, 1u), ICOAC_OK);
     return state;
 }
@@ -126,8 +128,9 @@ static void compare_with_closed_form(const icoac_config_t *cfg, test_rng_t *rng,
         hd[i] = (double)h[i];
     }
     innovation = (double)(icoac_real_t)test_uniform(rng, -3, 3);
-    /* the likelihood variance is sigma_L^2 (spec L2), whatever the exploration std sigma_u */
-    r = (double)cfg->actor.likelihood_std * (double)cfg->actor.likelihood_std;
+    /* the likelihood variance is sigma_L^2 (spec L2), whatever the exploration std sigma_u;
+     * sigma_L = sigma_u when likelihood_std is 0 (the literal reading) */
+    r = test_likelihood_var(&cfg->actor);
     closed_form(&prior, hd, innovation, r, &post);
     actor_update_in_place(cfg, &state, h, (icoac_real_t)innovation);
     /* float: a few hundred ulps of the largest prior entry (the update subtracts nearly equal terms) */
@@ -148,9 +151,11 @@ static void test_update_matches_closed_form(void **unused)
     int n;
     (void)unused;
     (void)rl_state(&cfg);
-    for (n = 0; n < 300; ++n) {
-        cfg.actor.likelihood_std = (icoac_real_t)(n % 3 == 0 ? 1.0 : (n % 3 == 1 ? 0.5 : 3.0));
-        /* sigma_u differs from sigma_L in most cases: it must not enter the posterior step */
+    for (n = 0; n < 400; ++n) {
+        /* 0: sigma_L = sigma_u */
+        cfg.actor.likelihood_std = (icoac_real_t)(n % 4 == 0 ? 1.0 : (n % 4 == 1 ? 0.5 : (n % 4 == 2 ? 3.0 : 0.0)));
+        /* sigma_u differs from sigma_L in most cases: it must not enter the posterior step but
+         * through likelihood_std = 0 */
         cfg.actor.noise_std = (icoac_real_t)(n % 5 == 0 ? 1.0 : (n % 5 < 3 ? 0.25 : 7.0));
         compare_with_closed_form(&cfg, &rng, n % 2 ? 10.0 : 1.0);
     }
@@ -200,7 +205,7 @@ static void test_forgetting_inflates_first(void **unused)
             inflated.cov[i][j] = prior.cov[i][j] / (double)cfg.actor.forgetting;
         }
     }
-    closed_form(&inflated, hd, 0.7, 1.0, &post);
+    closed_form(&inflated, hd, 0.7, test_likelihood_var(&cfg.actor), &post);
     actor_update_in_place(&cfg, &state, h, (icoac_real_t)0.7);
     for (i = 0; i < N; ++i) {
         assert_close(mean_of(&state)[i], post.mean[i], REAL_IS_FLOAT ? 1e-4 : 1e-12);
@@ -262,7 +267,8 @@ static void test_update_staged_into_spare(void **unused)
 }
 
 /* Sigma stays exactly symmetric and positive definite over many updates; it matches the
- * information-form accumulation Sigma^-1 = Sigma_0^-1 + sum h h^T / sigma_u^2. */
+ * information-form accumulation Sigma^-1 = Sigma_0^-1 + sum h h^T / sigma_L^2 (sigma_L = sigma_u
+ * = 1 by default). */
 static void run_long(double forgetting, int n_updates)
 {
     icoac_config_t cfg;
@@ -290,7 +296,7 @@ static void run_long(double forgetting, int n_updates)
                     print_error("update %d: cov not symmetric at (%d, %d)\n", n, i, j);
                     fail();
                 }
-                info[i][j] = forgetting * info[i][j] + (double)h[i] * (double)h[j];
+                info[i][j] = forgetting * info[i][j] + (double)h[i] * (double)h[j] / test_likelihood_var(&cfg.actor);
             }
         }
         if (!icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov_of(&state)), lower)) {
@@ -340,54 +346,72 @@ static void test_long_run_with_forgetting(void **unused)
     run_long(0.999, 100000);
 }
 
-/* Eq. 7-8 through icoac_step: u_ob - h^T mu = alpha * delta * eps, h = G x~(s_t). */
+/* Eq. 7-8 through icoac_step with the posterior reading: u_ob - h^T mu = alpha * delta * eps,
+ * h = G x~(s_t), likelihood variance sigma_L^2; likelihood_std 0 (the default) takes sigma_L =
+ * sigma_u (the literal reading), for sigma_u = 1 and for another sigma_u, and an explicit
+ * sigma_L != sigma_u is used as given. */
 static void test_step_wiring(void **unused)
 {
-    icoac_config_t cfg = test_default_config();
-    icoac_state_t state;
-    icoac_output_t out;
-    icoac_prior_t p = test_prior(0.1, 0.05, 0.3, 0.1, 0.5);
-    icoac_input_t s1 = test_input(0.4, -0.2, 0.08, 0.6, 0);
-    icoac_input_t s2 = test_input(0.41, -0.2, 0.25, 0.6, ICOAC_INPUT_TERMINAL);
-    gauss_t prior, post;
-    icoac_prior_t posterior;
-    double hd[N], z = 0, eps;
-    int i, j;
-    int32_t slot;
+    static const double cases[][2] = {{1.0, 0.0}, {0.5, 0.0}, {2.0, 0.0}, {0.5, 2.0}}; /* sigma_u, likelihood_std */
+    size_t c;
     (void)unused;
-    cfg.mode = ICOAC_MODE_RL;
-    p.cov[0][2] = p.cov[2][0] = (icoac_real_t)0.1;
-    assert_int_equal(icoac_init(&cfg, &state, &p, 2024u), ICOAC_OK);
-    for (i = 0; i < N; ++i) {
-        prior.mean[i] = (double)p.mean[i];
-        for (j = 0; j < N; ++j) {
-            prior.cov[i][j] = (double)p.cov[i][j];
+    for (c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        icoac_config_t cfg = test_default_config();
+        icoac_state_t state;
+        icoac_output_t out;
+        icoac_prior_t p = test_prior(0.1, 0.05, 0.3, 0.1, 0.5);
+        icoac_input_t s1 = test_input(0.4, -0.2, 0.08, 0.6, 0);
+        icoac_input_t s2 = test_input(0.41, -0.2, 0.25, 0.6, ICOAC_INPUT_TERMINAL);
+        gauss_t prior, post, other;
+        icoac_prior_t posterior;
+        double hd[N], z = 0, eps, r, diff = 0;
+        int i, j;
+        int32_t slot;
+        cfg.mode = ICOAC_MODE_RL;
+        test_literal_reading(&cfg);
+        cfg.actor.noise_std = (icoac_real_t)cases[c][0];
+        cfg.actor.likelihood_std = (icoac_real_t)cases[c][1];
+        assert_int_equal(icoac_config_check(&cfg), ICOAC_OK);
+        r = cases[c][1] != 0.0 ? cases[c][1] * cases[c][1] : cases[c][0] * cases[c][0];
+        p.cov[0][2] = p.cov[2][0] = (icoac_real_t)0.1;
+        assert_int_equal(icoac_init(&cfg, &state, &p, 2024u), ICOAC_OK);
+        for (i = 0; i < N; ++i) {
+            prior.mean[i] = (double)p.mean[i];
+            for (j = 0; j < N; ++j) {
+                prior.cov[i][j] = (double)p.cov[i][j];
+            }
+            hd[i] = 10.0 * test_scale(i, (double)s1.s[i], 1);
+            z += prior.mean[i] * test_scale(i, (double)s1.s[i], 1);
         }
-        hd[i] = 10.0 * test_scale(i, (double)s1.s[i], 1);
-        z += prior.mean[i] * test_scale(i, (double)s1.s[i], 1);
-    }
-    assert_int_equal(icoac_step(&cfg, &state, &s1, &out), ICOAC_OK);
-    eps = (double)out.noise;
-    assert_true(eps != 0.0);
-    assert_close(out.z, z, 1e-5);
-    assert_close(out.force, 10.0 * z + eps, 1e-4); /* no reflex at s1 */
-    slot = icoac_priv_state_c(&state)->cov_slot;
-    assert_int_equal(icoac_step(&cfg, &state, &s2, &out), ICOAC_OK);
-    assert_close(out.td_error, -1.0, 0.0);
-    /* the learning tick committed the staged covariance by flipping the slot */
-    assert_int_equal(icoac_priv_state_c(&state)->cov_slot, slot ^ 1);
-    assert_int_equal(icoac_get_posterior(&state, &posterior), ICOAC_OK);
-    assert_memory_equal(posterior.cov, cov_of(&state), sizeof posterior.cov);
-    assert_memory_equal(posterior.mean, mean_of(&state), sizeof posterior.mean);
-    closed_form(&prior, hd, 0.5 * -1.0 * eps, 1.0, &post);
-    for (i = 0; i < N; ++i) {
-        assert_close(mean_of(&state)[i], post.mean[i], REAL_IS_FLOAT ? 1e-5 : 1e-12);
-        for (j = 0; j < N; ++j) {
-            assert_close(cov_of(&state)[i][j], post.cov[i][j], REAL_IS_FLOAT ? 1e-5 : 1e-12);
+        assert_int_equal(icoac_step(&cfg, &state, &s1, &out), ICOAC_OK);
+        eps = (double)out.noise;
+        assert_true(eps != 0.0);
+        assert_close(out.z, z, 1e-5);
+        assert_close(out.force, 10.0 * z + eps, 1e-4); /* no reflex at s1 */
+        slot = icoac_priv_state_c(&state)->cov_slot;
+        assert_int_equal(icoac_step(&cfg, &state, &s2, &out), ICOAC_OK);
+        assert_close(out.td_error, -1.0, 0.0);
+        /* the learning tick committed the staged covariance by flipping the slot */
+        assert_int_equal(icoac_priv_state_c(&state)->cov_slot, slot ^ 1);
+        assert_int_equal(icoac_get_posterior(&state, &posterior), ICOAC_OK);
+        assert_memory_equal(posterior.cov, cov_of(&state), sizeof posterior.cov);
+        assert_memory_equal(posterior.mean, mean_of(&state), sizeof posterior.mean);
+        closed_form(&prior, hd, 0.5 * -1.0 * eps, r, &post);
+        for (i = 0; i < N; ++i) {
+            assert_close(mean_of(&state)[i], post.mean[i], REAL_IS_FLOAT ? 1e-5 : 1e-12);
+            for (j = 0; j < N; ++j) {
+                assert_close(cov_of(&state)[i][j], post.cov[i][j], REAL_IS_FLOAT ? 1e-5 : 1e-12);
+            }
         }
+        assert_close(out.cov_trace, post.cov[0][0] + post.cov[1][1] + post.cov[2][2] + post.cov[3][3],
+                     REAL_IS_FLOAT ? 1e-5 : 1e-12);
+        /* the variance matters here: with sigma_L^2 = 1 the step would differ unless r is 1 */
+        closed_form(&prior, hd, 0.5 * -1.0 * eps, 1.0, &other);
+        for (i = 0; i < N; ++i) {
+            diff += fabs(other.cov[i][i] - post.cov[i][i]);
+        }
+        assert_true(r == 1.0 ? diff == 0.0 : diff > 1e-3);
     }
-    assert_close(out.cov_trace, post.cov[0][0] + post.cov[1][1] + post.cov[2][2] + post.cov[3][3],
-                 REAL_IS_FLOAT ? 1e-5 : 1e-12);
 }
 
 

@@ -66,6 +66,26 @@ static inline icoac_config_t test_default_config(void)
     return cfg;
 }
 
+/* The paper's literal reading of the actor (harness configuration `literal`): the posterior
+ * update with sigma_L = sigma_u (likelihood_std 0), per tick, exploring at every tick, the
+ * literal critic. The defaults chose the gradient reading and an exploration schedule instead. */
+static inline void test_literal_reading(icoac_config_t *cfg)
+{
+    cfg->actor.update = ICOAC_ACTOR_POSTERIOR;
+    cfg->actor.likelihood_std = 0;
+    cfg->actor.batch = 0;
+    cfg->actor.explore_ticks = 0;
+    cfg->critic.quirks = 0;
+}
+
+/* sigma_L^2 of the posterior and mean readings: actor.likelihood_std squared, or sigma_u^2
+ * (actor.noise_std) when it is 0. */
+static inline double test_likelihood_var(const icoac_actor_config_t *actor)
+{
+    const double std = actor->likelihood_std != 0 ? (double)actor->likelihood_std : (double)actor->noise_std;
+    return std * std;
+}
+
 /* Prior with the given mean and covariance c * I. */
 static inline icoac_prior_t test_prior(double w0, double w1, double w2, double w3, double c)
 {

@@ -44,20 +44,20 @@ static void test_defaults_match_spec(void **unused)
     assert_close(cfg.actor.forgetting, 1.0, 0.0);
     assert_int_equal(cfg.actor.reflex, 1);
     assert_int_equal(cfg.actor.act_with_sample, 0);
-    /* spec L2-L4, A10: the literal readings by default */
+    /* spec L2-L4, A10: the literal critic, per-tick updates and sigma_L = sigma_u (0); the actor
+     * reading and its exploration schedule, and the search group, chosen by the learner sweeps */
     assert_int_equal(cfg.learn, 1);
     assert_int_equal(cfg.critic.quirks, 0);
-    assert_int_equal(cfg.actor.update, ICOAC_ACTOR_POSTERIOR);
+    assert_int_equal(cfg.actor.update, ICOAC_ACTOR_GRADIENT);
     assert_close(cfg.actor.rate, 0.01, tol * 0.01);
-    assert_close(cfg.actor.likelihood_std, 1.0, 0.0);
-    assert_true(cfg.actor.likelihood_std == cfg.actor.noise_std); /* sigma_L = sigma_u (literal) */
+    assert_true(cfg.actor.likelihood_std == 0); /* 0: sigma_L = sigma_u (literal) */
     assert_int_equal(cfg.actor.batch, 0);
-    assert_int_equal(cfg.actor.explore_ticks, 0);
-    assert_int_equal(cfg.search.batch, 4);
-    assert_close(cfg.search.elite_fraction, 0.5, 0.0);
+    assert_int_equal(cfg.actor.explore_ticks, 1000);
+    assert_int_equal(cfg.search.batch, 8);
+    assert_close(cfg.search.elite_fraction, 0.25, 0.0);
     assert_close(cfg.search.step, 0.5, 0.0);
-    assert_close(cfg.search.floor, 0.1, tol * 0.1);
-    assert_close(cfg.search.cov_scale, 1.0, 0.0);
+    assert_close(cfg.search.floor, 1.0, 0.0);
+    assert_close(cfg.search.cov_scale, 64.0, 0.0);
     /* Each group's default is the configuration default's group (same fill: padding agrees). */
     memset(&filled, 0xA5, sizeof filled);
     memset(&policy, 0xA5, sizeof policy);

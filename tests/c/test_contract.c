@@ -58,8 +58,9 @@ static int output_cleared(const icoac_output_t *o, icoac_real_t weight_norm)
 }
 
 /* A rejected tick leaves every byte of the state as it was, except the counters and the
- * scratch the tick stages into: the critic's spare kept-unit slot (active[active_slot ^ 1])
- * and the spare covariance buffer (cov_buffer[cov_slot ^ 1]). The slots themselves stay. */
+ * scratch the tick stages into: the critic's spare kept-unit slot (active[active_slot ^ 1]),
+ * the spare covariance buffer (cov_buffer[cov_slot ^ 1]) and the per-trial batch's staged
+ * shift (batch.staged_shift). The slots and the batch's sums themselves stay. */
 static void assert_rejected_state(const icoac_state_t *state, const icoac_state_t *before)
 {
     icoac_state_t expect = *before;
@@ -72,6 +73,7 @@ static void assert_rejected_state(const icoac_state_t *state, const icoac_state_
     e->counters = s->counters;
     memcpy(&e->active[active_spare], &s->active[active_spare], sizeof e->active[active_spare]);
     memcpy(e->cov_buffer[cov_spare], s->cov_buffer[cov_spare], sizeof e->cov_buffer[cov_spare]);
+    memcpy(e->batch.staged_shift, s->batch.staged_shift, sizeof e->batch.staged_shift);
     assert_memory_equal(state, &expect, sizeof expect);
 }
 
@@ -206,7 +208,8 @@ static void test_unclipped_huge_input(void **unused)
 /* Reproducer 3: priors the check accepted but whose derived values overflowed (|w|^2 of a mean
  * of 1e30: OK ticks with an infinite |w|), or which a host that flushes subnormals reads
  * differently (a subnormal diagonal becomes 0, a subnormal asymmetry disappears). Now rejected;
- * the largest accepted covariance, inflated by forgetting, gives numeric faults. */
+ * the largest accepted covariance, inflated by forgetting (posterior reading, the literal one),
+ * gives numeric faults. */
 static void test_prior_bounds(void **unused)
 {
     icoac_config_t cfg = test_default_config();
@@ -230,6 +233,7 @@ static void test_prior_bounds(void **unused)
 
     prior = test_prior(ICOAC_PRIOR_MEAN_MAX, 0.1, 0.5, 0.1, (double)ICOAC_PRIOR_COV_MAX);
     cfg.mode = ICOAC_MODE_RL;
+    test_literal_reading(&cfg);
     cfg.actor.forgetting = ICOAC_FORGETTING_MIN;
     assert_int_equal(icoac_prior_check(&prior), ICOAC_OK);
     assert_int_equal(icoac_init(&cfg, &state, &prior, 5u), ICOAC_OK);
@@ -240,9 +244,9 @@ static void test_prior_bounds(void **unused)
     assert_int_equal(priv(&state)->counters.numeric_faults, (uint32_t)faults);
 }
 
-/* Forgetting inflates Sigma_w by 1/lambda per tick; at s = 0 no observation informs it, so it
- * overflows after ~128 ticks at lambda = 0.5. Every tick is OK and finite until then, every
- * later one a numeric fault. */
+/* Forgetting inflates Sigma_w by 1/lambda per tick (posterior reading, exploring at every
+ * tick); at s = 0 no observation informs it, so it overflows after ~128 ticks at lambda = 0.5.
+ * Every tick is OK and finite until then, every later one a numeric fault. */
 static void test_forgetting_overflow_is_a_fault(void **unused)
 {
     icoac_config_t cfg = test_default_config();
@@ -252,6 +256,7 @@ static void test_forgetting_overflow_is_a_fault(void **unused)
     int first_fault = -1;
     (void)unused;
     cfg.mode = ICOAC_MODE_RL;
+    test_literal_reading(&cfg);
     cfg.actor.forgetting = ICOAC_FORGETTING_MIN;
     assert_int_equal(icoac_init(&cfg, &state, NULL, 11u), ICOAC_OK);
     for (k = 0; k < (REAL_IS_FLOAT ? 400 : 2200); ++k) {
@@ -268,7 +273,9 @@ static void test_forgetting_overflow_is_a_fault(void **unused)
 }
 
 /* Random walks over accepted extreme configurations and extreme finite inputs: every tick
- * keeps the contract (checked_step asserts it). */
+ * keeps the contract (checked_step asserts it). RL runs cycle through the three actor readings
+ * (sigma_L = sigma_u or the largest sigma_L), per tick or per trial, with or without an
+ * exploration schedule. */
 static void test_contract_random_extremes(void **unused)
 {
     static const double extremes[] = {0.0, -0.0, 1e-39, -1e-39, 1e-6, 0.5, -1.0, 3.0, 1e6, -1e12, 1e30, -3e38};
@@ -294,6 +301,10 @@ static void test_contract_random_extremes(void **unused)
         cfg.policy.input_range[run % 4] = ICOAC_RANGE_MIN;
         cfg.critic.range[(run + 1) % 4] = ICOAC_RANGE_MIN;
         cfg.critic.threshold = run % 7 ? cfg.critic.threshold : ICOAC_R(0.0);
+        cfg.actor.update = (run / 16) % 3;
+        cfg.actor.batch = (run / 48) % 2;
+        cfg.actor.explore_ticks = run % 11 < 4 ? 0 : (run % 11 < 8 ? 3 : 1000);
+        cfg.actor.likelihood_std = run % 13 ? ICOAC_R(0.0) : ICOAC_NOISE_STD_MAX;
         assert_int_equal(icoac_init(&cfg, &state, NULL, (uint64_t)run), ICOAC_OK);
         for (k = 0; k < 300; ++k) {
             icoac_input_t in;

@@ -98,7 +98,8 @@ static void test_run_cell_outcomes(void **unused)
 }
 
 /* A controller that faults numerically mid-run (the largest accepted prior covariance,
- * inflated by forgetting in the directions the observations inform least) ends its cell as
+ * inflated by forgetting in the directions the observations inform least: the posterior
+ * reading, the one forgetting belongs to, as in the literal configuration) ends its cell as
  * ERROR with ICOAC_ERR_NUMERIC and finite recorded weights; such cells used to end SUCCESS or
  * FAILED with NaN weights. */
 static void test_numeric_fault_marks_cell_error(void **unused)
@@ -111,6 +112,7 @@ static void test_numeric_fault_marks_cell_error(void **unused)
     int i, j, k;
     (void)unused;
     cfg.mode = ICOAC_MODE_RL;
+    test_literal_reading(&cfg);
     cfg.actor.forgetting = ICOAC_FORGETTING_MIN;
     cells[0] = make_cell(0.0, 0.0, 1u);
     cells[1] = make_cell(0.5, DEG(1.0), 2u);

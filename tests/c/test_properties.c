@@ -69,40 +69,59 @@ static void test_reset_keeps_learning_code_timing(void **unused)
     assert_memory_equal(priv(&state)->w, priv(&before)->w, sizeof priv(&state)->w);
 }
 
+/* For the default (gradient) reading and the literal (posterior) one, which also moves
+ * Sigma_w: a reset keeps what was learned. */
 static void test_reset_keeps_learning_rl(void **unused)
 {
-    icoac_config_t cfg = test_default_config();
-    icoac_state_t state, before;
-    icoac_output_t out;
-    test_rng_t rng = {1234u};
-    icoac_input_t in;
-    int k, nonzero = 0;
+    int literal;
     (void)unused;
-    cfg.mode = ICOAC_MODE_RL;
-    assert_int_equal(icoac_init(&cfg, &state, NULL, 5u), ICOAC_OK);
-    for (k = 0; k < 50; ++k) {
-        in = calm_input(&rng);
-        if (k % 10 == 9) {
-            in.flags = ICOAC_INPUT_TERMINAL;
+    for (literal = 0; literal <= 1; ++literal) {
+        icoac_config_t cfg = test_default_config();
+        icoac_state_t state, before;
+        icoac_output_t out;
+        icoac_prior_t post;
+        test_rng_t rng = {1234u};
+        icoac_input_t in;
+        int k, i, nonzero = 0, moved = 0;
+        cfg.mode = ICOAC_MODE_RL;
+        if (literal) {
+            test_literal_reading(&cfg);
         }
+        assert_int_equal(icoac_init(&cfg, &state, NULL, 5u), ICOAC_OK);
+        for (k = 0; k < 50; ++k) {
+            in = calm_input(&rng);
+            if (k % 10 == 9) {
+                in.flags = ICOAC_INPUT_TERMINAL;
+            }
+            assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+        }
+        for (k = 0; k < ICOAC_CRITIC_UNITS; ++k) {
+            nonzero += priv(&state)->v[k] != 0;
+        }
+        assert_true(nonzero > 0);
+        /* the actor learned too: mu_w left 0; the posterior reading moved Sigma_w off I */
+        assert_true(priv(&state)->weight_norm > 0);
+        assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_OK);
+        for (i = 0; i < N; ++i) {
+            moved += post.cov[i][i] != 1;
+        }
+        assert_true(literal ? moved == N : moved == 0);
+        before = state;
+        assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+        assert_memory_equal(priv(&state)->w, priv(&before)->w, sizeof priv(&state)->w);
+        assert_memory_equal(icoac_priv_cov_c(priv(&state)), icoac_priv_cov_c(priv(&before)),
+                            sizeof(icoac_real_t) * N * N);
+        assert_memory_equal(priv(&state)->v, priv(&before)->v, sizeof priv(&state)->v);
+        assert_int_equal(priv(&state)->has_prev, 0);
+        /* the first tick of a trial has no transition to learn from */
+        in = calm_input(&rng);
         assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+        assert_true(out.td_error == 0);
+        assert_memory_equal(priv(&state)->w, priv(&before)->w, sizeof priv(&state)->w);
+        assert_memory_equal(icoac_priv_cov_c(priv(&state)), icoac_priv_cov_c(priv(&before)),
+                            sizeof(icoac_real_t) * N * N);
+        assert_memory_equal(priv(&state)->v, priv(&before)->v, sizeof priv(&state)->v);
     }
-    for (k = 0; k < ICOAC_CRITIC_UNITS; ++k) {
-        nonzero += priv(&state)->v[k] != 0;
-    }
-    assert_true(nonzero > 0);
-    before = state;
-    assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
-    assert_memory_equal(priv(&state)->w, priv(&before)->w, sizeof priv(&state)->w);
-    assert_memory_equal(icoac_priv_cov_c(priv(&state)), icoac_priv_cov_c(priv(&before)), sizeof(icoac_real_t) * N * N);
-    assert_memory_equal(priv(&state)->v, priv(&before)->v, sizeof priv(&state)->v);
-    assert_int_equal(priv(&state)->has_prev, 0);
-    /* the first tick of a trial has no transition to learn from */
-    in = calm_input(&rng);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
-    assert_true(out.td_error == 0);
-    assert_memory_equal(priv(&state)->w, priv(&before)->w, sizeof priv(&state)->w);
-    assert_memory_equal(priv(&state)->v, priv(&before)->v, sizeof priv(&state)->v);
 }
 
 static void test_no_penalty_change_no_learning(void **unused)
@@ -396,7 +415,7 @@ static void test_output_written_on_success(void **unused)
 {
     int variant;
     (void)unused;
-    for (variant = 0; variant < 6; ++variant) {
+    for (variant = 0; variant < 9; ++variant) {
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
         test_rng_t rng = {0x0B7u + (uint64_t)variant};
@@ -408,6 +427,9 @@ static void test_output_written_on_success(void **unused)
         case 3: cfg.mode = ICOAC_MODE_RL; break;
         case 4: cfg.mode = ICOAC_MODE_RL; cfg.actor.act_with_sample = 1; break;
         case 5: cfg.mode = ICOAC_MODE_RL; cfg.actor.reflex = 0; cfg.policy.reflex_mode = ICOAC_REFLEX_GAIN; break;
+        case 6: cfg.mode = ICOAC_MODE_RL; test_literal_reading(&cfg); break;
+        case 7: cfg.mode = ICOAC_MODE_RL; cfg.actor.explore_ticks = 10; break; /* trials of 25 ticks */
+        case 8: cfg.mode = ICOAC_MODE_RL; cfg.actor.update = ICOAC_ACTOR_MEAN; cfg.actor.batch = 1; break;
         default: break;
         }
         assert_int_equal(icoac_init(&cfg, &state, &p, 77u), ICOAC_OK);

@@ -197,7 +197,7 @@ static void assert_gauss_close(const gauss_t *got, const gauss_t *want, double m
 static void reading_step(const icoac_actor_config_t *a, const gauss_t *prior, const double h[N], double delta,
                          double eps, double offset, gauss_t *post)
 {
-    const double sigma_l2 = (double)a->likelihood_std * (double)a->likelihood_std;
+    const double sigma_l2 = test_likelihood_var(a); /* likelihood_std, or sigma_u when 0 */
     const double sigma_u2 = (double)a->noise_std * (double)a->noise_std;
     const double iota = offset + (double)a->scale * delta * eps;
     double ch[N], s;
@@ -229,10 +229,11 @@ static void reading_step(const icoac_actor_config_t *a, const gauss_t *prior, co
 
 static const char *const reading_names[3] = {"posterior", "mean", "gradient"};
 
-/* One step of each reading, from a random prior and random settings, with sigma_L != sigma_u,
- * acting with mu_w or a sample, on a terminal (delta = -1) or a non-terminal transition (delta
- * from random critic weights): the posterior and step against the formula, and Sigma_w bitwise
- * the prior for mean and gradient. */
+/* One step of each reading, from a random prior and random settings, with sigma_L != sigma_u
+ * (a quarter of the cases with likelihood_std 0: sigma_L = sigma_u), acting with mu_w or a
+ * sample, on a terminal (delta = -1) or a non-terminal transition (delta from random critic
+ * weights): the posterior and step against the formula, and Sigma_w bitwise the prior for mean
+ * and gradient. */
 static void test_single_step_each_reading(void **unused)
 {
     test_rng_t rng = {0x5EAD1u};
@@ -258,6 +259,9 @@ static void test_single_step_each_reading(void **unused)
         cfg.actor.noise_std = (icoac_real_t)test_uniform(&rng, 0.3, 3.0);
         cfg.actor.scale = (icoac_real_t)test_uniform(&rng, 0.1, 2.0);
         cfg.actor.rate = (icoac_real_t)test_uniform(&rng, 1e-3, 0.3);
+        if ((n / 12) % 4 == 3) {
+            cfg.actor.likelihood_std = 0;
+        }
         assert_int_equal(icoac_init(&cfg, &state, &p, (uint64_t)n + 1u), ICOAC_OK);
         random_critic(&state, &rng, 0.5);
         posterior_of(&state, &before);
@@ -416,7 +420,8 @@ static void test_mean_and_gradient_keep_sigma(void **unused)
  * forgetting), mu' = mu + P^-1 sum h iota / sigma_L^2, Sigma' = P^-1 (posterior) or Sigma
  * (mean); gradient: mu' = mu + beta / sigma_u^2 sum delta eps h. With explore_ticks N only the
  * transitions whose first tick explored (t < N) count. A trial cut by a reset (no terminal
- * tick) changes nothing, and its sums do not leak into the next trial. */
+ * tick) changes nothing, and its sums do not leak into the next trial. sigma_L is drawn apart
+ * from sigma_u, or is sigma_u (likelihood_std 0) in a few cases. */
 typedef struct {
     int reading;
     int explore;
@@ -443,6 +448,9 @@ static void run_batch_case(const batch_case_t *bc, int n_case)
     cfg.actor.noise_std = (icoac_real_t)test_uniform(&rng, 0.5, 2.0);
     cfg.actor.rate = (icoac_real_t)test_uniform(&rng, 1e-3, 0.05);
     cfg.actor.scale = (icoac_real_t)test_uniform(&rng, 0.2, 1.0);
+    if (n_case % 5 == 0 || n_case == 6) {
+        cfg.actor.likelihood_std = 0; /* sigma_L = sigma_u */
+    }
     assert_int_equal(icoac_init(&cfg, &state, &p, 100u + (uint64_t)n_case), ICOAC_OK);
     for (trial = 0; trial < 6; ++trial) {
         const int cut = trial == 2; /* ended by a reset, not a failure */
@@ -451,7 +459,7 @@ static void run_batch_case(const batch_case_t *bc, int n_case)
         gauss_t start, now, want;
         double info[N][N], shift[N], prec[N][N], inv[N][N];
         double lambda_inv = bc->forgetting < 1.0 ? 1.0 / (double)cfg.actor.forgetting : 1.0;
-        const double sigma_l2 = (double)cfg.actor.likelihood_std * (double)cfg.actor.likelihood_std;
+        const double sigma_l2 = test_likelihood_var(&cfg.actor);
         int t, i, j, observed = 0;
         reset_ok(&cfg, &state);
         random_critic(&state, &rng, 0.5);

@@ -34,8 +34,9 @@
  * Contract, checked after every call (abort on violation):
  *   init    status = icoac_config_check when that fails, else icoac_prior_check when that
  *           fails, else OK or ICOAC_ERR_NUMERIC (search mode: or ICOAC_ERR_BAD_PRIOR, when
- *           cov_scale * the prior covariance is not positive definite); icoac_config_check_field
- *           agrees and names a field exactly when the check fails; the checks accept only
+ *           cov_scale * the prior covariance is not positive definite); a rejected init leaves
+ *           the state bytewise untouched; icoac_config_check_field agrees and names a field
+ *           exactly when the check fails; the checks accept only
  *           documented ranges of the groups the mode uses (ICO: policy, ico; RL: policy,
  *           critic, actor; search: policy, search); after OK the learned state (w, |w|, cov,
  *           w_act, v) is finite and holds the prior (search: cov = cov_scale * the prior's,
@@ -43,7 +44,8 @@
  *   step    returned status = out.status, a known status; non-finite s <=> NONFINITE_INPUT;
  *           the counters count the tick and its rejection.
  *           OK: every real output written (out is NaN-filled before the call) and finite, the
- *           learned state finite, cov exactly symmetric, out.weight_norm = |w|; force and
+ *           learned state finite, cov exactly symmetric, out.weight_norm = |w|; the trial's
+ *           tick count + 1 on a non-terminal RL or search step (ICO does not count); force and
  *           noise 0 on a terminal step; q 0 in RL and search; value, td_error, noise,
  *           cov_trace 0 in ICO; value, td_error, noise 0 and cov_trace = trace(cov) in search;
  *           with learn = 0 (the no-learning control) w, |w|, cov, v, the actor's batch sums
@@ -297,8 +299,9 @@ static int actor_documented(const icoac_actor_config_t *a)
            a->forgetting <= ICOAC_R(1.0) && is_flag(a->reflex) && is_flag(a->act_with_sample) &&
            (a->update == ICOAC_ACTOR_POSTERIOR || a->update == ICOAC_ACTOR_MEAN ||
             a->update == ICOAC_ACTOR_GRADIENT) &&
-           finite_non_negative(a->rate) && finite_positive(a->likelihood_std) && is_flag(a->batch) &&
-           a->explore_ticks >= 0;
+           finite_non_negative(a->rate) &&
+           (a->likelihood_std == ICOAC_R(0.0) || finite_positive(a->likelihood_std)) && /* 0: sigma_u */
+           is_flag(a->batch) && a->explore_ticks >= 0;
 }
 
 static int search_documented(const icoac_search_config_t *s)
@@ -536,9 +539,10 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
                  "op %d: terminal step with force %g noise %g", op, (double)out.force, (double)out.noise);
         FZ_CHECK(out.weight_norm == after.weight_norm, "op %d: out.weight_norm %g, state |w| %g", op,
                  (double)out.weight_norm, (double)after.weight_norm);
-        FZ_CHECK(after.trial_ticks == before.trial_ticks + (terminal ? 0u : 1u),
-                 "op %d: trial tick count %u -> %u (terminal %d)", op, (unsigned)before.trial_ticks,
-                 (unsigned)after.trial_ticks, terminal);
+        /* RL and search count the non-terminal ticks of a trial; ICO does not count */
+        FZ_CHECK(after.trial_ticks == before.trial_ticks + (terminal || cfg->mode == ICOAC_MODE_ICO ? 0u : 1u),
+                 "op %d: trial tick count %u -> %u (terminal %d, mode %d)", op, (unsigned)before.trial_ticks,
+                 (unsigned)after.trial_ticks, terminal, (int)cfg->mode);
         if (cfg->mode == ICOAC_MODE_RL) {
             check_rl_step(cfg, &before, &after, &out, terminal, op);
         } else if (cfg->mode == ICOAC_MODE_SEARCH) {
@@ -620,6 +624,19 @@ static void check_refusals(const icoac_config_t *cfg)
              "NULL argument not refused with ICOAC_ERR_NULL");
 }
 
+/* Every byte of the state is `fill`. */
+static int untouched(const icoac_state_t *state, unsigned char fill)
+{
+    const unsigned char *bytes = (const unsigned char *)state;
+    size_t i;
+    for (i = 0; i < sizeof *state; ++i) {
+        if (bytes[i] != fill) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* icoac_init against the checks; returns 1 when the state is initialised. */
 static int check_init(const icoac_config_t *cfg, icoac_state_t *state, const icoac_prior_t *prior, uint64_t seed)
 {
@@ -646,8 +663,11 @@ static int check_init(const icoac_config_t *cfg, icoac_state_t *state, const ico
         FZ_CHECK(prior_status != ICOAC_OK || prior_documented(prior),
                  "icoac_prior_check accepted a non-finite or asymmetric prior");
     }
-    memset(state, 0, sizeof *state);
+    /* a fill the rejected inits must leave as it is */
+    memset(state, 0x5A, sizeof *state);
     status = (int32_t)icoac_init(cfg, state, prior, seed);
+    FZ_CHECK(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC || untouched(state, 0x5A),
+             "icoac_init returned %d (%s) and wrote to the state", (int)status, status_name(status));
     if (config_status != ICOAC_OK) {
         FZ_CHECK(status == config_status, "icoac_init returned %d, icoac_config_check %d", (int)status,
                  (int)config_status);

@@ -8,6 +8,7 @@ value tables below mirror fuzz_input.c. Files named repro-* are known reproducer
     python3 tests/fuzz/gen_corpus.py --check  # exit 1 unless the committed corpus is current
 """
 import argparse
+import math
 import struct
 import sys
 from pathlib import Path
@@ -76,10 +77,10 @@ CONFIG_DEFAULT = {"mode": 0, "learn": 1,
                   "critic.range[0]": 2.4, "critic.range[1]": 3.5, "critic.range[2]": 0.2094384,
                   "critic.range[3]": 2.0, "critic.threshold": 0.001, "critic.quirks": 0,
                   "actor.noise_std": 1.0, "actor.scale": 0.5, "actor.forgetting": 1.0,
-                  "actor.reflex": 1, "actor.act_with_sample": 0, "actor.update": 0, "actor.rate": 0.01,
-                  "actor.likelihood_std": 1.0, "actor.batch": 0, "actor.explore_ticks": 0,
-                  "search.batch": 4, "search.elite_fraction": 0.5, "search.step": 0.5, "search.floor": 0.1,
-                  "search.cov_scale": 1.0}
+                  "actor.reflex": 1, "actor.act_with_sample": 0, "actor.update": 2, "actor.rate": 0.01,
+                  "actor.likelihood_std": 0.0, "actor.batch": 0, "actor.explore_ticks": 1000,
+                  "search.batch": 8, "search.elite_fraction": 0.25, "search.step": 0.5, "search.floor": 1.0,
+                  "search.cov_scale": 64.0}
 assert list(CONFIG_DEFAULT) == CONFIG_FIELDS
 
 
@@ -181,8 +182,9 @@ def config_raw(fmt, fields=None):
     return b"\x01" + bytes(raw)
 
 
-def prior(*mutations):
-    """None: NULL; (): mean 0, cov I; else (field, value[, mirror]) mutations of that."""
+def prior(*mutations, fmt="f"):
+    """None: NULL; (): mean 0, cov I; else (field, value[, mirror]) mutations of that; fmt: the
+    real type's struct code (for Exact values)."""
     if mutations == (None,):
         return b"\x00"
     if not mutations:
@@ -193,7 +195,7 @@ def prior(*mutations):
         field, v = m[0], m[1]
         mirror = len(m) > 2 and m[2]
         index = int(field[4:]) if isinstance(field, str) else 4 + 4 * field[0] + field[1]
-        out += bytes([index | (0x80 if mirror else 0)]) + real(v)
+        out += bytes([index | (0x80 if mirror else 0)]) + real(v, fmt)
     return out
 
 
@@ -231,9 +233,44 @@ EXERCISE = (steps(ZERO, 2) + steps((0.5, 0.3, 0.05, 0.2), 4) + steps((2.5, 1.0, 
 
 
 # Six trials of different lengths, each ended by a failure and a reset: a search batch of 4
-# updates once (and a batch of 2 three times).
+# updates once (and a batch of 2 three times; the default batch of 8 needs SEARCH_TRIALS * 2).
 SEARCH_TRIALS = b"".join(steps((0.1 * k, -0.2, 0.02 * k, 0.3), 2 + 3 * k) + step((2.5, 1.0, "0.25", 1.0), terminal=True)
                          + RESET for k in range(6))
+
+
+def rounded(fmt):
+    """Rounding to the real type of struct code fmt. IEEE double operations on two reals of
+    that type, then this rounding, give the real type's correctly rounded +, -, *, / and sqrt."""
+    return lambda x: struct.unpack("<" + fmt, struct.pack("<" + fmt, x))[0]
+
+
+def next_up(x, fmt):
+    """The next real of type fmt above x > 0."""
+    bits_fmt = {"f": "<I", "d": "<Q"}[fmt]
+    bits = struct.unpack(bits_fmt, struct.pack("<" + fmt, x))[0]
+    return struct.unpack("<" + fmt, struct.pack(bits_fmt, bits + 1))[0]
+
+
+def prior_lost_by_scale(fmt, scale):
+    """(c, b): the prior cov I with cov[0][1] = cov[1][0] = c and cov[1][1] = b passes the
+    Cholesky test of icoac_prior_check (pivot b - c^2 > 0 by a few ulps), but scale * it, as
+    icoac_init forms Sigma0 in search mode, does not: its pivot rounds to <= 0. The test is
+    replayed here in the real type's arithmetic, in the order of icoac_priv_cholesky4."""
+    r = rounded(fmt)
+
+    def second_pivot(a, c, b):
+        l00 = r(math.sqrt(a))
+        l10 = r(c / l00)
+        return r(b - r(l10 * l10))
+
+    for i in range(1, 20000):
+        c = r(0.5 + i / 40000.0)
+        b = r(c * c)
+        for _ in range(4):
+            b = next_up(b, fmt)
+            if second_pivot(1.0, c, b) > 0 and second_pivot(r(scale), r(c * r(scale)), r(b * r(scale))) <= 0:
+                return c, b
+    raise AssertionError("no prior found")
 
 
 def controller_seeds(fmt):
@@ -244,8 +281,14 @@ def controller_seeds(fmt):
         "default-ico": config() + NO_PRIOR + seed(1) + EXERCISE,
         "default-rl": config(rl) + NO_PRIOR + seed(2) + EXERCISE + EXERCISE,
         "rl-sample": config({**rl, "actor.act_with_sample": 1}) + NO_PRIOR + seed(3) + EXERCISE + RESET + EXERCISE,
-        "rl-dense-forgetting": (config({**rl, "critic.threshold": "0", "actor.forgetting": 0.9}) + NO_PRIOR
-                                + seed(4) + EXERCISE),
+        # the paper's literal reading (harness configuration `literal`): the posterior update with
+        # sigma_L = sigma_u, exploring at every tick
+        "rl-literal": (config({**rl, "actor.update": 0, "actor.explore_ticks": 0}) + NO_PRIOR + seed(42)
+                       + EXERCISE * 2),
+        "rl-literal-sample": (config({**rl, "actor.update": 0, "actor.explore_ticks": 0, "actor.act_with_sample": 1})
+                              + NO_PRIOR + seed(43) + EXERCISE + RESET + EXERCISE),
+        "rl-dense-forgetting": (config({**rl, "critic.threshold": "0", "actor.forgetting": 0.9, "actor.update": 0})
+                                + NO_PRIOR + seed(4) + EXERCISE),
         "rl-no-reflex": config({**rl, "actor.reflex": 0, "critic.discount": "1"}) + NO_PRIOR + seed(5) + EXERCISE,
         "ico-literal": config({"ico.timing": 1}) + NO_PRIOR + seed(6) + EXERCISE,
         "ico-reflex-gain": config({"policy.reflex_mode": 1}) + NO_PRIOR + seed(7) + EXERCISE,
@@ -270,15 +313,17 @@ def controller_seeds(fmt):
         # schedule, the critic quirks, and the episodic search over several batches.
         "rl-mean": config({**rl, "actor.update": 1, "actor.likelihood_std": 0.25}) + NO_PRIOR + seed(19) + EXERCISE * 2,
         "rl-gradient": config({**rl, "actor.update": 2, "actor.rate": 0.1}) + NO_PRIOR + seed(20) + EXERCISE * 2,
-        "rl-batch-posterior": (config({**rl, "actor.batch": 1, "actor.forgetting": 0.9}) + NO_PRIOR + seed(21)
-                               + EXERCISE * 2),
+        "rl-batch-posterior": (config({**rl, "actor.batch": 1, "actor.forgetting": 0.9, "actor.update": 0})
+                               + NO_PRIOR + seed(21) + EXERCISE * 2),
         "rl-batch-mean": config({**rl, "actor.batch": 1, "actor.update": 1}) + NO_PRIOR + seed(22) + EXERCISE * 2,
         "rl-batch-gradient": (config({**rl, "actor.batch": 1, "actor.update": 2, "actor.rate": 1.0}) + NO_PRIOR
                               + seed(23) + EXERCISE * 2),
         "rl-explore-ticks": (config({**rl, "actor.explore_ticks": 5, "actor.act_with_sample": 1}) + NO_PRIOR
                              + seed(24) + EXERCISE * 2),
-        "rl-batch-explore-quirks": (config({**rl, "actor.batch": 1, "actor.explore_ticks": 3, "critic.quirks": 1})
-                                    + NO_PRIOR + seed(25) + EXERCISE * 2),
+        "rl-batch-explore-quirks": (config({**rl, "actor.batch": 1, "actor.explore_ticks": 3, "critic.quirks": 1,
+                                            "actor.update": 0}) + NO_PRIOR + seed(25) + EXERCISE * 2),
+        "rl-likelihood-std": (config({**rl, "actor.update": 0, "actor.likelihood_std": 3.0, "actor.noise_std": 0.5})
+                              + NO_PRIOR + seed(44) + EXERCISE * 2),
         "rl-quirks": config({**rl, "critic.quirks": 1, "critic.threshold": "0"}) + NO_PRIOR + seed(26) + EXERCISE,
         "rl-learner-extremes": (config({**rl, "actor.update": 2, "actor.rate": Exact(1000.0),
                                         "actor.noise_std": Exact(0.001), "actor.likelihood_std": Exact(1000.0),
@@ -288,22 +333,33 @@ def controller_seeds(fmt):
                                            "actor.scale": Exact(1000.0)}, fmt) + NO_PRIOR + seed(40) + EXERCISE),
         "rl-ignores-search-group": (config({**rl, "search.batch": 0, "search.floor": "nan", "search.cov_scale": "0"})
                                     + NO_PRIOR + seed(28) + EXERCISE),
-        "search-default": config(search) + NO_PRIOR + seed(29) + SEARCH_TRIALS,
+        "search-default": config(search) + NO_PRIOR + seed(29) + SEARCH_TRIALS * 3,
         "search-batch-1": config({**search, "search.batch": 1, "search.step": "1"}) + NO_PRIOR + seed(30) + SEARCH_TRIALS,
-        "search-step-1": (config({**search, "search.step": "1", "search.elite_fraction": "0.5", "search.floor": 1.0})
-                          + NO_PRIOR + seed(31) + SEARCH_TRIALS),
+        "search-step-1": (config({**search, "search.step": "1", "search.elite_fraction": "0.5", "search.floor": 1.0,
+                                  "search.batch": 4}) + NO_PRIOR + seed(31) + SEARCH_TRIALS),
+        # a = 1 with an elite of 2 and a small floor: Sigma' singular, the fallback Sigma' + diag(floor)
+        "search-step-1-singular": (config({**search, "search.step": "1", "search.elite_fraction": "0.5",
+                                           "search.floor": 1e-3, "search.batch": 4, "search.cov_scale": "1"})
+                                   + NO_PRIOR + seed(45) + SEARCH_TRIALS * 2),
         "search-max-batch": (config({**search, "search.batch": 16, "search.elite_fraction": "0.25"}) + NO_PRIOR
                              + seed(32) + SEARCH_TRIALS * 3),
-        "search-prior-scaled": (config({**search, "search.cov_scale": 16.0, "search.floor": "1e-5"})
+        "search-prior-scaled": (config({**search, "search.cov_scale": 16.0, "search.floor": "1e-5", "search.batch": 4})
                                 + prior(("mean2", 5.0), ((0, 1), 0.5, True), ((2, 2), 4.0)) + seed(33) + SEARCH_TRIALS),
+        # a prior icoac_prior_check accepts whose cov_scale * cov is not positive definite:
+        # ICOAC_ERR_BAD_PRIOR from icoac_init in search mode, the state untouched
+        "search-prior-lost-by-scale": (config({**search, "search.cov_scale": Exact(3.0)}, fmt)
+                                       + prior(((0, 1), Exact(prior_lost_by_scale(fmt, 3.0)[0]), True),
+                                               ((1, 1), Exact(prior_lost_by_scale(fmt, 3.0)[1])), fmt=fmt)
+                                       + seed(46) + SEARCH_TRIALS),
         "search-floor-max": (config({**search, "search.floor": Exact(1000.0), "search.cov_scale": Exact(1000.0),
                                      "search.batch": 2}, fmt) + NO_PRIOR + seed(34) + SEARCH_TRIALS),
         "search-floor-min": (config({**search, "search.floor": Exact(1e-6), "search.elite_fraction": Exact(1e-6),
                                      "search.step": Exact(1e-6), "search.batch": 3}, fmt) + NO_PRIOR + seed(41)
                              + SEARCH_TRIALS),
-        "search-no-learning": config({**search, "learn": 0}) + NO_PRIOR + seed(35) + SEARCH_TRIALS,
+        "search-no-learning": config({**search, "learn": 0, "search.batch": 4}) + NO_PRIOR + seed(35) + SEARCH_TRIALS,
         "search-ignores-other-groups": (config({**search, "ico.rate": "nan", "critic.range[0]": "1e-39",
-                                                "actor.noise_std": "0", "actor.update": 7, "critic.quirks": 2})
+                                                "actor.noise_std": "0", "actor.update": 7, "critic.quirks": 2,
+                                                "search.batch": 4})
                                         + NO_PRIOR + seed(36) + SEARCH_TRIALS),
         "search-bad-batch": config({**search, "search.batch": 17}) + NO_PRIOR + seed(37) + SEARCH_TRIALS,
         "search-nonfinite-terminal": (config({**search, "search.batch": 2}) + NO_PRIOR + seed(38) + steps(ZERO, 3)
@@ -395,6 +451,8 @@ def sim_seeds():
         "default-search": plant() + run() + config({"mode": 2, "search.batch": 2}) + NO_PRIOR + SIM_OPS,
         "search-prior": (plant() + run(max_trials=3) + config({"mode": 2, "search.batch": 1, "search.cov_scale": 4.0})
                          + prior(("mean2", 5.0), ("mean3", 1.0)) + SIM_OPS),
+        "rl-literal": (plant() + run() + config({"mode": 1, "actor.update": 0, "actor.explore_ticks": 0})
+                       + NO_PRIOR + SIM_OPS),
         "rl-learners": (plant() + run() + config({"mode": 1, "actor.update": 1, "actor.batch": 1,
                                                   "actor.explore_ticks": 50, "critic.quirks": 1}) + NO_PRIOR + SIM_OPS),
         "bad-arguments": (plant() + run() + config() + NO_PRIOR + op_cell("inf", 0.0, 1)

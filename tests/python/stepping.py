@@ -40,6 +40,14 @@ def posterior(state):
     return np.array(post.mean, dtype=float), np.array([list(r) for r in post.cov], dtype=float)
 
 
+def likelihood_var(cfg):
+    """sigma_L^2 of the posterior and mean readings: actor.likelihood_std squared, or sigma_u^2
+    (actor.noise_std) when it is 0 (the literal reading, the default)."""
+    a = cfg.controller.actor
+    std = a.likelihood_std if a.likelihood_std != 0 else a.noise_std
+    return float(std) ** 2
+
+
 def stored(s):
     """The state as the controller stores it (icoac_real_t)."""
     return np.asarray(s, dtype=float).astype(REAL).astype(float)

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from harness import _binding as B
-from harness import geometry
-from harness.config import build_config
+from harness import geometry, options
+from harness.config import CONDITION_OVERRIDES, NAMED_CONFIGURATIONS, build_config, named_sets, parse_sets
 from harness.errors import LibraryError
 
 
@@ -167,16 +167,54 @@ def test_config_defaults_match_spec():
     assert cri["discount"] == pytest.approx(0.95)
     assert act["noise_std"] == 1.0 and act["scale"] == 0.5 and act["forgetting"] == 1.0
     assert pol["clip_inputs"] is True and act["reflex"] is True and act["act_with_sample"] is False
-    # spec L2-L4, A10: the literal readings by default
+    # spec L2-L4, A10: the literal critic, per-tick updates and sigma_L = sigma_u (0); the actor
+    # reading, its exploration schedule and the search group chosen by the learner sweeps
     assert cri["quirks"] is False
-    assert act["update"] == "posterior" and act["rate"] == pytest.approx(0.01) and act["likelihood_std"] == 1.0
-    assert act["batch"] is False and act["explore_ticks"] == 0
-    assert sea == {"batch": 4, "elite_fraction": 0.5, "step": 0.5, "floor": pytest.approx(0.1), "cov_scale": 1.0}
+    assert act["update"] == "gradient" and act["rate"] == pytest.approx(0.01) and act["likelihood_std"] == 0.0
+    assert act["batch"] is False and act["explore_ticks"] == 1000
+    assert sea == {"batch": 8, "elite_fraction": 0.25, "step": 0.5, "floor": 1.0, "cov_scale": 64.0}
     assert p == {"gravity": 9.8, "cart_mass": 1.0, "pole_mass": 0.1, "half_length": 0.5, "dt": 0.01,
                  "x_limit": 2.4, "theta_limit": pytest.approx(math.radians(12)), "integrator": "euler",
                  "reserved": 0}
     assert r == {"max_trials": 100000, "success_steps": 100000, "init_velocity_noise": pytest.approx(1e-4)}
     assert d["prior"] is None
+
+
+def test_condition_overrides():
+    """The nine conditions over the C defaults: each learner's mode, its control the same with
+    learn = 0; search from N(0, I) with Sigma0 = 4 I (search.cov_scale 4), ico-search with the C
+    default c = 64; nothing else overridden."""
+    assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS) and options.CONDITIONS == (
+        "ico", "ico-rl", "ico-rl-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
+        "search-control")
+    assert options.CONTROL_OF == {"ico-rl-control": "ico-rl", "rl-control": "rl",
+                                  "ico-search-control": "ico-search", "search-control": "search"}
+    default = build_config().flat()
+    modes = {"ico": "ico", "ico-rl": "rl", "rl": "rl", "ico-search": "search", "search": "search"}
+    for condition in options.CONDITIONS:
+        flat = build_config(condition=condition).flat()
+        base = options.CONTROL_OF.get(condition, condition)
+        assert flat["mode"] == modes[base] and flat["learn"] is (condition not in options.CONTROL_OF)
+        assert flat["search.cov_scale"] == (4.0 if base == "search" else 64.0)
+        changed = {n for n in flat if flat[n] != default[n]}
+        assert changed <= {"mode", "learn", "search.cov_scale"}, condition
+        if condition in options.CONTROL_OF:  # a control is its condition with every update off
+            assert {n: v for n, v in flat.items() if n != "learn"} == \
+                {n: v for n, v in build_config(condition=base).flat().items() if n != "learn"}
+    assert set(options.SEARCH_CONDITIONS) == {c for c in options.CONDITIONS if modes[options.CONTROL_OF.get(c, c)]
+                                               == "search"}
+
+
+def test_literal_configuration():
+    """--configuration literal: the paper's literal reading over the defaults (the posterior step
+    with sigma_L = sigma_u, per tick, exploring at every tick, the literal critic); default: none."""
+    assert options.CONFIGURATION_NAMES == tuple(NAMED_CONFIGURATIONS) == ("default", "literal")
+    assert named_sets("default") == []
+    default = build_config(condition="rl").flat()
+    literal = build_config(parse_sets(named_sets("literal")), condition="rl").flat()
+    assert literal["actor.update"] == "posterior" and literal["actor.likelihood_std"] == 0.0
+    assert literal["actor.batch"] is False and literal["actor.explore_ticks"] == 0 and literal["critic.quirks"] is False
+    assert {n for n in literal if literal[n] != default[n]} == {"actor.update", "actor.explore_ticks"}
 
 
 def test_overrides_by_name():

@@ -16,6 +16,10 @@ from harness.config import build_config, make_prior
     ({"discount": 1.5}, "rl", B.ERR_BAD_CRITIC, "rejected: critic.discount=1.5"),
     ({"critic.td_clip": 0.0}, "rl", B.ERR_BAD_CRITIC, "rejected: critic.td_clip=0.0"),
     ({"noise_std": 0.0}, "rl", B.ERR_BAD_ACTOR, "rejected: actor.noise_std=0.0"),
+    # 0 (sigma_L = sigma_u) or [1e-3, 1e3]
+    ({"actor.likelihood_std": 5e-4}, "rl", B.ERR_BAD_ACTOR, "rejected: actor.likelihood_std=0.0005"),
+    ({"actor.likelihood_std": -1.0}, "rl", B.ERR_BAD_ACTOR, "rejected: actor.likelihood_std=-1.0"),
+    ({"search.cov_scale": 0.5}, "search", B.ERR_BAD_SEARCH, "rejected: search.cov_scale=0.5"),
     ({"mode": 7}, None, B.ERR_BAD_MODE, "rejected: mode=7"),
     ({"ico.timing": 2}, "ico", B.ERR_BAD_MODE, "rejected: ico.timing=2"),
     ({"dt": 0.0}, None, B.SIM_ERR_BAD_PLANT, "plant"),
@@ -28,6 +32,13 @@ def test_bad_values_raise_config_error_with_c_message(overrides, condition, stat
     assert info.value.c_message == B.status_str(status)
     assert B.status_str(status) in str(info.value)
     assert words in str(info.value)
+
+
+def test_likelihood_std_zero_follows_the_noise():
+    """actor.likelihood_std 0 (the default) is accepted: sigma_L = sigma_u; the C message names
+    both forms of the range."""
+    assert build_config({"actor.likelihood_std": 0.0}, condition="rl").controller.actor.likelihood_std == 0.0
+    assert "likelihood_std 0 or [1e-3, 1e3]" in B.status_str(B.ERR_BAD_ACTOR)
 
 
 def test_mode_checks_only_its_groups():

@@ -15,7 +15,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from harness import _binding as B
-from harness import config, grid, metrics, results
+from harness import config, grid, metrics, options, results
 from harness.config import (ALIASES, ALL_FIELDS, BOOLS, ENUMS, RunConfig, build_config, canonical, config_from_dict,
                             parse_sets, parse_value)
 from harness.errors import HarnessError
@@ -67,7 +67,7 @@ def test_build_config_accepts_and_round_trips_or_rejects(overrides):
         assert_round_trip(cfg)
 
 
-@given(st.sampled_from(ALL_FIELDS + tuple(ALIASES)), field_values, st.sampled_from(["ico", "rl", "search"]))
+@given(st.sampled_from(ALL_FIELDS + tuple(ALIASES)), field_values, st.sampled_from(options.CONDITIONS))
 def test_single_field_override(given_name, value, condition):
     cfg = total(build_config, {given_name: value}, condition=condition)
     if cfg is None:

@@ -6,7 +6,8 @@ from the observed states and what the ticks output (exploration noise eps, TD er
     mean       mu += Sigma0 h iota / (h^T Sigma0 h + sigma_L^2), Sigma stays Sigma0
     gradient   mu += beta delta eps h / sigma_u^2, Sigma stays
 
-with iota = alpha delta eps (+ h^T (w_act - mu) when acting with a sample) and h = G x~(s_t).
+with iota = alpha delta eps (+ h^T (w_act - mu) when acting with a sample) and h = G x~(s_t);
+sigma_L = actor.likelihood_std, or sigma_u (actor.noise_std) when it is 0 (the default).
 """
 import numpy as np
 import pytest
@@ -14,7 +15,8 @@ import pytest
 from harness import _binding as B
 from harness.config import build_config
 
-from stepping import FAILED, REAL, controller, features, posterior, random_prior, random_state, reset, stored, tick
+from stepping import (FAILED, REAL, controller, features, likelihood_var, posterior, random_prior, random_state, reset,
+                      stored, tick)
 
 READINGS = ("posterior", "mean", "gradient")
 FLOAT = B.real_dtype == np.float32
@@ -41,7 +43,7 @@ def reading_step(cfg, mu, sigma, h, delta, eps, offset=0.0):
     if a.update == B.ACTOR_UPDATES["gradient"]:
         return mu + a.rate * delta * eps * h / a.noise_std ** 2, sigma
     sh = sigma @ h
-    s = h @ sh + a.likelihood_std ** 2
+    s = h @ sh + likelihood_var(cfg)
     if a.update == B.ACTOR_UPDATES["mean"]:
         return mu + sh * iota / s, sigma
     return mu + sh * iota / s, sigma - np.outer(sh, sh) / s
@@ -52,13 +54,15 @@ def rl_config(reading, **over):
     return build_config({"actor.update": reading, "critic.threshold": 0.0, **over}, condition="rl")
 
 
+@pytest.mark.parametrize("likelihood_std", [2.5, 0.0], ids=["sigma_L", "sigma_u"])
 @pytest.mark.parametrize("sample", [False, True], ids=["act-mu", "act-sample"])
 @pytest.mark.parametrize("reading", READINGS)
-def test_each_step_matches_numpy(reading, sample):
+def test_each_step_matches_numpy(reading, sample, likelihood_std):
     """Along trials ending in failures (so that the critic learns and delta varies), every tick's
-    step equals the reading's formula from the posterior it started from; sigma_L != sigma_u."""
+    step equals the reading's formula from the posterior it started from; sigma_L != sigma_u, or
+    likelihood_std 0: sigma_L = sigma_u (0.7, not 1)."""
     rng = np.random.default_rng(READINGS.index(reading) * 2 + sample)
-    cfg = rl_config(reading, **{"actor.likelihood_std": 2.5, "actor.noise_std": 0.7, "actor.scale": 1.5,
+    cfg = rl_config(reading, **{"actor.likelihood_std": likelihood_std, "actor.noise_std": 0.7, "actor.scale": 1.5,
                                 "actor.rate": 0.02, "actor.act_with_sample": sample})
     mean0, cov0 = random_prior(rng, 0.3)
     state = controller(cfg, mean0, cov0, seed=5)
@@ -106,16 +110,17 @@ def test_readings_are_different_steps():
     assert np.array_equal(got["mean"][1], cov0) and np.array_equal(got["gradient"][1], cov0)
 
 
+@pytest.mark.parametrize("likelihood_std", [3.0, 0.0], ids=["sigma_L", "sigma_u"])
 @pytest.mark.parametrize("explore", [0, 6], ids=["always", "until-6"])
 @pytest.mark.parametrize("reading", READINGS)
-def test_batch_matches_accumulated_closed_form(reading, explore):
+def test_batch_matches_accumulated_closed_form(reading, explore, likelihood_std):
     """actor.batch: mu_w and Sigma_w stay over a trial; at its failure the closed form over the
     trial's (explored) observations: P = Sigma^-1 + sum h h^T / sigma_L^2, mu' = mu + P^-1 sum h
     iota / sigma_L^2, Sigma' = P^-1 (posterior) or Sigma (mean); gradient: mu' = mu + beta /
     sigma_u^2 sum delta eps h. A trial cut by a reset learns nothing and leaves no sums behind."""
     rng = np.random.default_rng(40 + READINGS.index(reading) + explore)
-    cfg = rl_config(reading, **{"actor.batch": True, "actor.explore_ticks": explore, "actor.likelihood_std": 3.0,
-                                "actor.noise_std": 1.3, "actor.rate": 0.01})
+    cfg = rl_config(reading, **{"actor.batch": True, "actor.explore_ticks": explore,
+                                "actor.likelihood_std": likelihood_std, "actor.noise_std": 1.3, "actor.rate": 0.01})
     a = cfg.controller.actor
     mean0, cov0 = random_prior(rng, 0.5)
     state = controller(cfg, mean0, cov0, seed=2)
@@ -150,7 +155,7 @@ def test_batch_matches_accumulated_closed_form(reading, explore):
         if reading == "gradient":
             want_mu, want_sigma = mu + a.rate / a.noise_std ** 2 * (de @ h), sigma
         else:
-            var = a.likelihood_std ** 2
+            var = likelihood_var(cfg)
             p = np.linalg.inv(sigma) + h.T @ h / var
             inv = np.linalg.inv(p)
             want_mu = mu + inv @ (h.T @ (a.scale * de)) / var

@@ -12,12 +12,16 @@ import pytest
 
 from harness import _binding as B
 from harness import grid, results
+from harness import options
 from harness import prior as P
-from harness.config import build_config, make_prior
+from harness.config import build_config, make_prior, named_sets, parse_sets
 
 REPO = Path(__file__).resolve().parents[2]
 PNG = b"\x89PNG\r\n\x1a\n"
 TINY_RL = {"max_trials": 30, "success_steps": 500}
+# The paper's literal reading of the actor (--configuration literal): the posterior update with
+# sigma_L = sigma_u, per tick, exploring at every tick. The defaults use the gradient reading.
+LITERAL = parse_sets(named_sets("literal"))
 
 
 def run_cli(*args, timeout=60):
@@ -110,10 +114,17 @@ def test_prior_from_results_records_provenance(ico_dir):
 
 
 # -- RL grids ------------------------------------------------------------------------------------------
-def test_rl_grid_deterministic_records_posterior(ico_dir):
+@pytest.mark.parametrize("configuration", ["default", "literal"])
+def test_rl_grid_deterministic_records_posterior(ico_dir, configuration):
+    """Deterministic for any thread count; each cell records the mu_w and Sigma_w it learned: the
+    literal (posterior) reading shrinks Sigma_w (no forgetting), the default gradient reading
+    keeps it at the prior, bit for bit."""
     info = P.from_results(ico_dir)
-    cfg = build_config(TINY_RL, condition="ico-rl", prior=info.prior())
+    over = {**TINY_RL, **(LITERAL if configuration == "literal" else {})}
+    cfg = build_config(over, condition="ico-rl", prior=info.prior())
     assert cfg.controller.mode == B.MODE_RL
+    assert cfg.controller.actor.update == B.ACTOR_UPDATES["posterior" if configuration == "literal" else "gradient"]
+    prior_cov = np.array([list(r) for r in info.prior().cov], dtype=float)  # in the real type
     a = grid.make_cells(5, [300, 611, 900])
     b = grid.make_cells(5, [300, 611, 900])
     grid.run_grid(cfg, a, threads=2, progress=False)
@@ -125,7 +136,10 @@ def test_rl_grid_deterministic_records_posterior(ico_dir):
     for cov in a["cov"]:
         assert np.array_equal(cov, cov.T)
         assert np.all(np.linalg.eigvalsh(cov) > 0)
-        assert np.trace(cov) < np.trace(info.cov)  # no forgetting: Sigma_w shrinks
+        if configuration == "literal":
+            assert np.trace(cov) < 0.99 * np.trace(prior_cov)  # no forgetting: Sigma_w shrinks
+        else:
+            assert np.array_equal(cov, prior_cov)  # the gradient reading moves mu_w only
     rl = build_config(TINY_RL, condition="rl", prior=P.rl_prior(info).prior())
     c = grid.make_cells(5, [611])
     grid.run_grid(rl, c, progress=False)
@@ -133,19 +147,23 @@ def test_rl_grid_deterministic_records_posterior(ico_dir):
 
 
 # -- the no-learning controls (spec L1) -----------------------------------------------------------------
+@pytest.mark.parametrize("configuration", ["default", "literal"])
 @pytest.mark.parametrize("condition", ["ico-rl-control", "rl-control"])
-def test_control_learns_nothing_and_equals_zero_rates(ico_dir, condition):
+def test_control_learns_nothing_and_equals_zero_rates(ico_dir, condition, configuration):
     """A control keeps the prior exactly (mu_w and Sigma_w of every cell), and its outcomes equal
-    those of its condition with the learning rates at 0 (critic rate, actor scale alpha)."""
+    those of its condition with the learning rates at 0: the critic rate and the actor's, the
+    rate beta of the default gradient reading, the scale alpha of the literal posterior one."""
     info = P.from_results(ico_dir)
     if condition == "rl-control":
         info = P.rl_prior(info)
     prior = info.prior()
-    control = build_config(TINY_RL, condition=condition, prior=prior)
+    named = LITERAL if configuration == "literal" else {}
+    control = build_config({**TINY_RL, **named}, condition=condition, prior=prior)
     assert control.controller.learn == 0 and control.controller.mode == B.MODE_RL
-    base = condition.removesuffix("-control")
-    zero = build_config({**TINY_RL, "critic.rate": 0, "actor.scale": 0}, condition=base, prior=prior)
-    learning = build_config(TINY_RL, condition=base, prior=prior)
+    base = options.CONTROL_OF[condition]
+    actor_rate = "actor.scale" if configuration == "literal" else "actor.rate"
+    zero = build_config({**TINY_RL, **named, "critic.rate": 0, actor_rate: 0}, condition=base, prior=prior)
+    learning = build_config({**TINY_RL, **named}, condition=base, prior=prior)
     cells = {name: grid.make_cells(5, [300, 611, 612, 900]) for name in ("control", "zero", "learning")}
     for name, cfg in (("control", control), ("zero", zero), ("learning", learning)):
         grid.run_grid(cfg, cells[name], threads=2, progress=False)
@@ -204,18 +222,23 @@ def closed_form(cfg, mu, sigma, s_t, delta, eps):
     rng = np.array(c.policy.input_range, dtype=float)
     h = c.policy.gain * np.clip(s_t / rng, -1.0, 1.0)
     y = h @ mu + c.actor.scale * delta * eps  # u_ob = mu_u + alpha * delta * eps
-    S = h @ sigma @ h + c.actor.likelihood_std ** 2  # the likelihood std sigma_L (spec L2), not sigma_u
+    # the likelihood std sigma_L (spec L2), not sigma_u; but sigma_u when likelihood_std is 0
+    sigma_l = c.actor.likelihood_std if c.actor.likelihood_std != 0 else c.actor.noise_std
+    S = h @ sigma @ h + sigma_l ** 2
     return mu + sigma @ h * (y - h @ mu) / S, sigma - np.outer(sigma @ h, sigma @ h) / S
 
 
 @pytest.mark.parametrize("noise_std, actor_scale, likelihood_std",
-                         [(1.0, 0.5, None), (2.0, 1.0, None), (2.0, 1.0, 2.0), (1.0, 0.5, 3.0)])
+                         [(1.0, 0.5, None), (2.0, 1.0, None), (2.0, 1.0, 2.0), (1.0, 0.5, 3.0), (0.5, 1.0, None)])
 def test_bayes_step_terminal_matches_closed_form(noise_std, actor_scale, likelihood_std):
-    over = {"noise_std": noise_std, "actor_scale": actor_scale}
+    """The posterior reading (the literal configuration) after one transition into a failure."""
+    over = {**LITERAL, "noise_std": noise_std, "actor_scale": actor_scale}
     if likelihood_std is not None:
         over["actor.likelihood_std"] = likelihood_std
     cfg = build_config(over, condition="rl")
-    assert cfg.controller.actor.likelihood_std == (likelihood_std or 1.0)  # default sigma_L = 1 N
+    assert cfg.controller.actor.update == B.ACTOR_UPDATES["posterior"]
+    # default sigma_L: 0, sigma_L = sigma_u (literal)
+    assert cfg.controller.actor.likelihood_std == (likelihood_std or 0.0)
     state = controller(cfg, MU, SIGMA, seed=11)
     out1 = tick(cfg, state, S_T)
     assert out1.status == 0 and out1.value == 0.0 and out1.noise != 0.0
@@ -232,7 +255,8 @@ def test_bayes_step_terminal_matches_closed_form(noise_std, actor_scale, likelih
 
 
 def test_bayes_step_zero_td_error_keeps_mean():
-    cfg = build_config({"discount": 0.95}, condition="rl")
+    """Posterior reading: delta = 0 keeps mu_w, and Sigma_w still shrinks."""
+    cfg = build_config({**LITERAL, "discount": 0.95}, condition="rl")
     state = controller(cfg, MU, SIGMA, seed=5)
     mu0, sig0 = posterior(state)
     out1 = tick(cfg, state, S_T)
@@ -242,6 +266,7 @@ def test_bayes_step_zero_td_error_keeps_mean():
     assert np.array_equal(mu, mu0)
     _, cov_ref = closed_form(cfg, mu0, sig0, S_T, 0.0, float(out1.noise))
     np.testing.assert_allclose(cov, cov_ref, rtol=2e-4, atol=2e-6)
+    assert np.trace(cov) < np.trace(sig0) * (1 - 1e-3)
 
 
 # -- CLI: grid, sweep, bench -------------------------------------------------------------------------
@@ -259,6 +284,22 @@ def test_cli_grid_ico_rl_records_prior(ico_dir, tmp_path):
     res = run_cli("grid", "--out", str(out), "--resume", "--quiet")
     assert res.returncode == 0, res.stderr
     assert json.loads((out / "run.json").read_text())["prior_info"] == pi
+
+
+def test_cli_configuration_literal(ico_dir, tmp_path):
+    """--configuration literal records the paper's literal reading, before --set (a later --set
+    wins); the default configuration records the gradient reading chosen by the sweeps."""
+    common = ["--prior-from", str(ico_dir), "--cells", "611", "--max-trials", "5", "--success-steps", "300", "--quiet"]
+    actors = {}
+    for name, extra in (("default", []), ("literal", ["--configuration", "literal"]),
+                        ("literal-set", ["--configuration", "literal", "--set", "actor.explore_ticks=7"])):
+        res = run_cli("grid", "--condition", "rl", "--out", str(tmp_path / name), *common, *extra)
+        assert res.returncode == 0, res.stderr
+        actors[name] = json.loads((tmp_path / name / "run.json").read_text())["config"]["controller"]["actor"]
+    assert actors["default"]["update"] == "gradient" and actors["default"]["explore_ticks"] == 1000
+    assert actors["literal"]["update"] == "posterior" and actors["literal"]["explore_ticks"] == 0
+    assert actors["literal"]["likelihood_std"] == 0.0 and actors["literal"]["batch"] is False
+    assert actors["literal-set"] == {**actors["literal"], "explore_ticks": 7}
 
 
 @pytest.mark.parametrize("args, words", [
@@ -324,24 +365,40 @@ def test_bench_quick_writes_comparison(tmp_path):
                  "fig1b_success_map.png"):
         data = (fig / name).read_bytes()
         assert data[:8] == PNG and len(data) > 5000
-    conds = ("ico", "ico-rl", "ico-rl-control", "rl", "rl-control")
+    # all nine conditions: ICO, then ICO->RL, RL, ICO->search and search, each with its control
+    conds = ("ico", "ico-rl", "ico-rl-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
+             "search-control")
+    assert options.CONDITIONS == conds
     for cond in conds:
         for seed in (0, 1):
             assert results.exists(out / cond / f"seed-{seed}")
     summary = json.loads((out / "summary.json").read_text())
     assert set(summary) == set(conds) and summary["ico"]["paper"]["success_rate"] == 0.68
     text = (out / "summary.md").read_text()
-    assert "ICO->RL" in text and "| ICO->RL | ICO->RL control |" in text
-    # the gain over the control, recomputed from the cells
-    gain = summary["ico-rl"]["gain_over_control"]
-    for i, seed in enumerate((0, 1)):
-        a, _ = results.load(out / "ico-rl" / f"seed-{seed}")
-        b, _ = results.load(out / "ico-rl-control" / f"seed-{seed}")
-        sa, sb = a["outcome"] == B.SUCCESS, b["outcome"] == B.SUCCESS
-        assert gain["cells_gained"]["per_seed"][i] == np.count_nonzero(sa & ~sb)
-        assert gain["cells_lost"]["per_seed"][i] == np.count_nonzero(~sa & sb)
+    assert "ICO->RL" in text
+    for control, cond in options.CONTROL_OF.items():
+        labels = options.CONDITION_LABELS
+        assert f"| {labels[cond]} | {labels[control]} |" in text
+        # the gain over the control, recomputed from the cells
+        gain = summary[cond]["gain_over_control"]
+        for i, seed in enumerate((0, 1)):
+            a, _ = results.load(out / cond / f"seed-{seed}")
+            b, _ = results.load(out / control / f"seed-{seed}")
+            sa, sb = a["outcome"] == B.SUCCESS, b["outcome"] == B.SUCCESS
+            assert gain["cells_gained"]["per_seed"][i] == np.count_nonzero(sa & ~sb)
+            assert gain["cells_lost"]["per_seed"][i] == np.count_nonzero(~sa & sb)
+        assert "gain_over_control" not in summary[control]
     bench = json.loads((out / "bench.json").read_text())
-    assert bench["complete"] and len(bench["stages"]) == 14
+    assert bench["complete"] and len(bench["stages"]) == 2 * len(conds) + 2 + 2  # grids, priors, summary, figures
+    # the search conditions: Sigma0 = 64 x the ICO prior's covariance (ico-search), 4 I (search)
+    for cond, scale in (("ico-search", 64.0), ("ico-search-control", 64.0), ("search", 4.0),
+                        ("search-control", 4.0)):
+        record = json.loads((out / cond / "seed-0" / "run.json").read_text())
+        controller = record["config"]["controller"]
+        assert controller["mode"] == "search" and controller["search"]["cov_scale"] == scale
+        assert controller["learn"] is (cond not in options.CONTROL_OF)
+        identity = record["prior_info"]["cov"] == np.eye(4).tolist()
+        assert identity is cond.startswith("search"), cond
     icorl = json.loads((out / "ico-rl" / "seed-0" / "run.json").read_text())
     assert icorl["prior_info"]["source"] == str((out / "ico" / "seed-0").resolve())
     assert icorl["config"]["run"]["max_trials"] == 100

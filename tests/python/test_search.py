@@ -1,6 +1,8 @@
 """The episodic search (mode search, spec L4; conditions ico-search and search) through the binding:
-the update after each batch of trials against a numpy reference of the same step, the per-trial
-draws in distribution, determinism, and the no-learning control (learn = 0).
+the update after each batch of trials against a numpy reference of the same step (with its
+fallback: when Sigma' is not positive definite, the floor is added to the whole diagonal), a step
+of 1 with small elites over many updates, the per-trial draws in distribution, determinism, and
+the no-learning control (learn = 0).
 
 Each trial's sampled w is read off the controller's output: its first four ticks observe
 s = r_i e_i / 2 (r the input ranges), where z = w^T x~ = w_i x~_i."""
@@ -49,9 +51,27 @@ def elite_size(cfg):
     return max(1, int(REAL(s.elite_fraction) * REAL(s.batch) + REAL(0.5)))
 
 
+def min_relative_pivot(m):
+    """The smallest pivot of the Cholesky factorisation of m, each relative to its diagonal entry;
+    the first one <= 0 when m is not positive definite (the factorisation stops there)."""
+    lower = np.zeros((4, 4))
+    smallest = 1.0
+    for j in range(4):
+        diag = m[j, j] - lower[j, :j] @ lower[j, :j]
+        smallest = min(smallest, diag / m[j, j])
+        if not diag > 0:
+            return smallest
+        lower[j, j] = np.sqrt(diag)
+        for i in range(j + 1, 4):
+            lower[i, j] = (m[i, j] - lower[i, :j] @ lower[j, :j]) / lower[j, j]
+    return smallest
+
+
 def reference_update(cfg, mu, sigma, floor, ws, lengths):
     """mu' = (1-a) mu + a mean_elite, Sigma' = (1-a) Sigma + a Cov_elite (about mu', / n_e), then
-    Sigma'_ii >= floor_i; the elite: the n_e longest trials, ties to the earlier one."""
+    Sigma'_ii >= floor_i; the elite: the n_e longest trials, ties to the earlier one. When Sigma'
+    is not positive definite (a rank-deficient elite, n_e <= 4, with a step near 1) the fallback
+    Sigma' + diag(floor). Returns mu', Sigma', the fallback and min_relative_pivot(Sigma')."""
     a = cfg.controller.search.step
     order = sorted(range(len(lengths)), key=lambda k: -lengths[k])  # stable: earlier first among ties
     elite = np.array([ws[k] for k in order[:elite_size(cfg)]])
@@ -60,7 +80,35 @@ def reference_update(cfg, mu, sigma, floor, ws, lengths):
     sigma1 = (1 - a) * sigma + a * d.T @ d / len(elite)
     idx = np.arange(4)
     sigma1[idx, idx] = np.maximum(sigma1[idx, idx], floor)
-    return mu1, sigma1
+    return mu1, sigma1, sigma1 + np.diag(floor), min_relative_pivot(sigma1)
+
+
+def check_update(mu, sigma, want, ws, what=""):
+    """The library's (mu', Sigma') against reference_update's: Sigma' when it is positive definite
+    with a margin (every relative pivot above a band for the rounding of Sigma' in the real type,
+    with the cancellation in w - mu'); in the band below, where Sigma' is singular up to rounding
+    (in exact arithmetic it is positive semidefinite) and the library's own Cholesky factorisation
+    passes or fails by rounding, Sigma' or the fallback. Returns True for the fallback."""
+    want_mu, want_sigma, fallback, pivot = want
+    scale = 1 + np.abs(np.array(ws)).max()
+    tol = 2e-6 if FLOAT else 1e-12
+    band = (1e-4 if FLOAT else 1e-10) * (1 + scale / np.sqrt(want_sigma.diagonal().min()))
+    np.testing.assert_allclose(mu, want_mu, rtol=0, atol=tol * scale, err_msg=what)
+    close = np.abs(sigma - want_sigma).max() <= 2 * tol * scale ** 2
+    if pivot > band or close:
+        np.testing.assert_allclose(sigma, want_sigma, rtol=0, atol=2 * tol * scale ** 2, err_msg=what)
+        return False
+    np.testing.assert_allclose(sigma, fallback, rtol=0, atol=2 * tol * scale ** 2, err_msg=what)
+    return True
+
+
+def assert_spd(sigma, floor, singular=False):
+    """Symmetric, above the floor, positive definite; with `singular` (a step near 1 and an elite
+    of 2 to 4, where the library may keep a Sigma' singular up to rounding) positive semidefinite
+    up to rounding."""
+    assert np.array_equal(sigma, sigma.T) and np.all(sigma.diagonal() >= floor)
+    margin = (1e-5 if FLOAT else 1e-13) * np.abs(sigma).max() if singular else 0.0
+    assert np.linalg.eigvalsh(sigma).min() > -margin
 
 
 def initial_cov(cfg, cov):
@@ -69,21 +117,30 @@ def initial_cov(cfg, cov):
 
 
 SETTINGS = [  # (batch, elite_fraction, step, floor, cov_scale)
-    (4, 0.5, 0.5, 0.1, 1.0),      # the defaults
+    (8, 0.25, 0.5, 1.0, 64.0),    # the defaults
+    (4, 0.5, 0.5, 0.1, 1.0),      # the defaults before the learner sweeps
     (5, 0.5, 0.3, 1.5, 1.0),      # round(2.5) = 3; the floor above Sigma0: active from the first update
     (8, 0.25, 0.7, 0.01, 4.0),
     (3, 1.0, 0.9, 0.05, 2.0),
     (6, 0.3, 0.5, 0.2, 16.0),     # round(1.8) = 2
     (16, 1.0, 1.0, 0.1, 1.0),     # a = 1: Sigma' = Cov of 16 trials (full rank)
+    (4, 0.5, 1.0, 0.1, 1.0),      # a = 1, n_e = 2: Sigma' of rank 1 but for the floor (the fallback)
+    (8, 0.25, 1.0, 1.0, 64.0),    # the defaults with a = 1
     (1, 1.0, 0.5, 0.1, 1.0),
 ]
+
+
+def small_elite_near_one(cfg):
+    """A step near 1 and an elite of 2 to 4: Sigma' can be singular (see assert_spd)."""
+    return cfg.controller.search.step >= 0.7 and 2 <= elite_size(cfg) <= 4
 
 
 @pytest.mark.parametrize("condition", ["search", "ico-search"])
 @pytest.mark.parametrize("setting", SETTINGS, ids=[f"K{s[0]}-rho{s[1]}-a{s[2]}-f{s[3]}-c{s[4]}" for s in SETTINGS])
 def test_update_matches_numpy(setting, condition):
     """Several batches: mu_w and Sigma_w stay until the batch's last failure, then equal the numpy
-    step from the trials' w and lengths (lengths drawn from a few values: many ties)."""
+    step from the trials' w and lengths (lengths drawn from a few values: many ties), with its
+    fallback where Sigma' is singular."""
     batch, rho, step, floor_f, cov_scale = setting
     rng = np.random.default_rng(batch * 100 + int(10 * step))
     if condition == "search":
@@ -107,14 +164,10 @@ def test_update_matches_numpy(setting, condition):
             if k + 1 < batch:
                 now = posterior(state)
                 assert np.array_equal(now[0], mu) and np.array_equal(now[1], sigma)
-        want_mu, want_sigma = reference_update(cfg, mu, sigma, floor, ws, lengths)
+        want = reference_update(cfg, mu, sigma, floor, ws, lengths)
         mu, sigma = posterior(state)
-        scale = 1 + np.abs(np.array(ws)).max()
-        tol = 2e-6 if FLOAT else 1e-12
-        np.testing.assert_allclose(mu, want_mu, rtol=0, atol=tol * scale)
-        np.testing.assert_allclose(sigma, want_sigma, rtol=0, atol=2 * tol * scale ** 2)
-        assert np.array_equal(sigma, sigma.T) and np.all(np.linalg.eigvalsh(sigma) > 0)
-        assert np.all(sigma.diagonal() >= floor)
+        check_update(mu, sigma, want, ws)
+        assert_spd(sigma, floor, singular=small_elite_near_one(cfg))
         floored += int(np.sum(sigma.diagonal() == floor))
     if floor_f > 1:
         assert floored >= 4  # the floor was exercised
@@ -149,7 +202,9 @@ def test_draws_have_the_search_distribution():
     the Sigma_w of an update (the draws follow the new Cholesky factor)."""
     rng = np.random.default_rng(11)
     mean0, cov0 = random_prior(rng, 0.5)
-    over = {"search.cov_scale": 3.0, "search.batch": 6, "search.elite_fraction": 0.5, "search.step": 0.9}
+    # a floor below Sigma0 (the default, f = 1, holds every variance at least at Sigma0's)
+    over = {"search.cov_scale": 3.0, "search.batch": 6, "search.elite_fraction": 0.5, "search.step": 0.9,
+            "search.floor": 0.1}
     frozen = build_config({**over, "learn": False}, condition="ico-search")
     learning = build_config(over, condition="ico-search")
     state = controller(frozen, mean0, cov0, seed=21)
@@ -159,6 +214,34 @@ def test_draws_have_the_search_distribution():
         run_trial(learning, state, length, rng)
     updated, _ = check_draws(frozen, state, rng, 20000)
     assert np.abs(updated - sigma).max() > 20 * se.max()  # a different distribution to match
+
+
+@pytest.mark.parametrize("setting", [(4, 0.5, 0.1, 1.0), (8, 0.25, 1.0, 64.0), (3, 1.0, 0.01, 1.0)],
+                         ids=["K4-rho0.5-f0.1", "K8-rho0.25-f1-c64", "K3-rho1-f0.01"])
+def test_step_one_small_elites(setting):
+    """a = 1 with an elite of 2 or 3 trials: Sigma' = Cov_elite (floored) is singular unless the
+    floor repairs it; then the floor is added to the whole diagonal (the update used to fail with
+    ICOAC_ERR_NUMERIC). Over many random updates from N(0, I): every terminal tick OK, every
+    update the reference's (its fallback where the library's Cholesky factorisation of Sigma'
+    fails), Sigma_w positive (semi)definite, the fallback taken in many updates."""
+    batch, rho, floor_f, cov_scale = setting
+    rng = np.random.default_rng(batch)
+    cfg = build_config({"search.batch": batch, "search.elite_fraction": rho, "search.step": 1.0,
+                        "search.floor": floor_f, "search.cov_scale": cov_scale}, condition="search")
+    updates = fallbacks = 0
+    for restart in range(6):  # mu_w random-walks at a = 1: a fresh start now and then
+        state = controller(cfg, seed=restart + 1)
+        floor = (REAL(floor_f) * initial_cov(cfg, np.eye(4)).diagonal().astype(REAL)).astype(float)
+        for _ in range(60):
+            mu, sigma = posterior(state)
+            lengths = [int(v) for v in rng.integers(4, 8, size=batch)]
+            ws = [run_trial(cfg, state, length, rng) for length in lengths]  # every terminal tick OK
+            want = reference_update(cfg, mu, sigma, floor, ws, lengths)
+            mu, sigma = posterior(state)
+            fallbacks += check_update(mu, sigma, want, ws, what=f"update {updates}")
+            assert_spd(sigma, floor, singular=True)
+            updates += 1
+    assert fallbacks > updates // 20, (fallbacks, updates)
 
 
 def test_deterministic_for_a_seed():
