@@ -288,8 +288,8 @@ def plot_fig3a(path: str | Path, labels: Sequence[str], all_stats: Sequence[Mapp
         ax.set_ylim(0, 105)
         ax.set_ylabel("success rate (%)")
         ax.set_title("(a) success rate, mean ± sd over seeds")
-        if ceiling:  # below the axes: the reference lines run across the whole plot
-            ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2, frameon=False, fontsize=7)
+        if ceiling:  # above the axes: the reference lines run across the whole plot
+            ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.08), ncol=3, frameon=False, fontsize=7)
         else:
             ax.legend(loc="upper left", frameon=False, fontsize=7)
         fig.tight_layout()

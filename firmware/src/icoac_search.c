@@ -86,6 +86,25 @@ static int elite_size(const icoac_search_config_t *search)
     return n < 1 ? 1 : (n > search->batch ? search->batch : n);
 }
 
+/* Each coordinate's variance given the earlier ones (the squared Cholesky pivot) at least this
+ * fraction of its variance: below it (correlations beyond 0.99995) Sigma' counts as singular. */
+#define SEARCH_MIN_PIVOT_FRACTION ICOAC_R(1.0e-4)
+
+/* lower = the Cholesky factor of cov, and every pivot a fair fraction of its diagonal entry. */
+static int well_conditioned(const icoac_real_t cov[N][N], icoac_real_t lower[N][N])
+{
+    int j;
+    if (!icoac_priv_cholesky4(cov, lower)) {
+        return 0;
+    }
+    for (j = 0; j < N; ++j) {
+        if (!(lower[j][j] * lower[j][j] >= SEARCH_MIN_PIVOT_FRACTION * cov[j][j])) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* The update after a full batch, staged into w, cov and lower: mu' = (1-a) mu + a mean_elite;
  * Sigma' = (1-a) Sigma + a Cov_elite about mu' (upper triangle mirrored), then
  * Sigma'_ii >= floor_i. Returns 0 when a value is not finite or Sigma' not positive definite. */
@@ -128,10 +147,10 @@ static int search_update(const icoac_search_config_t *search, const icoac_priv_s
     if (!icoac_priv_all_finite(w, N) || !icoac_priv_all_finite(&cov[0][0], N * N)) {
         return 0;
     }
-    if (!icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov), lower)) {
-        /* A rank-deficient elite (n_e <= 4) with a step near 1 leaves Sigma' singular, which a
-         * diagonal floor need not repair: add the floor to the diagonal instead, a positive
-         * definite bound below Sigma' (Sigma' is positive semidefinite up to rounding). */
+    if (!well_conditioned(ICOAC_PRIV_CONST_MAT4(cov), lower)) {
+        /* A rank-deficient elite (n_e <= 4) with a step near 1 leaves Sigma' singular or nearly
+         * so, which a diagonal floor need not repair: add the floor to the diagonal instead, a
+         * positive definite bound below Sigma' (Sigma' is positive semidefinite up to rounding). */
         for (i = 0; i < N; ++i) {
             cov[i][i] += st->search.floor[i];
         }

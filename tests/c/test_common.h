@@ -72,6 +72,8 @@ static inline icoac_config_t test_default_config(void)
 static inline void test_literal_reading(icoac_config_t *cfg)
 {
     cfg->actor.update = ICOAC_ACTOR_POSTERIOR;
+    cfg->actor.noise_std = 1;
+    cfg->actor.scale = (icoac_real_t)0.5;
     cfg->actor.likelihood_std = 0;
     cfg->actor.batch = 0;
     cfg->actor.explore_ticks = 0;

@@ -39,7 +39,7 @@ static void test_defaults_match_spec(void **unused)
     assert_close(cfg.critic.range[2], 0.2094384, tol);
     assert_close(cfg.critic.range[3], 2.0, 0.0);
     assert_close(cfg.critic.threshold, 0.001, tol * 0.001);
-    assert_close(cfg.actor.noise_std, 1.0, 0.0);
+    assert_close(cfg.actor.noise_std, 3.0, 0.0); /* chosen by the learner sweeps (literal: 1) */
     assert_close(cfg.actor.scale, 0.5, 0.0);
     assert_close(cfg.actor.forgetting, 1.0, 0.0);
     assert_int_equal(cfg.actor.reflex, 1);
@@ -49,7 +49,7 @@ static void test_defaults_match_spec(void **unused)
     assert_int_equal(cfg.learn, 1);
     assert_int_equal(cfg.critic.quirks, 0);
     assert_int_equal(cfg.actor.update, ICOAC_ACTOR_GRADIENT);
-    assert_close(cfg.actor.rate, 0.01, tol * 0.01);
+    assert_close(cfg.actor.rate, 0.001, tol * 0.001);
     assert_true(cfg.actor.likelihood_std == 0); /* 0: sigma_L = sigma_u (literal) */
     assert_int_equal(cfg.actor.batch, 0);
     assert_int_equal(cfg.actor.explore_ticks, 1000);

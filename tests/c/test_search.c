@@ -333,13 +333,15 @@ static void assert_gauss_close(const gauss_t *got, const gauss_t *want, double m
 }
 
 /* The library's update `now` against the reference: Sigma' when it is positive definite with a
- * margin (every relative pivot above `band`); in the band below, where Sigma' is singular up to
+ * margin (every relative pivot above `band`, and above the library's 1e-4 cut-off); in the band below, where Sigma' is singular up to
  * rounding (in exact arithmetic it is positive semidefinite) and the library's own Cholesky
  * factorisation in icoac_real_t passes or fails by rounding, Sigma' or the fallback
  * Sigma' + diag(floor). Returns 1 when `now` is the fallback. */
 static int assert_update_is_reference(const gauss_t *now, const reference_t *ref, double band, double mean_tol,
                                       double cov_tol, const char *what, int n)
 {
+    /* the library also treats Sigma' as singular when a relative pivot is below 1e-4 */
+    band = band > 1.01e-4 ? band : 1.01e-4;
     if (ref->pivot > band || gauss_within(now, &ref->next, mean_tol, cov_tol)) {
         assert_gauss_close(now, &ref->next, mean_tol, cov_tol, what, n);
         return 0;

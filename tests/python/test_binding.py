@@ -165,12 +165,12 @@ def test_config_defaults_match_spec():
     assert pol["zone_x"] == pytest.approx(2.35)
     assert cri["rate"] == pytest.approx(0.6)
     assert cri["discount"] == pytest.approx(0.95)
-    assert act["noise_std"] == 1.0 and act["scale"] == 0.5 and act["forgetting"] == 1.0
+    assert act["noise_std"] == 3.0 and act["scale"] == 0.5 and act["forgetting"] == 1.0
     assert pol["clip_inputs"] is True and act["reflex"] is True and act["act_with_sample"] is False
     # spec L2-L4, A10: the literal critic, per-tick updates and sigma_L = sigma_u (0); the actor
     # reading, its exploration schedule and the search group chosen by the learner sweeps
     assert cri["quirks"] is False
-    assert act["update"] == "gradient" and act["rate"] == pytest.approx(0.01) and act["likelihood_std"] == 0.0
+    assert act["update"] == "gradient" and act["rate"] == pytest.approx(0.001) and act["likelihood_std"] == 0.0
     assert act["batch"] is False and act["explore_ticks"] == 1000
     assert sea == {"batch": 8, "elite_fraction": 0.25, "step": 0.5, "floor": 1.0, "cov_scale": 64.0}
     assert p == {"gravity": 9.8, "cart_mass": 1.0, "pole_mass": 0.1, "half_length": 0.5, "dt": 0.01,
@@ -183,7 +183,8 @@ def test_config_defaults_match_spec():
 def test_condition_overrides():
     """The nine conditions over the C defaults: each learner's mode, its control the same with
     learn = 0; search from N(0, I) with Sigma0 = 4 I (search.cov_scale 4), ico-search with the C
-    default c = 64; nothing else overridden."""
+    default c = 64; RL alone with its own reading (mean, sigma_L 0.1, sigma_u 5, alpha 0.1,
+    exploration until tick 1000); nothing else overridden."""
     assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS) and options.CONDITIONS == (
         "ico", "ico-rl", "ico-rl-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
         "search-control")
@@ -197,7 +198,11 @@ def test_condition_overrides():
         assert flat["mode"] == modes[base] and flat["learn"] is (condition not in options.CONTROL_OF)
         assert flat["search.cov_scale"] == (4.0 if base == "search" else 64.0)
         changed = {n for n in flat if flat[n] != default[n]}
-        assert changed <= {"mode", "learn", "search.cov_scale"}, condition
+        rl_alone = {"actor.update", "actor.likelihood_std", "actor.noise_std", "actor.scale"}
+        assert changed <= {"mode", "learn", "search.cov_scale"} | (rl_alone if base == "rl" else set()), condition
+        if base == "rl":
+            assert (flat["actor.update"], flat["actor.likelihood_std"], flat["actor.noise_std"], flat["actor.scale"],
+                    flat["actor.explore_ticks"]) == ("mean", pytest.approx(0.1), 5.0, pytest.approx(0.1), 1000)
         if condition in options.CONTROL_OF:  # a control is its condition with every update off
             assert {n: v for n, v in flat.items() if n != "learn"} == \
                 {n: v for n, v in build_config(condition=base).flat().items() if n != "learn"}
@@ -210,11 +215,16 @@ def test_literal_configuration():
     with sigma_L = sigma_u, per tick, exploring at every tick, the literal critic); default: none."""
     assert options.CONFIGURATION_NAMES == tuple(NAMED_CONFIGURATIONS) == ("default", "literal")
     assert named_sets("default") == []
-    default = build_config(condition="rl").flat()
-    literal = build_config(parse_sets(named_sets("literal")), condition="rl").flat()
-    assert literal["actor.update"] == "posterior" and literal["actor.likelihood_std"] == 0.0
-    assert literal["actor.batch"] is False and literal["actor.explore_ticks"] == 0 and literal["critic.quirks"] is False
-    assert {n for n in literal if literal[n] != default[n]} == {"actor.update", "actor.explore_ticks"}
+    for condition in ("ico-rl", "rl"):
+        default = build_config(condition=condition).flat()
+        literal = build_config(parse_sets(named_sets("literal")), condition=condition).flat()
+        assert literal["actor.update"] == "posterior" and literal["actor.likelihood_std"] == 0.0
+        assert literal["actor.noise_std"] == 1.0 and literal["actor.scale"] == 0.5
+        assert literal["actor.batch"] is False and literal["actor.explore_ticks"] == 0 and literal["critic.quirks"] is False
+        # the same literal configuration whatever the condition's own reading
+        assert literal == build_config(parse_sets(named_sets("literal")), condition="ico-rl").flat()
+    assert {n for n in literal if literal[n] != build_config(condition="ico-rl").flat()[n]} == {
+        "actor.update", "actor.explore_ticks", "actor.noise_std"}
 
 
 def test_overrides_by_name():

@@ -11,7 +11,8 @@ import pytest
 from harness import _binding as B
 from harness import config, figures, results
 from harness import prior as P
-from harness.config import ALIASES, ALL_FIELDS, build_config, canonical, config_from_dict, parse_sets
+from harness.config import (ALIASES, ALL_FIELDS, build_config, canonical, config_from_dict, named_sets,
+                            parse_sets)
 from harness.tools import imports
 
 REPO = Path(__file__).resolve().parents[2]
@@ -102,7 +103,12 @@ def test_abi3_record_loads_with_the_same_configuration():
     cells, record = results.load(ABI3_ICO)
     assert record["abi"]["abi_version"] == 3 and "gain" in record["config"]["controller"]
     cfg = results.load_config(record)
-    assert cfg.to_dict() == build_config({"max_trials": 6000, "success_steps": 2000}, condition="ico").to_dict()
+    # a record from before the learners: their fields take the literal configuration's values (the
+    # record's own fields, sigma_u = 1 N among them, are those of the literal configuration too)
+    literal = parse_sets(named_sets("literal"))
+    assert cfg.to_dict() == build_config({"max_trials": 6000, "success_steps": 2000, **literal},
+                                         condition="ico").to_dict()
+    assert cfg.flat()["actor.update"] == "posterior" and cfg.flat()["actor.explore_ticks"] == 0
     results.check_resumable(record, condition="ico", seed=record["seed"], cfg=cfg, cell_indices=record["cells"])
     with pytest.raises(results.ResultsError, match=r"policy.gain 10.0 != 5.0"):
         results.check_resumable(record, condition="ico", seed=record["seed"], cell_indices=record["cells"],

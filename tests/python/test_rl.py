@@ -152,7 +152,8 @@ def test_rl_grid_deterministic_records_posterior(ico_dir, configuration):
 def test_control_learns_nothing_and_equals_zero_rates(ico_dir, condition, configuration):
     """A control keeps the prior exactly (mu_w and Sigma_w of every cell), and its outcomes equal
     those of its condition with the learning rates at 0: the critic rate and the actor's, the
-    rate beta of the default gradient reading, the scale alpha of the literal posterior one."""
+    rate beta of the gradient reading (ICO->RL's default), the scale alpha of the mean (RL
+    alone's default) and posterior (literal) ones."""
     info = P.from_results(ico_dir)
     if condition == "rl-control":
         info = P.rl_prior(info)
@@ -161,7 +162,8 @@ def test_control_learns_nothing_and_equals_zero_rates(ico_dir, condition, config
     control = build_config({**TINY_RL, **named}, condition=condition, prior=prior)
     assert control.controller.learn == 0 and control.controller.mode == B.MODE_RL
     base = options.CONTROL_OF[condition]
-    actor_rate = "actor.scale" if configuration == "literal" else "actor.rate"
+    reading = build_config({**TINY_RL, **named}, condition=base).flat()["actor.update"]
+    actor_rate = "actor.rate" if reading == "gradient" else "actor.scale"  # beta, or alpha of u_ob
     zero = build_config({**TINY_RL, **named, "critic.rate": 0, actor_rate: 0}, condition=base, prior=prior)
     learning = build_config({**TINY_RL, **named}, condition=base, prior=prior)
     cells = {name: grid.make_cells(5, [300, 611, 612, 900]) for name in ("control", "zero", "learning")}
@@ -278,7 +280,7 @@ def test_cli_grid_ico_rl_records_prior(ico_dir, tmp_path):
     record = json.loads((out / "run.json").read_text())
     pi = record["prior_info"]
     assert record["condition"] == "ico-rl" and record["config"]["controller"]["mode"] == "rl"
-    assert record["config"]["controller"]["actor"]["noise_std"] == 1.0
+    assert record["config"]["controller"]["actor"]["noise_std"] == 3.0  # the default sigma_u
     assert pi["source"] == str(ico_dir.resolve()) and pi["n_cells"] >= 2 and pi["ico_phase_simulated_time"] > 0
     assert pi["frame"] == {"x0_abs_max": 1.2, "theta0_abs_max_deg": 6.0} and len(pi["cov"]) == 4
     res = run_cli("grid", "--out", str(out), "--resume", "--quiet")
@@ -293,7 +295,7 @@ def test_cli_configuration_literal(ico_dir, tmp_path):
     actors = {}
     for name, extra in (("default", []), ("literal", ["--configuration", "literal"]),
                         ("literal-set", ["--configuration", "literal", "--set", "actor.explore_ticks=7"])):
-        res = run_cli("grid", "--condition", "rl", "--out", str(tmp_path / name), *common, *extra)
+        res = run_cli("grid", "--condition", "ico-rl", "--out", str(tmp_path / name), *common, *extra)
         assert res.returncode == 0, res.stderr
         actors[name] = json.loads((tmp_path / name / "run.json").read_text())["config"]["controller"]["actor"]
     assert actors["default"]["update"] == "gradient" and actors["default"]["explore_ticks"] == 1000

@@ -70,8 +70,8 @@ def min_relative_pivot(m):
 def reference_update(cfg, mu, sigma, floor, ws, lengths):
     """mu' = (1-a) mu + a mean_elite, Sigma' = (1-a) Sigma + a Cov_elite (about mu', / n_e), then
     Sigma'_ii >= floor_i; the elite: the n_e longest trials, ties to the earlier one. When Sigma'
-    is not positive definite (a rank-deficient elite, n_e <= 4, with a step near 1) the fallback
-    Sigma' + diag(floor). Returns mu', Sigma', the fallback and min_relative_pivot(Sigma')."""
+    is not positive definite, or a relative Cholesky pivot is below 1e-4 (a rank-deficient elite,
+    n_e <= 4, with a step near 1), the fallback Sigma' + diag(floor). Returns mu', Sigma', the fallback and min_relative_pivot(Sigma')."""
     a = cfg.controller.search.step
     order = sorted(range(len(lengths)), key=lambda k: -lengths[k])  # stable: earlier first among ties
     elite = np.array([ws[k] for k in order[:elite_size(cfg)]])
@@ -93,6 +93,7 @@ def check_update(mu, sigma, want, ws, what=""):
     scale = 1 + np.abs(np.array(ws)).max()
     tol = 2e-6 if FLOAT else 1e-12
     band = (1e-4 if FLOAT else 1e-10) * (1 + scale / np.sqrt(want_sigma.diagonal().min()))
+    band = max(band, 1.01e-4)  # the library also treats a relative pivot below 1e-4 as singular
     np.testing.assert_allclose(mu, want_mu, rtol=0, atol=tol * scale, err_msg=what)
     close = np.abs(sigma - want_sigma).max() <= 2 * tol * scale ** 2
     if pivot > band or close:
