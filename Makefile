@@ -92,6 +92,7 @@ sweeps: build venv
 	$(SWEEP) --stage 2 --only rl-stage2 --only rl-schedule-grid --only rl-noise-grid --only rl-noise-grid2 \
 	  --only rl-noise-grid3 --base actor.update=mean --base actor.likelihood_std=0.1
 	$(SWEEP) --report
+	cp $(SWEEP_OUT)/summary.md docs/sweeps.md
 
 # Microcontroller resource report: cross builds, QEMU runs, table in docs/porting.md.
 target-report: deps

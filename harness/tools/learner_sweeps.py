@@ -90,7 +90,10 @@ def _pct(row: dict | None, key: str) -> str:
 def report(out: Path) -> str:
     """One markdown table per sweep of OUT: each setting on the spread and the ICO-failed cells
     (success mean ± sd over the seeds, %; median trials to success), in run order."""
-    lines = [f"# Learner sweeps ({out})", ""]
+    lines = [f"# Learner sweeps ({out}; `make sweeps`, `python -m harness.tools.learner_sweeps --report`)", "",
+             "Success in % of the selection's cells, mean ± sd over the seeds; median trials to success. "
+             "Spread: 49 cells evenly over the grid; ICO-failed: the cells where the ICO grid of --prior-from failed.",
+             ""]
     for name, condition, _params, _one in STAGE_1 + STAGE_2:
         tables = {}
         for sel in SELECTIONS:
@@ -101,10 +104,18 @@ def report(out: Path) -> str:
         if not tables:
             continue
         meta = json.loads((out / f"{name}-{next(iter(tables))}" / "sweep.json").read_text())
+        commits = []
+        for sel in tables:
+            for run in json.loads((out / f"{name}-{sel}" / "sweep.json").read_text()).get("runs", []):
+                git = run.get("git") or {}
+                label = (git.get("commit") or "unknown")[:7] + ("+dirty" if git.get("dirty") else "")
+                if run.get("settings") and label not in commits:
+                    commits.append(label)
         keys = list(dict.fromkeys(k for t in tables.values() for k in t))
         n_failed = next((r["n_ico_failed"] for r in tables.get("ico-failed", {}).values()), "?")
         lines += [f"## {name} ({condition}; seeds {meta['seeds']}, cap {meta['max_trials']} trials; "
-                  f"fixed: {', '.join(meta['set']) or 'defaults'})", "",
+                  f"run at {', '.join(commits) or 'unrecorded commits'})", "",
+                  f"Fixed: {', '.join(meta['set']) or 'the defaults'}.", "",
                   f"| setting | spread 49 cells: success % (± sd) | median trials | ICO-failed {n_failed} cells: "
                   "success % (± sd) | median trials |", "|---|---|---|---|---|"]
         for k in keys:
