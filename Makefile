@@ -63,8 +63,11 @@ test-asan: build-asan
 test-c: build
 	ctest --preset release
 
+# Every Python test, the slow wheel build of tests/python/test_wheel.py too (about 30 s; skipped,
+# with its reason, when pip cannot reach a package index); PYTEST_ARGS='-m "not slow"' leaves it out.
+PYTEST_ARGS ?=
 test-python: build venv
-	$(VPY) -m pytest -q tests/python
+	$(VPY) -m pytest -q tests/python $(PYTEST_ARGS)
 
 build-fuzz: deps
 	cmake --preset fuzz >/dev/null
