@@ -30,12 +30,23 @@ deps:
 	  $(SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
 
-# Project venv; reinstalled when pyproject.toml changes.
+# Project venv; reinstalled when pyproject.toml changes. It gets the dependencies listed in
+# pyproject.toml (with the test extra) and this checkout on its path (a .pth file, behind the
+# current directory, so that a worktree's own harness/ wins) plus an `icoac-harness` script;
+# the library is the `make build` one. No wheel is built here (`pip install .` builds one: README).
+VENV_SITE = $$($(VPY) -c 'import sysconfig; print(sysconfig.get_path("purelib"))')
 venv: $(VENV)/.installed
 $(VENV)/.installed: pyproject.toml | deps
 	@[ -x $(VPY) ] || $(PYTHON) -m venv $(VENV)
 	$(VPY) -m pip install -q --upgrade pip
-	$(VPY) -m pip install -q -e '.[test]'
+	@# the setuptools editable install of before, and its metadata in the checkout
+	@$(VPY) -m pip uninstall -q -y icoac-harness 2>/dev/null || true; rm -rf icoac_harness.egg-info
+	$(VPY) -c 'import tomllib; p = tomllib.load(open("pyproject.toml", "rb"))["project"]; \
+	  print("\n".join(p["dependencies"] + p["optional-dependencies"]["test"]))' > $(VENV)/requirements.txt
+	$(VPY) -m pip install -q -r $(VENV)/requirements.txt
+	@echo "$(CURDIR)" > $(VENV_SITE)/icoac-harness-checkout.pth
+	@printf '#!%s\nfrom harness.cli import main\nraise SystemExit(main())\n' "$(CURDIR)/$(VPY)" > $(VENV)/bin/icoac-harness
+	@chmod +x $(VENV)/bin/icoac-harness
 	@touch $@
 
 build: deps
@@ -52,8 +63,11 @@ test-asan: build-asan
 test-c: build
 	ctest --preset release
 
+# Every Python test, the slow wheel build of tests/python/test_wheel.py too (about 30 s; skipped,
+# with its reason, when pip cannot reach a package index); PYTEST_ARGS='-m "not slow"' leaves it out.
+PYTEST_ARGS ?=
 test-python: build venv
-	$(VPY) -m pytest -q tests/python
+	$(VPY) -m pytest -q tests/python $(PYTEST_ARGS)
 
 build-fuzz: deps
 	cmake --preset fuzz >/dev/null

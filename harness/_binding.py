@@ -23,6 +23,10 @@ from .errors import HarnessError, LibraryError
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 LIBRARY_ENV = "ICOAC_SIM_LIBRARY"
+# The library of an installed package (a wheel: `pip install .`, pyproject.toml); absent in a checkout.
+PACKAGE_LIBRARY = Path(__file__).resolve().parent / "lib" / "libicoac_sim.so"
+BUILD_INFO = PACKAGE_LIBRARY.parent / "build_info.json"   # the commit the package was built from
+# The development build (`make build`, preset release) of the checkout the package runs from.
 DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.so"
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
@@ -54,30 +58,39 @@ class Cancelled(IcoacError):
     """The cancel flag was raised (ICOAC_SIM_CANCELLED); finished cells are kept."""
 
 
-def _library_path() -> Path:
+def _library_path() -> tuple[Path, str]:
+    """(path, source) of the library to load, source one of "env", "package", "build": the
+    ICOAC_SIM_LIBRARY path when the variable is set (even if nothing is there); else the
+    package's own library when installed; else the development build of the checkout."""
     env = os.environ.get(LIBRARY_ENV)
-    return Path(env) if env else DEFAULT_LIBRARY
+    if env:
+        return Path(env), "env"
+    if PACKAGE_LIBRARY.is_file():
+        return PACKAGE_LIBRARY, "package"
+    return DEFAULT_LIBRARY, "build"
 
 
-def _load() -> ctypes.CDLL:
-    path = _library_path()
+def _load(path: Path, source: str) -> ctypes.CDLL:
     if not path.is_file():
+        where = (f"{LIBRARY_ENV}={path}" if source == "env" else
+                 f"{PACKAGE_LIBRARY} (installed package) nor at {path} (development build)")
         raise LibraryError(
-            f"icoac_sim shared library not found at {path}; build it with `make build` "
-            f"(or set {LIBRARY_ENV} to its path)")
+            f"icoac_sim shared library not found at {where}; build it with `make build` "
+            f"(or install the package with `pip install .`, or set {LIBRARY_ENV} to its path)")
     try:
         return ctypes.CDLL(str(path))
     except OSError as exc:  # pragma: no cover - depends on the system
         raise LibraryError(f"cannot load {path}: {exc}") from exc
 
 
-lib = _load()
-LIBRARY_PATH = _library_path()
+LIBRARY_PATH, LIBRARY_SOURCE = _library_path()
+lib = _load(LIBRARY_PATH, LIBRARY_SOURCE)
 
 
 def _stale(detail: str) -> LibraryError:
-    return LibraryError(f"{LIBRARY_PATH} does not match the harness binding ({detail}); "
-                        "rebuild it with `make build`")
+    fix = ("reinstall the package (`pip install .`)" if LIBRARY_SOURCE == "package" else
+           "rebuild it with `make build`")
+    return LibraryError(f"{LIBRARY_PATH} does not match the harness binding ({detail}); {fix}")
 
 
 # -- ABI versions and sizes first ---------------------------------------------------------------
@@ -570,6 +583,7 @@ def abi_info() -> dict:
     """ABI description recorded with every result."""
     return {
         "library": str(LIBRARY_PATH),
+        "library_source": LIBRARY_SOURCE,
         "abi_version": int(lib.icoac_abi_version()),
         "sim_abi_version": int(lib.icoac_sim_abi_version()),
         "sizeof_real": int(_SIZEOF_REAL),

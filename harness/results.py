@@ -31,7 +31,17 @@ def _err(message: str) -> ResultsError:
 
 
 def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
-    """Commit of the repository and whether the working tree has uncommitted changes."""
+    """Commit of the repository and whether the working tree has uncommitted changes. For an
+    installed package (repo = its site-packages), the commit its wheel was built from, as the
+    build recorded it (harness/lib/build_info.json); None for both when unknown: a directory
+    that is not the top of a git work tree is not taken for the repository around it."""
+    if Path(repo) == B.REPO_ROOT and B.BUILD_INFO.is_file():
+        try:
+            info = json.loads(B.BUILD_INFO.read_text())
+            return {"commit": info.get("commit"), "dirty": info.get("dirty")}
+        except (OSError, ValueError, AttributeError):
+            return {"commit": None, "dirty": None}
+
     def git(*args: str) -> str | None:
         try:
             res = subprocess.run(["git", "-C", str(repo), *args], capture_output=True, text=True, timeout=10)
@@ -39,6 +49,9 @@ def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
             return None
         return res.stdout if res.returncode == 0 else None
 
+    top = git("rev-parse", "--show-toplevel")
+    if top is None or Path(top.strip()).resolve() != Path(repo).resolve():
+        return {"commit": None, "dirty": None}
     commit = git("rev-parse", "HEAD")
     status = git("status", "--porcelain", "--untracked-files=no")
     return {"commit": commit.strip() if commit else None,

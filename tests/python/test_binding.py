@@ -23,6 +23,34 @@ def test_struct_sizes_match_c():
         assert py == c, name
 
 
+def test_library_lookup_order(monkeypatch, tmp_path):
+    """ICOAC_SIM_LIBRARY when set (even to a missing file); else the installed package's own
+    library; else the checkout's development build."""
+    package, build = tmp_path / "pkg" / "libicoac_sim.so", tmp_path / "build" / "libicoac_sim.so"
+    monkeypatch.setattr(B, "PACKAGE_LIBRARY", package)
+    monkeypatch.setattr(B, "DEFAULT_LIBRARY", build)
+    monkeypatch.delenv(B.LIBRARY_ENV, raising=False)
+    assert B._library_path() == (build, "build")
+    package.parent.mkdir()
+    package.write_bytes(b"")
+    assert B._library_path() == (package, "package")
+    monkeypatch.setenv(B.LIBRARY_ENV, str(tmp_path / "none.so"))
+    assert B._library_path() == (tmp_path / "none.so", "env")
+    monkeypatch.setenv(B.LIBRARY_ENV, "")   # empty: not set
+    assert B._library_path() == (package, "package")
+    with pytest.raises(LibraryError, match="make build"):
+        B._load(tmp_path / "none.so", "env")
+    package.unlink()
+    with pytest.raises(LibraryError, match="installed package.*development build"):
+        B._load(build, "build")
+
+
+def test_checkout_is_not_an_installed_package():
+    # harness/lib/ exists only in an installed package (pyproject.toml, the wheel build).
+    assert not B.PACKAGE_LIBRARY.exists() or B.LIBRARY_SOURCE == "package"
+    assert B.abi_info()["library_source"] == B.LIBRARY_SOURCE in ("env", "package", "build")
+
+
 def test_state_is_opaque_aligned_storage():
     assert ctypes.sizeof(B.State) == B.lib.icoac_sizeof_state() == B.STATE_SIZE == B.CONSTANTS["ICOAC_STATE_SIZE"]
     assert ctypes.alignment(B.State) == 8

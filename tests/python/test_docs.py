@@ -1,5 +1,6 @@
-"""Every `python -m harness ...` command in README.md, docs/*.md and the Makefile still parses, and
-its --set / --param names and values build a configuration (nothing is run)."""
+"""Every `python -m harness ...` command in README.md, docs/*.md and the Makefile, and every
+`icoac-harness ...` command (the installed package's script), still parses, and its --set /
+--param names and values build a configuration (nothing is run)."""
 import re
 import shlex
 from pathlib import Path
@@ -16,8 +17,10 @@ PLACEHOLDERS = {"NAME": "variant", "SETTING": "integrator=rk4", "$(BENCH_PROFILE
 
 
 def _after(text: str):
-    """What follows 'python -m harness' in a command (None for other commands and harness.tools)."""
-    m = re.search(r"(?:python3?|\$\(VPY\)) -m harness(\s.*|$)", text, re.S)
+    """What follows 'python -m harness' in a command, or 'icoac-harness' at its start (None for
+    other commands, harness.tools, the package name alone and `icoac-harness: error: ...`)."""
+    m = (re.search(r"(?:python3?|\$\(VPY\)) -m harness(\s.*|$)", text, re.S)
+         or re.match(r"\s*(?:\S*/)?icoac-harness(\s+\S.*)", text, re.S))
     return " ".join(m.group(1).split()) if m else None
 
 

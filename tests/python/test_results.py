@@ -47,3 +47,20 @@ def test_load_missing(tmp_path):
         results.load(tmp_path / "nope")
     with pytest.raises(results.ResultsError, match="not a results directory"):
         results.load(tmp_path)
+
+
+def test_git_info_is_the_checkout_or_nothing(tmp_path, monkeypatch):
+    """The commit of the checkout the harness runs from; None for a folder that is not the top of
+    a git work tree (site-packages in a venv inside some repository); for an installed package,
+    what its wheel build recorded."""
+    here = results.git_info()
+    if here["commit"] is not None:   # a git checkout (not an unpacked archive)
+        assert len(here["commit"]) == 40 and isinstance(here["dirty"], bool)
+        assert results.git_info(B.REPO_ROOT / "tests") == {"commit": None, "dirty": None}
+    assert results.git_info(tmp_path) == {"commit": None, "dirty": None}
+    info = tmp_path / "build_info.json"
+    info.write_text('{"commit": "' + "a" * 40 + '", "dirty": false}')
+    monkeypatch.setattr(B, "BUILD_INFO", info)
+    assert results.git_info() == {"commit": "a" * 40, "dirty": False}
+    info.write_text("not json")
+    assert results.git_info() == {"commit": None, "dirty": None}
