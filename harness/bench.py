@@ -383,7 +383,7 @@ def run_bench(opt: BenchOptions, argv: Sequence[str] = ()) -> int:
 
     todo = stages(opt)  # validates the arguments before anything is written
     results.check_writable(opt.out)
-    with open_backend(opt.dask, quiet=opt.quiet) as session:
+    with open_backend(opt.dask) as session:
         return _run_stages(opt, todo, {"dask": session}, argv)
 
 

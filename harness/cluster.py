@@ -98,9 +98,8 @@ class DaskSession:
     """A client of a Dask cluster (a LocalCluster it owns, or an existing scheduler), as a context
     manager; run_grid runs one grid on it. One session serves every grid of a bench or a sweep."""
 
-    def __init__(self, spec: DaskSpec, quiet: bool = False):
+    def __init__(self, spec: DaskSpec):
         self.spec = spec.check()
-        self.quiet = quiet
         self.cluster = None
         self.client = None
         self.workers: dict[str, dict] = {}
@@ -123,6 +122,17 @@ class DaskSession:
     def _open(self, distributed) -> None:
         spec = self.spec
         if spec.workers is not None:
+            # Dask's statistical profiler samples every worker thread's stack every 10 ms: about 5 %
+            # of the CPU of a busy worker here, for a profile of one C call; and the event-loop
+            # health tick (20 ms), memory monitor (100 ms) and system monitor (500 ms) of the five
+            # event loops (scheduler, two nannies, two workers) cost 4.5 % of a core when idle. Off,
+            # or slower (1.2 % of a core), for the cluster this process starts (the nannies pass the
+            # configuration on to their workers, restarts included).
+            import dask
+            dask.config.set({"distributed.worker.profile.enabled": False,
+                             "distributed.admin.tick.interval": "500ms",
+                             "distributed.worker.memory.monitor-interval": "1s",
+                             "distributed.admin.system-monitor.interval": "2s"})
             try:
                 self.cluster = distributed.LocalCluster(
                     n_workers=spec.workers, threads_per_worker=spec.threads_per_worker, processes=True,
@@ -466,7 +476,7 @@ def _call_with_timeout(fn: Callable[[], Any], timeout: float) -> None:
     t.join(timeout)
 
 
-def open_backend(spec: DaskSpec | None, quiet: bool = False):
+def open_backend(spec: DaskSpec | None):
     """Context manager: a DaskSession for ``spec``, or None (the local threaded engine) when spec
     is None."""
     from contextlib import contextmanager
@@ -476,6 +486,6 @@ def open_backend(spec: DaskSpec | None, quiet: bool = False):
         if spec is None:
             yield None
             return
-        with DaskSession(spec, quiet=quiet) as session:
+        with DaskSession(spec) as session:
             yield session
     return manager()

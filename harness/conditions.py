@@ -126,7 +126,7 @@ def _run(cfg: RunConfig, cells: np.ndarray, *, out: Path, condition: str, seed: 
          checkpoint_every, checkpoint_cells, cancel_after, dask=None) -> tuple[np.ndarray, dict, bool]:
     if dask is not None and not hasattr(dask, "run_grid"):  # a DaskSpec: a session for this grid
         from .cluster import open_backend
-        with open_backend(dask, quiet=not progress) as session:
+        with open_backend(dask) as session:
             return _run(cfg, cells, out=out, condition=condition, seed=seed, threads=threads, indices=indices,
                         extra=extra, existing=existing, fresh=fresh, wall_before=wall_before, progress=progress,
                         checkpoint_every=checkpoint_every, checkpoint_cells=checkpoint_cells,

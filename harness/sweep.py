@@ -265,7 +265,7 @@ def run_sweep(opt: SweepOptions) -> int:
                         **({"dask": dataclasses.asdict(opt.dask)} if opt.dask is not None else {})}]
     meta_path.write_text(json.dumps({**meta, "runs": runs}, indent=2) + "\n")
 
-    with open_backend(opt.dask if pending else None, quiet=opt.quiet) as session:
+    with open_backend(opt.dask if pending else None) as session:
         t_all = time.monotonic()
         for i, setting in enumerate(todo, 1):
             key = key_of(setting)

@@ -34,6 +34,22 @@ CELLS = [0, 48, 606, 608, 610, 611, 612, 613, 614, 616, 657, 659, 661, 1224]
 CELL_SPEC = grid.format_cell_indices(CELLS)
 
 
+# A slower grid for the kill, cancel and Ctrl-C tests (rows theta0 = -1, 0, +1 deg; a few seconds on
+# 2 threads), so that an interruption lands inside the run on a fast machine too.
+SLOW_CAPS = {"max_trials": 6000, "success_steps": 5000}
+SLOW_SEED = 5
+SLOW_SPEC = "560-679"
+SLOW_CELLS = grid.parse_cell_indices(SLOW_SPEC)
+
+
+@pytest.fixture(scope="module")
+def slow_ref():
+    """The threaded run of the slow grid."""
+    cells = grid.make_cells(SLOW_SEED, SLOW_CELLS)
+    assert grid.run_grid(build_config(SLOW_CAPS), cells, threads=2, progress=False).complete
+    return cells
+
+
 @pytest.fixture(scope="module")
 def session():
     with cluster.DaskSession(cluster.DaskSpec(workers=2, threads_per_worker=1)) as s:
@@ -102,12 +118,10 @@ def test_resume_skips_finished_cells(session):
     assert_same(cells, ref)
 
 
-def test_killed_worker_costs_a_rerun_of_its_chunk(session):
+def test_killed_worker_costs_a_rerun_of_its_chunk(session, slow_ref):
     """SIGKILL of a worker while it runs a chunk (and others are pending): the chunk is rerun
     elsewhere (or on the restarted worker) and the grid equals the threaded one."""
-    cfg = build_config({"max_trials": 6000, "success_steps": 5000})
-    idx = list(range(600, 625))
-    ref = threaded(cfg, 6, idx)
+    cfg = build_config(SLOW_CAPS)
     pids = session.client.run(os.getpid)
     killed = {}
 
@@ -122,24 +136,23 @@ def test_killed_worker_costs_a_rerun_of_its_chunk(session):
                       pending=int(np.count_nonzero(snap["outcome"] == B.PENDING)))
         os.kill(pids[victim], signal.SIGKILL)
 
-    cells = grid.make_cells(6, idx)
-    res = session.run_grid(cfg, cells, progress=False, chunk_cells=2, checkpoint=checkpoint, checkpoint_cells=1)
+    cells = grid.make_cells(SLOW_SEED, SLOW_CELLS)
+    res = session.run_grid(cfg, cells, progress=False, chunk_cells=4, checkpoint=checkpoint, checkpoint_cells=1)
     assert killed, "no worker was running a chunk at any checkpoint"
     assert killed["pending"] > 0
     assert res.complete and not res.cancelled
-    assert_same(cells, ref, f"after killing {killed}")
+    assert_same(cells, slow_ref, f"after killing {killed}")
     deadline = time.monotonic() + 30  # the nanny restarts the worker: the next tests have two again
     while session.nthreads() < 2 and time.monotonic() < deadline:
         time.sleep(0.1)
     assert pids[killed["address"]] not in session.client.run(os.getpid).values()
 
 
-def test_cancel_then_resume_equals_uninterrupted(session, tmp_path):
+def test_cancel_then_resume_equals_uninterrupted(session, slow_ref):
     """cancel_event during a run: merged chunks saved (checkpoints hold only final cells), the
     rest PENDING and clean; a resume through the Dask backend gives the threaded cells."""
-    cfg = build_config(SMALL)
-    idx = list(range(600, 625))
-    ref = threaded(cfg, 3, idx)
+    cfg = build_config(SLOW_CAPS)
+    ref = slow_ref
     stop = threading.Event()
     snaps = []
 
@@ -147,8 +160,8 @@ def test_cancel_then_resume_equals_uninterrupted(session, tmp_path):
         snaps.append(snap)
         stop.set()
 
-    cells = grid.make_cells(3, idx)
-    res = session.run_grid(cfg, cells, progress=False, chunk_cells=1, checkpoint=checkpoint,
+    cells = grid.make_cells(SLOW_SEED, SLOW_CELLS)
+    res = session.run_grid(cfg, cells, progress=False, chunk_cells=2, checkpoint=checkpoint,
                            checkpoint_cells=1, cancel_event=stop)
     assert res.cancelled and res.status == B.SIM_CANCELLED
     pending = cells["outcome"] == B.PENDING
@@ -163,11 +176,12 @@ def test_cancel_then_resume_equals_uninterrupted(session, tmp_path):
     assert_same(cells, ref)
 
 
-def test_cancel_after_through_run_condition_and_resume(session, tmp_path):
+def test_cancel_after_through_run_condition_and_resume(session, tmp_path, slow_ref):
     out = tmp_path / "c"
-    common = dict(condition="ico", out=out, seed=2, threads=0, overrides=SMALL, cell_spec="590-630", progress=False)
-    ref = threaded(build_config(SMALL), 2, range(590, 631))
-    cells, record, cancelled = run_condition(dask=session, cancel_after=0.6, checkpoint_cells=1, **common)
+    common = dict(condition="ico", out=out, seed=SLOW_SEED, threads=0, overrides=SLOW_CAPS, cell_spec=SLOW_SPEC,
+                  progress=False)
+    ref = slow_ref
+    cells, record, cancelled = run_condition(dask=session, cancel_after=1.0, checkpoint_cells=1, **common)
     assert cancelled and not record["complete"]
     saved, _ = results.load(out)
     done = saved["outcome"] != B.PENDING
@@ -199,6 +213,20 @@ def test_abi_mismatch_names_the_difference():
     with pytest.raises(WorkerError, match=r"abi_version 6 != client's 999"):
         _worker.check_worker(expected)
     assert _worker.check_worker(_worker.abi_of(B))["library"] == str(B.LIBRARY_PATH)
+
+
+def test_c_error_on_a_worker_comes_back_as_the_same_exception(session):
+    """A configuration the C check rejects, sent past the client's check: the worker's ConfigError
+    (status and C message) reaches the client as it is, after the task's retries."""
+    cfg = build_config(SMALL)
+    cfg.controller.mode = 99
+    with pytest.raises(B.ConfigError) as want:
+        cfg.check()
+    cfg_bytes = (bytes(cfg.controller), bytes(cfg.plant), bytes(cfg.run), None)
+    fut = session.client.submit(_worker.run_chunk, "test-error", 0, cfg_bytes, grid.make_cells(0, [611]),
+                                _worker.abi_of(B), pure=False, retries=1)
+    exc = fut.exception(timeout=30)
+    assert type(exc) is B.ConfigError and exc.status == want.value.status and str(exc) == str(want.value)
 
 
 def test_sweep_on_the_cluster_equals_threads(session, ico_dir, tmp_path):
@@ -249,16 +277,15 @@ def test_cli_unreachable_scheduler_is_one_line(tmp_path, capsys, monkeypatch):
     assert err[-1].startswith("icoac-harness: error: cannot reach the Dask scheduler at tcp://127.0.0.1:"), err
 
 
-def test_cli_sigint_to_the_process_group_then_resume(tmp_path):
+def test_cli_sigint_to_the_process_group_then_resume(tmp_path, slow_ref):
     """`grid --workers 2` and Ctrl-C as a terminal sends it (SIGINT to the whole process group,
     workers included): exit 130 without a traceback, finished cells saved; `--resume` (threaded
     here, the results do not depend on the backend) finishes with the threaded engine's cells."""
     out = tmp_path / "g"
-    caps = {"max_trials": 6000, "success_steps": 5000}
-    ref = threaded(build_config(caps), 5, range(600, 625))
-    args = ["grid", "--out", out, "--cells", "600-624", "--seed", 5, "--max-trials", caps["max_trials"],
-            "--success-steps", caps["success_steps"], "--workers", 2, "--chunk-cells", 1, "--checkpoint-cells", 1,
-            "--quiet"]
+    ref = slow_ref
+    args = ["grid", "--out", out, "--cells", SLOW_SPEC, "--seed", SLOW_SEED, "--max-trials", SLOW_CAPS["max_trials"],
+            "--success-steps", SLOW_CAPS["success_steps"], "--workers", 2, "--chunk-cells", 2,
+            "--checkpoint-cells", 1, "--quiet"]
     proc = subprocess.Popen(harness(*args), cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
     deadline = time.monotonic() + 60
@@ -282,3 +309,20 @@ def test_cli_sigint_to_the_process_group_then_resume(tmp_path):
                          text=True, timeout=120)
     assert res.returncode == 0, res.stderr
     assert_same(results.load(out)[0], ref)
+
+
+def test_bench_on_the_cluster_equals_threads(session, tmp_path):
+    """Every grid of a bench (one seed, the quick profile's cells, small caps) on the cluster:
+    each results directory holds the threaded bench's cells; bench.json records the backend."""
+    from harness import bench
+    from harness.options import CONDITIONS
+    common = dict(profile="quick", seeds=1, seed=1, rl_max_trials=10, sets=["success_steps=1000"], quiet=True)
+    assert bench.run_bench(bench.BenchOptions(out=tmp_path / "t", threads=2, **common)) == 0
+    assert bench.run_bench(bench.BenchOptions(out=tmp_path / "d", dask=cluster.DaskSpec(scheduler=session.address),
+                                              **common)) == 0
+    for condition in CONDITIONS:
+        got = results.load(bench.seed_dir(tmp_path / "d", condition, 1))[0]
+        assert_same(got, results.load(bench.seed_dir(tmp_path / "t", condition, 1))[0], condition)
+    import json
+    meta = json.loads((tmp_path / "d" / "bench.json").read_text())["meta"]
+    assert meta["backend"]["kind"] == "dask" and meta["backend"]["threads"] == 2
