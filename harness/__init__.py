@@ -3,6 +3,8 @@
 Layers (no import cycle; `python -m harness.tools.imports` prints the graph): errors, options (no
 dependencies) < _binding (the C library, its constants and checked struct mirrors) < geometry,
 config < metrics, grid < results < prior < figures, conditions < bench, sweep < cli (arguments
-and reports only; imported by __main__ alone).
+and reports only; imported by __main__ alone). The Dask backend: _worker (what a worker runs;
+errors and options at import, the binding only inside a task) < cluster (the client side, after
+grid; imported by bench and sweep, and by conditions inside a function).
 """
 __version__ = "0.1.0"

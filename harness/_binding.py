@@ -45,6 +45,17 @@ class IcoacError(HarnessError):
             text = f"{context}: {text}"
         super().__init__(text)
 
+    def __reduce__(self):  # picklable (a Dask worker sends it back to the client), class and text kept
+        return _restore_error, (type(self), self.status, str(self))
+
+
+def _restore_error(cls: type, status: int, text: str) -> IcoacError:
+    err = cls.__new__(cls)
+    HarnessError.__init__(err, text)
+    err.status = int(status)
+    err.c_message = status_str(err.status)
+    return err
+
 
 class ConfigError(IcoacError):
     """A configuration, prior, plant, run or argument rejected (a bad-parameter status of the C

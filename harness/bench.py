@@ -275,6 +275,7 @@ class BenchOptions:
     ridge: float = P.DEFAULT_RIDGE
     rl_cov: str = "ico"
     ceiling: Path | None = None   # a ceiling.json (or its directory); default OUT/ceiling/ceiling.json
+    dask: Any = None              # a harness.cluster.DaskSpec: every grid on that Dask cluster (None: threads)
 
     def seed_list(self) -> list[int]:
         n = self.seeds if self.seeds is not None else PROFILES[self.profile]["seeds"]
@@ -306,7 +307,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
                 condition=condition, out=d, seed=seed, threads=opt.threads, overrides=overrides(condition),
                 cell_spec=cells_spec, resume=opt.resume and results.exists(d), fresh=not opt.resume,
                 progress=not opt.quiet, info=ctx.get(("prior", condition, seed)),
-                start_over="rerun bench without --resume")
+                start_over="rerun bench without --resume", dask=ctx.get("dask"))
             ctx[(condition, seed)] = (cells, record)
             s = record["summary"]
             progress(f"  {condition} seed {seed}: success {s['n_success']}/{s['n_cells']}, "
@@ -376,14 +377,23 @@ def stages(opt: BenchOptions) -> list[Stage]:
 
 
 def run_bench(opt: BenchOptions, argv: Sequence[str] = ()) -> int:
-    """Validate, then run every stage, logging wall times to OUT/bench.json; 130 if interrupted."""
-    ctx: dict = {}
+    """Validate, then run every stage, logging wall times to OUT/bench.json; 130 if interrupted.
+    With ``opt.dask`` one Dask session (harness.cluster) serves every grid."""
+    from .cluster import open_backend
+
     todo = stages(opt)  # validates the arguments before anything is written
     results.check_writable(opt.out)
+    with open_backend(opt.dask) as session:
+        return _run_stages(opt, todo, {"dask": session}, argv)
+
+
+def _run_stages(opt: BenchOptions, todo: list[Stage], ctx: dict, argv: Sequence[str]) -> int:
+    session = ctx.get("dask")
     log = BenchLog(Path(opt.out), {
         "profile": opt.profile, "seeds": opt.seed_list(),
         "rl_max_trials": opt.rl_max_trials, "resume": bool(opt.resume), "threads": opt.threads,
-        "set": list(opt.sets), "argv": list(argv)})
+        "set": list(opt.sets), "argv": list(argv),
+        **({"backend": session.describe()} if session is not None else {})})
     for i, stage in enumerate(todo, 1):
         progress(f"({i}/{len(todo)}) {stage.name}")
         t0 = time.monotonic()

@@ -117,6 +117,28 @@ def _add_rl_cov(parser) -> None:
                         help="RL-alone prior covariance: that of ICO->RL (default) or 1*I")
 
 
+THREADS_HELP = (f"C threads of the local engine, in [0, {O.MAX_THREADS}] (0, the default: all cores); "
+                "not with --scheduler or --workers")
+
+
+def _add_backend(parser) -> None:
+    """--scheduler / --workers (the Dask backend, harness.cluster), --threads-per-worker, --chunk-cells."""
+    d = parser.add_argument_group(
+        "Dask backend", "run the grids on a dask.distributed cluster instead of local C threads (same cells, "
+                        "checkpoints and resume; docs/cluster.md)")
+    where = d.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                       help="address of a running Dask scheduler, e.g. tcp://host:8786")
+    where.add_argument("--workers", type=_int_in(1, O.MAX_WORKERS, f"a number of workers in [1, {O.MAX_WORKERS}]"),
+                       default=None, metavar="N", help="start a local Dask cluster of N worker processes")
+    d.add_argument("--threads-per-worker", type=_int_in(1, O.MAX_THREADS, f"an integer in [1, {O.MAX_THREADS}]"),
+                   default=None, metavar="N", help="threads of each --workers process (default 1)")
+    d.add_argument("--chunk-cells", type=_int_in(1, O.MAX_CHUNK_CELLS, f"an integer in [1, {O.MAX_CHUNK_CELLS}]"),
+                   default=None, metavar="N",
+                   help=f"cells per Dask task (default: about {O.AUTO_CHUNKS_PER_THREAD} tasks per worker thread, "
+                        f"at most {O.AUTO_CHUNK_MAX} cells each)")
+
+
 def _add_seeds(parser, default_count: str) -> None:
     parser.add_argument("--seed", type=_seed, default=0, help="first seed, in [0, 2^64 - 1] (default 0)")
     parser.add_argument("--seeds", type=_seed_count, default=None, metavar="N",
@@ -147,7 +169,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="ICO results directory the rl / ico-rl prior is computed from")
     g.add_argument("--out", required=True, help="results directory (cells.npz, run.json); created if missing")
     g.add_argument("--seed", type=_seed, default=None, help="the grid's seed, in [0, 2^64 - 1] (default 0)")
-    g.add_argument("--threads", type=_threads, default=0, help=f"C threads in [0, {O.MAX_THREADS}] (0: all cores)")
+    g.add_argument("--threads", type=_threads, default=None, help=THREADS_HELP)
     g.add_argument("--max-trials", type=_positive_int, default=None,
                    help="trials before a cell fails, in [1, 2^63 - 1] (default 1e5)")
     g.add_argument("--success-steps", type=_positive_int, default=None,
@@ -172,6 +194,7 @@ def build_parser() -> argparse.ArgumentParser:
                         f"{every:g}, at most 86400)")
     g.add_argument("--quiet", action="store_true", help="no progress bar")
     _add_prior_args(g)
+    _add_backend(g)
     g.set_defaults(func=cmd_grid)
 
     f = sub.add_parser("figures", help="draw Fig. 1b, 1c-f, 1g from a results directory")
@@ -192,7 +215,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_seeds(b, "default: the profile's")
     b.add_argument("--rl-max-trials", type=_positive_int, default=None,
                    help="trial cap of the RL and ICO->RL grids (overrides the profile)")
-    b.add_argument("--threads", type=_threads, default=0, help=f"C threads in [0, {O.MAX_THREADS}] (0: all cores)")
+    b.add_argument("--threads", type=_threads, default=None, help=THREADS_HELP)
     b.add_argument("--configuration", choices=O.CONFIGURATION_NAMES, default=O.CONFIGURATION_NAMES[0],
                    help="named configuration applied before --set: the defaults, or the paper's literal "
                         "reading of the actor-critic (posterior actor, exploration always on, per-tick updates)")
@@ -203,6 +226,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="ceiling.json of `ceiling` (or its directory) shown in summary.md and Fig. 3a "
                         f"(default OUT/{O.CEILING_DIR}/{O.CEILING_FILE} if it exists)")
     _add_prior_args(b)
+    _add_backend(b)
     b.set_defaults(func=cmd_bench)
 
     w = sub.add_parser("sweep", help="factorial sweep of RL parameters on a cell subset")
@@ -225,9 +249,10 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--set", action="append", metavar="NAME=VALUE", help="fixed override for every setting")
     w.add_argument("--one-at-a-time", action="store_true",
                    help="vary one parameter at a time around the first value of each")
-    w.add_argument("--threads", type=_threads, default=0, help=f"C threads in [0, {O.MAX_THREADS}] (0: all cores)")
+    w.add_argument("--threads", type=_threads, default=None, help=THREADS_HELP)
     _add_rl_cov(w)
     w.add_argument("--quiet", action="store_true")
+    _add_backend(w)
     w.set_defaults(func=cmd_sweep)
 
     c = sub.add_parser(
@@ -291,6 +316,29 @@ def _frame(args):
     return P.parse_frame(args.prior_frame, args.prior_x, args.prior_theta)
 
 
+def _threads_arg(args) -> int:
+    return 0 if args.threads is None else args.threads
+
+
+def _dask_spec(args):
+    """The DaskSpec of --scheduler / --workers (None: the local threaded engine); the options that
+    apply to one backend only are refused with the other."""
+    dask = args.scheduler is not None or args.workers is not None
+    if not dask:
+        for flag, value in (("--threads-per-worker", args.threads_per_worker), ("--chunk-cells", args.chunk_cells)):
+            if value is not None:
+                raise UsageError(f"{flag} applies to the Dask backend (--scheduler ADDRESS or --workers N)")
+        return None
+    if args.threads is not None:
+        raise UsageError("--threads sets the local engine's C threads; with --scheduler or --workers every worker "
+                         "thread runs one chunk on one C thread (--threads-per-worker sets them for --workers)")
+    if args.scheduler is not None and args.threads_per_worker is not None:
+        raise UsageError("--threads-per-worker applies to --workers N; the workers of --scheduler have their own")
+    from .cluster import DaskSpec
+    return DaskSpec(scheduler=args.scheduler, workers=args.workers,
+                    threads_per_worker=args.threads_per_worker or 1, chunk_cells=args.chunk_cells).check()
+
+
 def cmd_grid(args) -> int:
     from . import conditions, metrics
 
@@ -300,13 +348,15 @@ def cmd_grid(args) -> int:
     info = None
     if explicit or not args.resume:
         info = conditions.condition_prior(condition, args.prior_from, _frame(args), args.prior_ridge, args.rl_cov)
+    spec = _dask_spec(args)
     cells, record, cancelled = conditions.run_condition(
-        condition=condition, out=Path(args.out), seed=args.seed or 0, threads=args.threads,
+        condition=condition, out=Path(args.out), seed=args.seed or 0, threads=_threads_arg(args),
         overrides=_overrides(args), cell_spec=args.cells, resume=args.resume, fresh=args.overwrite,
         progress=not args.quiet, checkpoint_every=args.checkpoint_every,
-        checkpoint_cells=args.checkpoint_cells, explicit=explicit or not args.resume, info=info)
+        checkpoint_cells=args.checkpoint_cells, explicit=explicit or not args.resume, info=info, dask=spec)
     print(metrics.format_summary(record["condition"], record["summary"]))
-    print(f"wall time {record['wall_time']:.1f} s on {record['threads']} threads -> {args.out}")
+    where = "Dask worker threads" if spec is not None else "threads"
+    print(f"wall time {record['wall_time']:.1f} s on {record['threads']} {where} -> {args.out}")
     if cancelled:
         print(f"interrupted: finished cells saved; resume with `python -m harness grid --out {args.out} --resume`",
               file=sys.stderr)
@@ -330,9 +380,9 @@ def cmd_bench(args) -> int:
 
     opt = bench.BenchOptions(
         profile=args.profile, out=Path(args.out), figures=Path(args.figures) if args.figures else None,
-        seed=args.seed, seeds=args.seeds, rl_max_trials=args.rl_max_trials, threads=args.threads,
+        seed=args.seed, seeds=args.seeds, rl_max_trials=args.rl_max_trials, threads=_threads_arg(args),
         sets=_sets(args), resume=args.resume, quiet=args.quiet, frame=_frame(args), ridge=args.prior_ridge,
-        rl_cov=args.rl_cov, ceiling=Path(args.ceiling) if args.ceiling else None)
+        rl_cov=args.rl_cov, ceiling=Path(args.ceiling) if args.ceiling else None, dask=_dask_spec(args))
     return bench.run_bench(opt, argv=sys.argv[1:])
 
 
@@ -343,7 +393,8 @@ def cmd_sweep(args) -> int:
         prior_from=Path(args.prior_from), out=Path(args.out), params=args.param, condition=args.condition,
         cells=args.cells, subset=args.subset, seed=args.seed, seeds=1 if args.seeds is None else args.seeds,
         max_trials=args.max_trials, success_steps=args.success_steps, sets=_sets(args),
-        one_at_a_time=args.one_at_a_time, threads=args.threads, rl_cov=args.rl_cov, quiet=args.quiet)
+        one_at_a_time=args.one_at_a_time, threads=_threads_arg(args), rl_cov=args.rl_cov, quiet=args.quiet,
+        dask=_dask_spec(args))
     return sweep.run_sweep(opt)
 
 

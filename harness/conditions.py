@@ -4,6 +4,7 @@ checkpointed, resumable grid run into a results directory (run_condition). The c
 reimplements a step."""
 from __future__ import annotations
 
+import functools
 import sys
 import time
 from pathlib import Path
@@ -52,8 +53,13 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
                   cell_spec=None, resume: bool = False, fresh: bool = False, progress: bool = True,
                   checkpoint_every: float | None = None, checkpoint_cells: int | None = None,
                   info: P.PriorInfo | None = None, explicit: bool = True, cancel_after: float | None = None,
-                  start_over: str = "rerun with --overwrite") -> tuple[np.ndarray, dict, bool]:
+                  start_over: str = "rerun with --overwrite", dask=None) -> tuple[np.ndarray, dict, bool]:
     """Run (or resume) one condition into a results directory; returns (cells, record, cancelled).
+
+    ``dask`` (a harness.cluster.DaskSession, or a DaskSpec for a session opened after every check
+    and closed after this grid) runs the grid on a Dask cluster instead of ``threads`` local C
+    threads, with the same cells, checkpoints and resume; run.json then records the backend
+    (``backend``) and the cluster's thread count.
 
     Everything is validated before the first byte is written: the arguments, the configuration
     (C checks), the output directory (a real write probe) and, when results exist, both files,
@@ -111,13 +117,25 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
         wall_before = 0.0
     return _run(cfg, cells, out=out, condition=condition, seed=seed, threads=threads, indices=indices,
                 extra=extra, existing=existing, fresh=fresh, wall_before=wall_before, progress=progress,
-                checkpoint_every=checkpoint_every, checkpoint_cells=checkpoint_cells, cancel_after=cancel_after)
+                checkpoint_every=checkpoint_every, checkpoint_cells=checkpoint_cells, cancel_after=cancel_after,
+                dask=dask)
 
 
 def _run(cfg: RunConfig, cells: np.ndarray, *, out: Path, condition: str, seed: int, threads: int,
          indices, extra, existing: bool, fresh: bool, wall_before: float, progress: bool,
-         checkpoint_every, checkpoint_cells, cancel_after) -> tuple[np.ndarray, dict, bool]:
-    n_threads = threads if threads > 0 else grid.default_threads()
+         checkpoint_every, checkpoint_cells, cancel_after, dask=None) -> tuple[np.ndarray, dict, bool]:
+    if dask is not None and not hasattr(dask, "run_grid"):  # a DaskSpec: a session for this grid
+        from .cluster import open_backend
+        with open_backend(dask) as session:
+            return _run(cfg, cells, out=out, condition=condition, seed=seed, threads=threads, indices=indices,
+                        extra=extra, existing=existing, fresh=fresh, wall_before=wall_before, progress=progress,
+                        checkpoint_every=checkpoint_every, checkpoint_cells=checkpoint_cells,
+                        cancel_after=cancel_after, dask=session)
+    if dask is not None:
+        n_threads = dask.nthreads()
+        extra = {**(extra or {}), "backend": dask.describe()}
+    else:
+        n_threads = threads if threads > 0 else grid.default_threads()
     results.check_writable(out)
     git = results.git_info()
 
@@ -132,10 +150,11 @@ def _run(cfg: RunConfig, cells: np.ndarray, *, out: Path, condition: str, seed: 
                 if (out / name).is_file():
                     (out / name).unlink()
         save(cells, 0.0)  # every cell PENDING: resumable from the first second
-    run = grid.run_grid(cfg, cells, threads=threads, progress=progress,
-                        checkpoint=lambda snap: save(snap, wall_before + time.monotonic() - t0),
-                        checkpoint_every=DEFAULT_CHECKPOINT_EVERY if checkpoint_every is None else checkpoint_every,
-                        checkpoint_cells=DEFAULT_CHECKPOINT_CELLS if checkpoint_cells is None else checkpoint_cells,
-                        cancel_after=cancel_after, desc=condition)
+    runner = functools.partial(grid.run_grid, threads=threads) if dask is None else dask.run_grid
+    run = runner(cfg, cells, progress=progress,
+                 checkpoint=lambda snap: save(snap, wall_before + time.monotonic() - t0),
+                 checkpoint_every=DEFAULT_CHECKPOINT_EVERY if checkpoint_every is None else checkpoint_every,
+                 checkpoint_cells=DEFAULT_CHECKPOINT_CELLS if checkpoint_cells is None else checkpoint_cells,
+                 cancel_after=cancel_after, desc=condition)
     record = save(cells, wall_before + run.wall_time)
     return cells, record, run.cancelled

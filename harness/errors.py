@@ -20,6 +20,12 @@ class LibraryError(HarnessError):
     """The shared library is missing or does not match this binding."""
 
 
+class WorkerError(HarnessError):
+    """A Dask worker that cannot run the harness: the library missing or unloadable there, another
+    ABI than the client's, the harness not importable, no worker at all, or a chunk that killed
+    its workers. The message names the worker and, where it applies, the library path."""
+
+
 class ResultsError(HarnessError):
     """A missing, unreadable or mismatching results directory."""
 

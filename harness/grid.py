@@ -197,12 +197,29 @@ def default_threads() -> int:
         return os.cpu_count() or 1
 
 
+def check_run_args(cells, checkpoint_every, checkpoint_cells) -> None:
+    """The arguments of a grid run that do not depend on the backend; ConfigError otherwise."""
+    if not isinstance(cells, np.ndarray) or cells.dtype != B.CELL_DTYPE or not cells.flags.c_contiguous \
+            or cells.ndim != 1 or not cells.flags.writeable:
+        raise _bad_arg("cells must be a 1-D contiguous writeable CELL_DTYPE array")
+    if not (isinstance(checkpoint_every, (int, float)) and math.isfinite(checkpoint_every) and checkpoint_every > 0):
+        raise _bad_arg(f"checkpoint_every must be a finite number of seconds > 0, got {checkpoint_every!r}")
+    if not _is_int(checkpoint_cells) or checkpoint_cells < 1:
+        raise _bad_arg(f"checkpoint_cells must be an integer >= 1, got {checkpoint_cells!r}")
+
+
+def check_coordinates(cells: np.ndarray) -> None:
+    if not (np.all(np.isfinite(cells["x0"])) and np.all(np.isfinite(cells["theta0"]))):
+        raise _bad_arg("cells must have finite x0 and theta0")
+
+
 def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool = True,
              checkpoint: Callable[[np.ndarray], None] | None = None,
              checkpoint_every: float = DEFAULT_CHECKPOINT_EVERY,
              checkpoint_cells: int = DEFAULT_CHECKPOINT_CELLS,
              poll_interval: float = 0.2, cancel_after: float | None = None,
-             cancel_event: threading.Event | None = None, desc: str = "grid") -> GridRun:
+             cancel_event: threading.Event | None = None, desc: str = "grid",
+             on_progress: Callable[[np.ndarray], None] | None = None) -> GridRun:
     """Run every PENDING cell of ``cells`` (modified in place) on ``threads`` C threads (0: all cores).
 
     The C call runs in a worker thread (ctypes releases the GIL); this thread polls the progress
@@ -216,22 +233,19 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
     than ``checkpoint_cells`` finished cells, none finished more than ``checkpoint_every +
     poll_interval`` seconds ago (plus the cells in progress). An exception from ``checkpoint``
     stops the C threads and is raised. Errors other than cancellation raise IcoacError.
+
+    ``on_progress(counters)``, if given, is called after every poll with the C progress counters
+    (cells, trials, steps so far; indices B.PROGRESS_*); the Dask workers (harness._worker) report
+    a running chunk's progress through it. An exception from it stops the C threads and is raised.
     """
-    if not isinstance(cells, np.ndarray) or cells.dtype != B.CELL_DTYPE or not cells.flags.c_contiguous \
-            or cells.ndim != 1 or not cells.flags.writeable:
-        raise _bad_arg("cells must be a 1-D contiguous writeable CELL_DTYPE array")
+    check_run_args(cells, checkpoint_every, checkpoint_cells)
     threads = check_threads(threads)
-    if not (isinstance(checkpoint_every, (int, float)) and math.isfinite(checkpoint_every) and checkpoint_every > 0):
-        raise _bad_arg(f"checkpoint_every must be a finite number of seconds > 0, got {checkpoint_every!r}")
-    if not _is_int(checkpoint_cells) or checkpoint_cells < 1:
-        raise _bad_arg(f"checkpoint_cells must be an integer >= 1, got {checkpoint_cells!r}")
     cfg.check()
     pending = int(np.count_nonzero(cells["outcome"] == B.PENDING))
     t_start = time.monotonic()
     if pending == 0 or cells.size == 0:
         return GridRun(cells, False, 0.0, B.OK)
-    if not (np.all(np.isfinite(cells["x0"])) and np.all(np.isfinite(cells["theta0"]))):
-        raise _bad_arg("cells must have finite x0 and theta0")
+    check_coordinates(cells)
     reset_pending(cells)
 
     cancel = np.zeros(1, dtype=np.int32)
@@ -265,6 +279,8 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
         while thread.is_alive():
             thread.join(poll_interval)
             bar.update(counters)
+            if on_progress is not None:
+                on_progress(counters)
             now = time.monotonic()
             if cancel_event is not None and cancel_event.is_set() and not cancel[0]:
                 cancel[0] = 1

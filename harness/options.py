@@ -34,6 +34,20 @@ MAX_SEEDS = 1000                # --seeds: 1 .. MAX_SEEDS
 DEFAULT_CHECKPOINT_CELLS = 25
 DEFAULT_CHECKPOINT_EVERY = 2.0
 
+# The Dask backend (harness.cluster: --scheduler ADDRESS or --workers N). Pending cells go out in
+# chunks of --chunk-cells cells, one task each; by default ceil(pending / (AUTO_CHUNKS_PER_THREAD x
+# worker threads)) cells, clipped to [1, AUTO_CHUNK_MAX], so every worker thread sees several chunks
+# (load balance, small loss when a worker dies) and a chunk is still seconds of C work.
+AUTO_CHUNKS_PER_THREAD = 8
+AUTO_CHUNK_MAX = 16
+MAX_CHUNK_CELLS = 1225           # at most the paper grid's cells per chunk
+MAX_WORKERS = 1024               # --workers N: 1 .. MAX_WORKERS local worker processes
+DASK_RETRIES = 3                 # retries of a chunk whose task raised (a dead worker is Dask's allowed-failures)
+DASK_CONNECT_TIMEOUT = 30.0      # s to reach a scheduler
+DASK_WORKER_TIMEOUT = 60.0       # s to wait for the first worker (and the longest a run waits with none)
+DASK_CANCEL_GRACE = 5.0          # s a cancel waits for running chunks to return their finished cells
+DASK_PROGRESS_EVERY = 0.5        # s between progress events of a running chunk
+
 # Trajectories (Fig. 1g): default length and the bound of the C buffers (40 bytes per step).
 TRAJECTORY_DURATION = 30.0      # s
 MAX_TRAJECTORY_STEPS = 1_000_000

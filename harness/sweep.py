@@ -6,6 +6,7 @@ records what the rows were computed with, so a resumed sweep with other cells/se
 from __future__ import annotations
 
 import csv
+import dataclasses
 import itertools
 import json
 import math
@@ -148,6 +149,7 @@ class SweepOptions:
     threads: int = 0
     rl_cov: str = RL_COV_NAMES[0]
     quiet: bool = False
+    dask: Any = None              # a harness.cluster.DaskSpec: every grid on that Dask cluster (None: threads)
 
 
 def _read_table(csv_path: Path) -> tuple[list[str] | None, list[dict[str, str]]]:
@@ -182,7 +184,10 @@ def _param_columns(header: list[str]) -> dict[str, str]:
 
 
 def run_sweep(opt: SweepOptions) -> int:
-    """Run every setting not yet in OUT/sweep.csv; 130 if interrupted."""
+    """Run every setting not yet in OUT/sweep.csv; 130 if interrupted. With ``opt.dask`` one Dask
+    session (harness.cluster), opened after every check, runs every grid."""
+    from .cluster import open_backend
+
     ico_dir = results.check_results_dir(opt.prior_from, "--prior-from")
     params = parse_params(opt.params)
     names = list(params)
@@ -256,54 +261,57 @@ def run_sweep(opt: SweepOptions) -> int:
     results.check_writable(out)
     pending = [key_of(st) for st in todo if key_of(st) not in done]
     if pending or not runs:
-        runs = runs + [{"git": results.git_info(), "library": str(B.LIBRARY_PATH), "settings": pending}]
+        runs = runs + [{"git": results.git_info(), "library": str(B.LIBRARY_PATH), "settings": pending,
+                        **({"dask": dataclasses.asdict(opt.dask)} if opt.dask is not None else {})}]
     meta_path.write_text(json.dumps({**meta, "runs": runs}, indent=2) + "\n")
 
-    t_all = time.monotonic()
-    for i, setting in enumerate(todo, 1):
-        key = key_of(setting)
-        label = ", ".join(f"{k}={v}" for k, v in setting.items())
-        if key in done:
-            print(f"[sweep] ({i}/{len(todo)}) {label}: already in {csv_path.name}, skipped", file=sys.stderr)
-            continue
-        cfg = config_for(setting)
-        t0 = time.monotonic()
-        rates, rates_failed, trials, elapsed = [], [], [], []
-        for seed in seeds:
-            cells = grid.make_cells(seed, indices)
-            res = grid.run_grid(cfg, cells, threads=opt.threads, progress=False)
-            if res.cancelled:
-                print("[sweep] interrupted: finished settings are in the CSV; rerun to resume", file=sys.stderr)
-                return 130
-            ok = metrics.success_mask(cells)
-            rates.append(float(ok.mean()))
-            if ico_failed.any():
-                rates_failed.append(float(ok[ico_failed].mean()))
-            trials.extend(cells["trials"][ok].tolist())
-            elapsed.extend(cells["elapsed_time"][ok].tolist())
-        wall = time.monotonic() - t0
-        row = {"key": key, "n_seeds": len(seeds), "n_cells": len(indices),
-               "success_rate_mean": f"{np.mean(rates):.6g}",
-               "success_rate_sd": f"{np.std(rates, ddof=1) if len(rates) > 1 else 0.0:.6g}",
-               "success_rate_ico_failed": f"{np.mean(rates_failed):.6g}" if rates_failed else "",
-               "n_ico_failed": int(ico_failed.sum()),
-               "median_trials": f"{np.median(trials):.6g}" if trials else "",
-               "mean_elapsed_time": f"{np.mean(elapsed):.6g}" if elapsed else "",
-               "wall_time": f"{wall:.3f}"}
-        if header is None:
-            header = names + list(COLUMNS)
-            with open(csv_path, "w", newline="") as fh:
-                csv.DictWriter(fh, fieldnames=header).writeheader()
-        columns = _param_columns(header)
-        for n in names:
-            row[columns[n]] = setting.get(n, "")
-        with open(csv_path, "a", newline="") as fh:
-            csv.DictWriter(fh, fieldnames=header, extrasaction="ignore").writerow(row)
-        rows.append({k: str(v) for k, v in row.items()})
-        done.add(key)
-        rf = f", ICO-failed cells {percent(np.mean(rates_failed))}" if rates_failed else ""
-        print(f"[sweep] ({i}/{len(todo)}) {label}: success {percent(np.mean(rates))}{rf}, "
-              f"{wall:.1f} s", file=sys.stderr, flush=True)
+    with open_backend(opt.dask if pending else None) as session:
+        t_all = time.monotonic()
+        for i, setting in enumerate(todo, 1):
+            key = key_of(setting)
+            label = ", ".join(f"{k}={v}" for k, v in setting.items())
+            if key in done:
+                print(f"[sweep] ({i}/{len(todo)}) {label}: already in {csv_path.name}, skipped", file=sys.stderr)
+                continue
+            cfg = config_for(setting)
+            t0 = time.monotonic()
+            rates, rates_failed, trials, elapsed = [], [], [], []
+            for seed in seeds:
+                cells = grid.make_cells(seed, indices)
+                res = (grid.run_grid(cfg, cells, threads=opt.threads, progress=False) if session is None
+                   else session.run_grid(cfg, cells, progress=False))
+                if res.cancelled:
+                    print("[sweep] interrupted: finished settings are in the CSV; rerun to resume", file=sys.stderr)
+                    return 130
+                ok = metrics.success_mask(cells)
+                rates.append(float(ok.mean()))
+                if ico_failed.any():
+                    rates_failed.append(float(ok[ico_failed].mean()))
+                trials.extend(cells["trials"][ok].tolist())
+                elapsed.extend(cells["elapsed_time"][ok].tolist())
+            wall = time.monotonic() - t0
+            row = {"key": key, "n_seeds": len(seeds), "n_cells": len(indices),
+                   "success_rate_mean": f"{np.mean(rates):.6g}",
+                   "success_rate_sd": f"{np.std(rates, ddof=1) if len(rates) > 1 else 0.0:.6g}",
+                   "success_rate_ico_failed": f"{np.mean(rates_failed):.6g}" if rates_failed else "",
+                   "n_ico_failed": int(ico_failed.sum()),
+                   "median_trials": f"{np.median(trials):.6g}" if trials else "",
+                   "mean_elapsed_time": f"{np.mean(elapsed):.6g}" if elapsed else "",
+                   "wall_time": f"{wall:.3f}"}
+            if header is None:
+                header = names + list(COLUMNS)
+                with open(csv_path, "w", newline="") as fh:
+                    csv.DictWriter(fh, fieldnames=header).writeheader()
+            columns = _param_columns(header)
+            for n in names:
+                row[columns[n]] = setting.get(n, "")
+            with open(csv_path, "a", newline="") as fh:
+                csv.DictWriter(fh, fieldnames=header, extrasaction="ignore").writerow(row)
+            rows.append({k: str(v) for k, v in row.items()})
+            done.add(key)
+            rf = f", ICO-failed cells {percent(np.mean(rates_failed))}" if rates_failed else ""
+            print(f"[sweep] ({i}/{len(todo)}) {label}: success {percent(np.mean(rates))}{rf}, "
+                  f"{wall:.1f} s", file=sys.stderr, flush=True)
     _write_md(out / "sweep.md", rows, names, meta)
     print(f"[sweep] {len(todo)} settings, wall time {time.monotonic() - t_all:.1f} s -> {csv_path}")
     return 0

@@ -57,6 +57,8 @@ def test_documented_command_parses(where, command):
     if words in ([], ["--help"]):
         return
     args = cli.build_parser().parse_args(words)
+    if hasattr(args, "scheduler"):  # the backend options combine (nothing connects)
+        cli._dask_spec(args)
     if getattr(args, "set", None):
         build_config(parse_sets(args.set))
     if args.command == "sweep":

@@ -89,20 +89,7 @@ def test_prior_errors():
         P.parse_frame("corner")
 
 
-# -- an ICO results directory shared by the CLI tests ----------------------------------------------
-ICO_CELLS = [0, 610, 611, 612, 613, 1224]
-
-
-@pytest.fixture(scope="module")
-def ico_dir(tmp_path_factory):
-    out = tmp_path_factory.mktemp("ico")
-    cfg = build_config({"max_trials": 6000, "success_steps": 2000})
-    cells = grid.make_cells(0, ICO_CELLS)
-    grid.run_grid(cfg, cells, threads=2, progress=False)
-    results.save(out, cells, cfg, condition="ico", seed=0, wall_time=0.0, threads=2, cell_indices=ICO_CELLS)
-    return out
-
-
+# -- the ICO results directory of the CLI tests: the ico_dir fixture of conftest.py ------------------
 def test_prior_from_results_records_provenance(ico_dir):
     info = P.from_results(ico_dir)
     cells, record = results.load(ico_dir)
