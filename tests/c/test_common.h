@@ -56,6 +56,33 @@ static inline double test_uniform(test_rng_t *r, double lo, double hi)
     return lo + (hi - lo) * ((double)(test_rng_u64(r) >> 11) * (1.0 / 9007199254740992.0));
 }
 
+/* A random prior N(m, s (A A^T + 0.05 I)) with m uniform in (-mean_half_width, mean_half_width),
+ * exactly symmetric and accepted by icoac_prior_check. */
+static inline icoac_prior_t test_random_prior(test_rng_t *rng, double mean_half_width, double scale)
+{
+    icoac_prior_t p;
+    double a[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
+    int i, j, k;
+    memset(&p, 0, sizeof p);
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        p.mean[i] = (icoac_real_t)test_uniform(rng, -mean_half_width, mean_half_width);
+        for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+            a[i][j] = test_uniform(rng, -1, 1);
+        }
+    }
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        for (j = 0; j <= i; ++j) {
+            double sum = i == j ? 0.05 : 0.0;
+            for (k = 0; k < ICOAC_N_INPUTS; ++k) {
+                sum += a[i][k] * a[j][k];
+            }
+            p.cov[i][j] = p.cov[j][i] = (icoac_real_t)(scale * sum);
+        }
+    }
+    assert_int_equal(icoac_prior_check(&p), ICOAC_OK);
+    return p;
+}
+
 /* Configuration with paper defaults and a checked status. */
 static inline icoac_config_t test_default_config(void)
 {

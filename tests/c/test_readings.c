@@ -63,32 +63,6 @@ static void posterior_of(const icoac_state_t *state, gauss_t *g)
     }
 }
 
-/* A random prior N(m, s (A A^T + 0.05 I)), exactly symmetric. */
-static icoac_prior_t random_prior(test_rng_t *rng, double scale)
-{
-    icoac_prior_t p;
-    double a[N][N];
-    int i, j, k;
-    memset(&p, 0, sizeof p);
-    for (i = 0; i < N; ++i) {
-        p.mean[i] = (icoac_real_t)test_uniform(rng, -0.5, 0.5);
-        for (j = 0; j < N; ++j) {
-            a[i][j] = test_uniform(rng, -1, 1);
-        }
-    }
-    for (i = 0; i < N; ++i) {
-        for (j = 0; j <= i; ++j) {
-            double sum = i == j ? 0.05 : 0.0;
-            for (k = 0; k < N; ++k) {
-                sum += a[i][k] * a[j][k];
-            }
-            p.cov[i][j] = p.cov[j][i] = (icoac_real_t)(scale * sum);
-        }
-    }
-    assert_int_equal(icoac_prior_check(&p), ICOAC_OK);
-    return p;
-}
-
 /* Random critic weights, so that non-terminal transitions have a TD error too. */
 static void random_critic(icoac_state_t *state, test_rng_t *rng, double amplitude)
 {
@@ -245,7 +219,7 @@ static void test_single_step_each_reading(void **unused)
         const int terminal = (n / 6) % 2;
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
-        icoac_prior_t p = random_prior(&rng, test_uniform(&rng, 0.02, 1.5));
+        icoac_prior_t p = test_random_prior(&rng, 0.5, test_uniform(&rng, 0.02, 1.5));
         icoac_input_t s1 = random_input(&rng, 0);
         icoac_input_t s2 = random_input(&rng, terminal ? ICOAC_INPUT_TERMINAL : 0u);
         icoac_output_t out1, out2;
@@ -309,7 +283,7 @@ static void test_single_step_each_reading(void **unused)
 static void test_readings_differ(void **unused)
 {
     test_rng_t rng = {0xD1FFu};
-    icoac_prior_t p = random_prior(&rng, 0.5);
+    icoac_prior_t p = test_random_prior(&rng, 0.5, 0.5);
     icoac_input_t s1 = test_input(0.5, -0.3, 0.05, 0.4, 0);
     icoac_input_t s2 = test_input(0.6, -0.3, 0.3, 0.4, ICOAC_INPUT_TERMINAL);
     gauss_t got[3];
@@ -349,7 +323,7 @@ static void run_keeps_prior(int reading, int n_ticks)
     test_rng_t rng = {0x10E6u + (uint64_t)reading};
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
-    icoac_prior_t p = random_prior(&rng, 0.3);
+    icoac_prior_t p = test_random_prior(&rng, 0.5, 0.3);
     const icoac_real_t trace = (p.cov[0][0] + p.cov[1][1]) + (p.cov[2][2] + p.cov[3][3]);
     icoac_input_t prev;
     icoac_output_t out, prev_out;
@@ -436,7 +410,7 @@ static void run_batch_case(const batch_case_t *bc, int n_case)
     test_rng_t rng = {0xBA7C4u + (uint64_t)n_case * 7919u};
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
-    icoac_prior_t p = random_prior(&rng, test_uniform(&rng, 0.1, 1.0));
+    icoac_prior_t p = test_random_prior(&rng, 0.5, test_uniform(&rng, 0.1, 1.0));
     int trial;
     cfg.mode = ICOAC_MODE_RL;
     cfg.actor.batch = 1;
@@ -597,7 +571,7 @@ static void test_explore_schedule(void **unused)
         test_rng_t rng = {0xE9u + (uint64_t)reading};
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
-        icoac_prior_t p = random_prior(&rng, 0.3);
+        icoac_prior_t p = test_random_prior(&rng, 0.5, 0.3);
         int trial, critic_moved = 0, actor_moved = 0;
         cfg.mode = ICOAC_MODE_RL;
         cfg.actor.update = reading;

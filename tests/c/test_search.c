@@ -64,32 +64,6 @@ static icoac_input_t random_input(test_rng_t *rng, uint32_t flags)
                       test_uniform(rng, -2.0, 2.0), flags);
 }
 
-/* A random prior N(m, s (A A^T + 0.05 I)), exactly symmetric. */
-static icoac_prior_t random_prior(test_rng_t *rng, double scale)
-{
-    icoac_prior_t p;
-    double a[N][N];
-    int i, j, k;
-    memset(&p, 0, sizeof p);
-    for (i = 0; i < N; ++i) {
-        p.mean[i] = (icoac_real_t)test_uniform(rng, -1.0, 1.0);
-        for (j = 0; j < N; ++j) {
-            a[i][j] = test_uniform(rng, -1, 1);
-        }
-    }
-    for (i = 0; i < N; ++i) {
-        for (j = 0; j <= i; ++j) {
-            double sum = i == j ? 0.05 : 0.0;
-            for (k = 0; k < N; ++k) {
-                sum += a[i][k] * a[j][k];
-            }
-            p.cov[i][j] = p.cov[j][i] = (icoac_real_t)(scale * sum);
-        }
-    }
-    assert_int_equal(icoac_prior_check(&p), ICOAC_OK);
-    return p;
-}
-
 static icoac_config_t search_config(int batch, double rho, double step, double floor_, double cov_scale)
 {
     icoac_config_t cfg = test_default_config();
@@ -382,7 +356,7 @@ static void test_update_matches_reference(void **unused)
         const double floor_ = n % 3 == 0 ? 1.5 : test_uniform(&rng, 1e-3, 0.5);
         const double cov_scale = 1.0 + (n % 4) * test_uniform(&rng, 0.5, 4.0);
         icoac_config_t cfg = search_config(batch, rho, step, floor_, cov_scale);
-        icoac_prior_t p = random_prior(&rng, test_uniform(&rng, 0.05, 1.0));
+        icoac_prior_t p = test_random_prior(&rng, 1.0, test_uniform(&rng, 0.05, 1.0));
         icoac_state_t state;
         double floor_d[N];
         int round, i, j;
@@ -679,7 +653,7 @@ static void test_step_one_small_elites(void **unused)
             reference_t want;
             if (u % 250 == 0) {
                 /* a fresh prior now and then: mu_w random-walks at a = 1 */
-                icoac_prior_t p = random_prior(&rng, test_uniform(&rng, 0.05, 1.0));
+                icoac_prior_t p = test_random_prior(&rng, 1.0, test_uniform(&rng, 0.05, 1.0));
                 assert_int_equal(icoac_init(&cfg, &state, u % 500 ? &p : NULL, 9u + (uint64_t)u), ICOAC_OK);
                 for (i = 0; i < N; ++i) {
                     floor_d[i] = (double)priv(&state)->search.floor[i];
@@ -842,7 +816,7 @@ static void test_samples_through_cholesky(void **unused)
     icoac_config_t cfg = search_config(8, 0.5, 0.6, 1e-3, 3.0);
     icoac_config_t frozen;
     icoac_state_t state;
-    icoac_prior_t p = random_prior(&rng, 0.5);
+    icoac_prior_t p = test_random_prior(&rng, 1.0, 0.5);
     gauss_t g;
     int i, j, k;
     (void)unused;
@@ -920,7 +894,7 @@ static void test_spd_over_many_updates(void **unused)
         const spd_case_t *sc = &cases[c];
         icoac_config_t cfg = search_config(sc->batch, sc->rho, sc->step, sc->floor_, sc->cov_scale);
         test_rng_t rng = {0x5BDu + c};
-        icoac_prior_t p = random_prior(&rng, 0.3);
+        icoac_prior_t p = test_random_prior(&rng, 1.0, 0.3);
         icoac_state_t state;
         const icoac_priv_state_t *st = priv(&state);
         int u, k, i, j;
@@ -977,7 +951,7 @@ static void test_deterministic_for_a_seed(void **unused)
 {
     icoac_config_t cfg = search_config(3, 0.5, 0.5, 0.1, 2.0);
     test_rng_t rng_p = {77u};
-    icoac_prior_t p = random_prior(&rng_p, 0.5);
+    icoac_prior_t p = test_random_prior(&rng_p, 1.0, 0.5);
     icoac_state_t a, b, other;
     test_rng_t inputs = {0xD5u};
     int trial;
@@ -1011,7 +985,7 @@ static void test_no_learning_control(void **unused)
     icoac_config_t learning = search_config(4, 0.5, 0.5, 0.1, 2.0);
     icoac_config_t control = learning;
     test_rng_t rng_p = {5u};
-    icoac_prior_t p = random_prior(&rng_p, 0.5);
+    icoac_prior_t p = test_random_prior(&rng_p, 1.0, 0.5);
     icoac_state_t c_state, l_state;
     icoac_state_t start;
     test_rng_t in_c = {9u}, in_l = {9u};
@@ -1055,7 +1029,7 @@ static void test_tick_outputs(void **unused)
     icoac_config_t cfg = search_config(2, 0.5, 0.5, 0.1, 1.0);
     icoac_state_t state;
     test_rng_t rng = {31u};
-    icoac_prior_t p = random_prior(&rng, 0.5);
+    icoac_prior_t p = test_random_prior(&rng, 1.0, 0.5);
     int k, i;
     (void)unused;
     assert_int_equal(icoac_init(&cfg, &state, &p, 8u), ICOAC_OK);
