@@ -10,7 +10,11 @@ APT_PACKAGES := cmake ninja-build gcc libc6-dev libcmocka-dev python3 python3-ve
   clang libclang-rt-14-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 BENCH_PROFILE ?= default
-BENCH_OUT ?= results/bench
+# The default profile writes results/bench and docs/figures; any other profile its own directories
+# (results/paper, docs/figures/paper), so the profiles never overwrite each other.
+BENCH_SUFFIX = $(if $(filter default,$(BENCH_PROFILE)),,/$(BENCH_PROFILE))
+BENCH_OUT ?= results/$(if $(BENCH_SUFFIX),$(BENCH_PROFILE),bench)
+BENCH_FIGURES ?= docs/figures$(BENCH_SUFFIX)
 # `make fuzz`: seconds per target, targets run at once, extra libFuzzer options.
 FUZZ_TIME ?= 600
 FUZZ_JOBS ?= 2
@@ -88,11 +92,12 @@ fuzz: build-fuzz
 bench-speed: build
 	./build/release/sim_host/icoac_bench
 
+# BENCH_ARGS: more bench options, e.g. BENCH_ARGS=--resume to continue a stopped run.
 # The linear-policy ceiling first (about 40 s; a rerun replays its cached search), then the
 # bench, which shows it in summary.md and Fig. 3a.
 bench: build venv bench-speed
 	$(VPY) -m harness ceiling --out $(BENCH_OUT)/ceiling --quiet
-	$(VPY) -m harness bench --profile $(BENCH_PROFILE) --out $(BENCH_OUT) --figures docs/figures
+	$(VPY) -m harness bench --profile $(BENCH_PROFILE) --out $(BENCH_OUT) --figures $(BENCH_FIGURES) $(BENCH_ARGS)
 
 # The learner sweeps that chose the defaults (docs/results.md), on the ICO grid of seed 0 of a
 # bench (make bench first); resumable, summary in $(SWEEP_OUT)/summary.md.
