@@ -1,8 +1,9 @@
 /* Normalized Gaussian critic on the 3x3x6x3 grid (spec 6), evaluated separably:
  * a_k = prod_i f_i(k_i) and sum_k a_k = prod_i sum_j f_i(j), so the normalized
  * activation is b_k = prod_i g_i(k_i) with per-dimension normalized factors g.
- * Units with b_k below critic->threshold count as 0 (spec 6); the value pass lists the
- * units it kept, and the TD update of the next tick walks that list.
+ * Units with b_k below critic->threshold count as 0 (spec 6). This file: the factors and the
+ * sparse kernel (the dense one is icoac_critic_dense.c); its value pass lists the units it
+ * kept, and the TD update of the next tick walks that list.
  * Layout: k = pair * 18 + cell with pair = a*3 + b over (x, x_dot) and cell = c*3 + d over
  * (theta, theta_dot); b_k is evaluated as (g_x[a] g_xd[b]) * (g_th[c] g_thd[d]).
  * All factors are <= 1, so a pair or cell product below the threshold rules out every unit it
@@ -86,9 +87,8 @@ void icoac_priv_critic_factors(const icoac_critic_config_t *critic, const icoac_
 
 #define ICOAC_CELLS ICOAC_CRITIC_CELLS
 
-/* Units are kept when b_k >= this floor: the threshold, or with threshold 0 the smallest
- * normal number (b_k below it is 0 under flush-to-zero and adds nothing to V either way). */
-static inline icoac_real_t kept_floor(const icoac_critic_config_t *critic)
+/* b_k below the smallest normal number is 0 under flush-to-zero and adds nothing to V either way. */
+icoac_real_t icoac_priv_critic_floor(const icoac_critic_config_t *critic)
 {
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
     const icoac_real_t smallest_normal = DBL_MIN;
@@ -114,7 +114,7 @@ static inline void kept_range(const icoac_real_t *g, int n, icoac_real_t thresho
 
 /* Cells with g_th g_thd >= threshold, sorted by product (largest first, ties in cell order). */
 static int sorted_cells(const icoac_real_t *gth, const icoac_real_t *gthd, icoac_real_t threshold,
-                        icoac_priv_critic_active_t *active)
+                        icoac_priv_critic_list_t *active)
 {
     int cells = 0;
     int c_begin, c_end, d_begin, d_end;
@@ -145,11 +145,12 @@ static int sorted_cells(const icoac_real_t *gth, const icoac_real_t *gthd, icoac
     return cells;
 }
 
-icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic, const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                                     const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
-                                     icoac_priv_critic_active_t *active)
+icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic,
+                                            const icoac_real_t v[ICOAC_CRITIC_UNITS],
+                                            const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+                                            icoac_priv_critic_list_t *active)
 {
-    const icoac_real_t threshold = kept_floor(critic);
+    const icoac_real_t threshold = icoac_priv_critic_floor(critic);
     const icoac_real_t *gx = factors;
     const icoac_real_t *gxd = gx + ICOAC_CRITIC_N_X;
     const icoac_real_t *gth = gxd + ICOAC_CRITIC_N_X_DOT;
@@ -193,9 +194,9 @@ icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic, const 
     return value;
 }
 
-/* v_k += step * b_k over the units listed by icoac_priv_critic_value. */
-void icoac_priv_critic_update(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_active_t *active,
-                              icoac_real_t step)
+/* v_k += step * b_k over the units listed by icoac_priv_critic_value_sparse. */
+void icoac_priv_critic_update_sparse(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_list_t *active,
+                                     icoac_real_t step)
 {
     int p;
     int i;

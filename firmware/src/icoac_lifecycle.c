@@ -7,8 +7,8 @@ static void clear_trial(icoac_priv_state_t *st)
     st->value_prev = ICOAC_R(0.0);
     st->noise_prev = ICOAC_R(0.0);
     memset(st->x_prev, 0, sizeof st->x_prev);
-    st->active[0].pairs = 0u;
-    st->active[1].pairs = 0u;
+    icoac_priv_critic_clear(&st->active[0]);
+    icoac_priv_critic_clear(&st->active[1]);
     st->trial_ticks = 0u;
     memset(&st->batch, 0, sizeof st->batch);
 }

@@ -209,15 +209,66 @@ int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
 int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_N_INPUTS],
                        const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out);
 
-/* Critic (icoac_critic.c): per-dimension normalized factors of s, V(s) with its kept-unit
- * list, and the TD update v_k += step * b_k over such a list. */
+/* Critic: per-dimension normalized factors of s (icoac_critic.c), V(s) with the units it kept,
+ * and the TD update v_k += step * b_k over such units. Two kernels compute the same units:
+ * - sparse (icoac_critic.c), for microcontrollers: a sorted list of the kept cells, walked in
+ *   leading runs per pair; V sums in that order.
+ * - dense (icoac_critic_dense.c), for hosts: every unit with a mask, in fixed-length loops a
+ *   compiler vectorizes, without data-dependent branches; V sums per cell over the pairs, then
+ *   over the cells.
+ * The update adds the same step to the same units in both; V differs by the rounding of the
+ * sum's order. ICOAC_CRITIC_DENSE=1 (the host build's default, CMake ICOAC_CRITIC_KERNEL)
+ * selects the dense kernel in icoac_priv_critic_value / _update; both are always built. */
 void icoac_priv_critic_factors(const icoac_critic_config_t *critic, const icoac_real_t s[ICOAC_N_INPUTS],
                                icoac_real_t factors[ICOAC_CRITIC_FACTORS]);
-icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic, const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                                     const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
-                                     icoac_priv_critic_active_t *active);
-void icoac_priv_critic_update(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_active_t *active,
-                              icoac_real_t step);
+/* b_k below this floor counts as 0: the threshold, or with threshold 0 the smallest normal number. */
+icoac_real_t icoac_priv_critic_floor(const icoac_critic_config_t *critic);
+icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic,
+                                            const icoac_real_t v[ICOAC_CRITIC_UNITS],
+                                            const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+                                            icoac_priv_critic_list_t *list);
+void icoac_priv_critic_update_sparse(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_list_t *list,
+                                     icoac_real_t step);
+icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic,
+                                           const icoac_real_t v[ICOAC_CRITIC_UNITS],
+                                           const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+                                           icoac_priv_critic_products_t *products);
+void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, icoac_real_t v[ICOAC_CRITIC_UNITS],
+                                    const icoac_priv_critic_products_t *products, icoac_real_t step);
+
+/* No unit kept: the empty eligibility of a trial's start. */
+static inline void icoac_priv_critic_clear(icoac_priv_critic_active_t *active)
+{
+#if defined(ICOAC_CRITIC_DENSE) && ICOAC_CRITIC_DENSE
+    active->dense.cell_begin = 0u;
+    active->dense.cell_end = 0u;
+#else
+    active->sparse.pairs = 0u;
+#endif
+}
+
+static inline icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic,
+                                                   const icoac_real_t v[ICOAC_CRITIC_UNITS],
+                                                   const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+                                                   icoac_priv_critic_active_t *active)
+{
+#if defined(ICOAC_CRITIC_DENSE) && ICOAC_CRITIC_DENSE
+    return icoac_priv_critic_value_dense(critic, v, factors, &active->dense);
+#else
+    return icoac_priv_critic_value_sparse(critic, v, factors, &active->sparse);
+#endif
+}
+
+static inline void icoac_priv_critic_update(const icoac_critic_config_t *critic, icoac_real_t v[ICOAC_CRITIC_UNITS],
+                                            const icoac_priv_critic_active_t *active, icoac_real_t step)
+{
+#if defined(ICOAC_CRITIC_DENSE) && ICOAC_CRITIC_DENSE
+    icoac_priv_critic_update_dense(critic, v, &active->dense, step);
+#else
+    (void)critic;
+    icoac_priv_critic_update_sparse(v, &active->sparse, step);
+#endif
+}
 
 /* Actor (icoac_actor.c). The step reads mu_w, Sigma_w and the batch sums from st and stages
  * the candidate mu_w in w, Sigma_w in cov (the spare buffer) and the batch's shift in its

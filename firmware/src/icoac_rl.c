@@ -87,7 +87,7 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     }
     /* commit */
     if (update) {
-        icoac_priv_critic_update(st->v, &st->active[cfg->critic.quirks ? slot_prev ^ 1 : slot_prev],
+        icoac_priv_critic_update(&cfg->critic, st->v, &st->active[cfg->critic.quirks ? slot_prev ^ 1 : slot_prev],
                                  cfg->critic.rate * checked[1]);
         icoac_priv_copy4(st->w, w);
         st->cov_slot ^= cov_changed;

@@ -16,7 +16,8 @@
 #define ICOAC_PRIV_STATE_MAGIC 0x1C0AC001u
 
 /* Critic units kept (b_k >= critic.threshold) at one state: the eligibility of the next TD
- * update. Pair p keeps the units of its first pair_cells[p] cells, in the listed cell order. */
+ * update, in the layout of the critic kernel that found them (icoac_priv.h).
+ * Sparse kernel: pair p keeps the units of its first pair_cells[p] cells, in the listed order. */
 typedef struct {
     icoac_real_t pair_product[ICOAC_CRITIC_PAIRS];     /* g_x * g_xdot of each listed pair */
     icoac_real_t cell_product[ICOAC_CRITIC_CELLS + 1]; /* g_theta * g_thetadot, largest first; 0 */
@@ -25,6 +26,21 @@ typedef struct {
     uint8_t cell[ICOAC_CRITIC_CELLS];                  /* c*3 + d */
     uint8_t pairs;                                     /* pairs listed */
     uint8_t cells;                                     /* cells listed */
+} icoac_priv_critic_list_t;
+
+/* Dense kernel: the products of every pair and every cell; unit pair * 18 + cell is kept when
+ * pair_product[pair] * cell_product[cell] reaches the threshold. Only cells in
+ * [cell_begin, cell_end) can be (the others have a product below it). */
+typedef struct {
+    icoac_real_t pair_product[ICOAC_CRITIC_PAIRS]; /* g_x[a] * g_xdot[b], pair = a*3 + b */
+    icoac_real_t cell_product[ICOAC_CRITIC_CELLS]; /* g_theta[c] * g_thetadot[d], cell = c*3 + d */
+    uint8_t cell_begin;
+    uint8_t cell_end; /* <= cell_begin: no unit kept */
+} icoac_priv_critic_products_t;
+
+typedef union {
+    icoac_priv_critic_list_t sparse;
+    icoac_priv_critic_products_t dense;
 } icoac_priv_critic_active_t;
 
 /* Per-trial sums of the actor's batch granularity (actor.batch), over the explored ticks. */

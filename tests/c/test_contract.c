@@ -105,27 +105,35 @@ static icoac_status_t checked_step(const icoac_config_t *cfg, icoac_state_t *sta
 /* Reproducer 1, first half: NaN critic factors (what a subnormal critic_range produced) must
  * not run the kept-unit scans off their arrays. Before the fix they read past the end of
  * cell_product (ASan: stack-buffer-overflow) and wrote through the indices they found. Here
- * NaN in every factor, then only in the (theta, theta_dot) factors: the value is then NaN,
- * which the tick rejects. */
+ * NaN in every factor, then only in the (theta, theta_dot) factors, for both kernels. The
+ * sparse kernel keeps nothing in the first case (V = 0) and gives NaN in the second; the dense
+ * one counts a NaN product as kept, so V is NaN in both, which the tick rejects. */
 static void check_scan(const icoac_critic_config_t *critic, const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                       const icoac_real_t factors[ICOAC_CRITIC_FACTORS], int expect_nan)
+                       const icoac_real_t factors[ICOAC_CRITIC_FACTORS], int sparse_nan)
 {
-    icoac_priv_critic_active_t active[2]; /* a neighbour to overrun into, as in the state */
+    icoac_priv_critic_list_t list[2]; /* a neighbour to overrun into, as in the state */
+    icoac_priv_critic_products_t products[2];
     icoac_real_t value;
     int i;
-    memset(active, 0, sizeof active);
-    value = icoac_priv_critic_value(critic, v, factors, &active[0]);
-    assert_int_equal(isnan((double)value) ? 1 : 0, expect_nan);
-    assert_true(active[0].cells <= ICOAC_CRITIC_CELLS);
-    assert_true(active[0].pairs <= ICOAC_CRITIC_PAIRS);
-    for (i = 0; i < active[0].pairs; ++i) {
-        assert_true(active[0].pair_cells[i] <= active[0].cells);
-        assert_true(active[0].pair[i] < ICOAC_CRITIC_PAIRS);
+    memset(list, 0, sizeof list);
+    value = icoac_priv_critic_value_sparse(critic, v, factors, &list[0]);
+    assert_int_equal(isnan((double)value) ? 1 : 0, sparse_nan);
+    assert_true(list[0].cells <= ICOAC_CRITIC_CELLS);
+    assert_true(list[0].pairs <= ICOAC_CRITIC_PAIRS);
+    for (i = 0; i < list[0].pairs; ++i) {
+        assert_true(list[0].pair_cells[i] <= list[0].cells);
+        assert_true(list[0].pair[i] < ICOAC_CRITIC_PAIRS);
     }
-    for (i = 0; i < active[0].cells; ++i) {
-        assert_true(active[0].cell[i] < ICOAC_CRITIC_CELLS);
+    for (i = 0; i < list[0].cells; ++i) {
+        assert_true(list[0].cell[i] < ICOAC_CRITIC_CELLS);
     }
-    assert_true(active[1].pairs == 0 && active[1].cells == 0);
+    assert_true(list[1].pairs == 0 && list[1].cells == 0);
+    memset(products, 0, sizeof products);
+    value = icoac_priv_critic_value_dense(critic, v, factors, &products[0]);
+    assert_true(isnan((double)value));
+    assert_true(products[0].cell_begin <= products[0].cell_end);
+    assert_true(products[0].cell_end <= ICOAC_CRITIC_CELLS);
+    assert_true(products[1].cell_begin == 0 && products[1].cell_end == 0);
 }
 
 static void test_critic_scan_bounded_for_nan(void **unused)
@@ -142,7 +150,7 @@ static void test_critic_scan_bounded_for_nan(void **unused)
     for (i = 0; i < ICOAC_CRITIC_FACTORS; ++i) {
         factors[i] = (icoac_real_t)NAN;
     }
-    check_scan(&cfg.critic, v, factors, 0); /* no pair passes: nothing kept */
+    check_scan(&cfg.critic, v, factors, 0); /* sparse: no pair passes, nothing kept */
     icoac_priv_critic_factors(&cfg.critic, s, factors);
     for (i = ICOAC_CRITIC_N_X + ICOAC_CRITIC_N_X_DOT; i < ICOAC_CRITIC_FACTORS; ++i) {
         factors[i] = (icoac_real_t)(i % 2 ? NAN : -NAN);

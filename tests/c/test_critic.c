@@ -1,5 +1,6 @@
 /* NGnet critic (spec 6): separable evaluation against the direct 4-D formula, the activity
- * threshold and the kept-unit list, and the TD(0) update through icoac_step in RL mode. */
+ * threshold and the kept-unit list, for both kernels (sparse: microcontrollers, dense: hosts);
+ * the dense kernel against the sparse one; the TD(0) update through icoac_step in RL mode. */
 #include "test_common.h"
 
 #include "icoac_priv.h"
@@ -60,9 +61,29 @@ static int near_threshold(double b, double threshold)
     return threshold > 0 && fabs(b - threshold) < 1e-5 * threshold;
 }
 
-/* b_k(s) from the library: the value pass lists the kept units, and an update with step 1 on
+/* The two critic kernels, whichever the build selects for icoac_step. */
+enum { SPARSE, DENSE, KERNELS };
+
+static icoac_real_t kernel_value(int kernel, const icoac_critic_config_t *critic, const icoac_real_t *v,
+                                 const icoac_real_t *factors, icoac_priv_critic_active_t *active)
+{
+    return kernel == DENSE ? icoac_priv_critic_value_dense(critic, v, factors, &active->dense)
+                           : icoac_priv_critic_value_sparse(critic, v, factors, &active->sparse);
+}
+
+static void kernel_update(int kernel, const icoac_critic_config_t *critic, icoac_real_t *v,
+                          const icoac_priv_critic_active_t *active, icoac_real_t step)
+{
+    if (kernel == DENSE) {
+        icoac_priv_critic_update_dense(critic, v, &active->dense, step);
+    } else {
+        icoac_priv_critic_update_sparse(v, &active->sparse, step);
+    }
+}
+
+/* b_k(s) from a kernel: the value pass finds the kept units, and an update with step 1 on
  * v = 0 writes their b_k into v. */
-static void library_b(const icoac_critic_config_t *critic, const icoac_real_t s[4], double b[K])
+static void library_b(int kernel, const icoac_critic_config_t *critic, const icoac_real_t s[4], double b[K])
 {
     icoac_real_t factors[ICOAC_CRITIC_FACTORS];
     icoac_real_t v[K];
@@ -70,8 +91,8 @@ static void library_b(const icoac_critic_config_t *critic, const icoac_real_t s[
     int k;
     memset(v, 0, sizeof v);
     icoac_priv_critic_factors(critic, s, factors);
-    assert_true(icoac_priv_critic_value(critic, v, factors, &active) == 0);
-    icoac_priv_critic_update(v, &active, (icoac_real_t)1.0);
+    assert_true(kernel_value(kernel, critic, v, factors, &active) == 0);
+    kernel_update(kernel, critic, v, &active, (icoac_real_t)1.0);
     for (k = 0; k < K; ++k) {
         b[k] = (double)v[k];
     }
@@ -136,23 +157,24 @@ static void test_separable_equals_direct(void **unused)
     int n, k;
     (void)unused;
     cfg.critic.threshold = 0; /* every unit */
-    for (n = 0; n < 400; ++n) {
+    for (n = 0; n < 2 * 400; ++n) {
+        const int kernel = n / 400;
         icoac_real_t s[4];
         double sum = 0;
-        random_state(&rng, n >= 200, s);
-        if (n == 0) {
+        random_state(&rng, n % 400 >= 200, s);
+        if (n % 400 == 0) {
             s[0] = s[1] = s[2] = s[3] = 0; /* between centres in theta */
-        } else if (n == 1) {
+        } else if (n % 400 == 1) {
             s[0] = (icoac_real_t)1.6; /* on a centre in x */
             s[1] = (icoac_real_t)-1e6;
             s[2] = (icoac_real_t)100.0;
             s[3] = (icoac_real_t)-1e4;
         }
-        library_b(&cfg.critic, s, bl);
+        library_b(kernel, &cfg.critic, s, bl);
         direct_b(s, bd);
         for (k = 0; k < K; ++k) {
             if (!(fabs(bl[k] - bd[k]) <= b_tol())) {
-                print_error("state %d (%g, %g, %g, %g) unit %d: %.10g vs %.10g\n", n, (double)s[0],
+                print_error("kernel %d state %d (%g, %g, %g, %g) unit %d: %.10g vs %.10g\n", kernel, n, (double)s[0],
                             (double)s[1], (double)s[2], (double)s[3], k, bl[k], bd[k]);
                 fail();
             }
@@ -163,7 +185,7 @@ static void test_separable_equals_direct(void **unused)
     }
 }
 
-static void check_value(icoac_config_t cfg, unsigned seed)
+static void check_value(icoac_config_t cfg, unsigned seed, int kernel)
 {
     test_rng_t rng = {seed};
     icoac_real_t v[K], factors[ICOAC_CRITIC_FACTORS], s[4];
@@ -182,7 +204,7 @@ static void check_value(icoac_config_t cfg, unsigned seed)
             expected += (double)v[k] * bd[k];
             slack += near_threshold(bd[k], (double)cfg.critic.threshold) ? fabs((double)v[k]) * bd[k] : 0;
         }
-        assert_close(icoac_priv_critic_value(&cfg.critic, v, factors, &active), expected,
+        assert_close(kernel_value(kernel, &cfg.critic, v, factors, &active), expected,
                      slack + (REAL_IS_FLOAT ? 1e-5 : 1e-12));
     }
 }
@@ -190,12 +212,16 @@ static void check_value(icoac_config_t cfg, unsigned seed)
 static void test_value_is_weighted_sum(void **unused)
 {
     icoac_config_t cfg = test_default_config();
+    int kernel;
     (void)unused;
-    check_value(cfg, 31u); /* default threshold 0.001 */
-    cfg.critic.threshold = 0;
-    check_value(cfg, 32u);
-    cfg.critic.threshold = (icoac_real_t)0.05;
-    check_value(cfg, 33u);
+    for (kernel = SPARSE; kernel < KERNELS; ++kernel) {
+        cfg.critic.threshold = (icoac_real_t)0.001; /* the default */
+        check_value(cfg, 31u, kernel);
+        cfg.critic.threshold = 0;
+        check_value(cfg, 32u, kernel);
+        cfg.critic.threshold = (icoac_real_t)0.05;
+        check_value(cfg, 33u, kernel);
+    }
 }
 
 static void test_threshold_drops_small_activations(void **unused)
@@ -206,10 +232,10 @@ static void test_threshold_drops_small_activations(void **unused)
     int n, k, dropped = 0, kept = 0;
     (void)unused;
     assert_true(cfg.critic.threshold == (icoac_real_t)0.001); /* the authors' cut-off is the default */
-    for (n = 0; n < 200; ++n) {
+    for (n = 0; n < 2 * 200; ++n) {
         icoac_real_t s[4];
-        random_state(&rng, n >= 150, s);
-        library_b(&cfg.critic, s, bl);
+        random_state(&rng, n % 200 >= 150, s);
+        library_b(n / 200, &cfg.critic, s, bl);
         direct_b(s, bd);
         for (k = 0; k < K; ++k) {
             if (near_threshold(bd[k], 0.001)) {
@@ -227,14 +253,14 @@ static void test_threshold_drops_small_activations(void **unused)
     assert_true(dropped > 0 && kept > 0);
 }
 
-/* The kept-unit list: pairs in order with their leading cells, cells sorted by product with a
+/* The sparse kernel's kept-unit list: pairs in order with their leading cells, cells sorted by product with a
  * zero sentinel, and exactly the units with b_k >= threshold. */
 static void test_kept_unit_list(void **unused)
 {
     icoac_config_t cfg = test_default_config();
     test_rng_t rng = {12u};
     icoac_real_t factors[ICOAC_CRITIC_FACTORS], v[K], s[4];
-    icoac_priv_critic_active_t active;
+    icoac_priv_critic_list_t active;
     int n, i, p, total_kept = 0;
     (void)unused;
     memset(v, 0, sizeof v);
@@ -243,7 +269,7 @@ static void test_kept_unit_list(void **unused)
         int listed[K];
         random_state(&rng, n % 3 == 2, s);
         icoac_priv_critic_factors(&cfg.critic, s, factors);
-        (void)icoac_priv_critic_value(&cfg.critic, v, factors, &active);
+        (void)icoac_priv_critic_value_sparse(&cfg.critic, v, factors, &active);
         direct_b(s, bd);
         assert_true(active.cells <= ICOAC_CRITIC_CELLS && active.pairs <= ICOAC_CRITIC_PAIRS);
         assert_true(active.cell_product[active.cells] == 0);
@@ -276,12 +302,55 @@ static void test_kept_unit_list(void **unused)
     s[2] = (icoac_real_t)0.01;
     s[3] = (icoac_real_t)0.1;
     icoac_priv_critic_factors(&cfg.critic, s, factors);
-    (void)icoac_priv_critic_value(&cfg.critic, v, factors, &active);
+    (void)icoac_priv_critic_value_sparse(&cfg.critic, v, factors, &active);
     assert_int_equal(active.pairs, ICOAC_CRITIC_PAIRS);
     assert_int_equal(active.cells, ICOAC_CRITIC_CELLS);
     for (p = 0; p < active.pairs; ++p) {
         assert_int_equal(active.pair_cells[p], ICOAC_CRITIC_CELLS);
     }
+}
+
+/* The host kernel against the microcontroller kernel: on random states (inside and far outside
+ * the grid), weights and steps, over thresholds 0, the default and 0.05, both keep the same
+ * units, so a sequence of updates with the same steps leaves both weight vectors equal bit for
+ * bit; V differs only by the rounding of the sum's order (relative to sum |v_k b_k|). */
+static void test_dense_matches_sparse(void **unused)
+{
+    const icoac_real_t thresholds[3] = {(icoac_real_t)0.0, (icoac_real_t)0.001, (icoac_real_t)0.05};
+    icoac_config_t cfg = test_default_config();
+    test_rng_t rng = {0xD15Eu};
+    icoac_real_t v_sparse[K], v_dense[K], factors[ICOAC_CRITIC_FACTORS], s[4];
+    icoac_priv_critic_active_t sparse, dense;
+    double max_rel = 0;
+    int t, n, k;
+    (void)unused;
+    for (t = 0; t < 3; ++t) {
+        cfg.critic.threshold = thresholds[t];
+        for (k = 0; k < K; ++k) {
+            v_sparse[k] = v_dense[k] = (icoac_real_t)test_uniform(&rng, -2, 2);
+        }
+        for (n = 0; n < 3000; ++n) {
+            double bd[K], magnitude = 0;
+            icoac_real_t value_sparse, value_dense, step;
+            random_state(&rng, n % 10 == 9, s);
+            icoac_priv_critic_factors(&cfg.critic, s, factors);
+            value_sparse = kernel_value(SPARSE, &cfg.critic, v_sparse, factors, &sparse);
+            value_dense = kernel_value(DENSE, &cfg.critic, v_dense, factors, &dense);
+            direct_b(s, bd);
+            for (k = 0; k < K; ++k) {
+                magnitude += fabs((double)v_sparse[k]) * bd[k];
+            }
+            assert_close(value_dense, value_sparse, (REAL_IS_FLOAT ? 2e-6 : 1e-14) * magnitude + 1e-30);
+            if (magnitude > 0) {
+                max_rel = fmax(max_rel, fabs((double)value_dense - (double)value_sparse) / magnitude);
+            }
+            step = (icoac_real_t)test_uniform(&rng, -0.05, 0.05);
+            kernel_update(SPARSE, &cfg.critic, v_sparse, &sparse, step);
+            kernel_update(DENSE, &cfg.critic, v_dense, &dense, step);
+            assert_memory_equal(v_dense, v_sparse, sizeof v_sparse);
+        }
+    }
+    assert_true(max_rel > 0); /* the orders do differ: the comparison is not vacuous */
 }
 
 static void step_ok(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
@@ -376,6 +445,7 @@ int main(void)
         cmocka_unit_test(test_value_is_weighted_sum),
         cmocka_unit_test(test_threshold_drops_small_activations),
         cmocka_unit_test(test_kept_unit_list),
+        cmocka_unit_test(test_dense_matches_sparse),
         cmocka_unit_test(test_td_update_through_step),
         cmocka_unit_test(test_td_clip),
     };
