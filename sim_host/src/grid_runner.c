@@ -9,40 +9,74 @@
 #define SIM_MAX_THREADS 256
 
 typedef struct {
-    const icoac_config_t *cfg;
-    const icoac_sim_plant_t *plant;
-    const icoac_sim_run_t *run;
-    const icoac_prior_t *prior;
+    sim_job_t sim;
     icoac_sim_cell_t *cells;
     int64_t n_cells;
-    const volatile int32_t *cancel;
-    volatile int64_t *progress;
     int64_t next_cell;       /* atomic */
     int32_t cancelled;       /* atomic */
 } grid_job_t;
 
-static void *worker(void *arg)
+/* The next pending cell started on lane: SIM_LANE_RUNNING, SIM_LANE_DONE when no cell is left,
+ * or SIM_LANE_CANCELLED. A cell whose controller cannot be initialised gets its status and the
+ * outcome ICOAC_SIM_ERROR. */
+static int take_cell(grid_job_t *job, sim_lane_t *lane)
 {
-    grid_job_t *job = (grid_job_t *)arg;
-    (void)sim_fpu_flush_subnormals(); /* a fresh thread: nothing to restore */
     for (;;) {
         const int64_t i = __atomic_fetch_add(&job->next_cell, 1, __ATOMIC_RELAXED);
         int32_t status;
+        int state;
         if (i >= job->n_cells) {
-            break;
+            return SIM_LANE_DONE;
         }
         if (job->cells[i].outcome != ICOAC_SIM_PENDING) {
             continue;
         }
-        status = sim_run_cell_checked(job->cfg, job->plant, job->run, job->prior, &job->cells[i],
-                                      job->cancel, job->progress);
-        if (status == ICOAC_SIM_CANCELLED) {
-            __atomic_store_n(&job->cancelled, 1, __ATOMIC_RELAXED);
-            break;
-        }
+        status = sim_lane_init(&job->sim, lane, &job->cells[i]);
         if (status != ICOAC_SIM_OK) {
             job->cells[i].status = status;
             __atomic_store_n(&job->cells[i].outcome, ICOAC_SIM_ERROR, __ATOMIC_RELEASE);
+            continue;
+        }
+        state = sim_lane_start(&job->sim, lane);
+        if (state != SIM_LANE_DONE) {
+            return state;
+        }
+    }
+}
+
+/* ICOAC_SIM_LANES cells in lockstep; a lane whose cell finished takes the next one. On a cancel the
+ * thread stops, and the cells of its other lanes stay PENDING (nothing of them was written). */
+static void *worker(void *arg)
+{
+    grid_job_t *job = (grid_job_t *)arg;
+    sim_lane_t lanes[ICOAC_SIM_LANES];
+    sim_lane_t *running[ICOAC_SIM_LANES];
+    int active = 0;
+    int l;
+    (void)sim_fpu_flush_subnormals(); /* a fresh thread: nothing to restore */
+    for (l = 0; l < ICOAC_SIM_LANES; ++l) {
+        const int state = take_cell(job, &lanes[l]);
+        if (state == SIM_LANE_CANCELLED) {
+            __atomic_store_n(&job->cancelled, 1, __ATOMIC_RELAXED);
+            return 0;
+        }
+        if (state == SIM_LANE_RUNNING) {
+            running[active++] = &lanes[l];
+        }
+    }
+    while (active > 0) {
+        for (l = 0; l < active; ++l) {
+            int state = sim_lane_tick(&job->sim, running[l]);
+            if (state == SIM_LANE_DONE) {
+                state = take_cell(job, running[l]);
+            }
+            if (state == SIM_LANE_CANCELLED) {
+                __atomic_store_n(&job->cancelled, 1, __ATOMIC_RELAXED);
+                return 0;
+            }
+            if (state == SIM_LANE_DONE) { /* no cell left for it */
+                running[l--] = running[--active];
+            }
         }
     }
     return 0;
@@ -94,14 +128,14 @@ int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_plant_t *p
             return status;
         }
     }
-    job.cfg = cfg;
-    job.plant = plant;
-    job.run = run;
-    job.prior = prior;
+    job.sim.cfg = cfg;
+    job.sim.plant = plant;
+    job.sim.run = run;
+    job.sim.prior = prior;
+    job.sim.cancel = cancel;
+    job.sim.progress = progress;
     job.cells = cells;
     job.n_cells = n_cells;
-    job.cancel = cancel;
-    job.progress = progress;
     job.next_cell = 0;
     job.cancelled = 0;
     n = thread_count(n_threads, n_cells);

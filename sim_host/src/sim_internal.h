@@ -29,11 +29,44 @@ void sim_start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t *rn
 /* The plant state as the controller's input; values outside its real range become NaN. */
 void sim_to_input(const double s[ICOAC_N_INPUTS], uint32_t flags, icoac_input_t *in);
 
-/* icoac_sim_run_cell without the argument checks (trial.c). */
-int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                             const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                             icoac_sim_cell_t *cell, const volatile int32_t *cancel,
-                             volatile int64_t *progress);
+/* What every cell of a run shares. */
+typedef struct {
+    const icoac_config_t *cfg;
+    const icoac_sim_plant_t *plant;
+    const icoac_sim_run_t *run;
+    const icoac_prior_t *prior;
+    const volatile int32_t *cancel;
+    volatile int64_t *progress;
+} sim_job_t;
+
+/* A cell in progress (trial.c): its controller, plant state and counters. A worker thread
+ * advances ICOAC_SIM_LANES of them in lockstep, one tick each in turn: their ticks are
+ * independent, so the processor overlaps one lane's dependency chain (controller -> force ->
+ * plant -> next observation) with the other's. */
+typedef struct {
+    icoac_state_t ctrl;
+    icoac_rng_t rng; /* the plant's: start velocities */
+    double s[ICOAC_N_INPUTS];
+    icoac_sim_cell_t *cell;
+    int64_t trials; /* finished trials */
+    int64_t total;  /* their steps */
+    int64_t steps;  /* steps of the trial in progress */
+    int32_t status;
+} sim_lane_t;
+
+/* sim_lane_start and sim_lane_tick: the lane runs on, its cell was written (outcome last, with
+ * release order), or the run was cancelled at the start of a trial (the cell left as it was). */
+#define SIM_LANE_RUNNING 0
+#define SIM_LANE_DONE 1
+#define SIM_LANE_CANCELLED 2
+
+/* A fresh controller for cell on lane; returns the status of icoac_init (the lane is unusable
+ * unless ICOAC_SIM_OK, and the cell untouched). */
+int32_t sim_lane_init(const sim_job_t *job, sim_lane_t *lane, icoac_sim_cell_t *cell);
+/* The first trial of an initialised lane: SIM_LANE_*. */
+int sim_lane_start(const sim_job_t *job, sim_lane_t *lane);
+/* One tick and plant step; at a trial's end the next trial or the cell's result: SIM_LANE_*. */
+int sim_lane_tick(const sim_job_t *job, sim_lane_t *lane);
 
 /* Flush subnormals to zero on this thread; returns the previous mode for sim_fpu_restore (fpu.c). */
 uint32_t sim_fpu_flush_subnormals(void);

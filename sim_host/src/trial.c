@@ -1,11 +1,16 @@
 /* The benchmark trial loop of one cell (spec 8-9): trials from a fresh controller until one
- * lasts success_steps or max_trials have failed. */
+ * lasts success_steps or max_trials have failed, as a lane (sim_internal.h) that advances one
+ * tick per call, so that a worker thread can interleave several cells. */
 #include <float.h>
 #include <math.h>
 #include <string.h>
 
 #include "icoac_sim/icoac_sim.h"
 #include "sim_internal.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
 #define SIM_REAL_MAX DBL_MAX
@@ -29,13 +34,30 @@ void sim_start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t *rn
 }
 
 /* The plant state as the controller's reals. A value outside the real type's range would be
- * an undefined conversion: it is passed as NaN, which the controller rejects. */
+ * an undefined conversion: it is passed as NaN, which the controller rejects.
+ * With SSE2 and float reals the four values go out in one 16-byte store. The compiler
+ * vectorizes icoac_step's reads of in->s into one 16-byte load, which cannot be forwarded from
+ * four 4-byte stores: it then waits until they retire, and that serializes the ticks of the
+ * engine's lanes (measured: two lanes in lockstep ran no faster than one). */
 void sim_to_input(const double s[4], uint32_t flags, icoac_input_t *in)
 {
+#if defined(__SSE2__) && !(defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE)
+    const __m128d magnitude = _mm_castsi128_pd(_mm_set1_epi64x(0x7FFFFFFFFFFFFFFFll));
+    const __m128d limit = _mm_set1_pd(SIM_REAL_MAX);
+    const __m128d nan = _mm_set1_pd((double)NAN);
+    const __m128d low = _mm_set_pd(s[1], s[0]);
+    const __m128d high = _mm_set_pd(s[3], s[2]);
+    const __m128d low_ok = _mm_cmple_pd(_mm_and_pd(low, magnitude), limit); /* false for NaN */
+    const __m128d high_ok = _mm_cmple_pd(_mm_and_pd(high, magnitude), limit);
+    const __m128 low_real = _mm_cvtpd_ps(_mm_or_pd(_mm_and_pd(low_ok, low), _mm_andnot_pd(low_ok, nan)));
+    const __m128 high_real = _mm_cvtpd_ps(_mm_or_pd(_mm_and_pd(high_ok, high), _mm_andnot_pd(high_ok, nan)));
+    _mm_storeu_ps(in->s, _mm_movelh_ps(low_real, high_real));
+#else
     int i;
     for (i = 0; i < ICOAC_N_INPUTS; ++i) {
         in->s[i] = fabs(s[i]) <= SIM_REAL_MAX ? (icoac_real_t)s[i] : (icoac_real_t)NAN;
     }
+#endif
     in->flags = flags;
 }
 
@@ -52,50 +74,6 @@ static void store_posterior(const icoac_state_t *ctrl, icoac_sim_cell_t *cell)
     }
 }
 
-/* One trial; returns the steps run, or -1 on a controller error. *balanced is 1 when the trial
- * lasted success_steps steps without failing (a failure at the last step is a failure). */
-static int64_t run_trial(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                         const icoac_sim_run_t *run, icoac_state_t *ctrl, const icoac_sim_cell_t *cell,
-                         icoac_rng_t *rng, int32_t *status, int *balanced)
-{
-    double s[4];
-    icoac_input_t in;
-    icoac_output_t out;
-    int64_t steps = 0;
-    *balanced = 0;
-    sim_start_trial(cell, run->init_velocity_noise, rng, s);
-    *status = (int32_t)icoac_reset(cfg, ctrl);
-    while (*status == ICOAC_SIM_OK && steps < run->success_steps) {
-        sim_to_input(s, 0u, &in);
-        *status = (int32_t)icoac_step(cfg, ctrl, &in, &out);
-        if (*status != ICOAC_SIM_OK) {
-            break;
-        }
-        icoac_sim_plant_step(plant, s, (double)out.force);
-        ++steps;
-        if (sim_failed(plant, s)) {
-            /* Let the controller learn from the failure state; it rejects NaN plant states,
-             * which end the trial like any failure, but a numeric fault is an error. */
-            sim_to_input(s, ICOAC_INPUT_TERMINAL, &in);
-            if (icoac_step(cfg, ctrl, &in, &out) == ICOAC_ERR_NUMERIC) {
-                *status = ICOAC_ERR_NUMERIC;
-                return -1;
-            }
-            return steps;
-        }
-    }
-    if (*status != ICOAC_SIM_OK) {
-        return -1;
-    }
-    *balanced = 1;
-    return steps;
-}
-
-static int cancelled(const volatile int32_t *cancel)
-{
-    return cancel != 0 && __atomic_load_n(cancel, __ATOMIC_RELAXED) != 0;
-}
-
 static void add_progress(volatile int64_t *progress, int index, int64_t amount)
 {
     if (progress != 0) {
@@ -103,52 +81,90 @@ static void add_progress(volatile int64_t *progress, int index, int64_t amount)
     }
 }
 
-int32_t sim_run_cell_checked(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                             const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                             icoac_sim_cell_t *cell, const volatile int32_t *cancel,
-                             volatile int64_t *progress)
+/* The cell's result from the lane; outcome last, with release order: a reader that sees it
+ * non-PENDING sees the rest. */
+static int finish(const sim_job_t *job, sim_lane_t *lane, int32_t outcome)
 {
-    icoac_state_t ctrl;
-    icoac_rng_t rng;
-    int32_t status;
-    int64_t trials = 0;
-    int64_t total = 0;
-    int64_t steps = 0;
-    int balanced = 0;
+    icoac_sim_cell_t *cell = lane->cell;
+    cell->trials = lane->trials;
+    cell->total_steps = lane->total;
+    cell->last_trial_steps = outcome == ICOAC_SIM_ERROR ? 0 : lane->steps;
+    cell->elapsed_time = job->plant->dt * (double)lane->total;
+    store_posterior(&lane->ctrl, cell);
+    cell->status = lane->status;
+    __atomic_store_n(&cell->outcome, outcome, __ATOMIC_RELEASE);
+    add_progress(job->progress, ICOAC_SIM_PROGRESS_CELLS, 1);
+    return SIM_LANE_DONE;
+}
 
-    status = (int32_t)icoac_init(cfg, &ctrl, prior, icoac_mix_seed(cell->seed, 1u));
-    if (status != ICOAC_SIM_OK) {
-        return status;
+/* A new trial from the cell's start (a cancel request is honoured here, between trials). */
+static int start_trial(const sim_job_t *job, sim_lane_t *lane)
+{
+    if (job->cancel != 0 && __atomic_load_n(job->cancel, __ATOMIC_RELAXED) != 0) {
+        return SIM_LANE_CANCELLED;
     }
-    icoac_rng_seed(&rng, cell->seed, 2u);
-    while (trials < run->max_trials) {
-        if (cancelled(cancel)) {
-            return ICOAC_SIM_CANCELLED;
-        }
-        steps = run_trial(cfg, plant, run, &ctrl, cell, &rng, &status, &balanced);
-        if (steps < 0) {
-            break;
-        }
-        ++trials;
-        total += steps;
-        add_progress(progress, ICOAC_SIM_PROGRESS_TRIALS, 1);
-        add_progress(progress, ICOAC_SIM_PROGRESS_STEPS, steps);
-        if (balanced) {
-            break;
-        }
+    sim_start_trial(lane->cell, job->run->init_velocity_noise, &lane->rng, lane->s);
+    lane->steps = 0;
+    lane->status = (int32_t)icoac_reset(job->cfg, &lane->ctrl);
+    return lane->status == ICOAC_SIM_OK ? SIM_LANE_RUNNING : finish(job, lane, ICOAC_SIM_ERROR);
+}
+
+/* A trial ended: it lasted success_steps steps (balanced), or failed. */
+static int end_trial(const sim_job_t *job, sim_lane_t *lane, int balanced)
+{
+    ++lane->trials;
+    lane->total += lane->steps;
+    add_progress(job->progress, ICOAC_SIM_PROGRESS_TRIALS, 1);
+    add_progress(job->progress, ICOAC_SIM_PROGRESS_STEPS, lane->steps);
+    if (balanced) {
+        return finish(job, lane, ICOAC_SIM_SUCCESS);
     }
-    cell->trials = trials;
-    cell->total_steps = total;
-    cell->last_trial_steps = steps < 0 ? 0 : steps;
-    cell->elapsed_time = plant->dt * (double)total;
-    store_posterior(&ctrl, cell);
-    cell->status = status;
-    /* Outcome last, with release order: a reader that sees it non-PENDING sees the rest. */
-    __atomic_store_n(&cell->outcome,
-                     steps < 0 ? ICOAC_SIM_ERROR : (balanced ? ICOAC_SIM_SUCCESS : ICOAC_SIM_FAILED),
-                     __ATOMIC_RELEASE);
-    add_progress(progress, ICOAC_SIM_PROGRESS_CELLS, 1);
-    return ICOAC_SIM_OK;
+    if (lane->trials >= job->run->max_trials) {
+        return finish(job, lane, ICOAC_SIM_FAILED);
+    }
+    return start_trial(job, lane);
+}
+
+int32_t sim_lane_init(const sim_job_t *job, sim_lane_t *lane, icoac_sim_cell_t *cell)
+{
+    const int32_t status = (int32_t)icoac_init(job->cfg, &lane->ctrl, job->prior, icoac_mix_seed(cell->seed, 1u));
+    icoac_rng_seed(&lane->rng, cell->seed, 2u);
+    lane->cell = cell;
+    lane->trials = 0;
+    lane->total = 0;
+    lane->steps = 0;
+    lane->status = status;
+    return status;
+}
+
+int sim_lane_start(const sim_job_t *job, sim_lane_t *lane)
+{
+    return start_trial(job, lane);
+}
+
+int sim_lane_tick(const sim_job_t *job, sim_lane_t *lane)
+{
+    icoac_input_t in;
+    icoac_output_t out;
+    sim_to_input(lane->s, 0u, &in);
+    lane->status = (int32_t)icoac_step(job->cfg, &lane->ctrl, &in, &out);
+    if (lane->status != ICOAC_SIM_OK) {
+        return finish(job, lane, ICOAC_SIM_ERROR);
+    }
+    icoac_sim_plant_step(job->plant, lane->s, (double)out.force);
+    ++lane->steps;
+    if (sim_failed(job->plant, lane->s)) {
+        /* Let the controller learn from the failure state; it rejects NaN plant states,
+         * which end the trial like any failure, but a numeric fault is an error. */
+        sim_to_input(lane->s, ICOAC_INPUT_TERMINAL, &in);
+        if (icoac_step(job->cfg, &lane->ctrl, &in, &out) == ICOAC_ERR_NUMERIC) {
+            lane->status = ICOAC_ERR_NUMERIC;
+            return finish(job, lane, ICOAC_SIM_ERROR);
+        }
+        return end_trial(job, lane, 0);
+    }
+    /* a failure at the last step is a failure */
+    return lane->steps >= job->run->success_steps ? end_trial(job, lane, 1) : SIM_LANE_RUNNING;
 }
 
 int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
@@ -156,7 +172,10 @@ int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *p
                            icoac_sim_cell_t *cell, const volatile int32_t *cancel,
                            volatile int64_t *progress)
 {
+    const sim_job_t job = {cfg, plant, run, prior, cancel, progress};
+    sim_lane_t lane;
     uint32_t fpu_mode;
+    int state = SIM_LANE_RUNNING;
     int32_t status = sim_check_all(cfg, plant, run);
     if (status != ICOAC_SIM_OK) {
         return status;
@@ -165,7 +184,13 @@ int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *p
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
     fpu_mode = sim_fpu_flush_subnormals();
-    status = sim_run_cell_checked(cfg, plant, run, prior, cell, cancel, progress);
+    status = sim_lane_init(&job, &lane, cell);
+    if (status == ICOAC_SIM_OK) {
+        state = sim_lane_start(&job, &lane);
+        while (state == SIM_LANE_RUNNING) {
+            state = sim_lane_tick(&job, &lane);
+        }
+    }
     sim_fpu_restore(fpu_mode);
-    return status;
+    return state == SIM_LANE_CANCELLED ? ICOAC_SIM_CANCELLED : status;
 }

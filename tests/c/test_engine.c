@@ -1,6 +1,10 @@
-/* Host engine: determinism of cells and grids, thread-count independence, cancellation and
- * resume, argument checks, cell accounting, trajectory recorder. */
+/* Host engine: determinism of cells and grids, thread-count independence, the lanes of a
+ * thread, cancellation and resume, argument checks, cell accounting, trajectory recorder. */
+#define _POSIX_C_SOURCE 199309L /* nanosleep */
 #include "test_common.h"
+
+#include <pthread.h>
+#include <time.h>
 
 #include "icoac_sim/icoac_sim.h"
 
@@ -217,6 +221,112 @@ static void test_grid_thread_independent(void **unused)
     }
 }
 
+/* The lanes of a worker thread (ICOAC_SIM_LANES cells in lockstep, a lane refilled as its cell
+ * ends): every mode, cells of very different lengths (one-trial successes next to cells that
+ * run out of trials), a finished cell mixed in, an odd
+ * count, and 1 to 3 threads. Each cell equals its run alone through icoac_sim_run_cell. */
+static void test_lanes_match_single_cells(void **unused)
+{
+#define NLANE 11
+    static const int pick[NLANE] = {612, 0, 1224, 600, 24, 611, 613, 100, 1000, 587, 637};
+    static icoac_sim_cell_t grid[ICOAC_SIM_GRID_CELLS];
+    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_run_t run = small_run(40, 600);
+    const icoac_prior_t prior = test_prior(0.094, 0.066, 0.365, 0.080, 1e-3);
+    icoac_sim_cell_t solo[NLANE], cells[NLANE];
+    int mode, threads, i;
+    (void)unused;
+    assert_int_equal(icoac_sim_paper_grid(grid, ICOAC_SIM_GRID_CELLS, 99u), ICOAC_SIM_OK);
+    for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_SEARCH; ++mode) {
+        icoac_config_t cfg = test_default_config();
+        int64_t short_cells = 0, long_cells = 0; /* <= 10 trials, all max_trials */
+        cfg.mode = mode;
+        for (i = 0; i < NLANE; ++i) {
+            solo[i] = grid[pick[i]];
+            if (i == 4) {
+                solo[i].outcome = ICOAC_SIM_SUCCESS; /* finished before: skipped */
+                solo[i].trials = -3;
+                continue;
+            }
+            assert_int_equal(icoac_sim_run_cell(&cfg, &plant, &run, &prior, &solo[i], NULL, NULL), ICOAC_SIM_OK);
+            short_cells += solo[i].trials <= 10;
+            long_cells += solo[i].trials == run.max_trials;
+        }
+        assert_true(short_cells > 0 && long_cells > 0); /* the lanes do end at different times */
+        for (threads = 1; threads <= 3; ++threads) {
+            int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
+            memcpy(cells, solo, sizeof cells);
+            for (i = 0; i < NLANE; ++i) {
+                if (i != 4) {
+                    cells[i] = grid[pick[i]];
+                }
+            }
+            assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, &prior, cells, NLANE, threads, NULL, progress),
+                             ICOAC_SIM_OK);
+            assert_memory_equal(cells, solo, sizeof cells);
+            assert_int_equal(progress[ICOAC_SIM_PROGRESS_CELLS], NLANE - 1);
+        }
+    }
+#undef NLANE
+}
+
+typedef struct {
+    volatile int32_t *cancel;
+    volatile int64_t *progress;
+    int64_t after_trials;
+} canceller_t;
+
+static void *cancel_later(void *arg)
+{
+    canceller_t *c = (canceller_t *)arg;
+    const struct timespec pause = {0, 100000};
+    while (__atomic_load_n(&c->progress[ICOAC_SIM_PROGRESS_TRIALS], __ATOMIC_RELAXED) < c->after_trials) {
+        nanosleep(&pause, NULL);
+    }
+    __atomic_store_n(c->cancel, 1, __ATOMIC_RELAXED);
+    return NULL;
+}
+
+/* A cancel that arrives while lanes are mid-cell: every cell is either finished and equal to
+ * its uncancelled result, or still PENDING and untouched; a second call completes the grid. */
+static void test_cancel_mid_run(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_run_t run = small_run(300, 1000);
+    icoac_sim_cell_t cells[NSUB], reference[NSUB], before[NSUB];
+    volatile int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
+    volatile int32_t cancel = 0;
+    canceller_t canceller;
+    pthread_t thread;
+    int i, pending = 0;
+    (void)unused;
+    cfg.mode = ICOAC_MODE_RL;
+    subset(reference);
+    assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, NULL, reference, NSUB, 1, NULL, NULL), ICOAC_SIM_OK);
+    subset(cells);
+    memcpy(before, cells, sizeof cells);
+    canceller.cancel = &cancel;
+    canceller.progress = progress;
+    canceller.after_trials = 200;
+    assert_int_equal(pthread_create(&thread, NULL, cancel_later, &canceller), 0);
+    assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, NSUB, 1, &cancel, progress),
+                     ICOAC_SIM_CANCELLED);
+    assert_int_equal(pthread_join(thread, NULL), 0);
+    for (i = 0; i < NSUB; ++i) {
+        if (cells[i].outcome == ICOAC_SIM_PENDING) {
+            assert_memory_equal(&cells[i], &before[i], sizeof cells[i]);
+            ++pending;
+        } else {
+            assert_memory_equal(&cells[i], &reference[i], sizeof cells[i]);
+        }
+    }
+    assert_true(pending > 0);
+    cancel = 0;
+    assert_int_equal(icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, NSUB, 1, &cancel, NULL), ICOAC_SIM_OK);
+    assert_memory_equal(cells, reference, sizeof cells);
+}
+
 static void test_cancel_and_resume(void **unused)
 {
     icoac_config_t cfg = test_default_config();
@@ -414,6 +524,8 @@ int main(void)
         cmocka_unit_test(test_run_cell_outcomes),
         cmocka_unit_test(test_grid_thread_independent),
         cmocka_unit_test(test_cancel_and_resume),
+        cmocka_unit_test(test_lanes_match_single_cells),
+        cmocka_unit_test(test_cancel_mid_run),
         cmocka_unit_test(test_bad_parameters),
         cmocka_unit_test(test_numeric_fault_marks_cell_error),
         cmocka_unit_test(test_failure_at_the_last_step),

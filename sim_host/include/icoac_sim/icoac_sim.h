@@ -30,6 +30,10 @@ typedef enum {
 
 #define ICOAC_SIM_PI 3.14159265358979323846
 
+/* Cells each thread of icoac_sim_run_grid advances in lockstep, one tick each in turn (their
+ * ticks overlap in the processor; no cell's result depends on it). */
+#define ICOAC_SIM_LANES 2
+
 /* Valid plant and run ranges (closed): no subnormal or absurd value reaches the integrator,
  * whose worker threads flush subnormals to zero. */
 #define ICOAC_SIM_PHYS_MIN 1.0e-6   /* gravity (m/s^2), masses (kg), half_length, x_limit (m) */
