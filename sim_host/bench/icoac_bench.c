@@ -1,5 +1,6 @@
 /* Speed benchmark: nanoseconds per closed-loop tick (controller step + plant step) on one
- * core, and grid throughput on all cores. Prints figures; asserts nothing.
+ * core, in the engine and for one cell alone, and grid throughput on all cores. Prints
+ * figures; asserts nothing.
  * Usage: icoac_bench [--quick]  */
 #define _POSIX_C_SOURCE 199309L
 #include <stdio.h>
@@ -22,34 +23,58 @@ static const icoac_prior_t balanced_prior = {
     {0.094f, 0.066f, 0.365f, 0.080f},
     {{1e-4f, 0, 0, 0}, {0, 1e-4f, 0, 0}, {0, 0, 1e-4f, 0}, {0, 0, 0, 1e-4f}}};
 
-/* Ticks of one cell run on this thread, in ns per plant step. */
-static double ns_per_tick(int mode, int64_t steps, int64_t *ticks_out)
+/* A cell that balances for steps ticks from the bench's start. */
+static void balanced_cell(icoac_sim_cell_t *cell, uint64_t seed)
+{
+    memset(cell, 0, sizeof *cell);
+    cell->x0 = -0.5;
+    cell->theta0 = -4.0 * ICOAC_SIM_PI / 180.0;
+    cell->seed = seed;
+}
+
+/* ns per plant step of n_cells balanced cells: n_cells == 1 through icoac_sim_run_cell (one
+ * cell alone: the latency of a tick), else icoac_sim_run_grid on one thread (the engine's
+ * throughput, ICOAC_SIM_LANES cells in lockstep). */
+static double ns_per_tick(int mode, int64_t steps, int n_cells, int64_t *ticks_out)
 {
     icoac_config_t cfg;
     icoac_sim_plant_t plant;
     icoac_sim_run_t run;
-    icoac_sim_cell_t cell;
+    icoac_sim_cell_t cells[ICOAC_SIM_LANES];
     volatile int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
     double t0;
     double elapsed;
+    int32_t status;
+    int i;
     icoac_config_default(&cfg);
     cfg.mode = mode;
     icoac_sim_plant_default(&plant);
     icoac_sim_run_default(&run);
     run.success_steps = steps;
     run.max_trials = 1000;
-    memset(&cell, 0, sizeof cell);
-    cell.x0 = -0.5;
-    cell.theta0 = -4.0 * ICOAC_SIM_PI / 180.0;
-    cell.seed = 7u;
+    for (i = 0; i < n_cells; ++i) {
+        balanced_cell(&cells[i], 7u + (uint64_t)i);
+    }
     t0 = now_seconds();
-    if (icoac_sim_run_cell(&cfg, &plant, &run, &balanced_prior, &cell, 0, progress) != ICOAC_SIM_OK) {
-        fprintf(stderr, "icoac_bench: run_cell failed\n");
+    status = n_cells == 1 ? icoac_sim_run_cell(&cfg, &plant, &run, &balanced_prior, &cells[0], 0, progress)
+                          : icoac_sim_run_grid(&cfg, &plant, &run, &balanced_prior, cells, n_cells, 1, 0, progress);
+    elapsed = now_seconds() - t0;
+    if (status != ICOAC_SIM_OK) {
+        fprintf(stderr, "icoac_bench: %s\n", icoac_sim_status_str(status));
         exit(1);
     }
-    elapsed = now_seconds() - t0;
     *ticks_out = progress[ICOAC_SIM_PROGRESS_STEPS];
     return 1e9 * elapsed / (double)*ticks_out;
+}
+
+static void print_tick(const char *name, int mode, int64_t steps, double target)
+{
+    int64_t ticks;
+    double one = ns_per_tick(mode, steps, 1, &ticks);
+    double engine = ns_per_tick(mode, steps, ICOAC_SIM_LANES, &ticks);
+    printf("%s tick, one core: %6.1f ns in the engine (%d cells in lockstep; target <= %.0f ns), "
+           "%6.1f ns for one cell alone  [%lld ticks]\n",
+           name, engine, ICOAC_SIM_LANES, target, one, (long long)ticks);
 }
 
 int main(int argc, char **argv)
@@ -60,8 +85,6 @@ int main(int argc, char **argv)
     icoac_sim_run_t run;
     icoac_sim_cell_t *grid = calloc(ICOAC_SIM_GRID_CELLS, sizeof *grid);
     volatile int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
-    int64_t ticks;
-    double ns;
     double t0;
     double wall;
 
@@ -69,12 +92,8 @@ int main(int argc, char **argv)
         return 1;
     }
     printf("icoac_bench: %u-byte reals, reference build (no fast-math)\n", icoac_sizeof_real());
-    ns = ns_per_tick(ICOAC_MODE_ICO, quick ? 200000 : 5000000, &ticks);
-    printf("ICO tick (controller + Euler plant), one core: %6.1f ns  [%lld ticks; target <= 40 ns]\n",
-           ns, (long long)ticks);
-    ns = ns_per_tick(ICOAC_MODE_RL, quick ? 50000 : 1000000, &ticks);
-    printf("RL  tick (critic + actor + plant),  one core: %6.1f ns  [%lld ticks; target <= 300 ns]\n",
-           ns, (long long)ticks);
+    print_tick("ICO", ICOAC_MODE_ICO, quick ? 200000 : 5000000, 25.0);
+    print_tick("RL ", ICOAC_MODE_RL, quick ? 50000 : 1000000, 150.0);
 
     icoac_config_default(&cfg);
     icoac_sim_plant_default(&plant);
