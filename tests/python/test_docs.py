@@ -13,7 +13,7 @@ from harness.config import build_config, parse_sets
 REPO = Path(__file__).resolve().parents[2]
 # Placeholders the documents use, with a value each stands for.
 PLACEHOLDERS = {"NAME": "variant", "SETTING": "integrator=rk4", "$(BENCH_PROFILE)": "quick",
-                "$(BENCH_OUT)": "results/bench"}
+                "$(BENCH_OUT)": "results/bench", "$(BENCH_FIGURES)": "docs/figures", "$(BENCH_ARGS)": "--resume"}
 
 
 def _after(text: str):
