@@ -96,11 +96,13 @@ def _binding(worker=None):
 
 
 def abi_of(B) -> dict[str, Any]:
-    """What client and workers must agree on: the ABI versions, the real type, the struct and
-    cell sizes (everything a chunk's bytes depend on), and the harness version."""
+    """What client and workers must agree on: the ABI versions, the real type, the critic kernel
+    (its V rounds differently), the struct and cell sizes (everything a chunk's bytes depend on),
+    and the harness version."""
     from . import __version__
     return {"abi_version": int(B.lib.icoac_abi_version()), "sim_abi_version": int(B.lib.icoac_sim_abi_version()),
-            "sizeof_real": int(B.lib.icoac_sizeof_real()), "sizeof_config": int(B.lib.icoac_sizeof_config()),
+            "sizeof_real": int(B.lib.icoac_sizeof_real()), "critic_dense": int(B.CONSTANTS["ICOAC_CRITIC_DENSE"]),
+            "sizeof_config": int(B.lib.icoac_sizeof_config()),
             "sizeof_prior": int(B.lib.icoac_sizeof_prior()), "sizeof_plant": int(B.lib.icoac_sim_sizeof_plant()),
             "sizeof_run": int(B.lib.icoac_sim_sizeof_run()), "sizeof_cell": int(B.CELL_DTYPE.itemsize),
             "harness_version": __version__}

@@ -1,4 +1,5 @@
-/* Grid runner: independent cells shared out to worker threads through an atomic counter. */
+/* Grid runner: independent cells shared out to worker threads through an atomic counter; each
+ * thread advances ICOAC_SIM_LANES of them in lockstep (sim_internal.h). */
 #include <math.h>
 #include <pthread.h>
 #include <unistd.h>

@@ -13,6 +13,8 @@ static const icoac_sim_constant_t constants[] = {
     CONSTANT(ICOAC_N_INPUTS),
     CONSTANT(ICOAC_CRITIC_UNITS),
     CONSTANT(ICOAC_STATE_SIZE),
+    CONSTANT(ICOAC_CRITIC_DENSE), /* the critic kernel of this build: 1 dense, 0 sparse */
+    CONSTANT(ICOAC_SIM_LANES),
     CONSTANT(ICOAC_INPUT_TERMINAL),
     /* switches */
     CONSTANT(ICOAC_MODE_ICO),

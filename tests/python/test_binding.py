@@ -62,6 +62,9 @@ def test_abi_versions():
     assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 2
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
+    # the host build's defaults: the dense critic kernel, two lanes per engine thread
+    assert info["critic_kernel"] == "dense" and B.CONSTANTS["ICOAC_CRITIC_DENSE"] == 1
+    assert info["lanes"] == B.CONSTANTS["ICOAC_SIM_LANES"] == 2
 
 
 def test_every_mirror_matches_the_c_field_table():
