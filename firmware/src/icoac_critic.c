@@ -87,7 +87,8 @@ void icoac_priv_critic_factors(const icoac_critic_config_t *critic, const icoac_
 
 #define ICOAC_CELLS ICOAC_CRITIC_CELLS
 
-/* b_k below the smallest normal number is 0 under flush-to-zero and adds nothing to V either way. */
+/* With threshold 0 the floor is the smallest normal number: b_k below it is 0 under
+ * flush-to-zero and adds nothing to V either way. */
 icoac_real_t icoac_priv_critic_floor(const icoac_critic_config_t *critic)
 {
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE

@@ -213,9 +213,9 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
  * and the TD update v_k += step * b_k over such units. Two kernels compute the same units:
  * - sparse (icoac_critic.c), for microcontrollers: a sorted list of the kept cells, walked in
  *   leading runs per pair; V sums in that order.
- * - dense (icoac_critic_dense.c), for hosts: every unit with a mask, in fixed-length loops a
- *   compiler vectorizes, without data-dependent branches; V sums per cell over the pairs, then
- *   over the cells.
+ * - dense (icoac_critic_dense.c), for hosts: a mask over every pair and the cells of one range,
+ *   in loops without data-dependent branches that a compiler vectorizes; V sums per cell over
+ *   the pairs, then over the cells.
  * The update adds the same step to the same units in both; V differs by the rounding of the
  * sum's order. ICOAC_CRITIC_DENSE=1 (the host build's default, CMake ICOAC_CRITIC_KERNEL)
  * selects the dense kernel in icoac_priv_critic_value / _update; both are always built. */
