@@ -36,7 +36,7 @@ CELL_SPEC = grid.format_cell_indices(CELLS)
 
 # A slower grid for the kill, cancel and Ctrl-C tests (rows theta0 = -1, 0, +1 deg; a few seconds on
 # 2 threads), so that an interruption lands inside the run on a fast machine too.
-SLOW_CAPS = {"max_trials": 6000, "success_steps": 5000}
+SLOW_CAPS = {"max_trials": 100000, "success_steps": 5000}  # about 3 s threaded (engine with lanes)
 SLOW_SEED = 5
 SLOW_SPEC = "560-679"
 SLOW_CELLS = grid.parse_cell_indices(SLOW_SPEC)
