@@ -1,5 +1,6 @@
 """Tests load the real shared library; nothing is built or skipped here."""
 import os
+import signal
 from pathlib import Path
 
 import pytest
@@ -17,6 +18,11 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "icoac"))
 
 
 def pytest_configure(config):
+    # A suite started in the background by a non-interactive shell inherits SIGINT ignored, and
+    # so would every harness it starts: the Ctrl-C tests (test_kill, test_dask) would then see
+    # a run that ignores SIGINT. A handler (unlike SIG_IGN) is reset to the default at exec.
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     lib = Path(os.environ.get("ICOAC_SIM_LIBRARY", REPO / "build/release/sim_host/libicoac_sim.so"))
     if not lib.is_file():
         raise pytest.UsageError(f"icoac_sim shared library missing at {lib}: build it with `make build` "
