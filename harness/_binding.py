@@ -30,7 +30,7 @@ BUILD_INFO = PACKAGE_LIBRARY.parent / "build_info.json"   # the commit the packa
 DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.so"
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
-ABI_VERSION = 6
+ABI_VERSION = 7
 SIM_ABI_VERSION = 2
 
 
@@ -514,8 +514,10 @@ _PROTOTYPES = {
     "icoac_config_check": ([_P(Config)], ctypes.c_int),
     "icoac_config_check_field": ([_P(Config), _P(ctypes.c_char_p)], ctypes.c_int),
     "icoac_init": ([_P(Config), _P(State), _P(Prior), ctypes.c_uint64], ctypes.c_int),
-    "icoac_reset": ([_P(Config), _P(State)], ctypes.c_int),
-    "icoac_step": ([_P(Config), _P(State), _P(Input), _P(Output)], ctypes.c_int),
+    "icoac_retune": ([_P(State), _P(Config)], ctypes.c_int),
+    "icoac_reset": ([_P(State)], ctypes.c_int),
+    "icoac_step": ([_P(State), _P(Input), _P(Output)], ctypes.c_int),
+    "icoac_get_config": ([_P(State), _P(Config)], ctypes.c_int),
     "icoac_get_posterior": ([_P(State), _P(Prior)], ctypes.c_int),
     "icoac_get_counters": ([_P(State), _P(Counters)], ctypes.c_int),
     "icoac_prior_check": ([_P(Prior)], ctypes.c_int),

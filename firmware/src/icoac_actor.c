@@ -128,6 +128,10 @@ ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, cons
     icoac_real_t precision[N][N];
     int i;
     int j;
+    if (actor->update != ICOAC_ACTOR_POSTERIOR && actor->update != ICOAC_ACTOR_MEAN &&
+        actor->update != ICOAC_ACTOR_GRADIENT) {
+        return -2;
+    }
     if (actor->update == ICOAC_ACTOR_GRADIENT) {
         const icoac_real_t step = actor->rate / (actor->noise_std * actor->noise_std);
         for (i = 0; i < N; ++i) {
@@ -229,9 +233,11 @@ int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t 
         }
         return 0;
     }
-    default:
+    case ICOAC_ACTOR_POSTERIOR:
         posterior_step(actor, st, h, innovation, w, cov);
         return 1;
+    default:
+        return -2;
     }
 }
 

@@ -158,7 +158,6 @@ icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic,
     const icoac_real_t *gthd = gth + ICOAC_CRITIC_N_THETA;
     const int cells = sorted_cells(gth, gthd, threshold, active);
     icoac_real_t value = ICOAC_R(0.0);
-    int pairs = 0;
     int a;
     int b;
     for (a = 0; a < ICOAC_CRITIC_N_X; ++a) {
@@ -169,7 +168,8 @@ icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic,
             const icoac_real_t *product = active->cell_product;
             const uint8_t *cell = active->cell;
             icoac_real_t unit_b;
-            int kept;
+            active->pair_product[pair] = pair_product;
+            active->pair_cells[pair] = 0u;
             /* threshold <= pair_product <= 1 as bit patterns: false for NaN, Inf and negative
              * values, so pair_product * 0 = 0 and the sentinel ends the scan below */
             if (!icoac_priv_nonneg_at_least(pair_product, threshold) ||
@@ -181,32 +181,30 @@ icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic,
                 value += u[*cell++] * unit_b;
                 unit_b = pair_product * *++product;
             }
-            kept = (int)(cell - active->cell);
-            if (kept > 0) {
-                active->pair_product[pairs] = pair_product;
-                active->pair[pairs] = (uint8_t)pair;
-                active->pair_cells[pairs] = (uint8_t)kept;
-                ++pairs;
-            }
+            active->pair_cells[pair] = (uint8_t)(cell - active->cell);
         }
     }
     active->cells = (uint8_t)cells;
-    active->pairs = (uint8_t)pairs;
     return value;
 }
 
-/* v_k += step * b_k over the units listed by icoac_priv_critic_value_sparse. */
+/* v_k += step * b_k over the units listed by icoac_priv_critic_value_sparse. The list lives in
+ * the state between ticks, so what it holds is bounded here without a test: the pairs are the
+ * loop's, and a count or a cell index is masked (the list's arrays and the weights have room for
+ * a masked value: icoac_state.h). A list the value pass wrote is unchanged by the masks. */
 void icoac_priv_critic_update_sparse(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_list_t *active,
                                      icoac_real_t step)
 {
     int p;
-    int i;
-    for (p = 0; p < (int)active->pairs; ++p) {
+    for (p = 0; p < ICOAC_CRITIC_PAIRS; ++p) {
         const icoac_real_t pair_step = step * active->pair_product[p];
-        const int kept = active->pair_cells[p];
-        icoac_real_t *u = v + (int)active->pair[p] * ICOAC_CELLS;
-        for (i = 0; i < kept; ++i) {
-            u[active->cell[i]] += pair_step * active->cell_product[i];
+        const uint8_t *cell = active->cell;
+        const uint8_t *const end = cell + (active->pair_cells[p] & ICOAC_PRIV_CELL_MASK);
+        const icoac_real_t *product = active->cell_product;
+        icoac_real_t *u = v + p * ICOAC_CELLS;
+        ICOAC_PRIV_OPAQUE(u);
+        while (cell != end) {
+            u[*cell++ & ICOAC_PRIV_CELL_MASK] += pair_step * *product++;
         }
     }
 }

@@ -91,8 +91,9 @@ void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, icoac_r
                                     const icoac_priv_critic_products_t *products, icoac_real_t step)
 {
     const icoac_real_t threshold = icoac_priv_critic_floor(critic);
+    /* the range lives in the state between ticks: bounded, whatever it holds */
     const int begin = products->cell_begin;
-    const int end = products->cell_end;
+    const int end = products->cell_end < ICOAC_CRITIC_CELLS ? (int)products->cell_end : ICOAC_CRITIC_CELLS;
     int p, j;
     for (p = 0; p < ICOAC_CRITIC_PAIRS; ++p) {
         const icoac_real_t pair_product = products->pair_product[p];

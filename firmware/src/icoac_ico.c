@@ -102,6 +102,11 @@ int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
     out->td_error = ICOAC_R(0.0);
     out->noise = ICOAC_R(0.0);
     out->cov_trace = ICOAC_R(0.0);
-    return cfg->ico.timing == ICOAC_ICO_TIMING_LITERAL ? literal_timing(cfg, st, scaled, penalty, terminal, out)
-                                                       : code_timing(cfg, st, scaled, penalty, terminal, out);
+    if (cfg->ico.timing == ICOAC_ICO_TIMING_CODE) {
+        return code_timing(cfg, st, scaled, penalty, terminal, out);
+    }
+    if (cfg->ico.timing == ICOAC_ICO_TIMING_LITERAL) {
+        return literal_timing(cfg, st, scaled, penalty, terminal, out);
+    }
+    return ICOAC_PRIV_TICK_BAD_STATE;
 }

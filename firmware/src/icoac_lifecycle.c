@@ -1,4 +1,5 @@
-/* Lifecycle of a controller state: init, reset per trial, and the accessors. */
+/* Lifecycle of a controller state: init, live retuning, reset per trial (with the check of a
+ * state's content), and the accessors. */
 #include "icoac_priv.h"
 
 static void clear_trial(icoac_priv_state_t *st)
@@ -11,6 +12,51 @@ static void clear_trial(icoac_priv_state_t *st)
     icoac_priv_critic_clear(&st->active[1]);
     st->trial_ticks = 0u;
     memset(&st->batch, 0, sizeof st->batch);
+}
+
+/* What the tick takes from the configuration in force, derived once: 1 / policy.input_range
+ * and the search's floors. */
+static void derive(icoac_priv_state_t *st)
+{
+    int i;
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        st->inv_range[i] = ICOAC_R(1.0) / st->config.policy.input_range[i];
+    }
+    if (st->config.mode == ICOAC_MODE_SEARCH) {
+        icoac_priv_search_floors(&st->config.search, &st->search);
+    }
+}
+
+/* 1 when the state holds what the library writes: a configuration icoac_config_check accepts,
+ * slots 0 or 1, finite learned values and generator, and (search) a recorded count inside the
+ * batch arrays and a positive prior variance. Derived values are not checked: reset derives them
+ * again. */
+static int state_ok(const icoac_priv_state_t *st)
+{
+    const icoac_priv_search_t *search = &st->search;
+    int i;
+    if (icoac_config_check(&st->config) != ICOAC_OK || (st->cov_slot & ~1) != 0 || (st->active_slot & ~1) != 0 ||
+        (st->rng.has_spare & ~1) != 0 || !icoac_priv_finite(st->rng.spare_normal)) {
+        return 0;
+    }
+    if (!icoac_priv_all_finite(st->w, ICOAC_N_INPUTS) || !icoac_priv_finite(st->weight_norm) ||
+        !icoac_priv_all_finite(&icoac_priv_cov_c(st)[0][0], ICOAC_N_INPUTS * ICOAC_N_INPUTS) ||
+        !icoac_priv_all_finite(st->v, ICOAC_CRITIC_UNITS)) {
+        return 0;
+    }
+    if (st->config.mode != ICOAC_MODE_SEARCH) {
+        return 1;
+    }
+    if (search->count < 0 || search->count >= ICOAC_SEARCH_BATCH_MAX ||
+        !icoac_priv_all_finite(&search->lower[0][0], ICOAC_N_INPUTS * ICOAC_N_INPUTS)) {
+        return 0;
+    }
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        if (!(search->prior_var[i] > ICOAC_R(0.0)) || !icoac_priv_finite(search->prior_var[i])) {
+            return 0;
+        }
+    }
+    return 1;
 }
 
 icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const icoac_prior_t *prior,
@@ -39,6 +85,7 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const
         return status;
     }
     memset(state, 0, sizeof *state);
+    st->config = *cfg;
     if (prior != 0) {
         memcpy(st->w, prior->mean, sizeof st->w);
         memcpy(st->cov_buffer[0], prior->cov, sizeof st->cov_buffer[0]);
@@ -47,31 +94,55 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const
             st->cov_buffer[0][i][i] = ICOAC_R(1.0);
         }
     }
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-        st->inv_range[i] = ICOAC_R(1.0) / cfg->policy.input_range[i];
-    }
     if (cfg->mode == ICOAC_MODE_SEARCH) {
-        icoac_priv_search_init(&cfg->search, st);
+        icoac_priv_search_init(&st->config.search, st);
     }
     st->weight_norm = ICOAC_PRIV_SQRT(icoac_priv_dot4(st->w, st->w));
     icoac_rng_seed(&st->rng, seed, 0x1C0ACu);
     st->magic = ICOAC_PRIV_STATE_MAGIC;
-    return icoac_reset(cfg, state);
+    return icoac_reset(state);
 }
 
-icoac_status_t icoac_reset(const icoac_config_t *cfg, icoac_state_t *state)
+icoac_status_t icoac_retune(icoac_state_t *state, const icoac_config_t *cfg)
 {
     icoac_priv_state_t *st = icoac_priv_state(state);
+    icoac_status_t status;
     if (cfg == 0 || state == 0) {
         return ICOAC_ERR_NULL;
     }
-    if (st->magic != ICOAC_PRIV_STATE_MAGIC) {
+    if (!icoac_priv_initialised(st)) {
         return ICOAC_ERR_NOT_INITIALISED;
     }
+    status = icoac_config_check(cfg);
+    if (status != ICOAC_OK) {
+        return status;
+    }
+    if (cfg->mode != st->config.mode) {
+        return ICOAC_ERR_RETUNE_MODE;
+    }
+    st->config = *cfg;
+    derive(st);
+    return ICOAC_OK;
+}
+
+icoac_status_t icoac_reset(icoac_state_t *state)
+{
+    icoac_priv_state_t *st = icoac_priv_state(state);
+    if (state == 0) {
+        return ICOAC_ERR_NULL;
+    }
+    if (!icoac_priv_initialised(st)) {
+        return ICOAC_ERR_NOT_INITIALISED;
+    }
+    if (!state_ok(st)) {
+        return ICOAC_ERR_BAD_STATE;
+    }
+    derive(st);
     clear_trial(st);
-    if (cfg->mode == ICOAC_MODE_RL && cfg->actor.act_with_sample) {
+    st->magic = ICOAC_PRIV_STATE_MAGIC;
+    if (st->config.mode == ICOAC_MODE_RL && st->config.actor.act_with_sample) {
         icoac_priv_actor_sample(st);
-    } else if (cfg->mode == ICOAC_MODE_SEARCH) {
+    } else if (st->config.mode == ICOAC_MODE_SEARCH) {
         icoac_priv_search_sample(st);
     } else {
         icoac_priv_copy4(st->w_act, st->w);
@@ -85,7 +156,7 @@ icoac_status_t icoac_get_posterior(const icoac_state_t *state, icoac_prior_t *po
     if (state == 0 || posterior == 0) {
         return ICOAC_ERR_NULL;
     }
-    if (st->magic != ICOAC_PRIV_STATE_MAGIC) {
+    if (!icoac_priv_initialised(st)) {
         return ICOAC_ERR_NOT_INITIALISED;
     }
     memcpy(posterior->mean, st->w, sizeof posterior->mean);
@@ -99,10 +170,23 @@ icoac_status_t icoac_get_counters(const icoac_state_t *state, icoac_counters_t *
     if (state == 0 || counters == 0) {
         return ICOAC_ERR_NULL;
     }
-    if (st->magic != ICOAC_PRIV_STATE_MAGIC) {
+    if (!icoac_priv_initialised(st)) {
         return ICOAC_ERR_NOT_INITIALISED;
     }
     *counters = st->counters;
+    return ICOAC_OK;
+}
+
+icoac_status_t icoac_get_config(const icoac_state_t *state, icoac_config_t *cfg)
+{
+    const icoac_priv_state_t *st = icoac_priv_state_c(state);
+    if (state == 0 || cfg == 0) {
+        return ICOAC_ERR_NULL;
+    }
+    if (!icoac_priv_initialised(st)) {
+        return ICOAC_ERR_NOT_INITIALISED;
+    }
+    *cfg = st->config;
     return ICOAC_OK;
 }
 

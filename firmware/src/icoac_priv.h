@@ -22,6 +22,14 @@
 #define ICOAC_PRIV_LIBM_EXP expf
 #endif
 
+/* The pointer p as a value the compiler cannot see through: it keeps p in a register instead
+ * of folding it into every address computed from it (GCC and clang; elsewhere nothing). */
+#if defined(__GNUC__)
+#define ICOAC_PRIV_OPAQUE(p) __asm__("" : "+r"(p))
+#else
+#define ICOAC_PRIV_OPAQUE(p) ((void)0)
+#endif
+
 /* Kept out of line: a per-trial path whose frame should not add to the per-tick one. */
 #if defined(__GNUC__)
 #define ICOAC_PRIV_NOINLINE __attribute__((__noinline__))
@@ -200,6 +208,11 @@ static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_rea
  * its scratch (the spare covariance buffer and the spare kept-unit list, never read before a
  * commit). */
 
+/* What a mode's tick returns. */
+#define ICOAC_PRIV_TICK_NUMERIC 0   /* a staged value was not finite: nothing committed */
+#define ICOAC_PRIV_TICK_OK 1        /* committed */
+#define ICOAC_PRIV_TICK_BAD_STATE 2 /* an unknown switch in the state's configuration: nothing committed */
+
 /* ICO rule, both timings (icoac_ico.c). */
 int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
                         const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
@@ -227,6 +240,8 @@ icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic,
                                             const icoac_real_t v[ICOAC_CRITIC_UNITS],
                                             const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
                                             icoac_priv_critic_list_t *list);
+/* v: ICOAC_PRIV_CRITIC_WEIGHTS entries (the state's) when the list may be corrupted; a list the
+ * value pass wrote touches the first ICOAC_CRITIC_UNITS only. */
 void icoac_priv_critic_update_sparse(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_list_t *list,
                                      icoac_real_t step);
 icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic,
@@ -243,7 +258,7 @@ static inline void icoac_priv_critic_clear(icoac_priv_critic_active_t *active)
     active->dense.cell_begin = 0u;
     active->dense.cell_end = 0u;
 #else
-    active->sparse.pairs = 0u;
+    memset(active->sparse.pair_cells, 0, sizeof active->sparse.pair_cells);
 #endif
 }
 
@@ -274,7 +289,7 @@ static inline void icoac_priv_critic_update(const icoac_critic_config_t *critic,
  * the candidate mu_w in w, Sigma_w in cov (the spare buffer) and the batch's shift in its
  * scratch; h = G x~(t); observed: the transition's tick explored (L3); trial_end: a terminal
  * tick. Returns 1 when cov holds a new Sigma_w, 0 when Sigma_w stays, -1 when the batch sums
- * or its closed form failed. icoac_priv_actor_commit_batch follows the tick's checks. */
+ * or its closed form failed, -2 for an unknown actor.update (a corrupted state). icoac_priv_actor_commit_batch follows the tick's checks. */
 int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t *st,
                           const icoac_real_t h[ICOAC_N_INPUTS], icoac_real_t delta, int observed, int trial_end,
                           icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
@@ -297,6 +312,8 @@ void icoac_priv_search_sample(icoac_priv_state_t *st);
 int icoac_priv_search_prior_ok(const icoac_search_config_t *search,
                                const icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
 void icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st);
+/* The floors search.floor * Sigma0_ii of the recorded prior variances (icoac_retune, icoac_reset). */
+void icoac_priv_search_floors(const icoac_search_config_t *search, icoac_priv_search_t *recorded);
 
 /* Gaussian helpers (icoac_gauss.c). */
 /* m = L L^T; returns 0 when m is not positive definite. */

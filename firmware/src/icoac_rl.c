@@ -29,7 +29,7 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     icoac_real_t factors[ICOAC_CRITIC_FACTORS];
     icoac_real_t w[ICOAC_N_INPUTS];
     icoac_real_t h[ICOAC_N_INPUTS];
-    icoac_real_t (*cov)[ICOAC_N_INPUTS] = st->cov_buffer[st->cov_slot ^ 1]; /* the spare */
+    icoac_real_t (*cov)[ICOAC_N_INPUTS] = icoac_priv_cov_spare(st);
     /* Staged and checked. Named values, not an array: a compiler vectorizes the check of an
      * array into one load of what was just stored value by value, which x86 cannot forward
      * from the stores (it waits until they retire: measured, about 10 ns a tick). */
@@ -38,7 +38,7 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     icoac_real_t norm = st->weight_norm; /* |w| */
     icoac_real_t trace;                  /* of Sigma_w */
     icoac_real_t policy_force = ICOAC_R(0.0); /* G z */
-    const int slot_prev = st->active_slot;
+    const int slot_prev = st->active_slot & 1;
     const int learn = st->has_prev;         /* a transition into s exists: delta is defined */
     const int update = learn && cfg->learn; /* ... and the critic and actor learn from it */
     /* the transition's first tick explored (L3): its noise is the actor's observation */
@@ -67,7 +67,7 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
         }
         cov_changed = icoac_priv_actor_step(&cfg->actor, st, h, delta, observed, terminal, w, cov);
         if (cov_changed < 0) {
-            return 0;
+            return cov_changed == -1 ? ICOAC_PRIV_TICK_NUMERIC : ICOAC_PRIV_TICK_BAD_STATE;
         }
         norm = ICOAC_PRIV_SQRT(icoac_priv_dot4(w, w));
         if (cov_changed) {
@@ -94,7 +94,7 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
         icoac_priv_critic_update(&cfg->critic, st->v, &st->active[cfg->critic.quirks ? slot_prev ^ 1 : slot_prev],
                                  cfg->critic.rate * delta);
         icoac_priv_copy4(st->w, w);
-        st->cov_slot ^= cov_changed;
+        st->cov_slot = (st->cov_slot & 1) ^ cov_changed;
         st->weight_norm = norm;
         if (!cfg->actor.act_with_sample) {
             icoac_priv_copy4(st->w_act, w);

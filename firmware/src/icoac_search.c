@@ -5,6 +5,12 @@
 
 #define N ICOAC_N_INPUTS
 
+/* floor_i = f * (c * prior variance_i), the arithmetic of Sigma0's diagonal. */
+static icoac_real_t floor_of(const icoac_search_config_t *search, icoac_real_t prior_var)
+{
+    return search->floor * (prior_var * search->cov_scale);
+}
+
 /* Sigma0 = c * cov, its floors and its Cholesky factor; 0 when not finite or not PD. */
 static int scaled_prior(const icoac_search_config_t *search, const icoac_real_t cov[N][N], icoac_real_t sigma0[N][N],
                         icoac_real_t floor[N], icoac_real_t lower[N][N])
@@ -12,10 +18,10 @@ static int scaled_prior(const icoac_search_config_t *search, const icoac_real_t 
     int i;
     int j;
     for (i = 0; i < N; ++i) {
+        floor[i] = floor_of(search, cov[i][i]);
         for (j = 0; j < N; ++j) {
             sigma0[i][j] = cov[i][j] * search->cov_scale;
         }
-        floor[i] = search->floor * sigma0[i][i];
     }
     return icoac_priv_all_finite(&sigma0[0][0], N * N) && icoac_priv_all_finite(floor, N) &&
            icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(sigma0), lower);
@@ -32,8 +38,20 @@ int icoac_priv_search_prior_ok(const icoac_search_config_t *search, const icoac_
 void icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st)
 {
     icoac_real_t (*cov)[N] = icoac_priv_cov(st);
+    int i;
     st->search.count = 0;
+    for (i = 0; i < N; ++i) {
+        st->search.prior_var[i] = cov[i][i];
+    }
     (void)scaled_prior(search, ICOAC_PRIV_CONST_MAT4(cov), cov, st->search.floor, st->search.lower);
+}
+
+void icoac_priv_search_floors(const icoac_search_config_t *search, icoac_priv_search_t *recorded)
+{
+    int i;
+    for (i = 0; i < N; ++i) {
+        recorded->floor[i] = floor_of(search, recorded->prior_var[i]);
+    }
 }
 
 void icoac_priv_search_sample(icoac_priv_state_t *st)
@@ -46,6 +64,7 @@ void icoac_priv_search_sample(icoac_priv_state_t *st)
 /* The batch being closed: the recorded trials 0..count-1, then the trial ending now. */
 typedef struct {
     const icoac_priv_search_t *recorded;
+    int count; /* recorded trials */
     const icoac_real_t *last_w;
     uint32_t last_ticks;
     int size;
@@ -53,12 +72,12 @@ typedef struct {
 
 static const icoac_real_t *trial_w(const closing_batch_t *b, int k)
 {
-    return k < b->recorded->count ? b->recorded->w[k] : b->last_w;
+    return k < b->count ? b->recorded->w[k] : b->last_w;
 }
 
 static uint32_t trial_ticks(const closing_batch_t *b, int k)
 {
-    return k < b->recorded->count ? b->recorded->ticks[k] : b->last_ticks;
+    return k < b->count ? b->recorded->ticks[k] : b->last_ticks;
 }
 
 /* The n_elite longest trials, longest first; ties go to the earlier trial. */
@@ -79,11 +98,15 @@ static void choose_elite(const closing_batch_t *b, int n_elite, uint8_t elite[IC
     }
 }
 
-/* Elite size n_e = max(1, round(rho K)). */
-static int elite_size(const icoac_search_config_t *search)
+/* Elite size n_e = max(1, round(rho K)), at most K; the value is bounded before its conversion,
+ * so a corrupted rho (NaN, huge) converts nothing out of range. */
+static int elite_size(const icoac_search_config_t *search, int batch)
 {
-    const int n = (int)(search->elite_fraction * (icoac_real_t)search->batch + ICOAC_R(0.5));
-    return n < 1 ? 1 : (n > search->batch ? search->batch : n);
+    const icoac_real_t n = search->elite_fraction * (icoac_real_t)batch + ICOAC_R(0.5);
+    if (!(n >= ICOAC_R(1.0))) {
+        return 1;
+    }
+    return n >= (icoac_real_t)batch ? batch : (int)n;
 }
 
 /* Each coordinate's variance given the earlier ones (the squared Cholesky pivot) at least this
@@ -109,12 +132,11 @@ static int well_conditioned(const icoac_real_t cov[N][N], icoac_real_t lower[N][
  * Sigma' = (1-a) Sigma + a Cov_elite about mu' (upper triangle mirrored), then
  * Sigma'_ii >= floor_i. Returns 0 when a value is not finite or Sigma' not positive definite. */
 static int search_update(const icoac_search_config_t *search, const icoac_priv_state_t *st,
-                         const closing_batch_t *b, icoac_real_t w[N], icoac_real_t cov[N][N],
+                         const closing_batch_t *b, int n_elite, icoac_real_t w[N], icoac_real_t cov[N][N],
                          icoac_real_t lower[N][N])
 {
     const icoac_real_t (*sigma)[N] = icoac_priv_cov_c(st);
     const icoac_real_t a = search->step;
-    const int n_elite = elite_size(search);
     const icoac_real_t inv_n = ICOAC_R(1.0) / (icoac_real_t)n_elite;
     uint8_t elite[ICOAC_SEARCH_BATCH_MAX];
     int e;
@@ -161,35 +183,46 @@ static int search_update(const icoac_search_config_t *search, const icoac_priv_s
     return icoac_priv_all_finite(&lower[0][0], N * N);
 }
 
+/* x clamped to [lo, hi]. */
+static int clamp_int(int32_t x, int lo, int hi)
+{
+    return x < lo ? lo : (x > hi ? hi : (int)x);
+}
+
 /* A terminal tick ends the trial: record (w_act, length); a full batch updates (staged: on a
- * failure nothing is recorded and 0 is returned). */
+ * failure nothing is recorded and 0 is returned). The batch closes when at least batch - 1
+ * trials are recorded (more after a retune to a smaller batch). Count and batch are clamped to
+ * the arrays, whatever the state holds. */
 ICOAC_PRIV_NOINLINE static int end_trial(const icoac_config_t *cfg, icoac_priv_state_t *st)
 {
     icoac_priv_search_t *recorded = &st->search;
+    const int batch = clamp_int(cfg->search.batch, 1, ICOAC_SEARCH_BATCH_MAX);
+    const int count = clamp_int(recorded->count, 0, ICOAC_SEARCH_BATCH_MAX - 1);
     closing_batch_t b;
     icoac_real_t w[N];
     icoac_real_t lower[N][N];
-    icoac_real_t (*cov)[N] = st->cov_buffer[st->cov_slot ^ 1]; /* the spare */
+    icoac_real_t (*cov)[N] = icoac_priv_cov_spare(st);
     int i;
     int j;
     if (!cfg->learn) {
         return 1;
     }
-    if (recorded->count + 1 < cfg->search.batch) {
-        icoac_priv_copy4(recorded->w[recorded->count], st->w_act);
-        recorded->ticks[recorded->count] = st->trial_ticks;
-        recorded->count++;
+    if (count + 1 < batch) {
+        icoac_priv_copy4(recorded->w[count], st->w_act);
+        recorded->ticks[count] = st->trial_ticks;
+        recorded->count = count + 1;
         return 1;
     }
     b.recorded = recorded;
+    b.count = count;
     b.last_w = st->w_act;
     b.last_ticks = st->trial_ticks;
-    b.size = recorded->count + 1;
-    if (!search_update(&cfg->search, st, &b, w, cov, lower)) {
+    b.size = count + 1;
+    if (!search_update(&cfg->search, st, &b, elite_size(&cfg->search, batch), w, cov, lower)) {
         return 0;
     }
     icoac_priv_copy4(st->w, w);
-    st->cov_slot ^= 1;
+    st->cov_slot = (st->cov_slot & 1) ^ 1;
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
             recorded->lower[i][j] = lower[i][j];

@@ -13,19 +13,30 @@
 #define ICOAC_PRIV_MAY_ALIAS
 #endif
 
-#define ICOAC_PRIV_STATE_MAGIC 0x1C0AC001u
+/* The header word of an initialised state; it changes with the layout. A terminal tick turns a
+ * trial's word into the ended one until icoac_reset: a tick in between is refused. */
+#define ICOAC_PRIV_STATE_MAGIC 0x1C0AC070u
+#define ICOAC_PRIV_STATE_ENDED 0x1C0AC07Eu
+
+/* The sparse kernel's TD update indexes a pair's units with cell & ICOAC_PRIV_CELL_MASK and the
+ * critic weights have room for the last pair's masked index: whatever bytes the kept-unit list
+ * holds, the update stays inside them (an index from a valid list is below ICOAC_CRITIC_CELLS,
+ * so the mask changes nothing). */
+#define ICOAC_PRIV_CELL_MASK 31
+#define ICOAC_PRIV_CRITIC_WEIGHTS ((ICOAC_CRITIC_PAIRS - 1) * ICOAC_CRITIC_CELLS + ICOAC_PRIV_CELL_MASK + 1)
+ICOAC_STATIC_ASSERT(ICOAC_CRITIC_CELLS <= ICOAC_PRIV_CELL_MASK + 1, cell_index_fits_its_mask);
 
 /* Critic units kept (b_k >= critic.threshold) at one state: the eligibility of the next TD
  * update, in the layout of the critic kernel that found them (icoac_priv.h).
- * Sparse kernel: pair p keeps the units of its first pair_cells[p] cells, in the listed order. */
+ * Sparse kernel: pair p = a*3 + b keeps the units of the first pair_cells[p] cells of the
+ * list, in the listed order (0: none). The list's arrays have ICOAC_PRIV_CELL_MASK + 1 slots, so
+ * a count or index masked with it stays inside them whatever the state holds. */
 typedef struct {
-    icoac_real_t pair_product[ICOAC_CRITIC_PAIRS];     /* g_x * g_xdot of each listed pair */
-    icoac_real_t cell_product[ICOAC_CRITIC_CELLS + 1]; /* g_theta * g_thetadot, largest first; 0 */
-    uint8_t pair[ICOAC_CRITIC_PAIRS];                  /* a*3 + b */
-    uint8_t pair_cells[ICOAC_CRITIC_PAIRS];            /* leading cells kept by each pair */
-    uint8_t cell[ICOAC_CRITIC_CELLS];                  /* c*3 + d */
-    uint8_t pairs;                                     /* pairs listed */
-    uint8_t cells;                                     /* cells listed */
+    icoac_real_t pair_product[ICOAC_CRITIC_PAIRS];           /* g_x * g_xdot of each pair */
+    icoac_real_t cell_product[ICOAC_PRIV_CELL_MASK];         /* g_theta * g_thetadot, largest first; 0 */
+    uint8_t pair_cells[ICOAC_CRITIC_PAIRS];                  /* leading cells kept by each pair */
+    uint8_t cell[ICOAC_PRIV_CELL_MASK];                      /* c*3 + d */
+    uint8_t cells;                                           /* cells listed */
 } icoac_priv_critic_list_t;
 
 /* Dense kernel: the products of every pair and every cell; unit pair * 18 + cell is kept when
@@ -56,21 +67,24 @@ typedef struct {
     uint32_t ticks[ICOAC_SEARCH_BATCH_MAX];                 /* its length (the return) */
     icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS];     /* Cholesky factor of Sigma_w */
     icoac_real_t floor[ICOAC_N_INPUTS];                     /* search.floor * Sigma0_ii */
-    int32_t count;                                          /* trials recorded */
+    icoac_real_t prior_var[ICOAC_N_INPUTS];                 /* the prior's variances: Sigma0_ii / cov_scale */
+    int32_t count;                                          /* trials recorded, [0, search.batch) */
 } icoac_priv_search_t;
 
 /* Everything the controller owns. The small per-tick fields come first: a Cortex-M load or
  * store reaches 1020 bytes past the base, so fields behind the large arrays cost an address
  * computation per access. */
 typedef struct ICOAC_PRIV_MAY_ALIAS {
-    uint32_t magic;                                   /* set by icoac_init */
+    uint32_t magic;                                   /* set by icoac_init; ENDED after a terminal tick */
     int32_t has_prev;                                 /* a previous tick of this trial is cached */
+    icoac_config_t config;                            /* in force: checked by icoac_init / icoac_retune,
+                                                         checked again by icoac_reset */
     icoac_real_t inv_range[ICOAC_N_INPUTS];           /* 1 / policy.input_range, derived by icoac_init */
     icoac_real_t w[ICOAC_N_INPUTS];                   /* ICO weights, or actor mean mu_w */
     icoac_real_t weight_norm;                         /* |w|, refreshed when w changes */
     icoac_real_t w_act[ICOAC_N_INPUTS];               /* weights used to act (mu_w or a sample) */
-    int32_t cov_slot;                                 /* index of Sigma_w in cov_buffer */
-    int32_t active_slot;                              /* index of s_t's entry in active */
+    int32_t cov_slot;                                 /* index of Sigma_w in cov_buffer (read & 1) */
+    int32_t active_slot;                              /* index of s_t's entry in active (read & 1) */
     icoac_real_t x_prev[ICOAC_N_INPUTS];              /* scaled observation of the previous tick */
     icoac_real_t penalty_prev;                        /* r of the previous ICO observation */
     icoac_real_t value_prev;                          /* V(s_t) */
@@ -80,7 +94,8 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
     icoac_counters_t counters;
     icoac_real_t cov_buffer[2][ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* Sigma_w, and the spare the RL tick stages into */
     icoac_priv_critic_active_t active[2];             /* kept critic units of s_t and of s */
-    icoac_real_t v[ICOAC_CRITIC_UNITS];               /* critic weights */
+    icoac_real_t v[ICOAC_PRIV_CRITIC_WEIGHTS];        /* critic weights: ICOAC_CRITIC_UNITS, then room
+                                                         for the masked index (never read) */
     icoac_priv_actor_batch_t batch;                   /* RL, actor.batch: this trial's sums */
     icoac_priv_search_t search;                       /* search mode */
 } icoac_priv_state_t;
@@ -99,15 +114,27 @@ static inline const icoac_priv_state_t *icoac_priv_state_c(const icoac_state_t *
     return (const icoac_priv_state_t *)(const void *)state;
 }
 
-/* The actor covariance Sigma_w. */
+/* The actor covariance Sigma_w, and the spare buffer a tick stages a new one into. The slot is
+ * masked, so any state content indexes inside the buffer. */
 static inline icoac_real_t (*icoac_priv_cov(icoac_priv_state_t *st))[ICOAC_N_INPUTS]
 {
-    return st->cov_buffer[st->cov_slot];
+    return st->cov_buffer[st->cov_slot & 1];
 }
 
 static inline const icoac_real_t (*icoac_priv_cov_c(const icoac_priv_state_t *st))[ICOAC_N_INPUTS]
 {
-    return (const icoac_real_t(*)[ICOAC_N_INPUTS])st->cov_buffer[st->cov_slot];
+    return (const icoac_real_t(*)[ICOAC_N_INPUTS])st->cov_buffer[st->cov_slot & 1];
+}
+
+static inline icoac_real_t (*icoac_priv_cov_spare(icoac_priv_state_t *st))[ICOAC_N_INPUTS]
+{
+    return st->cov_buffer[(st->cov_slot & 1) ^ 1];
+}
+
+/* The state's trial has started and not ended. */
+static inline int icoac_priv_initialised(const icoac_priv_state_t *st)
+{
+    return st->magic == ICOAC_PRIV_STATE_MAGIC || st->magic == ICOAC_PRIV_STATE_ENDED;
 }
 
 #endif /* ICOAC_STATE_H */

@@ -27,17 +27,29 @@ static icoac_status_t rejected(const icoac_priv_state_t *st, icoac_output_t *out
     return status;
 }
 
-icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in,
-                          icoac_output_t *out)
+/* The slow path of a state that is not in a trial: ended by a terminal tick, or never set up. */
+ICOAC_PRIV_NOINLINE static icoac_status_t not_in_trial(icoac_priv_state_t *st, icoac_output_t *out)
+{
+    clear_output(out);
+    if (st->magic == ICOAC_PRIV_STATE_ENDED) {
+        st->counters.ticks++;
+        return rejected(st, out, ICOAC_ERR_TRIAL_ENDED);
+    }
+    out->status = ICOAC_ERR_NOT_INITIALISED;
+    return ICOAC_ERR_NOT_INITIALISED;
+}
+
+icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
 {
     static const icoac_real_t zeros[ICOAC_N_INPUTS] = {ICOAC_R(0.0), ICOAC_R(0.0), ICOAC_R(0.0),
                                                         ICOAC_R(0.0)};
     icoac_priv_state_t *st = icoac_priv_state(state);
+    const icoac_config_t *cfg;
     icoac_real_t scaled[ICOAC_N_INPUTS];
     icoac_priv_zone_t zone;
     int terminal;
     int ok;
-    if (cfg == 0 || state == 0 || in == 0 || out == 0) {
+    if (state == 0 || in == 0 || out == 0) {
         if (out != 0) {
             clear_output(out);
             out->status = ICOAC_ERR_NULL;
@@ -45,10 +57,9 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state, const
         return ICOAC_ERR_NULL;
     }
     if (st->magic != ICOAC_PRIV_STATE_MAGIC) {
-        clear_output(out);
-        out->status = ICOAC_ERR_NOT_INITIALISED;
-        return ICOAC_ERR_NOT_INITIALISED;
+        return not_in_trial(st, out);
     }
+    cfg = &st->config;
     st->counters.ticks++;
     /* s_i * 0 is 0 for finite s_i and NaN for NaN or Inf: one test for all four. */
     if (!(icoac_priv_dot4(in->s, zeros) == ICOAC_R(0.0))) {
@@ -64,12 +75,20 @@ icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state, const
         ok = icoac_priv_rl_tick(cfg, st, in->s, scaled, terminal, out);
     } else if (cfg->mode == ICOAC_MODE_SEARCH) {
         ok = icoac_priv_search_tick(cfg, st, scaled, terminal, out);
-    } else {
+    } else if (cfg->mode == ICOAC_MODE_ICO) {
         ok = icoac_priv_ico_tick(cfg, st, scaled, zone.penalty, terminal, out);
+    } else {
+        ok = ICOAC_PRIV_TICK_BAD_STATE;
     }
-    if (!ok) {
+    if (ok != ICOAC_PRIV_TICK_OK) {
+        if (ok == ICOAC_PRIV_TICK_BAD_STATE) {
+            return rejected(st, out, ICOAC_ERR_BAD_STATE);
+        }
         st->counters.numeric_faults++;
         return rejected(st, out, ICOAC_ERR_NUMERIC);
+    }
+    if (terminal) {
+        st->magic = ICOAC_PRIV_STATE_ENDED;
     }
     out->weight_norm = st->weight_norm;
     out->status = ICOAC_OK;

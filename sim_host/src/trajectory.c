@@ -40,7 +40,7 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t 
     *n_steps = 0;
     for (k = 0; k < max_steps; ++k) {
         sim_to_input(s, 0u, &in);
-        status = (int32_t)icoac_step(cfg, &ctrl, &in, &out);
+        status = (int32_t)icoac_step(&ctrl, &in, &out);
         if (status != ICOAC_SIM_OK) {
             break;
         }

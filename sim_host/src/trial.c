@@ -105,7 +105,7 @@ static int start_trial(const sim_job_t *job, sim_lane_t *lane)
     }
     sim_start_trial(lane->cell, job->run->init_velocity_noise, &lane->rng, lane->s);
     lane->steps = 0;
-    lane->status = (int32_t)icoac_reset(job->cfg, &lane->ctrl);
+    lane->status = (int32_t)icoac_reset(&lane->ctrl);
     return lane->status == ICOAC_SIM_OK ? SIM_LANE_RUNNING : finish(job, lane, ICOAC_SIM_ERROR);
 }
 
@@ -147,7 +147,7 @@ int sim_lane_tick(const sim_job_t *job, sim_lane_t *lane)
     icoac_input_t in;
     icoac_output_t out;
     sim_to_input(lane->s, 0u, &in);
-    lane->status = (int32_t)icoac_step(job->cfg, &lane->ctrl, &in, &out);
+    lane->status = (int32_t)icoac_step(&lane->ctrl, &in, &out);
     if (lane->status != ICOAC_SIM_OK) {
         return finish(job, lane, ICOAC_SIM_ERROR);
     }
@@ -157,7 +157,7 @@ int sim_lane_tick(const sim_job_t *job, sim_lane_t *lane)
         /* Let the controller learn from the failure state; it rejects NaN plant states,
          * which end the trial like any failure, but a numeric fault is an error. */
         sim_to_input(lane->s, ICOAC_INPUT_TERMINAL, &in);
-        if (icoac_step(job->cfg, &lane->ctrl, &in, &out) == ICOAC_ERR_NUMERIC) {
+        if (icoac_step(&lane->ctrl, &in, &out) == ICOAC_ERR_NUMERIC) {
             lane->status = ICOAC_ERR_NUMERIC;
             return finish(job, lane, ICOAC_SIM_ERROR);
         }

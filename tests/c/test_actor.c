@@ -383,13 +383,13 @@ static void test_step_wiring(void **unused)
             hd[i] = 10.0 * test_scale(i, (double)s1.s[i], 1);
             z += prior.mean[i] * test_scale(i, (double)s1.s[i], 1);
         }
-        assert_int_equal(icoac_step(&cfg, &state, &s1, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(&state, &s1, &out), ICOAC_OK);
         eps = (double)out.noise;
         assert_true(eps != 0.0);
         assert_close(out.z, z, 1e-5);
         assert_close(out.force, 10.0 * z + eps, 1e-4); /* no reflex at s1 */
         slot = icoac_priv_state_c(&state)->cov_slot;
-        assert_int_equal(icoac_step(&cfg, &state, &s2, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(&state, &s2, &out), ICOAC_OK);
         assert_close(out.td_error, -1.0, 0.0);
         /* the learning tick committed the staged covariance by flipping the slot */
         assert_int_equal(icoac_priv_state_c(&state)->cov_slot, slot ^ 1);
@@ -464,7 +464,7 @@ static void test_posterior_sample_per_trial(void **unused)
         for (i = 0; i < N; ++i) {
             n[i] = (double)icoac_rng_normal(&copy);
         }
-        assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+        assert_int_equal(icoac_reset(&state), ICOAC_OK);
         for (i = 0; i < N; ++i) {
             double expect = (double)mean_of(&state)[i];
             for (j = 0; j <= i; ++j) {

@@ -84,6 +84,15 @@ static inline icoac_prior_t test_random_prior(test_rng_t *rng, double mean_half_
 }
 
 /* Configuration with paper defaults and a checked status. */
+/* cfg is the configuration in force in state: the tests pass the one they initialised or last
+ * retuned the state with (the state keeps its own copy; editing cfg alone changes nothing). */
+static inline void test_assert_config_in_force(const icoac_config_t *cfg, const icoac_state_t *state)
+{
+    icoac_config_t in_force;
+    assert_int_equal(icoac_get_config(state, &in_force), ICOAC_OK);
+    assert_memory_equal(&in_force, cfg, sizeof in_force);
+}
+
 static inline icoac_config_t test_default_config(void)
 {
     icoac_config_t cfg;

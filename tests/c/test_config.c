@@ -684,8 +684,8 @@ static void test_each_field_named_or_ignored(void **unused)
                     fail();
                 }
                 assert_int_equal(icoac_init(&cfg, &state, NULL, 3u), ICOAC_OK);
-                assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
-                assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+                assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
+                assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
                 assert_true(isfinite((double)out.force));
             }
         }
@@ -755,14 +755,16 @@ static void test_unused_groups_ignored(void **unused)
                                           k % 40 == 39 ? ICOAC_INPUT_TERMINAL : 0u);
             memset(&out, 0, sizeof out);
             memset(&out_twin, 0, sizeof out_twin);
-            assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
-            assert_int_equal(icoac_step(&clean, &twin, &in, &out_twin), ICOAC_OK);
+            assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
+            assert_int_equal(icoac_step(&twin, &in, &out_twin), ICOAC_OK);
             assert_memory_equal(&out, &out_twin, sizeof out);
             if (k % 40 == 39) {
-                assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
-                assert_int_equal(icoac_reset(&clean, &twin), ICOAC_OK);
+                assert_int_equal(icoac_reset(&state), ICOAC_OK);
+                assert_int_equal(icoac_reset(&twin), ICOAC_OK);
             }
         }
+        /* the same state but for the unused groups of the configuration it keeps */
+        icoac_priv_state(&state)->config = clean;
         assert_memory_equal(&state, &twin, sizeof state);
     }
     /* the case table's rejections of a mode's own group, in every other mode */
@@ -907,21 +909,18 @@ static void test_null_pointers(void **unused)
     assert_int_equal(icoac_init(NULL, &state, NULL, 0u), ICOAC_ERR_NULL);
     assert_int_equal(icoac_init(&cfg, NULL, NULL, 0u), ICOAC_ERR_NULL);
     assert_int_equal(icoac_init(&cfg, &state, NULL, 0u), ICOAC_OK);
-    assert_int_equal(icoac_reset(NULL, &state), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_reset(&cfg, NULL), ICOAC_ERR_NULL);
+    assert_int_equal(icoac_reset(NULL), ICOAC_ERR_NULL);
+    assert_int_equal(icoac_retune(NULL, &cfg), ICOAC_ERR_NULL);
+    assert_int_equal(icoac_retune(&state, NULL), ICOAC_ERR_NULL);
     memset(&out, 0x7F, sizeof out);
-    assert_int_equal(icoac_step(NULL, &state, &in, &out), ICOAC_ERR_NULL);
+    assert_int_equal(icoac_step(NULL, &in, &out), ICOAC_ERR_NULL);
     assert_int_equal(out.status, ICOAC_ERR_NULL);
     assert_true(out.force == 0);
     memset(&out, 0x7F, sizeof out);
-    assert_int_equal(icoac_step(&cfg, NULL, &in, &out), ICOAC_ERR_NULL);
+    assert_int_equal(icoac_step(&state, NULL, &out), ICOAC_ERR_NULL);
     assert_int_equal(out.status, ICOAC_ERR_NULL);
     assert_true(out.force == 0);
-    memset(&out, 0x7F, sizeof out);
-    assert_int_equal(icoac_step(&cfg, &state, NULL, &out), ICOAC_ERR_NULL);
-    assert_int_equal(out.status, ICOAC_ERR_NULL);
-    assert_true(out.force == 0);
-    assert_int_equal(icoac_step(&cfg, &state, &in, NULL), ICOAC_ERR_NULL);
+    assert_int_equal(icoac_step(&state, &in, NULL), ICOAC_ERR_NULL);
     assert_int_equal(icoac_get_posterior(NULL, &post), ICOAC_ERR_NULL);
     assert_int_equal(icoac_get_posterior(&state, NULL), ICOAC_ERR_NULL);
     assert_int_equal(icoac_get_counters(NULL, &counters), ICOAC_ERR_NULL);
@@ -936,7 +935,6 @@ static void test_null_pointers(void **unused)
 
 static void test_not_initialised(void **unused)
 {
-    icoac_config_t cfg = test_default_config();
     icoac_state_t state;
     icoac_state_t copy;
     icoac_input_t in = test_input(0.1, 0, 0.05, 0, 0);
@@ -947,17 +945,17 @@ static void test_not_initialised(void **unused)
     memset(&state, 0, sizeof state);
     memset(&out, 0x7F, sizeof out);
     copy = state;
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_ERR_NOT_INITIALISED);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_ERR_NOT_INITIALISED);
     assert_int_equal(out.status, ICOAC_ERR_NOT_INITIALISED);
     assert_true(out.force == 0);
-    assert_int_equal(icoac_reset(&cfg, &state), ICOAC_ERR_NOT_INITIALISED);
+    assert_int_equal(icoac_reset(&state), ICOAC_ERR_NOT_INITIALISED);
     assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_ERR_NOT_INITIALISED);
     assert_int_equal(icoac_get_counters(&state, &counters), ICOAC_ERR_NOT_INITIALISED);
     assert_memory_equal(&state, &copy, sizeof state);
     /* Garbage is not mistaken for an initialised state. */
     memset(&state, 0xA5, sizeof state);
     copy = state;
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_ERR_NOT_INITIALISED);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_ERR_NOT_INITIALISED);
     assert_int_equal(icoac_get_counters(&state, &counters), ICOAC_ERR_NOT_INITIALISED);
     assert_memory_equal(&state, &copy, sizeof state);
 }
@@ -966,7 +964,7 @@ static void test_status_strings(void **unused)
 {
     static const icoac_status_t all[] = {
         ICOAC_OK, ICOAC_ERR_NULL, ICOAC_ERR_NOT_INITIALISED, ICOAC_ERR_NONFINITE_INPUT, ICOAC_ERR_NUMERIC,
-        ICOAC_ERR_BAD_MODE, ICOAC_ERR_BAD_SCALE, ICOAC_ERR_BAD_GAIN, ICOAC_ERR_BAD_ZONE,
+        ICOAC_ERR_TRIAL_ENDED, ICOAC_ERR_BAD_STATE, ICOAC_ERR_RETUNE_MODE, ICOAC_ERR_BAD_MODE, ICOAC_ERR_BAD_SCALE, ICOAC_ERR_BAD_GAIN, ICOAC_ERR_BAD_ZONE,
         ICOAC_ERR_BAD_ICO_RATE, ICOAC_ERR_BAD_CRITIC, ICOAC_ERR_BAD_ACTOR, ICOAC_ERR_BAD_PRIOR,
         ICOAC_ERR_BAD_SEARCH};
     const size_t n = sizeof all / sizeof all[0];
@@ -995,7 +993,7 @@ static void test_sizeof_functions(void **unused)
 {
     (void)unused;
     assert_int_equal(icoac_abi_version(), ICOAC_ABI_VERSION);
-    assert_int_equal(ICOAC_ABI_VERSION, 6);
+    assert_int_equal(ICOAC_ABI_VERSION, 7);
     assert_int_equal(ICOAC_ERR_BAD_SEARCH, 18);
     assert_int_equal(ICOAC_MODE_SEARCH, 2);
     assert_int_equal(ICOAC_ACTOR_POSTERIOR, 0);

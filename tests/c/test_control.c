@@ -21,10 +21,10 @@ static void run(const icoac_config_t *cfg, icoac_state_t *state, const icoac_pri
         icoac_output_t out;
         const uint32_t flags = k % 97 == 96 ? ICOAC_INPUT_TERMINAL : 0u;
         icoac_input_t in = wandering_input(&rng, flags);
-        assert_int_equal(icoac_step(cfg, state, &in, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
         forces[k] = (double)out.force;
         if (flags != 0u) {
-            assert_int_equal(icoac_reset(cfg, state), ICOAC_OK);
+            assert_int_equal(icoac_reset(state), ICOAC_OK);
         }
     }
 }

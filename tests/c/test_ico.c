@@ -57,7 +57,7 @@ static void run_scaling(int clip)
         w[scale_rows[r].component] = 1.0;
         init_with_w(&cfg, &state, w[0], w[1], w[2], w[3]);
         in = test_input(s[0], s[1], s[2], s[3], 0);
-        assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
         expected = test_scale(scale_rows[r].component, (double)in.s[scale_rows[r].component], clip);
         if (clip) {
             assert_true(fabs(expected) <= 1.0);
@@ -96,7 +96,7 @@ static void test_feature_is_dot_product(void **unused)
         cfg.policy.clip_inputs = (int32_t)(k & 1);
         cfg.ico.rate = 0;
         init_with_w(&cfg, &state, w[0], w[1], w[2], w[3]);
-        assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
         for (i = 0; i < 4; ++i) {
             z += w[i] * test_scale(i, (double)in.s[i], cfg.policy.clip_inputs);
         }
@@ -149,7 +149,7 @@ static void run_zone_table(int reflex_mode, double reflex_force, const double w[
         cfg.policy.reflex_mode = reflex_mode;
         cfg.policy.reflex_force = (icoac_real_t)reflex_force;
         init_with_w(&cfg, &state, w[0], w[1], w[2], w[3]);
-        assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
         if (out.reflex != row->reflex || out.penalty != row->penalty) {
             print_error("row %s: U = %g r = %g, expected U = %g r = %g\n", row->name, (double)out.reflex,
                         (double)out.penalty, row->reflex, row->penalty);
@@ -201,7 +201,7 @@ static void test_zone_edges_are_strict(void **unused)
         in = test_input(0, 0, 0, 0, 0);
         in.s[0] = (icoac_real_t)edges[e][0] * cfg.policy.zone_x;
         in.s[2] = (icoac_real_t)edges[e][1] * cfg.policy.zone_theta;
-        assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
         assert_true(out.reflex == 0 && out.penalty == 0);
     }
 }
@@ -258,7 +258,7 @@ static void test_ico_code_timing(void **unused)
 
     /* tick 1: outside the zone, r = 0 -> 0: no learning */
     in = test_input(0.5, 0.2, 0.05, -0.3, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     assert_true(out.q == 0 && out.penalty == 0);
     get_w(&state, w);
     for (i = 0; i < 4; ++i) {
@@ -267,7 +267,7 @@ static void test_ico_code_timing(void **unused)
 
     /* tick 2: enters the zone (theta > 11.5 deg), r 0 -> -1: q = 1, w += mu |x~| */
     in = test_input(-1.0, 4.0, 0.205, -1.0, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     assert_true(out.q == 1 && out.penalty == -1 && out.reflex == 1);
     z = 0;
     for (i = 0; i < 4; ++i) {
@@ -291,7 +291,7 @@ static void test_ico_code_timing(void **unused)
 
     /* tick 3: still in the zone (other side, other state): no more learning, acts with the new w */
     in = test_input(2.37, -0.5, -0.1, 0.7, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     assert_true(out.q == 0 && out.penalty == -1 && out.reflex == -1);
     z = 0;
     for (i = 0; i < 4; ++i) {
@@ -306,7 +306,7 @@ static void test_ico_code_timing(void **unused)
 
     /* tick 4: leaves the zone, r -1 -> 0: q = 0 */
     in = test_input(0.0, 0.0, 0.0, 0.0, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     assert_true(out.q == 0 && out.penalty == 0);
     {
         double w4[4];
@@ -316,7 +316,7 @@ static void test_ico_code_timing(void **unused)
 
     /* tick 5: enters again (x < -2.35): learns again with this tick's x~ */
     in = test_input(-2.36, 0.35, -0.02, 0.1, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     assert_true(out.q == 1 && out.reflex == 1);
     {
         double w5[4];
@@ -339,9 +339,9 @@ static void test_ico_code_timing_ignores_terminal(void **unused)
     (void)unused;
     init_with_w(&cfg, &state, 0.1, 0.1, 0.1, 0.1);
     in = test_input(0.1, 0.1, 0.1, 0.1, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     in = test_input(0.1, 0.1, 0.25, 0.1, ICOAC_INPUT_TERMINAL);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     assert_true(out.q == 0);
     assert_true(out.force == 0);
     get_w(&state, w);
@@ -349,9 +349,9 @@ static void test_ico_code_timing_ignores_terminal(void **unused)
         assert_true(w[i] == (double)(icoac_real_t)0.1);
     }
     /* r_prev is still 0: the next in-zone observation learns */
-    assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+    assert_int_equal(icoac_reset(&state), ICOAC_OK);
     in = test_input(0.1, 0.1, 0.205, 0.1, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     assert_true(out.q == 1);
 }
 
@@ -371,12 +371,12 @@ static void test_ico_literal_timing(void **unused)
     init_with_w(&cfg, &state, w0[0], w0[1], w0[2], w0[3]);
 
     a = test_input(0.5, -0.2, 0.15, 1.5, 0); /* outside the zone */
-    assert_int_equal(icoac_step(&cfg, &state, &a, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &a, &out), ICOAC_OK);
     assert_true(out.q == 0);
 
     /* observes the zone: update with the previous tick's x~(a), then act with the new w */
     b = test_input(0.6, -0.1, 0.203, 1.4, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &b, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &b, &out), ICOAC_OK);
     assert_true(out.q == 1 && out.penalty == -1);
     z = 0;
     for (i = 0; i < 4; ++i) {
@@ -392,7 +392,7 @@ static void test_ico_literal_timing(void **unused)
 
     /* staying in the zone: no more learning */
     c = test_input(0.7, -0.1, 0.207, 1.3, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &c, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &c, &out), ICOAC_OK);
     assert_true(out.q == 0);
     {
         double w2[4];
@@ -413,11 +413,11 @@ static void test_ico_literal_timing_terminal(void **unused)
     cfg.ico.timing = ICOAC_ICO_TIMING_LITERAL;
     init_with_w(&cfg, &state, 0, 0, 0, 0);
     a = test_input(-0.3, 0.8, -0.19, -1.7, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &a, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &a, &out), ICOAC_OK);
     assert_true(out.q == 0);
     /* jump straight to a failure state (theta < -12 deg), flagged terminal: learned from, no action */
     f = test_input(-0.29, 0.8, -0.215, -1.7, ICOAC_INPUT_TERMINAL);
-    assert_int_equal(icoac_step(&cfg, &state, &f, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &f, &out), ICOAC_OK);
     assert_true(out.q == 1);
     assert_true(out.force == 0);
     get_w(&state, w);
@@ -425,9 +425,9 @@ static void test_ico_literal_timing_terminal(void **unused)
         assert_close(w[i], 1e-4 * fabs(test_scale(i, (double)a.s[i], 1)), 4.0 * REAL_EPS * 1e-4);
     }
     /* after a reset the first tick has no previous observation: no update even if r changes */
-    assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+    assert_int_equal(icoac_reset(&state), ICOAC_OK);
     a = test_input(0.0, 0.0, 0.0, 0.0, 0);
-    assert_int_equal(icoac_step(&cfg, &state, &a, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &a, &out), ICOAC_OK);
     assert_true(out.q == 0);
 }
 
@@ -444,8 +444,8 @@ static void test_jump_over_zone(void **unused)
         icoac_input_t f = test_input(0.0, 0.0, DEG(12.5), 1.0, ICOAC_INPUT_TERMINAL);
         cfg.ico.timing = timing;
         assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
-        assert_int_equal(icoac_step(&cfg, &state, &a, &out), ICOAC_OK);
-        assert_int_equal(icoac_step(&cfg, &state, &f, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(&state, &a, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(&state, &f, &out), ICOAC_OK);
         assert_true(out.q == (timing == ICOAC_ICO_TIMING_LITERAL ? 1 : 0));
         assert_true((out.weight_norm > 0) == (timing == ICOAC_ICO_TIMING_LITERAL));
     }

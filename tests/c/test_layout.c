@@ -85,7 +85,7 @@ static void test_constants_table(void **unused)
     }
     /* spot checks against the headers */
     assert_true(constant("ICOAC_ABI_VERSION") == ICOAC_ABI_VERSION);
-    assert_true(constant("ICOAC_ABI_VERSION") == 6);
+    assert_true(constant("ICOAC_ABI_VERSION") == 7);
     assert_true(constant("ICOAC_SIM_ABI_VERSION") == ICOAC_SIM_ABI_VERSION);
     assert_true(constant("ICOAC_SIM_ABI_VERSION") == 2);
     assert_true(constant("ICOAC_N_INPUTS") == ICOAC_N_INPUTS);

@@ -50,13 +50,13 @@ static void test_reset_keeps_learning_code_timing(void **unused)
     (void)unused;
     assert_int_equal(icoac_init(&cfg, &state, NULL, 5u), ICOAC_OK);
     in = calm_input(&rng);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     in = zone_input(&rng);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     assert_true(out.q == 1);
     assert_true(out.weight_norm > 0);
     before = state;
-    assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+    assert_int_equal(icoac_reset(&state), ICOAC_OK);
     assert_memory_equal(priv(&state)->w, priv(&before)->w, sizeof priv(&state)->w);
     assert_memory_equal(icoac_priv_cov_c(priv(&state)), icoac_priv_cov_c(priv(&before)), sizeof(icoac_real_t) * N * N);
     assert_memory_equal(priv(&state)->v, priv(&before)->v, sizeof priv(&state)->v);
@@ -64,7 +64,7 @@ static void test_reset_keeps_learning_code_timing(void **unused)
     assert_memory_equal(&priv(&state)->rng, &priv(&before)->rng, sizeof priv(&state)->rng);
     /* r_prev persisted: starting the new trial inside the zone gives no learning */
     in = zone_input(&rng);
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
     assert_true(out.q == 0);
     assert_memory_equal(priv(&state)->w, priv(&before)->w, sizeof priv(&state)->w);
 }
@@ -93,7 +93,10 @@ static void test_reset_keeps_learning_rl(void **unused)
             if (k % 10 == 9) {
                 in.flags = ICOAC_INPUT_TERMINAL;
             }
-            assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+            assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
+            if (k % 10 == 9 && k < 49) {
+                assert_int_equal(icoac_reset(&state), ICOAC_OK); /* the next trial */
+            }
         }
         for (k = 0; k < ICOAC_CRITIC_UNITS; ++k) {
             nonzero += priv(&state)->v[k] != 0;
@@ -107,7 +110,7 @@ static void test_reset_keeps_learning_rl(void **unused)
         }
         assert_true(literal ? moved == N : moved == 0);
         before = state;
-        assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+        assert_int_equal(icoac_reset(&state), ICOAC_OK);
         assert_memory_equal(priv(&state)->w, priv(&before)->w, sizeof priv(&state)->w);
         assert_memory_equal(icoac_priv_cov_c(priv(&state)), icoac_priv_cov_c(priv(&before)),
                             sizeof(icoac_real_t) * N * N);
@@ -115,7 +118,7 @@ static void test_reset_keeps_learning_rl(void **unused)
         assert_int_equal(priv(&state)->has_prev, 0);
         /* the first tick of a trial has no transition to learn from */
         in = calm_input(&rng);
-        assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
         assert_true(out.td_error == 0);
         assert_memory_equal(priv(&state)->w, priv(&before)->w, sizeof priv(&state)->w);
         assert_memory_equal(icoac_priv_cov_c(priv(&state)), icoac_priv_cov_c(priv(&before)),
@@ -142,10 +145,10 @@ static void test_no_penalty_change_no_learning(void **unused)
         /* many calm ticks, with resets: r stays 0 */
         for (k = 0; k < 20000; ++k) {
             if (k % 1000 == 999) {
-                assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+                assert_int_equal(icoac_reset(&state), ICOAC_OK);
             }
             in = calm_input(&rng);
-            assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+            assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
             assert_true(out.q == 0);
         }
         assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_OK);
@@ -153,7 +156,7 @@ static void test_no_penalty_change_no_learning(void **unused)
         /* then only in-zone ticks: exactly one onset, hence one update */
         for (k = 0; k < 20000; ++k) {
             in = zone_input(&rng);
-            assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+            assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
             learned += out.q != 0;
         }
         assert_int_equal(learned, 1);
@@ -167,10 +170,11 @@ static void warm_up(const icoac_config_t *cfg, icoac_state_t *state)
     icoac_output_t out;
     icoac_input_t in;
     int k;
+    test_assert_config_in_force(cfg, state);
     for (k = 0; k < 30; ++k) {
         /* ends inside the zone so that penalty_prev = -1 (ICO) and x_prev is non-zero */
         in = (k % 7 == 3 || k >= 28) ? zone_input(&rng) : calm_input(&rng);
-        assert_int_equal(icoac_step(cfg, state, &in, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
     }
 }
 
@@ -243,7 +247,7 @@ static void test_nonfinite_inputs(void **unused)
                     before = counters_of(&state);
                     in.s[comp] = (icoac_real_t)bad[b];
                     memset(&out, 0x7F, sizeof out);
-                    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_ERR_NONFINITE_INPUT);
+                    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_ERR_NONFINITE_INPUT);
                     /* fully cleared: force 0, q 0, ..., |w| of the unchanged state */
                     assert_output_cleared(&out, ICOAC_ERR_NONFINITE_INPUT, priv(&state)->weight_norm);
                     after = counters_of(&state);
@@ -257,8 +261,8 @@ static void test_nonfinite_inputs(void **unused)
                      * (same fill for both: icoac_step does not write struct padding) */
                     memset(&out, 0, sizeof out);
                     memset(&out_twin, 0, sizeof out_twin);
-                    assert_int_equal(icoac_step(&cfg, &state, &next, &out), ICOAC_OK);
-                    assert_int_equal(icoac_step(&cfg, &twin, &next, &out_twin), ICOAC_OK);
+                    assert_int_equal(icoac_step(&state, &next, &out), ICOAC_OK);
+                    assert_int_equal(icoac_step(&twin, &next, &out_twin), ICOAC_OK);
                     assert_memory_equal(&out, &out_twin, sizeof out);
                     assert_memory_equal(priv(&state)->w, priv(&twin)->w, sizeof priv(&state)->w);
                     assert_memory_equal(priv(&state)->v, priv(&twin)->v, sizeof priv(&state)->v);
@@ -283,7 +287,7 @@ static void test_output_status_and_counters(void **unused)
     assert_true(c.ticks == 0 && c.nonfinite == 0 && c.numeric_faults == 0);
     for (k = 0; k < 10; ++k) {
         in = calm_input(&rng);
-        assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+        assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
         assert_int_equal(out.status, ICOAC_OK);
     }
     c = counters_of(&state);
@@ -292,11 +296,11 @@ static void test_output_status_and_counters(void **unused)
     assert_int_equal(c.numeric_faults, 0u);
     /* a rejected observation counts as a tick and as non-finite */
     in.s[1] = (icoac_real_t)NAN;
-    assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_ERR_NONFINITE_INPUT);
+    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_ERR_NONFINITE_INPUT);
     c = counters_of(&state);
     assert_true(c.ticks == 11u && c.nonfinite == 1u && c.numeric_faults == 0u);
     /* a reset keeps the counters; icoac_init clears them */
-    assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+    assert_int_equal(icoac_reset(&state), ICOAC_OK);
     c = counters_of(&state);
     assert_true(c.ticks == 11u && c.nonfinite == 1u);
     assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
@@ -328,31 +332,28 @@ static void test_output_cleared_on_each_error(void **unused)
             cfg.policy.input_range[0] = ICOAC_RANGE_MIN;
             /* ICOAC_ERR_NULL */
             memset(&out, fills[f], sizeof out);
-            assert_int_equal(icoac_step(NULL, &state, &in, &out), ICOAC_ERR_NULL);
+            assert_int_equal(icoac_step(NULL, &in, &out), ICOAC_ERR_NULL);
             assert_output_cleared(&out, ICOAC_ERR_NULL, ICOAC_R(0.0));
             memset(&out, fills[f], sizeof out);
-            assert_int_equal(icoac_step(&cfg, NULL, &in, &out), ICOAC_ERR_NULL);
-            assert_output_cleared(&out, ICOAC_ERR_NULL, ICOAC_R(0.0));
-            memset(&out, fills[f], sizeof out);
-            assert_int_equal(icoac_step(&cfg, &state, NULL, &out), ICOAC_ERR_NULL);
+            assert_int_equal(icoac_step(&state, NULL, &out), ICOAC_ERR_NULL);
             assert_output_cleared(&out, ICOAC_ERR_NULL, ICOAC_R(0.0));
             /* ICOAC_ERR_NOT_INITIALISED */
             memset(&state, 0, sizeof state);
             memset(&out, fills[f], sizeof out);
-            assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_ERR_NOT_INITIALISED);
+            assert_int_equal(icoac_step(&state, &in, &out), ICOAC_ERR_NOT_INITIALISED);
             assert_output_cleared(&out, ICOAC_ERR_NOT_INITIALISED, ICOAC_R(0.0));
             /* ICOAC_ERR_NONFINITE_INPUT, after a few ticks: |w| > 0 */
             assert_int_equal(icoac_init(&cfg, &state, &p, 4u), ICOAC_OK);
-            assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
-            assert_int_equal(icoac_step(&cfg, &state, &in, &out), ICOAC_OK);
+            assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
+            assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
             assert_true(priv(&state)->weight_norm > 0);
             memset(&out, fills[f], sizeof out);
-            assert_int_equal(icoac_step(&cfg, &state, &nan_in, &out), ICOAC_ERR_NONFINITE_INPUT);
+            assert_int_equal(icoac_step(&state, &nan_in, &out), ICOAC_ERR_NONFINITE_INPUT);
             assert_output_cleared(&out, ICOAC_ERR_NONFINITE_INPUT, priv(&state)->weight_norm);
             /* ICOAC_ERR_NUMERIC: the reflex and penalty of the tick are cleared too */
             snapshot = state;
             memset(&out, fills[f], sizeof out);
-            assert_int_equal(icoac_step(&cfg, &state, &huge, &out), ICOAC_ERR_NUMERIC);
+            assert_int_equal(icoac_step(&state, &huge, &out), ICOAC_ERR_NUMERIC);
             assert_output_cleared(&out, ICOAC_ERR_NUMERIC, priv(&state)->weight_norm);
             assert_true(priv(&state)->weight_norm == priv(&snapshot)->weight_norm);
             assert_int_equal(counters_of(&state).numeric_faults, 1u);
@@ -372,8 +373,8 @@ static void step_writes_every_field(const icoac_config_t *cfg, icoac_state_t *st
     size_t i;
     memset(&a, 0x7F, sizeof a);
     memset(&b, 0xFF, sizeof b);
-    assert_int_equal(icoac_step(cfg, state, in, &a), ICOAC_OK);
-    assert_int_equal(icoac_step(cfg, &twin, in, &b), ICOAC_OK);
+    assert_int_equal(icoac_step(state, in, &a), ICOAC_OK);
+    assert_int_equal(icoac_step(&twin, in, &b), ICOAC_OK);
     assert_memory_equal(state, &twin, sizeof twin);
     assert_int_equal(a.status, ICOAC_OK);
     assert_int_equal(b.status, ICOAC_OK);
@@ -440,7 +441,7 @@ static void test_output_written_on_success(void **unused)
             }
             step_writes_every_field(&cfg, &state, &in, &terminal_ticks, &learning_ticks);
             if (k % 25 == 24) {
-                assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+                assert_int_equal(icoac_reset(&state), ICOAC_OK);
             }
         }
         assert_true(terminal_ticks == 16);

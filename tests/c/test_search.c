@@ -28,8 +28,9 @@ typedef struct {
 
 static void step_ok(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
 {
+    test_assert_config_in_force(cfg, state);
     memset(out, 0x7F, sizeof *out);
-    assert_int_equal(icoac_step(cfg, state, in, out), ICOAC_OK);
+    assert_int_equal(icoac_step(state, in, out), ICOAC_OK);
 }
 
 static const icoac_priv_state_t *priv(const icoac_state_t *state)
@@ -200,13 +201,13 @@ static icoac_status_t run_trial(const icoac_config_t *cfg, icoac_state_t *state,
     icoac_input_t in;
     icoac_output_t out;
     int t;
-    assert_int_equal(icoac_reset(cfg, state), ICOAC_OK);
+    assert_int_equal(icoac_reset(state), ICOAC_OK);
     for (t = 0; t < ticks; ++t) {
         in = random_input(rng, 0);
         step_ok(cfg, state, &in, &out);
     }
     in = random_input(rng, ICOAC_INPUT_TERMINAL);
-    return icoac_step(cfg, state, &in, &out);
+    return icoac_step(state, &in, &out);
 }
 
 /* The reference update of spec L4 in double. */
@@ -380,7 +381,7 @@ static void test_update_matches_reference(void **unused)
                 /* few distinct lengths: many ties */
                 ticks[k] = (int)test_uniform(&rng, 0, 5);
                 tol = expected_draw(&state, drawn, &singular_draws);
-                assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+                assert_int_equal(icoac_reset(&state), ICOAC_OK);
                 w_act_of(&state, w[k]);
                 for (i = 0; i < N; ++i) {
                     assert_close(w[k][i], drawn[i], tol);
@@ -445,7 +446,7 @@ static icoac_status_t finish_trial(const icoac_config_t *cfg, icoac_state_t *sta
         step_ok(cfg, state, &in, &out);
     }
     in = random_input(rng, ICOAC_INPUT_TERMINAL);
-    return icoac_step(cfg, state, &in, &out);
+    return icoac_step(state, &in, &out);
 }
 
 /* Hand-made batches: the elite is chosen by length, ties to the earlier trial; its size is
@@ -483,7 +484,7 @@ static void test_elite_choice(void **unused)
         int k, i, n_e = 0, n_o = 0;
         assert_int_equal(icoac_init(&cfg, &state, NULL, 50u + c), ICOAC_OK);
         for (k = 0; k < ec->batch; ++k) {
-            assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+            assert_int_equal(icoac_reset(&state), ICOAC_OK);
             w_act_of(&state, w[k]);
             assert_int_equal(finish_trial(&cfg, &state, &rng, ec->ticks[k]), ICOAC_OK);
         }
@@ -568,7 +569,7 @@ static void trial_with(const icoac_config_t *cfg, icoac_state_t *state, const do
 {
     test_rng_t rng = {(uint64_t)ticks + 1u};
     int i;
-    assert_int_equal(icoac_reset(cfg, state), ICOAC_OK);
+    assert_int_equal(icoac_reset(state), ICOAC_OK);
     for (i = 0; i < N; ++i) {
         icoac_priv_state(state)->w_act[i] = (icoac_real_t)w[i];
     }
@@ -631,7 +632,7 @@ static void test_step_one_small_elites(void **unused)
         {
             /* the next draws go through the new factor */
             double drawn[N], w[N], tol = expected_draw(&state, drawn, NULL);
-            assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+            assert_int_equal(icoac_reset(&state), ICOAC_OK);
             w_act_of(&state, w);
             for (i = 0; i < N; ++i) {
                 assert_close(w[i], drawn[i], tol);
@@ -662,7 +663,7 @@ static void test_step_one_small_elites(void **unused)
             posterior_of(&state, &start);
             for (k = 0; k < sc->batch; ++k) {
                 ticks[k] = (int)(test_rng_u64(&rng) % 4u);
-                assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+                assert_int_equal(icoac_reset(&state), ICOAC_OK);
                 w_act_of(&state, w[k]);
                 if (finish_trial(&cfg, &state, &rng, ticks[k]) != ICOAC_OK) {
                     print_error("case %u, update %d: terminal tick not OK\n", (unsigned)c, u);
@@ -779,13 +780,14 @@ static void check_sample_statistics(const icoac_config_t *cfg, icoac_state_t *st
     gauss_t g;
     double sum[N] = {0}, sum2[N][N] = {{0}};
     int n, i, j;
+    test_assert_config_in_force(cfg, state);
     posterior_of(state, &g);
     for (n = 0; n < n_samples; ++n) {
         double w[N], drawn[N], tol = 0;
         if (n % 997 == 0) {
             tol = expected_draw(state, drawn, NULL);
         }
-        assert_int_equal(icoac_reset(cfg, state), ICOAC_OK);
+        assert_int_equal(icoac_reset(state), ICOAC_OK);
         w_act_of(state, w);
         if (n % 997 == 0) {
             for (i = 0; i < N; ++i) {
@@ -856,6 +858,7 @@ static void test_samples_through_cholesky(void **unused)
     }
     frozen = cfg;
     frozen.learn = 0;
+    assert_int_equal(icoac_retune(&state, &frozen), ICOAC_OK);
     posterior_of(&state, &g);
     assert_true(fabs(g.cov[0][1] - (double)p.cov[0][1] * 3.0) > 1e-3); /* Sigma_w moved */
     check_sample_statistics(&frozen, &state, 200000);
@@ -906,13 +909,13 @@ static void test_spd_over_many_updates(void **unused)
                 icoac_input_t in;
                 icoac_output_t out;
                 int t, ticks = (int)(test_rng_u64(&rng) % 4u);
-                assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+                assert_int_equal(icoac_reset(&state), ICOAC_OK);
                 for (t = 0; t < ticks; ++t) {
                     in = test_input(0.1, 0.0, 0.01, 0.0, 0);
                     step_ok(&cfg, &state, &in, &out);
                 }
                 in = test_input(0.1, 0.0, 0.3, 0.0, ICOAC_INPUT_TERMINAL);
-                if (icoac_step(&cfg, &state, &in, &out) != ICOAC_OK) {
+                if (icoac_step(&state, &in, &out) != ICOAC_OK) {
                     print_error("case %u, update %d: terminal tick -> %d\n", (unsigned)c, u, (int)out.status);
                     fail();
                 }
@@ -964,8 +967,8 @@ static void test_deterministic_for_a_seed(void **unused)
     for (trial = 0; trial < 60; ++trial) {
         const int ticks = (int)test_uniform(&inputs, 0, 30);
         int t;
-        assert_int_equal(icoac_reset(&cfg, &a), ICOAC_OK);
-        assert_int_equal(icoac_reset(&cfg, &b), ICOAC_OK);
+        assert_int_equal(icoac_reset(&a), ICOAC_OK);
+        assert_int_equal(icoac_reset(&b), ICOAC_OK);
         for (t = 0; t <= ticks; ++t) {
             icoac_input_t in = random_input(&inputs, t == ticks ? ICOAC_INPUT_TERMINAL : 0u);
             icoac_output_t oa, ob;
@@ -999,8 +1002,8 @@ static void test_no_learning_control(void **unused)
         double wc[N], wl[N], w_prev[N];
         const int ticks = trial % 6;
         w_act_of(&c_state, w_prev);
-        assert_int_equal(icoac_reset(&control, &c_state), ICOAC_OK);
-        assert_int_equal(icoac_reset(&learning, &l_state), ICOAC_OK);
+        assert_int_equal(icoac_reset(&c_state), ICOAC_OK);
+        assert_int_equal(icoac_reset(&l_state), ICOAC_OK);
         w_act_of(&c_state, wc);
         w_act_of(&l_state, wl);
         distinct += memcmp(wc, w_prev, sizeof wc) != 0;
@@ -1055,7 +1058,7 @@ static void test_tick_outputs(void **unused)
         assert_true(out.noise == 0 && out.value == 0 && out.td_error == 0 && out.q == 0);
         if (terminal) {
             assert_true(out.force == 0 && out.z == 0);
-            assert_int_equal(icoac_reset(&cfg, &state), ICOAC_OK);
+            assert_int_equal(icoac_reset(&state), ICOAC_OK);
         } else {
             assert_close(out.z, z, (REAL_IS_FLOAT ? 1e-5 : 1e-13) * (1.0 + fabs(z)));
             assert_close(out.force, GAIN * z + reflex, (REAL_IS_FLOAT ? 1e-4 : 1e-12) * (1.0 + fabs(GAIN * z)));

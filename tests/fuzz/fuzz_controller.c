@@ -502,7 +502,7 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
     learned_take(state, &before);
     counted = counters_of(state);
     memset(&out, 0xff, sizeof out); /* NaN in every real: each must be written */
-    status = (int32_t)icoac_step(cfg, state, in, &out);
+    status = (int32_t)icoac_step(state, in, &out);
     learned_take(state, &after);
     counted_after = counters_of(state);
     for (i = 0; i < N; ++i) {
@@ -574,7 +574,7 @@ static void check_reset(const icoac_config_t *cfg, icoac_state_t *state, int op)
     const char *field;
     int32_t status;
     learned_take(state, &before);
-    status = (int32_t)icoac_reset(cfg, state);
+    status = (int32_t)icoac_reset(state);
     learned_take(state, &after);
     FZ_CHECK(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC, "op %d: icoac_reset returned %d (%s)", op,
              (int)status, status_name(status));
@@ -603,11 +603,11 @@ static void check_refusals(const icoac_config_t *cfg)
     memset(&blank, 0, sizeof blank);
     memset(&in, 0, sizeof in);
     memset(&out, 0xff, sizeof out);
-    status = (int32_t)icoac_step(cfg, &blank, &in, &out);
+    status = (int32_t)icoac_step(&blank, &in, &out);
     FZ_CHECK(status == ICOAC_ERR_NOT_INITIALISED && out.status == status && out.force == ICOAC_R(0.0),
              "icoac_step on a zeroed state: %d / out.status %d / force %g", (int)status, (int)out.status,
              (double)out.force);
-    FZ_CHECK(icoac_reset(cfg, &blank) == ICOAC_ERR_NOT_INITIALISED, "icoac_reset on a zeroed state");
+    FZ_CHECK(icoac_reset(&blank) == ICOAC_ERR_NOT_INITIALISED, "icoac_reset on a zeroed state");
     FZ_CHECK(icoac_get_posterior(&blank, &posterior) == ICOAC_ERR_NOT_INITIALISED,
              "icoac_get_posterior on a zeroed state");
     {
@@ -616,9 +616,9 @@ static void check_refusals(const icoac_config_t *cfg)
                  "icoac_get_counters on a zeroed state");
     }
     memset(&out, 0xff, sizeof out);
-    status = (int32_t)icoac_step(0, &blank, &in, &out);
+    status = (int32_t)icoac_step(0, &in, &out);
     FZ_CHECK(status == ICOAC_ERR_NULL && out.status == status && out.force == ICOAC_R(0.0),
-             "icoac_step(NULL config): %d", (int)status);
+             "icoac_step(NULL state): %d", (int)status);
     FZ_CHECK(icoac_config_check(0) == ICOAC_ERR_NULL && icoac_prior_check(0) == ICOAC_ERR_NULL &&
                  icoac_init(cfg, 0, 0, 0u) == ICOAC_ERR_NULL,
              "NULL argument not refused with ICOAC_ERR_NULL");

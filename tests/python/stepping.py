@@ -18,18 +18,33 @@ def controller(cfg, mean=None, cov=None, seed=1):
     return state
 
 
+def assert_in_force(cfg, state):
+    """cfg (a RunConfig) is the configuration the state keeps (icoac_get_config): the one it was
+    initialised or last retuned with."""
+    in_force = B.Config()
+    B.check_status(B.lib.icoac_get_config(ctypes.byref(state), ctypes.byref(in_force)))
+    assert bytes(in_force) == bytes(cfg.controller)
+
+
+def retune(cfg, state):
+    """Make cfg the state's configuration (icoac_retune: live tuning, keeps what was learned)."""
+    B.check_status(B.lib.icoac_retune(ctypes.byref(state), ctypes.byref(cfg.controller)))
+
+
 def reset(cfg, state):
-    B.check_status(B.lib.icoac_reset(ctypes.byref(cfg.controller), ctypes.byref(state)))
+    assert_in_force(cfg, state)
+    B.check_status(B.lib.icoac_reset(ctypes.byref(state)))
 
 
 def tick(cfg, state, s, terminal=False, expect=B.OK):
     """One icoac_step on s; the output (its status must be `expect`)."""
+    assert_in_force(cfg, state)
     inp = B.Input()
     for i in range(B.N_INPUTS):
         inp.s[i] = float(s[i])
     inp.flags = B.INPUT_TERMINAL if terminal else 0
     out = B.Output()
-    status = B.lib.icoac_step(ctypes.byref(cfg.controller), ctypes.byref(state), ctypes.byref(inp), ctypes.byref(out))
+    status = B.lib.icoac_step(ctypes.byref(state), ctypes.byref(inp), ctypes.byref(out))
     assert status == expect == out.status, (status, out.status)
     return out
 

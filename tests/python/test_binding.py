@@ -58,7 +58,7 @@ def test_state_is_opaque_aligned_storage():
 
 
 def test_abi_versions():
-    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 6
+    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 7
     assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 2
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
@@ -166,7 +166,7 @@ def test_counters_and_posterior_accessors():
     for s in ([0.1, 0.0, 0.01, 0.0], [math.nan, 0.0, 0.0, 0.0], [0.1, 0.0, 0.02, 0.0]):
         for i, v in enumerate(s):
             inp.s[i] = v
-        B.lib.icoac_step(ctypes.byref(cfg.controller), ctypes.byref(state), ctypes.byref(inp), ctypes.byref(out))
+        B.lib.icoac_step(ctypes.byref(state), ctypes.byref(inp), ctypes.byref(out))
     counters = B.get_counters(state)
     assert (counters.ticks, counters.nonfinite, counters.numeric_faults) == (3, 1, 0)
     post = B.get_posterior(state)

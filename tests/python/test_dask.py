@@ -210,7 +210,7 @@ def test_worker_without_the_library_is_a_clear_error(tmp_path):
 
 def test_abi_mismatch_names_the_difference():
     expected = {**_worker.abi_of(B), "abi_version": 999}
-    with pytest.raises(WorkerError, match=r"abi_version 6 != client's 999"):
+    with pytest.raises(WorkerError, match=r"abi_version 7 != client's 999"):
         _worker.check_worker(expected)
     assert _worker.check_worker(_worker.abi_of(B))["library"] == str(B.LIBRARY_PATH)
 

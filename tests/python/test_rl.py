@@ -189,8 +189,7 @@ def tick(cfg, state, s, terminal=False):
         inp.s[i] = s[i]
     inp.flags = B.INPUT_TERMINAL if terminal else 0
     out = B.Output()
-    B.check_status(B.lib.icoac_step(ctypes.byref(cfg.controller), ctypes.byref(state), ctypes.byref(inp),
-                                    ctypes.byref(out)))
+    B.check_status(B.lib.icoac_step(ctypes.byref(state), ctypes.byref(inp), ctypes.byref(out)))
     return out
 
 

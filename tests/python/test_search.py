@@ -16,7 +16,7 @@ from harness import conditions, grid
 from harness import prior as P
 from harness.config import build_config
 
-from stepping import FAILED, REAL, controller, posterior, random_prior, random_state, reset, scaled, stored, tick
+from stepping import FAILED, REAL, controller, posterior, random_prior, random_state, reset, retune, scaled, stored, tick
 
 FIXTURES = Path(__file__).resolve().parent / "fixtures"
 ABI3_ICO = FIXTURES / "abi3_ico"  # an ICO results directory: the ico-search prior
@@ -211,8 +211,10 @@ def test_draws_have_the_search_distribution():
     state = controller(frozen, mean0, cov0, seed=21)
     sigma, se = check_draws(frozen, state, rng, 20000)
     assert np.abs(sigma[0, 1]) > 10 * se[0, 1]  # the correlations are there to be matched
+    retune(learning, state)
     for length in (4, 9, 5, 12, 6, 7):  # one update
         run_trial(learning, state, length, rng)
+    retune(frozen, state)
     updated, _ = check_draws(frozen, state, rng, 20000)
     assert np.abs(updated - sigma).max() > 20 * se.max()  # a different distribution to match
 

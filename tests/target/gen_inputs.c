@@ -56,13 +56,13 @@ static int emit(const char *name, const char *upper, int32_t mode, uint64_t seed
     printf("static const replay_tick_t replay_%s[REPLAY_%s_N] = {\n", name, upper);
     for (i = 0; i < n_ticks; ++i) {
         if ((flags & 2u) != 0u) {
-            icoac_reset(&cfg, &st);
+            icoac_reset(&st);
         }
         for (k = 0; k < ICOAC_N_INPUTS; ++k) {
             in.s[k] = (float)s[k];
         }
         in.flags = (flags & 1u) ? ICOAC_INPUT_TERMINAL : 0u;
-        icoac_step(&cfg, &st, &in, &out);
+        icoac_step(&st, &in, &out);
         printf("    {{%af, %af, %af, %af}, %uu},\n", (double)in.s[0], (double)in.s[1],
                (double)in.s[2], (double)in.s[3], flags);
         if ((flags & 1u) != 0u) {

@@ -1,9 +1,11 @@
 /* icoac: ICO-learning / Bayesian actor-critic controller, one 100 Hz tick per call.
  *
- * Allocation-free C99. The caller owns a const configuration (may live in flash),
- * a state struct (everything learned plus per-trial caches) and one input/output
- * pair per tick. Call order: icoac_config_default -> edit -> icoac_config_check
- * -> icoac_init, then per tick icoac_step; icoac_reset at each new trial.
+ * Allocation-free C99. The caller owns a configuration (may live in flash), a state struct
+ * (everything learned, the configuration in force and per-trial caches) and one input/output
+ * pair per tick. Call order: icoac_config_default -> edit -> icoac_config_check -> icoac_init,
+ * which copies the configuration into the state; then per tick icoac_step, and icoac_reset at
+ * each new trial. The state uses its own copy: editing the caller's configuration afterwards
+ * changes nothing until icoac_retune checks and applies it (live tuning).
  */
 #ifndef ICOAC_H
 #define ICOAC_H
@@ -152,12 +154,13 @@ typedef struct {
 
 /* Controller state: caller-owned storage of ICOAC_STATE_SIZE bytes, 8-byte aligned (it may be
  * a static, a stack or a struct member; no heap). Its layout is private and may change
- * between releases: read it through icoac_get_posterior and icoac_get_counters. The size has
- * room for later learners. */
+ * between releases: read it through icoac_get_posterior, icoac_get_counters and
+ * icoac_get_config. It holds a copy of the configuration in force. The size has room for
+ * later learners. */
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
-#define ICOAC_STATE_SIZE 3584
+#define ICOAC_STATE_SIZE 4096
 #else
-#define ICOAC_STATE_SIZE 1792
+#define ICOAC_STATE_SIZE 2048
 #endif
 typedef struct {
     uint64_t opaque[ICOAC_STATE_SIZE / 8];
@@ -212,30 +215,54 @@ icoac_status_t icoac_config_check_field(const icoac_config_t *cfg, const char **
 /* Validate a prior (the bounds at icoac_prior_t). */
 icoac_status_t icoac_prior_check(const icoac_prior_t *prior);
 
-/* Check cfg and prior, then clear state. prior NULL: mean 0, covariance I.
- * In ICO mode the prior mean is the initial w. seed drives exploration noise. */
+/* Check cfg and prior, then clear state and keep a copy of cfg in it (the caller's cfg is not
+ * read again). prior NULL: mean 0, covariance I. In ICO mode the prior mean is the initial w.
+ * seed drives exploration noise. Restores everything: the way out of any error. */
 icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state,
                           const icoac_prior_t *prior, uint64_t seed);
 
+/* Live tuning: check cfg and make it the configuration in force, keeping everything learned
+ * (w, mu_w and Sigma_w, critic weights, the search's recorded trials) and the trial in
+ * progress. Re-derives what icoac_init derived from the configuration: 1/policy.input_range
+ * and, in search mode, the floors search.floor * search.cov_scale * prior variance, to which
+ * Sigma_w's diagonal is raised (the initial Sigma0 = cov_scale * prior covariance is icoac_init's
+ * alone; a new search.batch takes effect when the batch in progress is closed, at the first
+ * terminal tick with at least batch - 1 trials recorded). The mode cannot change
+ * (ICOAC_ERR_RETUNE_MODE: icoac_init with icoac_get_posterior's result as the prior). On any
+ * error the state is unchanged. */
+icoac_status_t icoac_retune(icoac_state_t *state, const icoac_config_t *cfg);
+
 /* Start a new trial: forget the previous tick, keep everything learned. A per-trial batch
- * (actor.batch) not ended by a terminal tick is dropped. Search mode draws the trial's w. */
-icoac_status_t icoac_reset(const icoac_config_t *cfg, icoac_state_t *state);
+ * (actor.batch) not ended by a terminal tick is dropped. Search mode draws the trial's w.
+ * Checks the state first (ICOAC_ERR_BAD_STATE, state unchanged, when its configuration copy,
+ * its indices or its learned values are not what the library writes: a corrupted state). */
+icoac_status_t icoac_reset(icoac_state_t *state);
 
 /* One tick: learn from the transition into in->s, then act on it. The return value is the
- * tick's status; out->status holds the same value, for hosts that log the output. Contract: with a configuration icoac_config_check accepts and a
- * finite in->s, either ICOAC_OK with a finite output and a finite learned state (w, Sigma_w,
- * v), or an error status with force 0 and everything the state holds (learned values, caches, RNG)
- * unchanged but for its counters:
- * ICOAC_ERR_NONFINITE_INPUT for a NaN/Inf observation, ICOAC_ERR_NUMERIC when a value the tick
- * derived (force, new weights, covariance or its trace, critic value or TD error) was not finite. */
-icoac_status_t icoac_step(const icoac_config_t *cfg, icoac_state_t *state,
-                          const icoac_input_t *in, icoac_output_t *out);
+ * tick's status; out->status holds the same value, for hosts that log the output.
+ * Contract: with a state that icoac_init, icoac_retune and icoac_step left, and a finite in->s,
+ * either ICOAC_OK with a finite output and a finite learned state (w, Sigma_w, v), or an error
+ * status with force 0 and everything the state holds (learned values, caches, RNG) unchanged
+ * but for its counters:
+ * - ICOAC_ERR_NONFINITE_INPUT for a NaN/Inf observation;
+ * - ICOAC_ERR_NUMERIC when a value the tick derived (force, new weights, covariance or its
+ *   trace, critic value or TD error) was not finite;
+ * - ICOAC_ERR_TRIAL_ENDED after a terminal tick (ICOAC_INPUT_TERMINAL) that returned ICOAC_OK:
+ *   every tick is refused until icoac_reset, so a repeated terminal tick cannot record a trial
+ *   twice (a terminal tick that failed leaves the trial open).
+ * Whatever bytes the state holds (corrupted memory), a tick reads and writes only inside
+ * state, in and out, with no undefined behaviour; a corrupted mode or switch gives
+ * ICOAC_ERR_BAD_STATE, and icoac_reset checks the rest. */
+icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out);
 
 /* Current weights (ICO w or actor mean mu_w) and covariance Sigma_w. */
 icoac_status_t icoac_get_posterior(const icoac_state_t *state, icoac_prior_t *posterior);
 
 /* The state's counters. */
 icoac_status_t icoac_get_counters(const icoac_state_t *state, icoac_counters_t *counters);
+
+/* The configuration in force (icoac_init's or the last icoac_retune's). */
+icoac_status_t icoac_get_config(const icoac_state_t *state, icoac_config_t *cfg);
 
 /* Layout checks for bindings (field offsets: icoac_sim's layout table on the host). */
 uint32_t icoac_abi_version(void);

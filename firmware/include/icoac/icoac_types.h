@@ -9,7 +9,7 @@ extern "C" {
 #endif
 
 /* Bump when a public struct layout or an enum value changes. */
-#define ICOAC_ABI_VERSION 6
+#define ICOAC_ABI_VERSION 7
 
 /* Real-number type: float by default; define ICOAC_REAL_DOUBLE=1 for double. */
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
@@ -54,6 +54,9 @@ typedef enum {
     ICOAC_ERR_NOT_INITIALISED = 2,  /* state not set up by icoac_init */
     ICOAC_ERR_NONFINITE_INPUT = 3,  /* observation had NaN/Inf: safe output, no learning */
     ICOAC_ERR_NUMERIC = 4,          /* a value derived in this tick was not finite: force 0, nothing learned */
+    ICOAC_ERR_TRIAL_ENDED = 5,      /* a tick after a terminal tick without icoac_reset: force 0, nothing learned */
+    ICOAC_ERR_BAD_STATE = 6,        /* the state's content is not one the library wrote (corrupted): icoac_init */
+    ICOAC_ERR_RETUNE_MODE = 7,      /* icoac_retune cannot change the mode: icoac_init (posterior as the prior) */
     ICOAC_ERR_BAD_MODE = 10,        /* mode, policy.reflex_mode, ico.timing, actor.update or a 0/1 flag out of range */
     ICOAC_ERR_BAD_SCALE = 11,       /* policy.input_range out of range */
     ICOAC_ERR_BAD_GAIN = 12,        /* policy.gain or policy.reflex_force out of range */

@@ -135,10 +135,8 @@ void port_ticks_end(uintptr_t sp)
     stack_keep_low(&stack_low);
 }
 
-static icoac_status_t step_stub(const icoac_config_t *cfg, icoac_state_t *state,
-                                const icoac_input_t *in, icoac_output_t *out)
+static icoac_status_t step_stub(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
 {
-    (void)cfg;
     (void)state;
     (void)in;
     out->force = 0.0f;
@@ -166,11 +164,10 @@ static uint32_t calibrate(uint32_t iterations)
     return timer_elapsed(t0, t1);
 }
 
-typedef icoac_status_t (*reset_fn)(const icoac_config_t *cfg, icoac_state_t *state);
+typedef icoac_status_t (*reset_fn)(icoac_state_t *state);
 
-static icoac_status_t reset_stub(const icoac_config_t *cfg, icoac_state_t *state)
+static icoac_status_t reset_stub(icoac_state_t *state)
 {
-    (void)cfg;
     (void)state;
     return ICOAC_OK;
 }
@@ -183,7 +180,7 @@ static uint32_t time_resets(replay_controller_t *ctrl, reset_fn fn, uint32_t n)
     uint32_t t0, i;
     t0 = timer_now();
     for (i = 0u; i < n; ++i) {
-        (void)call(&ctrl->cfg, &ctrl->state);
+        (void)call(&ctrl->state);
     }
     return timer_elapsed(t0, timer_now());
 }

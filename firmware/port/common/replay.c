@@ -178,11 +178,11 @@ uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step
             port_tick_start(kind);
         }
         if ((seq[i].flags & REPLAY_FLAG_RESET) != 0u) {
-            (void)icoac_reset(&ctrl->cfg, &ctrl->state);
+            (void)icoac_reset(&ctrl->state);
         }
         memcpy(in.s, seq[i].s, sizeof in.s);
         in.flags = terminal ? ICOAC_INPUT_TERMINAL : 0u;
-        (void)step(&ctrl->cfg, &ctrl->state, &in, &out);
+        (void)step(&ctrl->state, &in, &out);
         if (verbose) {
             print_tick(i, &out);
         } else {

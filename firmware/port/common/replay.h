@@ -18,8 +18,7 @@ typedef struct {
     uint8_t flags;           /* REPLAY_FLAG_* */
 } replay_tick_t;
 
-typedef icoac_status_t (*replay_step_fn)(const icoac_config_t *cfg, icoac_state_t *state,
-                                         const icoac_input_t *in, icoac_output_t *out);
+typedef icoac_status_t (*replay_step_fn)(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out);
 
 /* Kind of a tick, passed to the per-tick hooks of a non-verbose run. */
 #define REPLAY_TICK_PLAIN 0u  /* every tick but the next kind (trial starts included) */
