@@ -20,7 +20,9 @@ uint32_t icoac_rng_next_u32(icoac_rng_t *rng)
     const uint64_t old = rng->state;
     const uint32_t xorshifted = (uint32_t)(((old >> 18u) ^ old) >> 27u);
     const uint32_t rot = (uint32_t)(old >> 59u);
-    rng->state = old * PCG32_MULTIPLIER + rng->increment;
+    /* the increment is odd (icoac_rng_seed); forced so, so that a corrupted one cannot stall the
+     * generator on a fixed point (state 0, increment 0) */
+    rng->state = old * PCG32_MULTIPLIER + (rng->increment | 1u);
     return (xorshifted >> rot) | (xorshifted << ((0u - rot) & 31u));
 }
 
