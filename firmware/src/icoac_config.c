@@ -10,7 +10,7 @@ const char *icoac_status_str(icoac_status_t status)
     case ICOAC_ERR_NONFINITE_INPUT: return "non-finite observation (ignored, no learning)";
     case ICOAC_ERR_NUMERIC: return "numeric failure: a value derived in this tick was not finite (force 0, nothing learned)";
     case ICOAC_ERR_TRIAL_ENDED: return "trial ended by a terminal tick: call icoac_reset before the next tick";
-    case ICOAC_ERR_BAD_STATE: return "state corrupted (not as the library left it): call icoac_init";
+    case ICOAC_ERR_CORRUPT_STATE: return "state corrupted (not as the library left it): call icoac_init";
     case ICOAC_ERR_RETUNE_MODE: return "icoac_retune cannot change the mode: icoac_init with the posterior as the prior";
     case ICOAC_ERR_BAD_MODE: return "invalid switch (mode, policy.reflex_mode, ico.timing, actor.update or a 0/1 flag)";
     case ICOAC_ERR_BAD_SCALE: return "invalid policy.input_range (must be in [1e-6, 1e6])";

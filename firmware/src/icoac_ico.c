@@ -108,5 +108,5 @@ int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
     if (cfg->ico.timing == ICOAC_ICO_TIMING_LITERAL) {
         return literal_timing(cfg, st, scaled, penalty, terminal, out);
     }
-    return ICOAC_PRIV_TICK_BAD_STATE;
+    return ICOAC_PRIV_TICK_CORRUPT;
 }

@@ -28,9 +28,11 @@ static void derive(icoac_priv_state_t *st)
 }
 
 /* 1 when the state holds what the library writes: a configuration icoac_config_check accepts,
- * slots 0 or 1, finite learned values and generator, and (search) a recorded count inside the
- * batch arrays and a positive prior variance. Derived values are not checked: reset derives them
- * again. */
+ * slots 0 or 1, finite weights, covariance and generator, and (search) a recorded count inside
+ * the batch arrays and a positive prior variance. Derived values are not checked: reset derives
+ * them again. The 162 critic weights are not either (a per-trial cost the size of a tick's): the
+ * library never writes a non-finite one, and a corrupted one makes the ticks that read it
+ * ICOAC_ERR_NUMERIC. */
 static int state_ok(const icoac_priv_state_t *st)
 {
     const icoac_priv_search_t *search = &st->search;
@@ -40,8 +42,7 @@ static int state_ok(const icoac_priv_state_t *st)
         return 0;
     }
     if (!icoac_priv_all_finite(st->w, ICOAC_N_INPUTS) || !icoac_priv_finite(st->weight_norm) ||
-        !icoac_priv_all_finite(&icoac_priv_cov_c(st)[0][0], ICOAC_N_INPUTS * ICOAC_N_INPUTS) ||
-        !icoac_priv_all_finite(st->v, ICOAC_CRITIC_UNITS)) {
+        !icoac_priv_all_finite(&icoac_priv_cov_c(st)[0][0], ICOAC_N_INPUTS * ICOAC_N_INPUTS)) {
         return 0;
     }
     if (st->config.mode != ICOAC_MODE_SEARCH) {
@@ -135,7 +136,7 @@ icoac_status_t icoac_reset(icoac_state_t *state)
         return ICOAC_ERR_NOT_INITIALISED;
     }
     if (!state_ok(st)) {
-        return ICOAC_ERR_BAD_STATE;
+        return ICOAC_ERR_CORRUPT_STATE;
     }
     derive(st);
     clear_trial(st);

@@ -211,7 +211,7 @@ static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_rea
 /* What a mode's tick returns. */
 #define ICOAC_PRIV_TICK_NUMERIC 0   /* a staged value was not finite: nothing committed */
 #define ICOAC_PRIV_TICK_OK 1        /* committed */
-#define ICOAC_PRIV_TICK_BAD_STATE 2 /* an unknown switch in the state's configuration: nothing committed */
+#define ICOAC_PRIV_TICK_CORRUPT 2 /* an unknown switch in the state's configuration: nothing committed */
 
 /* ICO rule, both timings (icoac_ico.c). */
 int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,

@@ -67,7 +67,7 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
         }
         cov_changed = icoac_priv_actor_step(&cfg->actor, st, h, delta, observed, terminal, w, cov);
         if (cov_changed < 0) {
-            return cov_changed == -1 ? ICOAC_PRIV_TICK_NUMERIC : ICOAC_PRIV_TICK_BAD_STATE;
+            return cov_changed == -1 ? ICOAC_PRIV_TICK_NUMERIC : ICOAC_PRIV_TICK_CORRUPT;
         }
         norm = ICOAC_PRIV_SQRT(icoac_priv_dot4(w, w));
         if (cov_changed) {

@@ -78,11 +78,11 @@ icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_o
     } else if (cfg->mode == ICOAC_MODE_ICO) {
         ok = icoac_priv_ico_tick(cfg, st, scaled, zone.penalty, terminal, out);
     } else {
-        ok = ICOAC_PRIV_TICK_BAD_STATE;
+        ok = ICOAC_PRIV_TICK_CORRUPT;
     }
     if (ok != ICOAC_PRIV_TICK_OK) {
-        if (ok == ICOAC_PRIV_TICK_BAD_STATE) {
-            return rejected(st, out, ICOAC_ERR_BAD_STATE);
+        if (ok == ICOAC_PRIV_TICK_CORRUPT) {
+            return rejected(st, out, ICOAC_ERR_CORRUPT_STATE);
         }
         st->counters.numeric_faults++;
         return rejected(st, out, ICOAC_ERR_NUMERIC);

@@ -103,7 +103,7 @@ static void test_search_batch_edited_after_init(void **unused)
         assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
         assert_true(priv(state)->search.count >= 0 && priv(state)->search.count < ICOAC_SEARCH_BATCH_MAX);
     }
-    assert_int_equal(icoac_reset(state), ICOAC_ERR_BAD_STATE);
+    assert_int_equal(icoac_reset(state), ICOAC_ERR_CORRUPT_STATE);
     free(state);
     free(twin);
 }
@@ -206,7 +206,7 @@ static void test_retune_refuses_a_mode_change(void **unused)
 
 /* Reproducer: mode 99 and ico.timing 7 ran a default branch with status OK. A retune refuses
  * them (state unchanged); forced into the state's copy, the tick refuses them with
- * ICOAC_ERR_BAD_STATE (force 0, state unchanged but counters) and icoac_reset too. The same for
+ * ICOAC_ERR_CORRUPT_STATE (force 0, state unchanged but counters) and icoac_reset too. The same for
  * an unknown actor.update. */
 static void test_unknown_switches(void **unused)
 {
@@ -244,11 +244,11 @@ static void test_unknown_switches(void **unused)
         memcpy((unsigned char *)&priv_mut(state)->config + cases[c].offset, &cases[c].value, sizeof cases[c].value);
         copy = *state;
         memset(&out, 0x7F, sizeof out);
-        assert_int_equal(icoac_step(state, &in, &out), ICOAC_ERR_BAD_STATE);
-        assert_int_equal(out.status, ICOAC_ERR_BAD_STATE);
+        assert_int_equal(icoac_step(state, &in, &out), ICOAC_ERR_CORRUPT_STATE);
+        assert_int_equal(out.status, ICOAC_ERR_CORRUPT_STATE);
         assert_true(out.force == 0);
         assert_unchanged_but_scratch(state, &copy);
-        assert_int_equal(icoac_reset(state), ICOAC_ERR_BAD_STATE);
+        assert_int_equal(icoac_reset(state), ICOAC_ERR_CORRUPT_STATE);
         free(state);
     }
 }
@@ -256,9 +256,9 @@ static void test_unknown_switches(void **unused)
 /* Reproducers: actor.noise_std = NaN gave OK with a NaN force; critic.rate = 1e38 for three
  * trials broke the state for good (every later tick NUMERIC, even after a valid configuration
  * and a reset). Both are refused by the check of icoac_retune, the state unchanged; the trials
- * then run on the configuration in force. A state whose learned values were corrupted (NaN
- * critic weights, as a 1e38 rate used to leave) is refused by icoac_reset with
- * ICOAC_ERR_BAD_STATE, and icoac_init restores it. */
+ * then run on the configuration in force. Corrupted learned values (NaN critic weights, as a
+ * 1e38 rate used to leave) make the ticks ICOAC_ERR_NUMERIC and icoac_init restores the state;
+ * corrupted actor weights are refused by icoac_reset too. */
 static void test_nonfinite_fields_and_recovery(void **unused)
 {
     icoac_config_t cfg = test_default_config();
@@ -283,17 +283,18 @@ static void test_nonfinite_fields_and_recovery(void **unused)
     for (t = 0; t < 3; ++t) {
         trial(state, &rng, 50);
     }
-    /* corrupted learned values: the ticks fail, the reset says why, init restores */
+    /* corrupted learned values: the ticks fail, init restores */
     for (k = 0; k < ICOAC_CRITIC_UNITS; ++k) {
         priv_mut(state)->v[k] = k % 2 ? (icoac_real_t)NAN : (icoac_real_t)INFINITY;
     }
-    assert_int_equal(icoac_reset(state), ICOAC_ERR_BAD_STATE);
-    priv_mut(state)->magic = ICOAC_PRIV_STATE_MAGIC;
+    assert_int_equal(icoac_reset(state), ICOAC_OK);
     for (k = 0; k < 200; ++k) {
         in = calm(&rng, 0u);
         numeric += icoac_step(state, &in, &out) == ICOAC_ERR_NUMERIC;
     }
     assert_true(numeric > 0);
+    priv_mut(state)->w[2] = (icoac_real_t)NAN;
+    assert_int_equal(icoac_reset(state), ICOAC_ERR_CORRUPT_STATE);
     assert_int_equal(icoac_init(&cfg, state, NULL, 2u), ICOAC_OK);
     for (t = 0; t < 3; ++t) {
         trial(state, &rng, 50);
@@ -334,7 +335,7 @@ static void test_corrupted_elite_fraction(void **unused)
             priv_mut(state)->magic = ICOAC_PRIV_STATE_MAGIC;
             priv_mut(state)->trial_ticks = 0u;
         }
-        assert_int_equal(icoac_reset(state), ICOAC_ERR_BAD_STATE);
+        assert_int_equal(icoac_reset(state), ICOAC_ERR_CORRUPT_STATE);
         free(state);
     }
 }
@@ -367,7 +368,7 @@ static void test_corrupted_slots(void **unused)
             assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
         }
         priv_mut(state)->cov_slot = slots[s];
-        assert_int_equal(icoac_reset(state), ICOAC_ERR_BAD_STATE);
+        assert_int_equal(icoac_reset(state), ICOAC_ERR_CORRUPT_STATE);
         free(state);
     }
 }
@@ -468,13 +469,13 @@ static void test_random_state_bytes(void **unused)
             status = icoac_step(state, &in, &out);
             assert_int_equal(out.status, status);
             assert_true(status == ICOAC_OK || out.force == 0);
-            assert_true(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC || status == ICOAC_ERR_BAD_STATE ||
+            assert_true(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC || status == ICOAC_ERR_CORRUPT_STATE ||
                         status == ICOAC_ERR_TRIAL_ENDED || status == ICOAC_ERR_NONFINITE_INPUT);
         }
         copy = *state;
         status = icoac_reset(state);
-        assert_true(status == ICOAC_OK || status == ICOAC_ERR_BAD_STATE);
-        if (status == ICOAC_ERR_BAD_STATE) {
+        assert_true(status == ICOAC_OK || status == ICOAC_ERR_CORRUPT_STATE);
+        if (status == ICOAC_ERR_CORRUPT_STATE) {
             assert_memory_equal(state, &copy, sizeof copy);
         } else {
             in.flags = 0u;

@@ -234,7 +234,7 @@ icoac_status_t icoac_retune(icoac_state_t *state, const icoac_config_t *cfg);
 
 /* Start a new trial: forget the previous tick, keep everything learned. A per-trial batch
  * (actor.batch) not ended by a terminal tick is dropped. Search mode draws the trial's w.
- * Checks the state first (ICOAC_ERR_BAD_STATE, state unchanged, when its configuration copy,
+ * Checks the state first (ICOAC_ERR_CORRUPT_STATE, state unchanged, when its configuration copy,
  * its indices or its learned values are not what the library writes: a corrupted state). */
 icoac_status_t icoac_reset(icoac_state_t *state);
 
@@ -252,7 +252,7 @@ icoac_status_t icoac_reset(icoac_state_t *state);
  *   twice (a terminal tick that failed leaves the trial open).
  * Whatever bytes the state holds (corrupted memory), a tick reads and writes only inside
  * state, in and out, with no undefined behaviour; a corrupted mode or switch gives
- * ICOAC_ERR_BAD_STATE, and icoac_reset checks the rest. */
+ * ICOAC_ERR_CORRUPT_STATE, and icoac_reset checks the rest. */
 icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out);
 
 /* Current weights (ICO w or actor mean mu_w) and covariance Sigma_w. */

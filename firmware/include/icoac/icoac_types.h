@@ -55,7 +55,7 @@ typedef enum {
     ICOAC_ERR_NONFINITE_INPUT = 3,  /* observation had NaN/Inf: safe output, no learning */
     ICOAC_ERR_NUMERIC = 4,          /* a value derived in this tick was not finite: force 0, nothing learned */
     ICOAC_ERR_TRIAL_ENDED = 5,      /* a tick after a terminal tick without icoac_reset: force 0, nothing learned */
-    ICOAC_ERR_BAD_STATE = 6,        /* the state's content is not one the library wrote (corrupted): icoac_init */
+    ICOAC_ERR_CORRUPT_STATE = 6,    /* the state's content is not one the library wrote (corrupted): icoac_init */
     ICOAC_ERR_RETUNE_MODE = 7,      /* icoac_retune cannot change the mode: icoac_init (posterior as the prior) */
     ICOAC_ERR_BAD_MODE = 10,        /* mode, policy.reflex_mode, ico.timing, actor.update or a 0/1 flag out of range */
     ICOAC_ERR_BAD_SCALE = 11,       /* policy.input_range out of range */
