@@ -1,5 +1,5 @@
-/* Actor (spec 7, L2): the posterior, mean and gradient readings of one observation, per tick
- * or summed over a trial (batch, A14), and the per-trial sample of w. */
+/* Actor (method.md: the Bayesian actor, L2): the posterior, mean and gradient readings of one
+ * observation, per tick or summed over a trial (batch, A14), and the per-trial sample of w. */
 #include "icoac_priv.h"
 
 #define N ICOAC_N_INPUTS

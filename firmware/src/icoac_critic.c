@@ -1,7 +1,7 @@
-/* Normalized Gaussian critic on the 3x3x6x3 grid (spec 6), evaluated separably:
+/* Normalized Gaussian critic on the 3x3x6x3 grid (method.md, critic), evaluated separably:
  * a_k = prod_i f_i(k_i) and sum_k a_k = prod_i sum_j f_i(j), so the normalized
  * activation is b_k = prod_i g_i(k_i) with per-dimension normalized factors g.
- * Units with b_k below critic->threshold count as 0 (spec 6). This file: the factors and the
+ * Units with b_k below critic->threshold count as 0 (method.md, A10). This file: the factors and the
  * sparse kernel (the dense one is icoac_critic_dense.c); its value pass lists the units it
  * kept, and the TD update of the next tick walks that list.
  * Layout: k = pair * 18 + cell with pair = a*3 + b over (x, x_dot) and cell = c*3 + d over

@@ -1,5 +1,6 @@
-/* Features of a tick (spec 4-5, A2): input scaling, the penalty zone with its reflex, and the
- * reflex force. Private; static inline, as they run on every tick of every mode. */
+/* Features of a tick (method.md: input scaling, zone, force; A2): input scaling, the penalty
+ * zone with its reflex, and the reflex force. Private; static inline, as they run on every tick
+ * of every mode. */
 #ifndef ICOAC_FEATURES_H
 #define ICOAC_FEATURES_H
 
@@ -47,7 +48,7 @@ static inline icoac_priv_zone_t icoac_priv_zone(const icoac_policy_config_t *pol
     return zone;
 }
 
-/* Force of the reflex U (spec A2). */
+/* Force of the reflex U (method.md, A2). */
 static inline icoac_real_t icoac_priv_reflex_force(const icoac_policy_config_t *policy, icoac_real_t reflex)
 {
     return policy->reflex_mode == ICOAC_REFLEX_GAIN ? policy->gain * reflex : policy->reflex_force * reflex;

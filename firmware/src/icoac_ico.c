@@ -1,4 +1,4 @@
-/* ICO rule (Eq. 2-3) in both timings of spec A4, staged: the new weights, their norm and the
+/* ICO rule (Eq. 2-3) in both timings of A4 (method.md), staged: the new weights, their norm and the
  * force are stored only when finite. */
 #include "icoac_features.h"
 

@@ -1,5 +1,6 @@
-/* The actor-critic tick (spec 6-8b): the critic's TD error on the transition into s drives
- * the critic and the Bayesian actor, then the actor acts on s with exploration noise. */
+/* The actor-critic tick (method.md: critic, actor, one tick): the critic's TD error on the
+ * transition into s drives the critic and the Bayesian actor, then the actor acts on s with
+ * exploration noise. */
 #include "icoac_features.h"
 
 /* delta clipped to +-td_clip. */
@@ -14,7 +15,7 @@ static int off_diagonal_finite(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPU
     return icoac_priv_all_finite(&m[0][1], 3) && icoac_priv_all_finite(&m[1][2], 2) && icoac_priv_all_finite(&m[2][3], 1);
 }
 
-/* Actor-critic tick: learn from the transition s_t -> s (spec 8b steps 5-8), then act on s.
+/* Actor-critic tick: learn from the transition s_t -> s (method.md, one tick), then act on s.
  * V(s), delta, the actor's candidate mu_w and Sigma_w and the force are staged; the critic and
  * the actor are updated, and the caches advanced, only when they are finite. Returns 0, with
  * the state untouched, otherwise. Checked: V(s), delta, |w| (covers every w_i), the trace of

@@ -1,4 +1,4 @@
-/* The tick dispatcher (spec 8): input check, features, then the mode's tick. */
+/* The tick dispatcher (method.md, one tick): input check, features, then the mode's tick. */
 #include "icoac_features.h"
 
 /* Field by field: newlib-nano's memset goes byte by byte. */

@@ -1,4 +1,4 @@
-/* The paper's grid of initial conditions (spec 9): 25 angles x 49 positions. */
+/* The paper's grid of initial conditions (method.md, benchmark protocol): 25 angles x 49 positions. */
 #include <string.h>
 
 #include "icoac_sim/icoac_sim.h"

@@ -1,4 +1,4 @@
-/* Frictionless cart-pole (spec 3): Sutton's equations, explicit Euler or RK4. */
+/* Frictionless cart-pole (method.md, plant): Sutton's equations, explicit Euler or RK4. */
 #include <math.h>
 
 #include "icoac_sim/icoac_sim.h"

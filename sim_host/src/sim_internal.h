@@ -6,7 +6,7 @@
 
 #include "icoac_sim/icoac_sim.h"
 
-/* Failure test of spec 3 with strict limits; written so that NaN counts as failure.
+/* Failure test of the plant (method.md) with strict limits; written so that NaN counts as failure.
  * Non-finite velocities fail too (icoac_sim_failed contract: "or not finite"); otherwise the
  * next tick hands them to the controller, which rejects the observation and the cell ends
  * as ICOAC_SIM_ERROR instead of a failed trial. */

@@ -1,6 +1,7 @@
-/* The benchmark trial loop of one cell (spec 8-9): trials from a fresh controller until one
- * lasts success_steps or max_trials have failed, as a lane (sim_internal.h) that advances one
- * tick per call, so that a worker thread can interleave several cells. */
+/* The benchmark trial loop of one cell (method.md, benchmark protocol): trials from a fresh
+ * controller until one lasts success_steps or max_trials have failed, as a lane
+ * (sim_internal.h) that advances one tick per call, so that a worker thread can interleave
+ * several cells. */
 #include <float.h>
 #include <math.h>
 #include <string.h>

@@ -1,4 +1,4 @@
-/* Bayesian actor (spec 7): icoac_priv_actor_posterior against the closed-form Gaussian posterior,
+/* Bayesian actor (method.md): icoac_priv_actor_posterior against the closed-form Gaussian posterior,
  * long-run symmetry / positive definiteness, forgetting, and the Eq. 7-8 wiring in icoac_step. */
 #include "test_common.h"
 
@@ -128,7 +128,7 @@ static void compare_with_closed_form(const icoac_config_t *cfg, test_rng_t *rng,
         hd[i] = (double)h[i];
     }
     innovation = (double)(icoac_real_t)test_uniform(rng, -3, 3);
-    /* the likelihood variance is sigma_L^2 (spec L2), whatever the exploration std sigma_u;
+    /* the likelihood variance is sigma_L^2 (L2), whatever the exploration std sigma_u;
      * sigma_L = sigma_u when likelihood_std is 0 (the literal reading) */
     r = test_likelihood_var(&cfg->actor);
     closed_form(&prior, hd, innovation, r, &post);
@@ -416,7 +416,7 @@ static void test_step_wiring(void **unused)
 
 
 /* act_with_sample: at each reset the acting weights are mu + L n, L L^T = Sigma, n ~ N(0, I)
- * drawn from the controller's generator (spec 7 "act with a posterior sample"). */
+ * drawn from the controller's generator (method.md, Bayesian actor: acting with a sample). */
 static void test_posterior_sample_per_trial(void **unused)
 {
     icoac_config_t cfg = test_default_config();

@@ -152,7 +152,7 @@ static inline icoac_input_t test_input(double x, double xd, double th, double th
     return in;
 }
 
-/* Paper scaling (spec 4), written independently of the library, on the stored input. */
+/* Paper scaling (method.md, input scaling), written independently of the library, on the stored input. */
 static inline double test_scale(int i, double value, int clip)
 {
     static const double range[ICOAC_N_INPUTS] = {2.4, 3.5, 0.2094384, 2.0};

@@ -44,7 +44,7 @@ static void test_defaults_match_spec(void **unused)
     assert_close(cfg.actor.forgetting, 1.0, 0.0);
     assert_int_equal(cfg.actor.reflex, 1);
     assert_int_equal(cfg.actor.act_with_sample, 0);
-    /* spec L2-L4, A10: the literal critic, per-tick updates and sigma_L = sigma_u (0); the actor
+    /* L2-L4, A10 (method.md): the literal critic, per-tick updates and sigma_L = sigma_u (0); the actor
      * reading and its exploration schedule, and the search group, chosen by the learner sweeps */
     assert_int_equal(cfg.learn, 1);
     assert_int_equal(cfg.critic.quirks, 0);
@@ -171,7 +171,7 @@ RLMUT(m_scale_nan, c->actor.scale = NAN_R)
 RLMUT(m_forget_zero, c->actor.forgetting = 0)
 RLMUT(m_forget_big, c->actor.forgetting = 1.001f)
 RLMUT(m_forget_nan, c->actor.forgetting = NAN_R)
-/* Issue 8: accepted before, then NaN/Inf (or a critic overrun) in the tick. Both ends bounded. */
+/* Values once accepted that then gave NaN/Inf (or a critic overrun) in the tick. Both ends bounded. */
 MUT(m_range0_subnormal, c->policy.input_range[0] = (icoac_real_t)1e-39)
 MUT(m_range1_tiny, c->policy.input_range[1] = (icoac_real_t)9e-7)
 MUT(m_range2_huge, c->policy.input_range[2] = (icoac_real_t)1.1e6)
@@ -193,7 +193,7 @@ MUT(m_zone_theta_subnormal, c->policy.zone_theta = (icoac_real_t)(REAL_IS_FLOAT 
 MUT(m_zone_x_tiny, c->policy.zone_x = (icoac_real_t)9e-7)
 MUT(m_gain_subnormal, c->policy.gain = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
 RLMUT(m_threshold_subnormal, c->critic.threshold = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
-/* The learners' fields (spec L2-L4, A10), each bound from both sides. */
+/* The learners' fields (method.md, L2-L4, A10), each bound from both sides. */
 RLMUT(m_quirks_2, c->critic.quirks = 2)
 RLMUT(m_quirks_neg, c->critic.quirks = -1)
 RLMUT(m_update_3, c->actor.update = 3)
@@ -724,8 +724,8 @@ static void test_check_order_is_struct_order(void **unused)
 
 /* A mode ignores the groups it does not use, even when every field of them is bad: ICO runs
  * with a spoilt critic, actor and search, RL with a spoilt ico and search group (new with
- * issue 9), search with a spoilt ico, critic and actor. The controller behaves exactly as with
- * valid unused groups. */
+ * the one-file-per-stage restructuring), search with a spoilt ico, critic and actor. The
+ * controller behaves exactly as with valid unused groups. */
 static void test_unused_groups_ignored(void **unused)
 {
     int32_t mode;

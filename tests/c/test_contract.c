@@ -1,4 +1,4 @@
-/* The tick contract (issue 8): with an accepted configuration and a finite observation,
+/* The tick contract (design.md): with an accepted configuration and a finite observation,
  * icoac_step returns ICOAC_OK with a finite output and learned state, or an error status with
  * force 0 and the state unchanged but for its counters. Regression tests of the reproducers
  * an outside tester found: the critic scan that ran off its arrays, and OK ticks with a NaN or

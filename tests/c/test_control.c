@@ -1,4 +1,4 @@
-/* The no-learning control (spec L1, cfg.learn = 0): the same acting, exploration noise and
+/* The no-learning control (method.md L1, cfg.learn = 0): the same acting, exploration noise and
  * random stream as learning, with every update off. */
 #include "test_common.h"
 

@@ -1,4 +1,4 @@
-/* NGnet critic (spec 6): separable evaluation against the direct 4-D formula, the activity
+/* NGnet critic (method.md, critic): separable evaluation against the direct 4-D formula, the activity
  * threshold and the kept-unit list, for both kernels (sparse: microcontrollers, dense: hosts);
  * the dense kernel against the sparse one; the TD(0) update through icoac_step in RL mode. */
 #include "test_common.h"
@@ -45,7 +45,7 @@ static void direct_b(const icoac_real_t s_in[4], double b[K])
     }
 }
 
-/* The same with the activity threshold of spec 6: b_k < threshold counts as 0. */
+/* The same with the activity threshold (method.md, critic): b_k < threshold counts as 0. */
 static void direct_b_kept(const icoac_real_t s_in[4], double threshold, double b[K])
 {
     int k;
@@ -136,7 +136,7 @@ static void test_nonneg_at_least(void **unused)
 
 static void test_centres_of_spec(void **unused)
 {
-    /* the spec's listed centres: x {-1.6, 0, 1.6}; theta +-2, +-6, +-10 deg (to 4 digits) */
+    /* the centres listed in method.md: x {-1.6, 0, 1.6}; theta +-2, +-6, +-10 deg (to 4 digits) */
     const double x_c[3] = {-1.6, 0.0, 1.6};
     const double th_c[6] = {-10, -6, -2, 2, 6, 10};
     int j;

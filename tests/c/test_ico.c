@@ -431,7 +431,7 @@ static void test_ico_literal_timing_terminal(void **unused)
     assert_true(out.q == 0);
 }
 
-/* Code timing with a failure jump gives no learning, literal timing does (spec 5). */
+/* Code timing with a failure jump gives no learning, literal timing does (method.md, A4). */
 static void test_jump_over_zone(void **unused)
 {
     int timing;

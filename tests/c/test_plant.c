@@ -1,12 +1,12 @@
-/* Cart-pole plant against an independent evaluation of spec section 3; failure test;
- * parameter checks; the paper grid. */
+/* Cart-pole plant against an independent evaluation of its equations (method.md, plant);
+ * failure test; parameter checks; the paper grid. */
 #include "test_common.h"
 
 #include <stdlib.h>
 
 #include "icoac_sim/icoac_sim.h"
 
-/* Spec 3 rearranged: multiply the theta equation through by (m_c + m_p), then
+/* The plant equations rearranged: multiply the theta equation through by (m_c + m_p), then
  * x_acc = (F + m_p l (thd^2 sin - th_acc cos)) / (m_c + m_p). Long double. */
 static void ref_deriv(const long double s[4], long double force, long double ds[4])
 {
@@ -183,7 +183,7 @@ PMUT(p_xl, p->x_limit = 0)
 PMUT(p_tl, p->theta_limit = (double)NAN)
 PMUT(p_int, p->integrator = 2)
 PMUT(p_intneg, p->integrator = -1)
-/* Issue 8: subnormal or absurd values the workers would flush to zero or overflow on. */
+/* Subnormal or absurd values the workers would flush to zero or overflow on. */
 PMUT(p_dt_subnormal, p->dt = 1e-310)
 PMUT(p_dt_tiny, p->dt = 9e-7)
 PMUT(p_g_subnormal, p->gravity = 1e-310)

@@ -393,7 +393,8 @@ static void step_writes_every_field(const icoac_config_t *cfg, icoac_state_t *st
     assert_true(a.penalty == (a.reflex != 0 ? -1 : 0));
     if (terminal) {
         /* no action; z is 0 too but in ICO literal timing, which learns from the failure state
-         * first and reports the new weights' feature there (as before issue 9) */
+         * first and reports the new weights' feature there (as before the one-file-per-stage
+         * restructuring) */
         assert_true(a.force == 0 && a.noise == 0);
         if (cfg->mode == ICOAC_MODE_RL || cfg->ico.timing == ICOAC_ICO_TIMING_CODE) {
             assert_true(a.z == 0);

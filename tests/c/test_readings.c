@@ -1,4 +1,4 @@
-/* The actor readings and their switches (spec L2, L3, A10, A14) through icoac_step, each
+/* The actor readings and their switches (method.md, L2, L3, A10, A14) through icoac_step, each
  * against an independent double-precision formula computed here from what the ticks output
  * (the exploration noise eps, the TD error delta) and the observed states:
  *   posterior  S = h^T Sigma h + sigma_L^2, mu += Sigma h iota / S, Sigma -= Sigma h h^T Sigma / S
@@ -36,7 +36,7 @@ static void reset_ok(const icoac_config_t *cfg, icoac_state_t *state)
     assert_int_equal(icoac_reset(state), ICOAC_OK);
 }
 
-/* h = G x~(s), scaled and clipped as in spec 4, in double. */
+/* h = G x~(s), scaled and clipped as in method.md (input scaling), in double. */
 static void h_of(const icoac_input_t *in, double h[N])
 {
     int i;
@@ -169,7 +169,7 @@ static void assert_gauss_close(const gauss_t *got, const gauss_t *want, double m
 }
 
 /* One reading's step from (mu, Sigma) for an observation (h, delta, eps, offset = h^T (w_act -
- * mu)): the formulas of spec L2 in double. */
+ * mu)): the formulas of L2 (method.md) in double. */
 static void reading_step(const icoac_actor_config_t *a, const gauss_t *prior, const double h[N], double delta,
                          double eps, double offset, gauss_t *post)
 {
@@ -391,7 +391,7 @@ static void test_mean_and_gradient_keep_sigma(void **unused)
 }
 
 /* actor.batch: over a trial the acting weights, mu_w and Sigma_w stay; at its terminal tick
- * the closed form of spec L2 / A14 over the trial's observations (h_t, eps_t, delta_t),
+ * the closed form of L2 / A14 (method.md) over the trial's observations (h_t, eps_t, delta_t),
  * recorded here from the ticks: P = Sigma^-1 + sum h h^T / sigma_L^2 (Sigma / lambda_f with
  * forgetting), mu' = mu + P^-1 sum h iota / sigma_L^2, Sigma' = P^-1 (posterior) or Sigma
  * (mean); gradient: mu' = mu + beta / sigma_u^2 sum delta eps h. With explore_ticks N only the
@@ -619,7 +619,7 @@ static void test_explore_schedule(void **unused)
     }
 }
 
-/* b_k(s) from the 4-D definition (spec 6), in long double (log space), no threshold. */
+/* b_k(s) from the 4-D definition (method.md, critic), in long double (log space), no threshold. */
 static void direct_b(const icoac_real_t s_in[4], double b[K])
 {
     long double logs[K], top = -1e300L, total = 0;

@@ -1,4 +1,4 @@
-/* Episodic search (ICOAC_MODE_SEARCH, spec L4) through the public API, each trial a reset, a
+/* Episodic search (ICOAC_MODE_SEARCH, method.md L4) through the public API, each trial a reset, a
  * few ticks and a terminal tick, with the trial's sampled weights read from the state:
  *   - the update after each batch against a reference written here in double: the elite (the
  *     n_e = max(1, round(rho K)) longest trials, ties to the earlier trial), its mean, its
@@ -210,7 +210,7 @@ static icoac_status_t run_trial(const icoac_config_t *cfg, icoac_state_t *state,
     return icoac_step(state, &in, &out);
 }
 
-/* The reference update of spec L4 in double. */
+/* The reference update of L4 (method.md, episodic search) in double. */
 typedef struct {
     gauss_t next;     /* mu', and Sigma' = (1-a) Sigma + a Cov_elite with Sigma'_ii >= floor_i */
     gauss_t fallback; /* mu', and Sigma' + diag(floor): what a Sigma' not positive definite becomes */
@@ -576,7 +576,7 @@ static void trial_with(const icoac_config_t *cfg, icoac_state_t *state, const do
     assert_int_equal(finish_trial(cfg, state, &rng, ticks), ICOAC_OK);
 }
 
-/* A step of 1 with a rank-deficient elite (spec L4): Sigma' = Cov_elite (floored) is singular
+/* A step of 1 with a rank-deficient elite (L4): Sigma' = Cov_elite (floored) is singular
  * unless the diagonal floor repairs it; then the floor is added to the whole diagonal instead
  * of failing with ICOAC_ERR_NUMERIC (what it did before).
  *   By hand: K = 2 = n_e, mu = 0, Sigma0 = I, floor 0.1; the elite +-d gives mu' = 0 and

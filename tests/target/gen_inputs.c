@@ -14,7 +14,7 @@
 #define N_TICKS 400
 #define SEED_ICO 20240601u
 #define SEED_RL 20240602u
-/* Search mode (spec L4): search.batch = SEARCH_BATCH, the rest default. Trials of a sampled w
+/* Search mode (method.md, L4): search.batch = SEARCH_BATCH, the rest default. Trials of a sampled w
  * often balance for hundreds of ticks; the seed was picked (by trying the seeds from 20240603
  * on) for short trials: the 600 ticks end 18 trials, so 6 of the terminal ticks run the
  * per-batch update. */

@@ -22,23 +22,23 @@ extern "C" {
 typedef enum {
     ICOAC_MODE_ICO = 0,   /* ICO rule on w (Eq. 2-3) */
     ICOAC_MODE_RL = 1,    /* NGnet critic + Bayesian actor on (mu_w, Sigma_w) (Eq. 6-8) */
-    ICOAC_MODE_SEARCH = 2 /* episodic search on (mu_w, Sigma_w): one sample per trial (spec L4) */
+    ICOAC_MODE_SEARCH = 2 /* episodic search on (mu_w, Sigma_w): one sample per trial (method.md, L4) */
 } icoac_mode_t;
 
-/* How the actor moves mu_w (and Sigma_w) per observation (spec L2). */
+/* How the actor moves mu_w (and Sigma_w) per observation (method.md, L2). */
 typedef enum {
     ICOAC_ACTOR_POSTERIOR = 0, /* sequential Bayesian posterior (literal Eq. 6-8): Sigma_w shrinks */
     ICOAC_ACTOR_MEAN = 1,      /* posterior-mean step with Sigma_w held at the prior */
     ICOAC_ACTOR_GRADIENT = 2   /* Gaussian-policy gradient step beta * delta * eps * h / sigma_u^2 */
 } icoac_actor_update_t;
 
-/* How the reflex U in {-1, 0, +1} enters the force (spec A2). */
+/* How the reflex U in {-1, 0, +1} enters the force (method.md, A2). */
 typedef enum {
     ICOAC_REFLEX_UNIT = 0,  /* F = G*z + U*reflex_force (literal Eq. 5, 1 N) */
     ICOAC_REFLEX_GAIN = 1   /* F = G*(z + U) (authors' code, 10 N) */
 } icoac_reflex_mode_t;
 
-/* When the ICO rule sees the penalty change (spec A4). */
+/* When the ICO rule sees the penalty change (method.md, A4). */
 typedef enum {
     ICOAC_ICO_TIMING_CODE = 0,   /* r from the pre-step state, failure states unseen, r_prev persists */
     ICOAC_ICO_TIMING_LITERAL = 1 /* r(t+1) from the post-step state incl. failure, update with x~(t) */
@@ -118,7 +118,7 @@ typedef struct {
                                     (literal). 1000 (10 s) */
 } icoac_actor_config_t;
 
-/* Episodic search over N(mu_w, Sigma_w) (ICOAC_MODE_SEARCH, spec L4): each trial acts with one
+/* Episodic search over N(mu_w, Sigma_w) (ICOAC_MODE_SEARCH, method.md L4): each trial acts with one
  * sample w (F = G w^T x~ + reflex, no noise); after `batch` failed trials the best
  * round(elite_fraction * batch) (at least 1) by length move mu_w and Sigma_w by `step`.
  * Defaults chosen by a sweep for the ICO prior (docs/results.md). */
@@ -198,7 +198,8 @@ typedef struct {
     int32_t status;           /* icoac_status_t of this tick */
 } icoac_output_t;
 
-/* Paper defaults (spec section 2) of every group, ICO mode. */
+/* Defaults of every group, ICO mode: the paper's values, and the learner sweeps' choices for the
+ * actor and the search (docs/method.md lists each with its source). */
 void icoac_config_default(icoac_config_t *cfg);
 void icoac_policy_config_default(icoac_policy_config_t *policy);
 void icoac_ico_config_default(icoac_ico_config_t *ico);

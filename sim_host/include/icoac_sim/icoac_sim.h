@@ -24,7 +24,7 @@ typedef enum {
 } icoac_sim_status_t;
 
 typedef enum {
-    ICOAC_SIM_EULER = 0, /* explicit Euler, Sutton's update order (spec 3) */
+    ICOAC_SIM_EULER = 0, /* explicit Euler, Sutton's update order (method.md, A1) */
     ICOAC_SIM_RK4 = 1    /* classical Runge-Kutta, same dt */
 } icoac_sim_integrator_t;
 
@@ -57,7 +57,7 @@ typedef struct {
     int32_t reserved;   /* 0 */
 } icoac_sim_plant_t;
 
-/* Benchmark protocol of one cell (spec 9). */
+/* Benchmark protocol of one cell (method.md). */
 typedef struct {
     int64_t max_trials;          /* trials before a cell counts as failed, >= 1. 1e5 */
     int64_t success_steps;       /* steps of one trial that make a success, >= 1. 1e5 (1000 s) */
