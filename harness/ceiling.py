@@ -78,7 +78,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from . import _binding as B
-from . import geometry, grid, metrics, results
+from . import geometry, grid, literals, metrics, results
 from . import prior as P
 from .conditions import run_condition
 from .config import RunConfig, build_config, make_prior, parse_sets
@@ -138,10 +138,10 @@ def parse_weights(text: str, what: str = "--w") -> tuple[float, ...]:
     """'w1,w2,w3,w4' -> as_weights."""
     parts = [p.strip() for p in str(text).strip().strip("()[]").split(",")]
     try:
-        values = [float(p) for p in parts]
-    except ValueError:
+        values = [literals.real(p) for p in parts]
+    except literals.NumberError as exc:
         raise UsageError(f"{what} expects {B.N_INPUTS} comma-separated numbers w_x,w_xdot,w_theta,w_thetadot, "
-                         f"got {text!r:.60}") from None
+                         f"got {text!r:.60} (a value {exc})") from None
     return as_weights(values, what)
 
 

@@ -16,6 +16,7 @@ import math
 import sys
 from pathlib import Path
 
+from . import literals
 from . import options as O
 from .errors import HarnessError, UsageError
 
@@ -29,19 +30,22 @@ class _Parser(argparse.ArgumentParser):
 
 # -- argument types ------------------------------------------------------------------------------------
 def _integer(text: str) -> int:
-    """An integer written as digits or as an integral float ('6000', '1e5'); never inf/nan."""
-    t = text.strip()
+    """An integer written as ASCII digits or as an integral real ('6000', '1e5'); never inf/nan."""
     try:
-        return int(t, 10)
-    except ValueError:
-        pass
+        return literals.integer(text)
+    except literals.NumberError as exc:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r:.40}, which {exc}") from None
+
+
+def _real(text: str) -> float:
+    """A real number (harness.literals: ASCII digits, no value that rounds to 0 or a subnormal)."""
     try:
-        value = float(t)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"invalid integer {text!r:.40}") from None
-    if not math.isfinite(value) or not value.is_integer():
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r:.40}")
-    return int(value)
+        return literals.real(text)
+    except literals.NumberError as exc:
+        raise argparse.ArgumentTypeError(f"value {text!r:.40} {exc}") from None
+
+
+_real.__name__ = "number"
 
 
 def _int_in(lo: int, hi: int, what: str):
@@ -66,7 +70,7 @@ def _seed_count(text: str) -> int:
     if "," in text:
         parts = [p.strip() for p in text.split(",")]
         hint = ""
-        if all(p.isdigit() for p in parts) and [int(p) for p in parts] == list(
+        if all(literals.is_integer_text(p) for p in parts) and [int(p) for p in parts] == list(
                 range(int(parts[0]), int(parts[0]) + len(parts))):
             hint = f"; for the seeds {text.strip()} write --seed {int(parts[0])} --seeds {len(parts)}"
         raise argparse.ArgumentTypeError(f"--seeds is a number of seeds (seeds --seed .. --seed + N - 1), "
@@ -79,10 +83,7 @@ _seed_count.__name__ = "integer"
 
 def _positive_float(hi: float, what: str):
     def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"invalid number {text!r:.40}") from None
+        value = _real(text)
         if not (math.isfinite(value) and 0 < value <= hi):
             raise argparse.ArgumentTypeError(f"expected {what}, got {text!r:.40}")
         return value
@@ -102,11 +103,11 @@ SET_HELP = ("override a parameter (repeatable): NAME is group.field (policy.gain
 def _add_prior_args(parser, rl_cov: bool = True) -> None:
     parser.add_argument("--prior-frame", choices=O.FRAME_NAMES, default=O.FRAME_NAMES[0],
                         help="ICO cells for the prior: central frame (default) or all successful cells")
-    parser.add_argument("--prior-x", type=float, default=None,
+    parser.add_argument("--prior-x", type=_real, default=None,
                         help=f"frame half-width |x0| (m), default {O.PRIOR_FRAME[0]:g}")
-    parser.add_argument("--prior-theta", type=float, default=None,
+    parser.add_argument("--prior-theta", type=_real, default=None,
                         help=f"frame half-height |theta0| (deg), default {O.PRIOR_FRAME[1]:g}")
-    parser.add_argument("--prior-ridge", type=float, default=O.PRIOR_RIDGE,
+    parser.add_argument("--prior-ridge", type=_real, default=O.PRIOR_RIDGE,
                         help=f"ridge added to the prior covariance (default {O.PRIOR_RIDGE:g})")
     if rl_cov:
         _add_rl_cov(parser)

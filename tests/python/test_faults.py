@@ -451,3 +451,56 @@ def test_help_documents_bounds(capsys):
     with pytest.raises(SystemExit):
         cli.main(["figures", "--help"])
     assert "1e6 plant steps" in " ".join(capsys.readouterr().out.split())
+
+
+# -- strict parsing: numbers in ASCII digits that survive rounding ----------------------------------------
+STRICT = [
+    (["--set", "gain=1e-400"], ["policy.gain", "'1e-400'", "rounds to 0"]),
+    (["--set", "dt=1e-400"], ["dt", "rounds to 0"]),
+    (["--set", "input_range=[1e-400,3.5,0.2,2]"], ["input_range", "rounds to 0"]),
+    (["--prior-ridge", "1e-400"], ["--prior-ridge", "rounds to 0"]),
+    (["--set", "max_trials=５０"], ["max_trials", "ASCII"]),
+    (["--set", "gain=１"], ["policy.gain", "ASCII"]),
+    (["--cells", "６１１"], ["bad cell index", "ASCII"]),
+    (["--max-trials", "５０"], ["--max-trials"]),
+    (["--seed", "１"], ["--seed"]),
+    (["--max-trials", "1_000"], ["--max-trials"]),
+    (["--set", "max_trials=1_000"], ["max_trials"]),
+    (["--checkpoint-every", "１"], ["--checkpoint-every"]),
+]
+
+
+@pytest.mark.parametrize("args, words", STRICT, ids=[" ".join(a)[:40] for a, _ in STRICT])
+def test_strict_parsing(capsys, tmp_path, args, words):
+    out = tmp_path / "out"
+    caps = [a for field, cap in (("max_trials", ["--max-trials", "50"]), ("success_steps", ["--success-steps", "200"]))
+            if not any(field in arg or field.replace("_", "-") in arg for arg in args) for a in cap]
+    rc, _, err = main(capsys, "grid", "--out", out, "--cells", "611", "--quiet", *caps, *args)
+    assert_one_line_error(rc, err, *words)
+    assert not out.exists()
+
+
+def test_zero_and_small_normal_values_pass(capsys, tmp_path):
+    rc, _, err = main(capsys, "grid", "--out", tmp_path / "o", "--cells", "611", *TINY_ARGS,
+                      "--set", "critic.threshold=0.0e-400", "--set", "ico_rate=2.5e-38", "--set", "zone_x=2.35")
+    assert rc == 0, err
+    controller = results.load(tmp_path / "o")[1]["config"]["controller"]
+    assert controller["critic"]["threshold"] == 0.0 and controller["ico"]["rate"] == pytest.approx(2.5e-38)
+
+
+SWEEP = ["sweep", "--out", "{tmp}/w", "--cells", "611"]
+CEILING = ["ceiling", "--out", "{tmp}/c", "--cells", "611", "--protocol", "first", "--success-steps", "200", "--quiet"]
+STRICT_COMMANDS = [
+    ([*SWEEP, "--param", "noise_std=1", "--set", "gain=1e-400"], ["gain", "rounds to 0"]),
+    ([*CEILING, "--w", "1e-400,1,1,1"], ["--w", "rounds to 0"]),
+    ([*CEILING, "--w", "１,1,1,1"], ["--w", "ASCII"]),
+]
+
+
+@pytest.mark.parametrize("args, words", STRICT_COMMANDS,
+                         ids=[" ".join(a[:1] + a[-4:])[:50] for a, _ in STRICT_COMMANDS])
+def test_strict_parsing_of_sweep_bench_ceiling(capsys, ico_dir, tmp_path, args, words):
+    args = [a.format(tmp=tmp_path) for a in args] + (["--prior-from", ico_dir] if args[0] == "sweep" else [])
+    rc, _, err = main(capsys, *args)
+    assert_one_line_error(rc, err, *words)
+    assert not [p for p in tmp_path.iterdir() if p.name in ("w", "b", "c")]
