@@ -24,7 +24,7 @@ from . import ceiling as C
 from . import figures, geometry, grid, metrics, results
 from . import prior as P
 from .conditions import run_condition
-from .config import build_config, parse_sets
+from .config import build_config, command_overrides, named_sets
 from .errors import ResultsError
 from .metrics import percent
 from .options import CONDITION_LABELS as LABELS, CONDITIONS, CONTROL_OF, PROFILE_NAMES
@@ -268,6 +268,7 @@ class BenchOptions:
     seeds: int | None = None
     rl_max_trials: int | None = None
     threads: int = 0
+    configuration: str = "default"   # a named configuration (config.NAMED_CONFIGURATIONS), then sets
     sets: Sequence[str] = ()
     resume: bool = False
     quiet: bool = False
@@ -290,15 +291,14 @@ def stages(opt: BenchOptions) -> list[Stage]:
     out = Path(opt.out)
     figdir = Path(opt.figures) if opt.figures else None
     seeds = opt.seed_list()
-    sets = parse_sets(opt.sets)
+    ico_sets = command_overrides(opt.configuration, opt.sets)
+    rl_sets = command_overrides(opt.configuration, opt.sets, {"--rl-max-trials": ("max_trials", opt.rl_max_trials)})
     cells_spec = profile["cells"]
 
     def overrides(condition):
-        over = dict(profile["ico"] if condition == "ico" else profile["rl"])
-        if condition != "ico" and opt.rl_max_trials is not None:
-            over["max_trials"] = opt.rl_max_trials
-        over.update(sets)
-        return over
+        if condition == "ico":
+            return {**profile["ico"], **ico_sets}
+        return {**profile["rl"], **rl_sets}
 
     def grid_stage(condition: str, seed: int):
         def run(ctx):
@@ -392,7 +392,7 @@ def _run_stages(opt: BenchOptions, todo: list[Stage], ctx: dict, argv: Sequence[
     log = BenchLog(Path(opt.out), {
         "profile": opt.profile, "seeds": opt.seed_list(),
         "rl_max_trials": opt.rl_max_trials, "resume": bool(opt.resume), "threads": opt.threads,
-        "set": list(opt.sets), "argv": list(argv),
+        "set": named_sets(opt.configuration, opt.sets), "argv": list(argv),
         **({"backend": session.describe()} if session is not None else {})})
     for i, stage in enumerate(todo, 1):
         progress(f"({i}/{len(todo)}) {stage.name}")

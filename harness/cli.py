@@ -241,7 +241,7 @@ def build_parser() -> argparse.ArgumentParser:
     sel.add_argument("--cells", default=None, help="cell indices, e.g. 0,5,600-610")
     sel.add_argument("--subset", type=_subset, default=None, help="N evenly spread cells, at most the grid's cell count")
     _add_seeds(w, "default 1")
-    w.add_argument("--max-trials", type=_positive_int, default=O.SWEEP_MAX_TRIALS,
+    w.add_argument("--max-trials", type=_positive_int, default=None,
                    help=f"trials before a cell fails (default {O.SWEEP_MAX_TRIALS})")
     w.add_argument("--success-steps", type=_positive_int, default=None)
     w.add_argument("--configuration", choices=O.CONFIGURATION_NAMES, default=O.CONFIGURATION_NAMES[0],
@@ -296,20 +296,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 # -- commands: arguments in, report out ----------------------------------------------------------------
-def _sets(args) -> list[str]:
-    """--configuration's items, then --set's."""
-    from .config import named_sets
-    return named_sets(args.configuration, args.set)
-
-
 def _overrides(args) -> dict:
-    from .config import parse_sets
-    over = parse_sets(_sets(args))
-    if args.max_trials is not None:
-        over["max_trials"] = args.max_trials
-    if args.success_steps is not None:
-        over["success_steps"] = args.success_steps
-    return over
+    """--configuration's items, replaced by --set's, with --max-trials and --success-steps (each
+    field given once)."""
+    from .config import command_overrides
+    return command_overrides(args.configuration, args.set, {"--max-trials": ("max_trials", args.max_trials),
+                                                            "--success-steps": ("success_steps", args.success_steps)})
 
 
 def _frame(args):
@@ -344,7 +336,7 @@ def cmd_grid(args) -> int:
     from . import conditions, metrics
 
     explicit = any(v is not None for v in (args.condition, args.seed, args.max_trials, args.success_steps,
-                                            args.cells, args.prior_from)) or bool(_sets(args))
+                                            args.cells, args.prior_from)) or bool(_overrides(args))
     condition = args.condition or O.CONDITIONS[0]
     info = None
     if explicit or not args.resume:
@@ -382,8 +374,9 @@ def cmd_bench(args) -> int:
     opt = bench.BenchOptions(
         profile=args.profile, out=Path(args.out), figures=Path(args.figures) if args.figures else None,
         seed=args.seed, seeds=args.seeds, rl_max_trials=args.rl_max_trials, threads=_threads_arg(args),
-        sets=_sets(args), resume=args.resume, quiet=args.quiet, frame=_frame(args), ridge=args.prior_ridge,
-        rl_cov=args.rl_cov, ceiling=Path(args.ceiling) if args.ceiling else None, dask=_dask_spec(args))
+        configuration=args.configuration, sets=args.set or [], resume=args.resume, quiet=args.quiet,
+        frame=_frame(args), ridge=args.prior_ridge, rl_cov=args.rl_cov,
+        ceiling=Path(args.ceiling) if args.ceiling else None, dask=_dask_spec(args))
     return bench.run_bench(opt, argv=sys.argv[1:])
 
 
@@ -393,9 +386,9 @@ def cmd_sweep(args) -> int:
     opt = sweep.SweepOptions(
         prior_from=Path(args.prior_from), out=Path(args.out), params=args.param, condition=args.condition,
         cells=args.cells, subset=args.subset, seed=args.seed, seeds=1 if args.seeds is None else args.seeds,
-        max_trials=args.max_trials, success_steps=args.success_steps, sets=_sets(args),
-        one_at_a_time=args.one_at_a_time, threads=_threads_arg(args), rl_cov=args.rl_cov, quiet=args.quiet,
-        dask=_dask_spec(args))
+        max_trials=args.max_trials, success_steps=args.success_steps, configuration=args.configuration,
+        sets=args.set or [], one_at_a_time=args.one_at_a_time, threads=_threads_arg(args), rl_cov=args.rl_cov,
+        quiet=args.quiet, dask=_dask_spec(args))
     return sweep.run_sweep(opt)
 
 

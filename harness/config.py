@@ -346,18 +346,42 @@ def parse_value(text: str) -> Any:
         return text
 
 
+def given_twice(name: str, first: str, second: str) -> UsageError:
+    """The error of a parameter set by two options (or twice by one): nothing given is ignored."""
+    return UsageError(f"{first} and {second} both set {name}; give it once")
+
+
 def parse_sets(items: Iterable[str] | None, option: str = "--set") -> dict[str, Any]:
-    """``NAME=VALUE`` strings -> {canonical name: value}; a later item for the same field (under
-    any of its names) wins. UsageError for an item without '=', ConfigError for an unknown name."""
+    """``NAME=VALUE`` strings -> {canonical name: value}. UsageError for an item without '=' and
+    for a field given twice (under any of its names); ConfigError for an unknown name."""
     out: dict[str, Any] = {}
+    given: dict[str, str] = {}
     for item in items or []:
         if "=" not in item:
             raise UsageError(f"{option} expects name=value, got {_short(item)}")
         name, value = item.split("=", 1)
         name = canonical(name.strip())
-        out.pop(name, None)
+        if name in given:
+            raise given_twice(name, f"{option} {given[name]}", f"{option} {item[:60]}")
+        given[name] = item[:60]
         out[name] = parse_value(value.strip())
     return out
+
+
+def command_overrides(configuration: str, sets: Iterable[str] | None,
+                      flags: Mapping[str, tuple[str, Any]] | None = None) -> dict[str, Any]:
+    """The overrides of a command: the items of the named ``configuration``, replaced field by field
+    by the ``sets`` items (--set), and the options that set one field each (``flags``: option ->
+    (canonical name, value, None when not given)). A field set by --set and by its own option is
+    a UsageError naming both, as is a field given twice by --set."""
+    user = parse_sets(sets)
+    for option, (name, value) in (flags or {}).items():
+        if value is None:
+            continue
+        if name in user:
+            raise given_twice(name, f"{option} {value}", f"--set {name}")
+        user[name] = value
+    return {**parse_sets(named_sets(configuration)), **user}
 
 
 # -- configurations ------------------------------------------------------------------------------------

@@ -22,7 +22,7 @@ from . import _binding as B
 from . import geometry, grid, metrics, results
 from . import prior as P
 from ._binding import ConfigError
-from .config import build_config, canonical, parse_sets, parse_value
+from .config import build_config, canonical, command_overrides, given_twice, named_sets, parse_sets, parse_value
 from .errors import SweepError, UsageError
 from .metrics import percent
 from .options import CONTROL_OF, FRAME_NAMES, RL_COV_NAMES, SWEEP_MAX_TRIALS
@@ -142,8 +142,9 @@ class SweepOptions:
     subset: int | None = None
     seed: int = 0
     seeds: int = 1
-    max_trials: int = SWEEP_MAX_TRIALS
+    max_trials: int | None = None     # None: --set max_trials, else SWEEP_MAX_TRIALS
     success_steps: int | None = None
+    configuration: str = "default"    # a named configuration (config.NAMED_CONFIGURATIONS), then sets
     sets: Sequence[str] = ()
     one_at_a_time: bool = False
     threads: int = 0
@@ -210,14 +211,19 @@ def run_sweep(opt: SweepOptions) -> int:
     ico_failed = np.array([(int(r), int(c)) in ico_known and (int(r), int(c)) not in ico_rc
                            for r, c in zip(pr, pc)], dtype=bool)
 
-    fixed = parse_sets(opt.sets)
-    fixed["max_trials"] = opt.max_trials
-    if opt.success_steps is not None:
-        fixed["success_steps"] = opt.success_steps
+    flags = {"--max-trials": ("max_trials", opt.max_trials), "--success-steps": ("success_steps", opt.success_steps)}
+    fixed = command_overrides(opt.configuration, opt.sets, flags)
+    explicit = {name: f"--set {name}" for name in parse_sets(opt.sets)}
+    explicit.update({name: option for option, (name, value) in flags.items() if value is not None})
+    for name in params:
+        if name in explicit:
+            raise given_twice(name, f"--param {name}", explicit[name])
+    fixed.setdefault("max_trials", SWEEP_MAX_TRIALS)
     out = results.check_out_dir(opt.out)
     meta = {"condition": opt.condition, "prior_from": str(ico_dir.resolve()), "cells": indices,
-            "n_cells": len(indices), "seeds": seeds, "max_trials": opt.max_trials,
-            "success_steps": opt.success_steps, "set": list(opt.sets), "rl_cov": opt.rl_cov}
+            "n_cells": len(indices), "seeds": seeds,
+            "max_trials": int(build_config({"max_trials": fixed["max_trials"]}, check=False).run.max_trials),
+            "success_steps": opt.success_steps, "set": named_sets(opt.configuration, opt.sets), "rl_cov": opt.rl_cov}
     meta_path = out / "sweep.json"
     csv_path = out / "sweep.csv"
     runs: list = []  # provenance of each invocation that ran settings (not compared on resume)

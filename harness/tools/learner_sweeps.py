@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 from .. import results
-from ..config import named_sets
 from ..sweep import SweepOptions, run_sweep
 
 SEEDS = 2
@@ -155,7 +154,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"[learner_sweeps] {name} on {label} cells", file=sys.stderr, flush=True)
             code = run_sweep(SweepOptions(prior_from=args.prior_from, out=args.out / f"{name}-{label}",
                                           params=params, condition=condition, seeds=SEEDS,
-                                          max_trials=MAX_TRIALS, sets=named_sets("literal", args.base),
+                                          max_trials=MAX_TRIALS, configuration="literal", sets=args.base,
                                           one_at_a_time=one_at_a_time, threads=args.threads, quiet=True,
                                           **selection))
             if code:

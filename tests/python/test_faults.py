@@ -453,12 +453,16 @@ def test_help_documents_bounds(capsys):
     assert "1e6 plant steps" in " ".join(capsys.readouterr().out.split())
 
 
-# -- strict parsing: numbers in ASCII digits that survive rounding ----------------------------------------
+# -- strict parsing: numbers in ASCII digits that survive rounding, no parameter given twice ----------------
 STRICT = [
     (["--set", "gain=1e-400"], ["policy.gain", "'1e-400'", "rounds to 0"]),
     (["--set", "dt=1e-400"], ["dt", "rounds to 0"]),
     (["--set", "input_range=[1e-400,3.5,0.2,2]"], ["input_range", "rounds to 0"]),
     (["--prior-ridge", "1e-400"], ["--prior-ridge", "rounds to 0"]),
+    (["--max-trials", "50", "--set", "max_trials=true"], ["--max-trials 50", "--set max_trials", "both set"]),
+    (["--max-trials", "50", "--set", "max_trials=-3"], ["--max-trials 50", "--set max_trials", "both set"]),
+    (["--success-steps", "50", "--set", "success_steps=60"], ["--success-steps", "--set success_steps"]),
+    (["--set", "gain=3", "--set", "policy.gain=4"], ["gain=3", "policy.gain=4", "both set policy.gain"]),
     (["--set", "max_trials=５０"], ["max_trials", "ASCII"]),
     (["--set", "gain=１"], ["policy.gain", "ASCII"]),
     (["--cells", "６１１"], ["bad cell index", "ASCII"]),
@@ -489,9 +493,17 @@ def test_zero_and_small_normal_values_pass(capsys, tmp_path):
 
 
 SWEEP = ["sweep", "--out", "{tmp}/w", "--cells", "611"]
+BENCH = ["bench", "--profile", "quick", "--seeds", "1", "--out", "{tmp}/b"]
 CEILING = ["ceiling", "--out", "{tmp}/c", "--cells", "611", "--protocol", "first", "--success-steps", "200", "--quiet"]
 STRICT_COMMANDS = [
+    ([*SWEEP, "--param", "noise_std=1", "--max-trials", "50", "--set", "max_trials=60"],
+     ["--max-trials 50", "--set max_trials"]),
+    ([*SWEEP, "--param", "noise_std=1,2", "--set", "noise_std=3"], ["--param actor.noise_std", "--set"]),
+    ([*SWEEP, "--param", "max_trials=10,20", "--max-trials", "50"], ["--param max_trials", "--max-trials"]),
     ([*SWEEP, "--param", "noise_std=1", "--set", "gain=1e-400"], ["gain", "rounds to 0"]),
+    ([*BENCH, "--rl-max-trials", "5", "--set", "max_trials=6"], ["--rl-max-trials 5", "--set max_trials"]),
+    ([*BENCH, "--set", "max_trials=3", "--set", "noise_std=1", "--set", "actor.noise_std=2"],
+     ["both set actor.noise_std"]),
     ([*CEILING, "--w", "1e-400,1,1,1"], ["--w", "rounds to 0"]),
     ([*CEILING, "--w", "１,1,1,1"], ["--w", "ASCII"]),
 ]
@@ -504,3 +516,12 @@ def test_strict_parsing_of_sweep_bench_ceiling(capsys, ico_dir, tmp_path, args, 
     rc, _, err = main(capsys, *args)
     assert_one_line_error(rc, err, *words)
     assert not [p for p in tmp_path.iterdir() if p.name in ("w", "b", "c")]
+
+
+def test_configuration_then_set_is_no_duplicate(capsys, tmp_path):
+    """--set replaces an item of the named configuration: that is its purpose, not a field given twice."""
+    rc, _, err = main(capsys, "grid", "--out", tmp_path / "o", "--cells", "611", *TINY_ARGS,
+                      "--configuration", "literal", "--set", "actor.noise_std=2")
+    assert rc == 0, err
+    assert results.load(tmp_path / "o")[1]["config"]["controller"]["actor"]["noise_std"] == 2.0
+

@@ -13,6 +13,7 @@ from harness import config, figures, results
 from harness import prior as P
 from harness.config import (ALIASES, ALL_FIELDS, build_config, canonical, config_from_dict, named_sets,
                             parse_sets)
+from harness.errors import UsageError
 from harness.tools import imports
 
 REPO = Path(__file__).resolve().parents[2]
@@ -57,12 +58,13 @@ def test_alias_and_canonical_give_identical_configs(alias):
     assert parse_sets([f"{alias}={text}"]) == parse_sets([f"{ALIASES[alias]}={text}"])
 
 
-def test_all_aliases_at_once_and_later_wins():
+def test_all_aliases_at_once_and_a_field_given_twice():
     a = build_config(VALUES, condition="rl")
     b = build_config({ALIASES[k]: v for k, v in VALUES.items()}, condition="rl")
     assert bytes(a.controller) == bytes(b.controller)
-    assert parse_sets(["gain=3", "policy.gain=4"]) == {"policy.gain": 4}
-    assert parse_sets(["policy.gain=4", "gain=3"]) == {"policy.gain": 3}
+    for items in (["gain=3", "policy.gain=4"], ["policy.gain=4", "gain=3"], ["gain=3", "gain=3"]):
+        with pytest.raises(UsageError, match=f"--set {items[0]} and --set {items[1]} both set policy.gain"):
+            parse_sets(items)
 
 
 def test_canonical_record_nested_and_flat_names():
