@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import results
+from .. import results, store
 from ..sweep import SweepOptions, run_sweep
 
 SEEDS = 2
@@ -142,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.report:
         path = args.out / "summary.md"
-        path.write_text(report(args.out))
+        store.write_text(path, report(args.out))
         print(path)
         return 0
     selections = {"spread": dict(subset=SPREAD_CELLS), "ico-failed": dict(cells=ico_failed_cells(args.prior_from))}

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from harness import _binding as B
-from harness import cli, grid, metrics, results
+from harness import cli, grid, metrics, results, store
 from harness.config import build_config
 
 CELLS = [610, 611, 612, 613]
@@ -53,7 +53,7 @@ def partial_dir(tmp_path_factory):
     cells = grid.make_cells(SEED, CELLS)
     grid.run_grid(cfg, cells, threads=2, progress=False)
     grid.reset_pending(cells, np.arange(cells.size) >= 2)
-    results.save(out, cells, cfg, condition="ico", seed=SEED, wall_time=0.5, threads=2, cell_indices=CELLS)
+    store.save(out, cells, cfg, condition="ico", seed=SEED, wall_time=0.5, threads=2, cell_indices=CELLS)
     return out
 
 
@@ -409,18 +409,18 @@ def test_write_probe_failure_is_one_line(capsys, tmp_path, monkeypatch):
 
 
 def test_checkpoint_write_failure_is_one_line(capsys, tmp_path, monkeypatch):
-    real_save = results.save
+    real_save = store.ResultsStore.save
     calls = []
 
     def save(*a, **k):
         calls.append(1)
         if len(calls) > 1:
-            raise OSError(errno.ENOSPC, "No space left on device", str(tmp_path / "o" / "cells.npz.tmp"))
+            raise OSError(errno.ENOSPC, "No space left on device", str(tmp_path / "o" / "cells.npz"))
         return real_save(*a, **k)
 
-    monkeypatch.setattr(results, "save", save)
+    monkeypatch.setattr(store.ResultsStore, "save", save)
     rc, _, err = main(capsys, "grid", "--out", tmp_path / "o", "--cells", "611", *TINY_ARGS)
-    assert_one_line_error(rc, err, "No space left on device", "cells.npz.tmp")
+    assert_one_line_error(rc, err, "No space left on device", "cells.npz")
     assert len(calls) == 2
     results.load(tmp_path / "o")  # the first (all PENDING) save is intact
 
