@@ -1,9 +1,10 @@
 """Python harness of the icoac controller: ctypes binding of libicoac_sim, grid runs, results, figures.
 
-Layers (no import cycle; `python -m harness.tools.imports` prints the graph): errors, options (no
-dependencies) < _binding (the C library, its constants and checked struct mirrors) < geometry,
-config < metrics, grid < results < prior < figures, conditions < bench, sweep < cli (arguments
-and reports only; imported by __main__ alone). The Dask backend: _worker (what a worker runs;
+Layers (no import cycle; `python -m harness.tools.imports` prints the graph): errors, options,
+literals (no dependencies) < _binding (the C library, its constants and checked struct mirrors)
+< geometry, config < metrics, grid < results < store (every write into an output directory),
+prior < figures, conditions < bench, sweep < cli (arguments and reports only; imported by
+__main__ alone). The Dask backend: _worker (what a worker runs;
 errors and options at import, the binding only inside a task) < cluster (the client side, after
 grid; imported by bench and sweep, and by conditions inside a function).
 """

@@ -10,7 +10,6 @@ Fig. 3a) when OUT/ceiling/ceiling.json exists or --ceiling names one.
 """
 from __future__ import annotations
 
-import json
 import math
 import sys
 import time
@@ -21,10 +20,10 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from . import ceiling as C
-from . import figures, geometry, grid, metrics, results
+from . import figures, geometry, grid, metrics, results, store
 from . import prior as P
 from .conditions import run_condition
-from .config import build_config, parse_sets
+from .config import build_config, command_overrides, named_sets
 from .errors import ResultsError
 from .metrics import percent
 from .options import CONDITION_LABELS as LABELS, CONDITIONS, CONTROL_OF, PROFILE_NAMES
@@ -185,8 +184,8 @@ def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] 
     out = Path(out)
     md = out / "summary.md"
     js = out / "summary.json"
-    md.write_text(summary_markdown(agg, ceiling))
-    js.write_text(json.dumps(agg, indent=2) + "\n")
+    store.write_text(md, summary_markdown(agg, ceiling))
+    store.write_json(js, agg)
     return md, js
 
 
@@ -220,15 +219,14 @@ class BenchLog:
 
     def __init__(self, out: Path, meta: Mapping[str, Any]):
         self.path = Path(out) / "bench.json"
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         self.t0 = time.monotonic()
         self.data: dict[str, Any] = {"meta": dict(meta), "stages": [], "total_wall_time": 0.0,
                                      "complete": False}
         previous = None
         if self.path.is_file():
-            try:
-                previous = json.loads(self.path.read_text())
-            except ValueError:
+            try:  # a damaged log is replaced, and a link is not followed
+                previous = results.read_json(self.path, follow=False)
+            except ResultsError:
                 previous = None
         if not isinstance(previous, dict):
             previous = None
@@ -243,7 +241,7 @@ class BenchLog:
     def flush(self, complete: bool = False) -> None:
         self.data["total_wall_time"] = round(time.monotonic() - self.t0, 3)
         self.data["complete"] = complete
-        self.path.write_text(json.dumps(self.data, indent=2) + "\n")
+        store.write_json(self.path, self.data)
 
 
 def progress(msg: str) -> None:
@@ -268,6 +266,7 @@ class BenchOptions:
     seeds: int | None = None
     rl_max_trials: int | None = None
     threads: int = 0
+    configuration: str = "default"   # a named configuration (config.NAMED_CONFIGURATIONS), then sets
     sets: Sequence[str] = ()
     resume: bool = False
     quiet: bool = False
@@ -290,15 +289,14 @@ def stages(opt: BenchOptions) -> list[Stage]:
     out = Path(opt.out)
     figdir = Path(opt.figures) if opt.figures else None
     seeds = opt.seed_list()
-    sets = parse_sets(opt.sets)
+    ico_sets = command_overrides(opt.configuration, opt.sets)
+    rl_sets = command_overrides(opt.configuration, opt.sets, {"--rl-max-trials": ("max_trials", opt.rl_max_trials)})
     cells_spec = profile["cells"]
 
     def overrides(condition):
-        over = dict(profile["ico"] if condition == "ico" else profile["rl"])
-        if condition != "ico" and opt.rl_max_trials is not None:
-            over["max_trials"] = opt.rl_max_trials
-        over.update(sets)
-        return over
+        if condition == "ico":
+            return {**profile["ico"], **ico_sets}
+        return {**profile["rl"], **rl_sets}
 
     def grid_stage(condition: str, seed: int):
         def run(ctx):
@@ -382,8 +380,7 @@ def run_bench(opt: BenchOptions, argv: Sequence[str] = ()) -> int:
     from .cluster import open_backend
 
     todo = stages(opt)  # validates the arguments before anything is written
-    results.check_writable(opt.out)
-    with open_backend(opt.dask) as session:
+    with store.DirectoryLock(opt.out), open_backend(opt.dask) as session:
         return _run_stages(opt, todo, {"dask": session}, argv)
 
 
@@ -392,7 +389,7 @@ def _run_stages(opt: BenchOptions, todo: list[Stage], ctx: dict, argv: Sequence[
     log = BenchLog(Path(opt.out), {
         "profile": opt.profile, "seeds": opt.seed_list(),
         "rl_max_trials": opt.rl_max_trials, "resume": bool(opt.resume), "threads": opt.threads,
-        "set": list(opt.sets), "argv": list(argv),
+        "set": named_sets(opt.configuration, opt.sets), "argv": list(argv),
         **({"backend": session.describe()} if session is not None else {})})
     for i, stage in enumerate(todo, 1):
         progress(f"({i}/{len(todo)}) {stage.name}")

@@ -65,9 +65,7 @@ full-horizon evaluation, checkpointed and resumed like ``grid``), ``ceiling.json
 from __future__ import annotations
 
 import ctypes
-import datetime as _dt
 import hashlib
-import json
 import math
 import sys
 import time
@@ -78,7 +76,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from . import _binding as B
-from . import geometry, grid, metrics, results
+from . import geometry, grid, literals, metrics, results, store
 from . import prior as P
 from .conditions import run_condition
 from .config import RunConfig, build_config, make_prior, parse_sets
@@ -138,10 +136,10 @@ def parse_weights(text: str, what: str = "--w") -> tuple[float, ...]:
     """'w1,w2,w3,w4' -> as_weights."""
     parts = [p.strip() for p in str(text).strip().strip("()[]").split(",")]
     try:
-        values = [float(p) for p in parts]
-    except ValueError:
+        values = [literals.real(p) for p in parts]
+    except literals.NumberError as exc:
         raise UsageError(f"{what} expects {B.N_INPUTS} comma-separated numbers w_x,w_xdot,w_theta,w_thetadot, "
-                         f"got {text!r:.60}") from None
+                         f"got {text!r:.60} (a value {exc})") from None
     return as_weights(values, what)
 
 
@@ -529,8 +527,9 @@ class _Store:
     """Every screening result, keyed by w, with the settings that determine them; a rerun with the
     same settings reuses them, other settings are refused."""
 
-    def __init__(self, path: Path, settings: dict[str, Any]):
+    def __init__(self, path: Path, settings: dict[str, Any], dir_fd: int):
         self.path = Path(path)
+        self.dir_fd = dir_fd
         self.settings = settings
         self.screens: dict[tuple[float, ...], Screen] = {}
         self.reused = 0
@@ -541,18 +540,11 @@ class _Store:
         if not self.path.is_file():
             return
         where = repr(str(self.path))
-        try:
-            data = json.loads(self.path.read_bytes())
-        except (OSError, ValueError, RecursionError) as exc:
-            raise ResultsError(f"cannot read {where}: {str(exc):.100}; use another --out") from None
+        data = results.read_json(self.path, follow=False)
         if not isinstance(data, dict) or data.get("format_version") != FORMAT_VERSION \
                 or not isinstance(data.get("screens"), list):
             raise ResultsError(f"{where} is not a ceiling search record; use another --out")
-        if data.get("settings") != self.settings:
-            old = data.get("settings") if isinstance(data.get("settings"), dict) else {}
-            diff = [k for k in self.settings if old.get(k) != self.settings[k]] or ["format"]
-            raise UsageError(f"{str(self.path.parent)!r} holds a ceiling search with other {', '.join(diff)}; "
-                             "use another --out")
+        store.check_same_settings(data.get("settings"), self.settings, self.path.parent, "a ceiling search")
         try:
             for row in data["screens"]:
                 w = as_weights(row["w"], "search.json")
@@ -578,13 +570,9 @@ class _Store:
             return
         data = {"format_version": FORMAT_VERSION, "settings": self.settings,
                 "screens": [{"w": list(w), **asdict(s)} for w, s in self.screens.items()]}
-        _write_json(self.path, data)
+        store.write_json(self.path, data, indent=1, dir_fd=self.dir_fd)
         self.dirty = False
         self.last = time.monotonic()
-
-
-def _write_json(path: Path, data: Any) -> None:
-    results._atomic_write(Path(path), lambda tmp: tmp.write_text(json.dumps(data, indent=1) + "\n"))
 
 
 # -- the command -----------------------------------------------------------------------------------------
@@ -623,7 +611,7 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
     """Validate everything, then search (or take --w), evaluate, bound, summarise; 130 if interrupted
     (finished screens and cells are kept; the same command resumes)."""
     t_start = time.monotonic()
-    out = results.check_out_dir(opt.out)
+    out = store.check_out_dir(opt.out)
     protocols = protocols_of(opt.protocol)
     seed = grid.check_seed(opt.seed, "--seed")
     threads = grid.check_threads(opt.threads)
@@ -657,120 +645,121 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
         prior_info = P.from_results(opt.prior_from)
         typical = ("ICO mean (--prior-from)", as_weights(prior_info.mean, "--prior-from mean"))
     template = grid.make_cells(seed, indices)
-    store = None
+    screen_settings = None
     if given is None:
-        screen_cfg = fixed_config(TYPICAL_ICO_WEIGHTS, "first", success_steps=screen_steps, overrides=overrides)
-        base = screen_cfg.to_dict()
+        base = fixed_config(TYPICAL_ICO_WEIGHTS, "first", success_steps=screen_steps, overrides=overrides).to_dict()
         base["prior"] = None
-        store = _Store(out / SEARCH_FILE, {"seed": seed, "cells": indices, "screen_steps": screen_steps,
-                                           "config": base})
-        if out.is_dir():
-            store.load()
-    results.check_writable(out)
-    git = results.git_info()
+        screen_settings = {"seed": seed, "cells": indices, "screen_steps": screen_steps, "config": base}
+    with store.DirectoryLock(out) as held:  # the whole run: search.json, evals/, ceiling.json
+        screens = None
+        if screen_settings is not None:
+            screens = _Store(out / SEARCH_FILE, screen_settings, held.dir_fd)
+            screens.load()
+        git = results.git_info()
 
-    settings = {"seed": seed, "cells": indices, "n_cells": int(template.size), "protocol": opt.protocol,
-                "max_trials": max_trials, "success_steps": success_steps, "set": overrides,
-                "w": list(given) if given is not None else None, "threads": threads,
-                "prior_from": None if prior_info is None else {"path": prior_info.source, "mean": list(prior_info.mean),
-                                                                "n_cells": prior_info.n_cells,
-                                                                "commit": prior_info.source_commit}}
-    if given is None:
-        settings.update(candidates=candidates, screen_steps=screen_steps, confirm=confirm)
-    record: dict[str, Any] = {"format_version": FORMAT_VERSION, "command": "ceiling", "argv": list(argv),
-                              "settings": settings, "git": git, "abi": B.abi_info(),
-                              "policy": {"gain": float(probe.controller.policy.gain),
-                                         "reflex_mode": probe.to_dict()["controller"]["policy"]["reflex_mode"],
-                                         "reflex_force": float(probe.controller.policy.reflex_force)}}
-
-    def full_eval(w, protocol):
-        d = eval_dir(out, w, protocol, success_steps, max_trials)
-        cells, rec = evaluate_into(d, w, protocol, seed=seed, indices=indices, max_trials=max_trials,
-                                   success_steps=success_steps, overrides=overrides, threads=threads,
-                                   progress=not opt.quiet)
-        return protocol_summary(cells, rec, out, d)
-
-    try:
-        _log(opt.quiet, f"first-step bound on {template.size} cells ...")
-        bound = first_step_bound(probe, template, threads)
-        record["first_step_bound"] = bound
-        if bound.get("computed"):
-            _log(opt.quiet, f"  {bound['n_lost']} cells lost at step 1 whatever the force "
-                            f"({bound['n_lost_interior']} interior): at most {bound['max_success']} of {bound['n_cells']}")
+        settings = {"seed": seed, "cells": indices, "n_cells": int(template.size), "protocol": opt.protocol,
+                    "max_trials": max_trials, "success_steps": success_steps, "set": overrides,
+                    "w": list(given) if given is not None else None, "threads": threads,
+                    "prior_from": None if prior_info is None else {
+                        "path": prior_info.source, "mean": list(prior_info.mean), "n_cells": prior_info.n_cells,
+                        "commit": prior_info.source_commit}}
         if given is None:
-            cfg_cache: dict = {}
+            settings.update(candidates=candidates, screen_steps=screen_steps, confirm=confirm)
+        record: dict[str, Any] = {"format_version": FORMAT_VERSION, "command": "ceiling", "argv": list(argv),
+                                  "settings": settings, "git": git, "abi": B.abi_info(),
+                                  "policy": {"gain": float(probe.controller.policy.gain),
+                                             "reflex_mode": probe.to_dict()["controller"]["policy"]["reflex_mode"],
+                                             "reflex_force": float(probe.controller.policy.reflex_force)}}
 
-            def cfg_for(w):
-                if w not in cfg_cache:
-                    cfg_cache.clear()
-                    cfg_cache[w] = fixed_config(w, "first", success_steps=screen_steps, overrides=overrides)
-                return cfg_cache[w]
+        def full_eval(w, protocol):
+            d = eval_dir(out, w, protocol, success_steps, max_trials)
+            cells, rec = evaluate_into(d, w, protocol, seed=seed, indices=indices, max_trials=max_trials,
+                                       success_steps=success_steps, overrides=overrides, threads=threads,
+                                       progress=not opt.quiet)
+            return protocol_summary(cells, rec, out, d)
 
-            def screen(w):
-                s = store.get(w)
-                if s is None:
-                    s = screen_cells(w, template, cfg_for, threads)
-                    store.add(w, s)
-                return s
+        try:
+            _log(opt.quiet, f"first-step bound on {template.size} cells ...")
+            bound = first_step_bound(probe, template, threads)
+            record["first_step_bound"] = bound
+            if bound.get("computed"):
+                _log(opt.quiet, f"  {bound['n_lost']} cells lost at step 1 whatever the force "
+                                f"({bound['n_lost_interior']} interior): at most {bound['max_success']} of "
+                                f"{bound['n_cells']}")
+            if given is None:
+                cfg_cache: dict = {}
 
-            def report(entry, best):
-                if entry is best or (entry["index"] + 1) % 50 == 0:
-                    _log(opt.quiet, f"  #{entry['index'] + 1}/{candidates} {entry['phase']} ({entry['label']}): "
-                                    f"{entry['n_success']} cells; best {best['n_success']} {format_w(best['w'])}")
+                def cfg_for(w):
+                    if w not in cfg_cache:
+                        cfg_cache.clear()
+                        cfg_cache[w] = fixed_config(w, "first", success_steps=screen_steps, overrides=overrides)
+                    return cfg_cache[w]
 
-            starts = [typical] + lqr_starts(probe)
-            _log(opt.quiet, f"search: {candidates} candidates screened at {screen_steps} steps (first trial), "
-                            f"{len(starts)} starting points")
-            t0 = time.monotonic()
-            res = search(screen, starts, candidates, seed, report=report)
-            store.flush()
-            screen_wall = time.monotonic() - t0
-            _log(opt.quiet, f"  {len(res.trace)} screened ({store.reused} from {SEARCH_FILE}) in {screen_wall:.1f} s, "
-                            f"stop: {res.stop}")
-            confirmed = []
-            t0 = time.monotonic()
-            for entry in res.ranked()[:confirm]:
-                w = tuple(entry["w"])
-                summ = full_eval(w, "first")
-                confirmed.append({"index": entry["index"], "w": list(w), "screen": {
-                    k: entry[k] for k in ("n_success", "n_success_interior", "total_steps")}, "first": summ})
-                _log(opt.quiet, f"  confirm #{entry['index'] + 1} {format_w(w)}: {summ['n_success']} of "
-                                f"{summ['n_cells']} at {success_steps} steps")
-            best = max(confirmed, key=lambda c: (c["first"]["n_success"], c["first"]["n_success_interior"],
-                                                 c["screen"]["n_success"], c["screen"]["total_steps"], -c["index"]))
-            record["search"] = {
-                "candidates": candidates, "screen_steps": screen_steps, "confirm": confirm, "seed": seed,
-                "stop": res.stop, "refinement_steps": res.refinement_steps,
-                "refinement_origins": res.refinement_origins, "screened": len(res.trace),
-                "phases": {p: sum(1 for e in res.trace if e["phase"] == p) for p in ("start", "random", "refine")},
-                "reused_screens": store.reused, "screen_wall_time": screen_wall,
-                "confirm_wall_time": time.monotonic() - t0,
-                "starts": res.starts, "screen_best": res.best, "confirmed": confirmed, "trace": res.trace}
-            best_w = tuple(best["w"])
-            protos = {"first": best["first"]}
-            source = "search"
-        else:
-            best_w, protos, source = given, {}, "--w"
-        for protocol in protocols:
-            if protocol not in protos:
-                _log(opt.quiet, f"{protocol} protocol of {format_w(best_w)} at {success_steps} steps ...")
-                protos[protocol] = full_eval(best_w, protocol)
-        record["best"] = {"w": list(best_w), "source": source,
-                          "protocols": {p: protos[p] for p in CEILING_PROTOCOLS if p in protos}}
-    except KeyboardInterrupt:
-        if store is not None:
-            store.flush()
-        print("interrupted: finished screens and cells are saved; rerun the same command to resume",
-              file=sys.stderr)
-        return 130
-    record["timestamp"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
-    record["wall_time"] = time.monotonic() - t_start
-    _write_json(out / CEILING_FILE, record)
-    md = out / SUMMARY_MD
-    md.write_text(summary_markdown(record))
-    print(md.read_text(), end="")
-    print(f"wall time {record['wall_time']:.1f} s -> {out / CEILING_FILE}")
-    return 0
+                def screen(w):
+                    s = screens.get(w)
+                    if s is None:
+                        s = screen_cells(w, template, cfg_for, threads)
+                        screens.add(w, s)
+                    return s
+
+                def report(entry, best):
+                    if entry is best or (entry["index"] + 1) % 50 == 0:
+                        _log(opt.quiet, f"  #{entry['index'] + 1}/{candidates} {entry['phase']} ({entry['label']}): "
+                                        f"{entry['n_success']} cells; best {best['n_success']} {format_w(best['w'])}")
+
+                starts = [typical] + lqr_starts(probe)
+                _log(opt.quiet, f"search: {candidates} candidates screened at {screen_steps} steps (first trial), "
+                                f"{len(starts)} starting points")
+                t0 = time.monotonic()
+                res = search(screen, starts, candidates, seed, report=report)
+                screens.flush()
+                screen_wall = time.monotonic() - t0
+                _log(opt.quiet, f"  {len(res.trace)} screened ({screens.reused} from {SEARCH_FILE}) in "
+                                f"{screen_wall:.1f} s, stop: {res.stop}")
+                confirmed = []
+                t0 = time.monotonic()
+                for entry in res.ranked()[:confirm]:
+                    w = tuple(entry["w"])
+                    summ = full_eval(w, "first")
+                    confirmed.append({"index": entry["index"], "w": list(w), "screen": {
+                        k: entry[k] for k in ("n_success", "n_success_interior", "total_steps")}, "first": summ})
+                    _log(opt.quiet, f"  confirm #{entry['index'] + 1} {format_w(w)}: {summ['n_success']} of "
+                                    f"{summ['n_cells']} at {success_steps} steps")
+                best = max(confirmed, key=lambda c: (c["first"]["n_success"], c["first"]["n_success_interior"],
+                                                     c["screen"]["n_success"], c["screen"]["total_steps"], -c["index"]))
+                record["search"] = {
+                    "candidates": candidates, "screen_steps": screen_steps, "confirm": confirm, "seed": seed,
+                    "stop": res.stop, "refinement_steps": res.refinement_steps,
+                    "refinement_origins": res.refinement_origins, "screened": len(res.trace),
+                    "phases": {p: sum(1 for e in res.trace if e["phase"] == p) for p in ("start", "random", "refine")},
+                    "reused_screens": screens.reused, "screen_wall_time": screen_wall,
+                    "confirm_wall_time": time.monotonic() - t0,
+                    "starts": res.starts, "screen_best": res.best, "confirmed": confirmed, "trace": res.trace}
+                best_w = tuple(best["w"])
+                protos = {"first": best["first"]}
+                source = "search"
+            else:
+                best_w, protos, source = given, {}, "--w"
+            for protocol in protocols:
+                if protocol not in protos:
+                    _log(opt.quiet, f"{protocol} protocol of {format_w(best_w)} at {success_steps} steps ...")
+                    protos[protocol] = full_eval(best_w, protocol)
+            record["best"] = {"w": list(best_w), "source": source,
+                              "protocols": {p: protos[p] for p in CEILING_PROTOCOLS if p in protos}}
+        except KeyboardInterrupt:
+            if screens is not None:
+                screens.flush()
+            print("interrupted: finished screens and cells are saved; rerun the same command to resume",
+                  file=sys.stderr)
+            return 130
+        record["timestamp"] = results.timestamp()
+        record["wall_time"] = time.monotonic() - t_start
+        text = summary_markdown(record)
+        store.write_json(out / CEILING_FILE, record, indent=1, dir_fd=held.dir_fd)
+        store.write_text(out / SUMMARY_MD, text, dir_fd=held.dir_fd)
+        print(text, end="")
+        print(f"wall time {record['wall_time']:.1f} s -> {out / CEILING_FILE}")
+        return 0
 
 
 # -- reports --------------------------------------------------------------------------------------------

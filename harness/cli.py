@@ -16,6 +16,7 @@ import math
 import sys
 from pathlib import Path
 
+from . import literals
 from . import options as O
 from .errors import HarnessError, UsageError
 
@@ -29,19 +30,22 @@ class _Parser(argparse.ArgumentParser):
 
 # -- argument types ------------------------------------------------------------------------------------
 def _integer(text: str) -> int:
-    """An integer written as digits or as an integral float ('6000', '1e5'); never inf/nan."""
-    t = text.strip()
+    """An integer written as ASCII digits or as an integral real ('6000', '1e5'); never inf/nan."""
     try:
-        return int(t, 10)
-    except ValueError:
-        pass
+        return literals.integer(text)
+    except literals.NumberError as exc:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r:.40}, which {exc}") from None
+
+
+def _real(text: str) -> float:
+    """A real number (harness.literals: ASCII digits, no value that rounds to 0 or a subnormal)."""
     try:
-        value = float(t)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"invalid integer {text!r:.40}") from None
-    if not math.isfinite(value) or not value.is_integer():
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r:.40}")
-    return int(value)
+        return literals.real(text)
+    except literals.NumberError as exc:
+        raise argparse.ArgumentTypeError(f"value {text!r:.40} {exc}") from None
+
+
+_real.__name__ = "number"
 
 
 def _int_in(lo: int, hi: int, what: str):
@@ -66,7 +70,7 @@ def _seed_count(text: str) -> int:
     if "," in text:
         parts = [p.strip() for p in text.split(",")]
         hint = ""
-        if all(p.isdigit() for p in parts) and [int(p) for p in parts] == list(
+        if all(literals.is_integer_text(p) for p in parts) and [int(p) for p in parts] == list(
                 range(int(parts[0]), int(parts[0]) + len(parts))):
             hint = f"; for the seeds {text.strip()} write --seed {int(parts[0])} --seeds {len(parts)}"
         raise argparse.ArgumentTypeError(f"--seeds is a number of seeds (seeds --seed .. --seed + N - 1), "
@@ -79,10 +83,7 @@ _seed_count.__name__ = "integer"
 
 def _positive_float(hi: float, what: str):
     def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"invalid number {text!r:.40}") from None
+        value = _real(text)
         if not (math.isfinite(value) and 0 < value <= hi):
             raise argparse.ArgumentTypeError(f"expected {what}, got {text!r:.40}")
         return value
@@ -102,11 +103,11 @@ SET_HELP = ("override a parameter (repeatable): NAME is group.field (policy.gain
 def _add_prior_args(parser, rl_cov: bool = True) -> None:
     parser.add_argument("--prior-frame", choices=O.FRAME_NAMES, default=O.FRAME_NAMES[0],
                         help="ICO cells for the prior: central frame (default) or all successful cells")
-    parser.add_argument("--prior-x", type=float, default=None,
+    parser.add_argument("--prior-x", type=_real, default=None,
                         help=f"frame half-width |x0| (m), default {O.PRIOR_FRAME[0]:g}")
-    parser.add_argument("--prior-theta", type=float, default=None,
+    parser.add_argument("--prior-theta", type=_real, default=None,
                         help=f"frame half-height |theta0| (deg), default {O.PRIOR_FRAME[1]:g}")
-    parser.add_argument("--prior-ridge", type=float, default=O.PRIOR_RIDGE,
+    parser.add_argument("--prior-ridge", type=_real, default=O.PRIOR_RIDGE,
                         help=f"ridge added to the prior covariance (default {O.PRIOR_RIDGE:g})")
     if rl_cov:
         _add_rl_cov(parser)
@@ -153,9 +154,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     g = sub.add_parser(
         "grid", help="run (or resume) the paper grid (or some of its cells) for one condition",
-        epilog=f"Checkpoints: cells.npz and run.json are rewritten atomically (about 1 ms for the full "
-               f"grid, at most once per 0.2 s poll) whenever --checkpoint-cells N cells (default "
-               f"{cells_}) finished since the last checkpoint, or --checkpoint-every SECONDS "
+        epilog=f"Checkpoints: cells.npz and run.json are rewritten atomically and fsynced (about 25 ms for "
+               f"the full grid on a local disk, at most once per 0.2 s poll) whenever --checkpoint-cells N "
+               f"cells (default {cells_}) finished since the last checkpoint, or --checkpoint-every SECONDS "
                f"(default {every:g}) passed with at least one newly finished cell. A SIGKILL "
                f"therefore loses at most max({cells_} cells, {every:g} s) of finished "
                f"work; in fact both limits hold at once, up to one 0.2 s poll: fewer than "
@@ -240,7 +241,7 @@ def build_parser() -> argparse.ArgumentParser:
     sel.add_argument("--cells", default=None, help="cell indices, e.g. 0,5,600-610")
     sel.add_argument("--subset", type=_subset, default=None, help="N evenly spread cells, at most the grid's cell count")
     _add_seeds(w, "default 1")
-    w.add_argument("--max-trials", type=_positive_int, default=O.SWEEP_MAX_TRIALS,
+    w.add_argument("--max-trials", type=_positive_int, default=None,
                    help=f"trials before a cell fails (default {O.SWEEP_MAX_TRIALS})")
     w.add_argument("--success-steps", type=_positive_int, default=None)
     w.add_argument("--configuration", choices=O.CONFIGURATION_NAMES, default=O.CONFIGURATION_NAMES[0],
@@ -295,20 +296,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 # -- commands: arguments in, report out ----------------------------------------------------------------
-def _sets(args) -> list[str]:
-    """--configuration's items, then --set's."""
-    from .config import named_sets
-    return named_sets(args.configuration, args.set)
-
-
 def _overrides(args) -> dict:
-    from .config import parse_sets
-    over = parse_sets(_sets(args))
-    if args.max_trials is not None:
-        over["max_trials"] = args.max_trials
-    if args.success_steps is not None:
-        over["success_steps"] = args.success_steps
-    return over
+    """--configuration's items, replaced by --set's, with --max-trials and --success-steps (each
+    field given once)."""
+    from .config import command_overrides
+    return command_overrides(args.configuration, args.set, {"--max-trials": ("max_trials", args.max_trials),
+                                                            "--success-steps": ("success_steps", args.success_steps)})
 
 
 def _frame(args):
@@ -343,7 +336,7 @@ def cmd_grid(args) -> int:
     from . import conditions, metrics
 
     explicit = any(v is not None for v in (args.condition, args.seed, args.max_trials, args.success_steps,
-                                            args.cells, args.prior_from)) or bool(_sets(args))
+                                            args.cells, args.prior_from)) or bool(_overrides(args))
     condition = args.condition or O.CONDITIONS[0]
     info = None
     if explicit or not args.resume:
@@ -365,11 +358,11 @@ def cmd_grid(args) -> int:
 
 
 def cmd_figures(args) -> int:
-    from . import figures, results
+    from . import figures, results, store
 
     cells, record = results.load(args.results, what="--results")
     figures.check_duration(record, args.duration)  # before anything is drawn
-    results.check_writable(args.out)
+    store.check_writable(args.out)
     for path in figures.make_figures(cells, record, args.out, duration=args.duration):
         print(path)
     return 0
@@ -381,8 +374,9 @@ def cmd_bench(args) -> int:
     opt = bench.BenchOptions(
         profile=args.profile, out=Path(args.out), figures=Path(args.figures) if args.figures else None,
         seed=args.seed, seeds=args.seeds, rl_max_trials=args.rl_max_trials, threads=_threads_arg(args),
-        sets=_sets(args), resume=args.resume, quiet=args.quiet, frame=_frame(args), ridge=args.prior_ridge,
-        rl_cov=args.rl_cov, ceiling=Path(args.ceiling) if args.ceiling else None, dask=_dask_spec(args))
+        configuration=args.configuration, sets=args.set or [], resume=args.resume, quiet=args.quiet,
+        frame=_frame(args), ridge=args.prior_ridge, rl_cov=args.rl_cov,
+        ceiling=Path(args.ceiling) if args.ceiling else None, dask=_dask_spec(args))
     return bench.run_bench(opt, argv=sys.argv[1:])
 
 
@@ -392,9 +386,9 @@ def cmd_sweep(args) -> int:
     opt = sweep.SweepOptions(
         prior_from=Path(args.prior_from), out=Path(args.out), params=args.param, condition=args.condition,
         cells=args.cells, subset=args.subset, seed=args.seed, seeds=1 if args.seeds is None else args.seeds,
-        max_trials=args.max_trials, success_steps=args.success_steps, sets=_sets(args),
-        one_at_a_time=args.one_at_a_time, threads=_threads_arg(args), rl_cov=args.rl_cov, quiet=args.quiet,
-        dask=_dask_spec(args))
+        max_trials=args.max_trials, success_steps=args.success_steps, configuration=args.configuration,
+        sets=args.set or [], one_at_a_time=args.one_at_a_time, threads=_threads_arg(args), rl_cov=args.rl_cov,
+        quiet=args.quiet, dask=_dask_spec(args))
     return sweep.run_sweep(opt)
 
 

@@ -13,10 +13,10 @@ from typing import Any
 import numpy as np
 
 from . import _binding as B
-from . import grid, results
+from . import grid, results, store
 from . import prior as P
 from .config import RunConfig, build_config
-from .errors import ResultsError, UsageError
+from .errors import UsageError
 from .options import CONDITIONS, CONTROL_OF, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY
 
 
@@ -61,74 +61,68 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     threads, with the same cells, checkpoints and resume; run.json then records the backend
     (``backend``) and the cluster's thread count.
 
-    Everything is validated before the first byte is written: the arguments, the configuration
-    (C checks), the output directory (a real write probe) and, when results exist, both files,
-    the recorded configuration and that the cells are exactly the recorded selection. A resume
-    writes nothing until new cells have finished; ``fresh`` discards existing results (after the
-    checks). A directory holding only one of the two files is refused unless ``fresh``. With
-    ``resume`` and not ``explicit`` the recorded condition, seed, cells, configuration and prior
-    are used.
+    Everything is validated before the first byte is written: the arguments and the configuration
+    (C checks) first; then the output directory is held (store.ResultsStore: created if missing,
+    a real write probe, the lock) and, when results exist, both files, the ABI of the library that
+    wrote them, the recorded configuration and that the cells are exactly the recorded selection
+    are checked. A resume writes nothing until new cells have finished (nothing at all when none
+    is pending); ``fresh`` discards existing results (after the checks). A directory holding only
+    one of the two files is refused unless ``fresh``. With ``resume`` and not ``explicit`` the
+    recorded condition, seed, cells, configuration and prior are used.
     """
-    out = results.check_out_dir(out)
+    out = store.check_out_dir(out)
     seed = grid.check_seed(seed)
     threads = grid.check_threads(threads)
     check_condition(condition)
     if resume and fresh:
         raise UsageError("--resume and --overwrite exclude each other")
-    have = results.present(out) if out.is_dir() else []
-    if resume and not have:
+    if resume and not (out.is_dir() and results.present(out)):
         raise UsageError(f"--resume: no results to resume in {str(out)!r}")
-    if len(have) == 1 and not fresh:
-        missing = results.RUN_FILE if have[0] == results.CELLS_FILE else results.CELLS_FILE
-        raise UsageError(f"{str(out)!r} holds {have[0]} but no {missing}: refusing to "
-                         f"{'resume' if resume else 'replace'} it; restore {missing}, or {start_over} "
-                         "to discard it and start over")
     try:
         indices = grid.parse_cell_indices(cell_spec)
     except B.ConfigError as exc:
         raise UsageError(f"--cells: {exc}") from None
     extra = prior_extra(info)
     prior = info.prior() if info is not None else None
-    existing = len(have) == 2 and not fresh
-    if existing:
-        try:
-            cells, record = results.load(out)
-        except ResultsError as exc:
-            raise UsageError(f"{exc} ({start_over} to discard these results and start over)") from None
-        if resume and not explicit:
-            cfg = results.load_config(record)
-            condition, seed, indices = record["condition"], record["seed"], record["cells"]
-            if record.get("prior_info") is not None:
-                extra = {"prior_info": record["prior_info"]}
+    cfg = None if resume and not explicit else build_config(overrides, condition=condition, prior=prior)
+    with store.ResultsStore(out, start_over=start_over) as st:
+        have = st.present()
+        if resume and not have:
+            raise UsageError(f"--resume: no results to resume in {str(out)!r}")
+        if len(have) == 1 and not fresh:
+            missing = results.RUN_FILE if have[0] == results.CELLS_FILE else results.CELLS_FILE
+            raise UsageError(f"{str(out)!r} holds {have[0]} but no {missing}: refusing to "
+                             f"{'resume' if resume else 'replace'} it; restore {missing}, or {start_over} "
+                             "to discard it and start over")
+        record = None
+        if len(have) == 2 and not fresh:
+            cells, record = st.load()
+            if cfg is None:
+                cfg = results.load_config(record)
+                condition, seed, indices = record["condition"], record["seed"], record["cells"]
+                if record.get("prior_info") is not None:
+                    extra = {"prior_info": record["prior_info"]}
+            store.check_resumable(record, condition=condition, seed=seed, cfg=cfg, cell_indices=indices)
+            n_pending = int((cells["outcome"] == B.PENDING).sum())
+            if progress:
+                print(f"resuming {out}: {n_pending} of {cells.size} cells pending", file=sys.stderr)
+            if n_pending == 0:  # nothing to run: nothing is written, the record stays as it is
+                return cells, record, False
         else:
-            cfg = build_config(overrides, condition=condition, prior=prior)
-        results.check_resumable(record, condition=condition, seed=seed, cfg=cfg, cell_indices=indices)
-        try:
-            results.check_cells_match(cells, record, repr(str(out / results.CELLS_FILE)))
-        except ResultsError as exc:
-            raise UsageError(f"{exc} ({start_over} to discard these results and start over)") from None
-        wall_before = float(record.get("wall_time", 0.0))
-        n_pending = int((cells["outcome"] == B.PENDING).sum())
-        if progress:
-            print(f"resuming {out}: {n_pending} of {cells.size} cells pending", file=sys.stderr)
-    else:
-        cfg = build_config(overrides, condition=condition, prior=prior)
-        cells = grid.make_cells(seed, indices)
-        wall_before = 0.0
-    return _run(cfg, cells, out=out, condition=condition, seed=seed, threads=threads, indices=indices,
-                extra=extra, existing=existing, fresh=fresh, wall_before=wall_before, progress=progress,
-                checkpoint_every=checkpoint_every, checkpoint_cells=checkpoint_cells, cancel_after=cancel_after,
-                dask=dask)
+            cells = grid.make_cells(seed, indices)
+        return _run(st, cfg, cells, previous=record, condition=condition, seed=seed, threads=threads,
+                    indices=indices, extra=extra, fresh=fresh, progress=progress, checkpoint_every=checkpoint_every,
+                    checkpoint_cells=checkpoint_cells, cancel_after=cancel_after, dask=dask)
 
 
-def _run(cfg: RunConfig, cells: np.ndarray, *, out: Path, condition: str, seed: int, threads: int,
-         indices, extra, existing: bool, fresh: bool, wall_before: float, progress: bool,
-         checkpoint_every, checkpoint_cells, cancel_after, dask=None) -> tuple[np.ndarray, dict, bool]:
+def _run(st: store.ResultsStore, cfg: RunConfig, cells: np.ndarray, *, previous: dict | None, condition: str,
+         seed: int, threads: int, indices, extra, fresh: bool, progress: bool, checkpoint_every, checkpoint_cells,
+         cancel_after, dask=None) -> tuple[np.ndarray, dict, bool]:
     if dask is not None and not hasattr(dask, "run_grid"):  # a DaskSpec: a session for this grid
         from .cluster import open_backend
         with open_backend(dask) as session:
-            return _run(cfg, cells, out=out, condition=condition, seed=seed, threads=threads, indices=indices,
-                        extra=extra, existing=existing, fresh=fresh, wall_before=wall_before, progress=progress,
+            return _run(st, cfg, cells, previous=previous, condition=condition, seed=seed, threads=threads,
+                        indices=indices, extra=extra, fresh=fresh, progress=progress,
                         checkpoint_every=checkpoint_every, checkpoint_cells=checkpoint_cells,
                         cancel_after=cancel_after, dask=session)
     if dask is not None:
@@ -136,19 +130,15 @@ def _run(cfg: RunConfig, cells: np.ndarray, *, out: Path, condition: str, seed: 
         extra = {**(extra or {}), "backend": dask.describe()}
     else:
         n_threads = threads if threads > 0 else grid.default_threads()
-    results.check_writable(out)
-    git = results.git_info()
+    wall_before = float(previous.get("wall_time", 0.0)) if previous is not None else 0.0
+    st.begin(previous, fresh=fresh, git=results.git_info())
 
     def save(snapshot, wall):
-        return results.save(out, snapshot, cfg, condition=condition, seed=seed, wall_time=wall,
-                            threads=n_threads, cell_indices=indices, extra=extra, git=git)
+        return st.save(snapshot, cfg, condition=condition, seed=seed, wall_time=wall, threads=n_threads,
+                       cell_indices=indices, extra=extra)
 
     t0 = time.monotonic()
-    if not existing:
-        if fresh:  # run.json first: an interruption leaves a partial directory, refused later
-            for name in (results.RUN_FILE, results.CELLS_FILE):
-                if (out / name).is_file():
-                    (out / name).unlink()
+    if previous is None:
         save(cells, 0.0)  # every cell PENDING: resumable from the first second
     runner = functools.partial(grid.run_grid, threads=threads) if dask is None else dask.run_grid
     run = runner(cfg, cells, progress=progress,

@@ -21,7 +21,7 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from . import _binding as B
-from . import options
+from . import literals, options
 from ._binding import ConfigError
 from .errors import UsageError
 
@@ -202,7 +202,6 @@ def _struct_to_dict(struct: ctypes.Structure, prefix: str = "") -> dict[str, Any
 
 # -- parsing of values ---------------------------------------------------------------------------------
 _INT_LIMITS = {ctypes.c_int32: (-2 ** 31, 2 ** 31 - 1), ctypes.c_int64: (-2 ** 63, 2 ** 63 - 1)}
-_INT_TEXT = re.compile(r"[+-]?[0-9]{1,30}")
 
 
 def _probe_statuses() -> dict[str, int]:
@@ -251,14 +250,10 @@ def _is_number(value: Any) -> bool:
 def _parse_int(name: str, ctype, value: Any) -> int:
     """An integer for an int32/int64 field, range-checked so that ctypes never truncates it."""
     if isinstance(value, str):
-        text = value.strip()
-        if _INT_TEXT.fullmatch(text):
-            value = int(text)
-        else:
-            try:
-                value = float(text)
-            except ValueError:
-                raise _bad(name, f"bad value {_short(value)}; expected an integer") from None
+        try:
+            value = literals.integer(value)
+        except literals.NumberError as exc:
+            raise _bad(name, f"bad value {_short(value)}, which {exc}; expected an integer") from None
     if not _is_number(value):
         raise _bad(name, f"bad value {_short(value)}; expected an integer")
     if isinstance(value, (float, np.floating)):
@@ -276,9 +271,9 @@ def _parse_real(name: str, ctype, value: Any) -> float:
     """A finite, normal (or zero) value representable in the field's C type."""
     if isinstance(value, str):
         try:
-            value = float(value.strip())
-        except ValueError:
-            raise _bad(name, f"bad value {_short(value)}; expected a number") from None
+            value = literals.real(value)
+        except literals.NumberError as exc:
+            raise _bad(name, f"value {_short(value)} {exc}") from None
     if not _is_number(value):
         raise _bad(name, f"bad value {_short(value)}; expected a number")
     try:
@@ -329,10 +324,9 @@ def _set_field(struct: ctypes.Structure, name: str, value: Any) -> None:
     ctype = dict(owner._fields_)[leaf]
     if issubclass(ctype, ctypes.Array):
         if isinstance(value, str):
-            try:
-                value = json.loads(value)
-            except (ValueError, RecursionError):
-                value = [v for v in value.replace("[", "").replace("]", "").split(",") if v.strip()]
+            parsed = parse_value(value)
+            value = parsed if not isinstance(parsed, str) else \
+                [v for v in value.replace("[", "").replace("]", "").split(",") if v.strip()]
         if isinstance(value, np.ndarray):
             value = value.tolist()
         if not isinstance(value, (list, tuple)) or len(value) != ctype._length_:
@@ -343,25 +337,51 @@ def _set_field(struct: ctypes.Structure, name: str, value: Any) -> None:
 
 
 def parse_value(text: str) -> Any:
-    """Value of a ``--set name=value`` option: JSON if it parses, else the raw string."""
+    """Value of a ``--set name=value`` option: JSON if it parses, its numbers read by
+    harness.literals, else the raw string (which the field's parser then reads, or refuses:
+    ``1e-400`` is no JSON number here, and no number of a field either)."""
     try:
-        return json.loads(text)
+        return json.loads(text, parse_float=literals.real)
     except (ValueError, RecursionError):
         return text
 
 
+def given_twice(name: str, first: str, second: str) -> UsageError:
+    """The error of a parameter set by two options (or twice by one): nothing given is ignored."""
+    return UsageError(f"{first} and {second} both set {name}; give it once")
+
+
 def parse_sets(items: Iterable[str] | None, option: str = "--set") -> dict[str, Any]:
-    """``NAME=VALUE`` strings -> {canonical name: value}; a later item for the same field (under
-    any of its names) wins. UsageError for an item without '=', ConfigError for an unknown name."""
+    """``NAME=VALUE`` strings -> {canonical name: value}. UsageError for an item without '=' and
+    for a field given twice (under any of its names); ConfigError for an unknown name."""
     out: dict[str, Any] = {}
+    given: dict[str, str] = {}
     for item in items or []:
         if "=" not in item:
             raise UsageError(f"{option} expects name=value, got {_short(item)}")
         name, value = item.split("=", 1)
         name = canonical(name.strip())
-        out.pop(name, None)
+        if name in given:
+            raise given_twice(name, f"{option} {given[name]}", f"{option} {item[:60]}")
+        given[name] = item[:60]
         out[name] = parse_value(value.strip())
     return out
+
+
+def command_overrides(configuration: str, sets: Iterable[str] | None,
+                      flags: Mapping[str, tuple[str, Any]] | None = None) -> dict[str, Any]:
+    """The overrides of a command: the items of the named ``configuration``, replaced field by field
+    by the ``sets`` items (--set), and the options that set one field each (``flags``: option ->
+    (canonical name, value, None when not given)). A field set by --set and by its own option is
+    a UsageError naming both, as is a field given twice by --set."""
+    user = parse_sets(sets)
+    for option, (name, value) in (flags or {}).items():
+        if value is None:
+            continue
+        if name in user:
+            raise given_twice(name, f"{option} {value}", f"--set {name}")
+        user[name] = value
+    return {**parse_sets(named_sets(configuration)), **user}
 
 
 # -- configurations ------------------------------------------------------------------------------------

@@ -64,8 +64,9 @@ def paper_grid(seed: int = 0) -> np.ndarray:
     return cells
 
 
-_INDEX = re.compile(r"[0-9]{1,18}")
-_RANGE = re.compile(r"([0-9]{1,18})\s*-\s*([0-9]{1,18})")
+# ASCII digits, as every number of the harness (harness.literals)
+_INDEX = re.compile(r"[0-9]{1,18}", re.ASCII)
+_RANGE = re.compile(r"([0-9]{1,18})\s*-\s*([0-9]{1,18})", re.ASCII)
 
 
 def parse_cell_indices(text: str | Sequence[int] | None, n_cells: int = B.GRID_CELLS) -> Optional[list[int]]:
@@ -77,7 +78,7 @@ def parse_cell_indices(text: str | Sequence[int] | None, n_cells: int = B.GRID_C
     out: set[int] = set()
     if isinstance(text, str):
         for part in text.split(","):
-            part = part.strip()
+            part = part.strip(" \t\n\r\f\v")
             if not part:
                 continue
             m = _RANGE.fullmatch(part)
@@ -94,7 +95,7 @@ def parse_cell_indices(text: str | Sequence[int] | None, n_cells: int = B.GRID_C
                     raise _bad_arg(f"cell index {i} out of range [0, {n_cells})")
                 out.add(i)
             else:
-                raise _bad_arg(f"bad cell index {part!r:.40}; expected i or a-b with 0 <= i < {n_cells}")
+                raise _bad_arg(f"bad cell index {part!r:.40}; expected i or a-b in ASCII digits, 0 <= i < {n_cells}")
     else:
         if isinstance(text, (bytes, bytearray, Mapping)) or not isinstance(text, Iterable):
             raise _bad_arg(f"cell indices must be a string or a sequence of integers, got {text!r:.60}")

@@ -2,11 +2,11 @@
 from __future__ import annotations
 
 import datetime as _dt
+import errno
 import json
 import math
 import os
 import subprocess
-import tempfile
 import zipfile
 from pathlib import Path
 from typing import Any, Mapping
@@ -58,56 +58,34 @@ def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
             "dirty": bool(status.strip()) if status is not None else None}
 
 
-def _atomic_write(path: Path, write) -> None:
-    """write(tmp) then rename over path: a reader (or a kill) sees the old file or the new one."""
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            tmp.unlink()
-        except OSError:
-            pass
-        raise
+def timestamp() -> str:
+    """Now, in UTC, to the second (ISO 8601): the time stamps of the records."""
+    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
 
-def check_out_dir(out: str | Path, what: str = "--out") -> Path:
-    """An output directory path that is not a file (it may not exist yet); nothing is created."""
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise _err(f"{what} {str(out)!r} exists and is not a directory")
-    return out
+def build_entry(git: Mapping[str, Any]) -> dict[str, Any]:
+    """The entry of ``builds`` (see make_record) describing this process: the commit it runs from
+    (git_info()), the library's ABI and the time."""
+    return {"commit": git.get("commit"), "dirty": git.get("dirty"), "abi": B.abi_info(),
+            "timestamp": timestamp()}
 
 
-def check_writable(out: str | Path, what: str = "--out") -> Path:
-    """Create the directory ``out`` if needed and prove it is writable by creating (and removing) a
-    temporary file in it; any failure is a ResultsError. Permission bits alone are not enough:
-    they do not apply to root, and a read-only mount or a path under a regular file must fail too."""
-    out = check_out_dir(out, what)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise _err(f"{what}: cannot create directory {str(out)!r}: {exc.strerror or exc}") from None
-    if not os.access(out, os.W_OK | os.X_OK):
-        raise _err(f"{what}: directory {str(out)!r} is not writable")
-    try:
-        fd, probe = tempfile.mkstemp(prefix=".icoac-write-test-", dir=out)
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise _err(f"{what}: directory {str(out)!r} is not writable: {exc.strerror or exc}") from None
-    return out
+def recorded_builds(record: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The ``builds`` of a run record; for a record written before the list existed, one entry
+    made of its ``git``, ``abi`` and ``timestamp`` (the build that wrote all its cells)."""
+    if isinstance(record.get("builds"), list):
+        return [dict(b) for b in record["builds"]]
+    git = record.get("git") or {}
+    return [{"commit": git.get("commit"), "dirty": git.get("dirty"), "abi": record.get("abi"),
+             "timestamp": record.get("timestamp")}]
 
 
-def save(out: str | Path, cells: np.ndarray, cfg: RunConfig, *, condition: str, seed: int,
-         wall_time: float, threads: int, cell_indices: list[int] | None = None,
-         extra: Mapping[str, Any] | None = None, git: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """Write cells.npz and run.json (atomically, so a checkpoint never leaves half a file).
-    ``git`` is git_info() computed once by the caller (a checkpoint then costs ~1 ms)."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    summ = metrics.summary(cells)
+def make_record(cells: np.ndarray, cfg: RunConfig, *, condition: str, seed: int, wall_time: float, threads: int,
+                builds: list[Mapping[str, Any]], cell_indices: list[int] | None = None,
+                extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """The run record (run.json) of ``cells``. ``builds`` lists every build that wrote cells of this
+    run, oldest first (one entry per session: build_entry); ``git`` and ``abi`` repeat the last."""
+    last = builds[-1]
     record: dict[str, Any] = {
         "format_version": FORMAT_VERSION,
         "condition": condition,
@@ -115,22 +93,16 @@ def save(out: str | Path, cells: np.ndarray, cfg: RunConfig, *, condition: str, 
         "cells": cell_indices,
         "complete": bool(np.all(cells["outcome"] != B.PENDING)),
         "config": cfg.to_dict(),
-        "git": dict(git) if git is not None else git_info(),
-        "abi": B.abi_info(),
-        "timestamp": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "git": {"commit": last.get("commit"), "dirty": last.get("dirty")},
+        "abi": last.get("abi"),
+        "builds": [dict(b) for b in builds],
+        "timestamp": timestamp(),
         "wall_time": float(wall_time),
         "threads": int(threads),
-        "summary": summ,
+        "summary": metrics.summary(cells),
     }
     if extra:
         record.update(extra)
-
-    def write_cells(tmp: Path) -> None:
-        with open(tmp, "wb") as fh:
-            np.savez(fh, cells=cells)
-
-    _atomic_write(out / CELLS_FILE, write_cells)
-    _atomic_write(out / RUN_FILE, lambda tmp: tmp.write_text(json.dumps(record, indent=2, sort_keys=False) + "\n"))
     return record
 
 
@@ -145,14 +117,30 @@ def present(path: str | Path) -> list[str]:
     return [name for name in (CELLS_FILE, RUN_FILE) if (path / name).is_file()]
 
 
-def read_cells(file: str | Path) -> np.ndarray:
+def open_file(file: Path, follow: bool = True):
+    """``file`` opened for reading in binary; with ``follow`` False a symbolic link is refused
+    (O_NOFOLLOW) rather than read through. OSError as open() raises it."""
+    if follow:
+        return open(file, "rb")
+    try:
+        fd = os.open(file, os.O_RDONLY | os.O_CLOEXEC | os.O_NOFOLLOW)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP and file.is_symlink():
+            raise _err(f"{str(file)!r} is a symbolic link; the results of a directory that is written are "
+                       "never read or written through a link (replace it with the file)") from None
+        raise
+    return os.fdopen(fd, "rb")
+
+
+def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
     """The cell array of a cells.npz, read without trusting it: one member ``cells.npy`` whose
     header says a 1-D CELL_DTYPE array of at most GRID_CELLS cells and whose size matches.
-    Anything else (truncated, empty, not a zip, other dtype or shape) raises ResultsError."""
+    Anything else (truncated, empty, not a zip, other dtype or shape) raises ResultsError, and
+    so does a symbolic link unless ``follow``."""
     file = Path(file)
     where = repr(str(file))
     try:
-        with zipfile.ZipFile(file) as zf:
+        with open_file(file, follow) as raw, zipfile.ZipFile(raw) as zf:
             names = zf.namelist()
             if names != ["cells.npy"]:
                 raise _err(f"{where} is not a cells file (members {names[:4]!r:.80}, expected ['cells.npy'])")
@@ -255,6 +243,10 @@ def check_record(record: Any, where: str = RUN_FILE) -> dict[str, Any]:
                        ("prior_info", (dict, type(None))), ("complete", bool), ("timestamp", str)):
         if key in record and not isinstance(record[key], kinds):
             raise _err(f"{where}: {key} has the wrong type ({type(record[key]).__name__})")
+    builds = record.get("builds", [{}])
+    if not isinstance(builds, list) or not builds or not all(
+            isinstance(b, dict) and isinstance(b.get("abi"), (dict, type(None))) for b in builds):
+        raise _err(f"{where}: builds must be a non-empty list of objects (commit, dirty, abi, timestamp)")
     for key in ("wall_time", "threads"):
         v = record.get(key, 0)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or v < 0 \
@@ -269,15 +261,16 @@ def check_record(record: Any, where: str = RUN_FILE) -> dict[str, Any]:
     return record
 
 
-def read_json(file: str | Path, lead: str = "") -> Any:
+def read_json(file: str | Path, lead: str = "", follow: bool = True) -> Any:
     """A JSON file of the harness (at most MAX_JSON_BYTES), parsed; ResultsError, prefixed with
-    ``lead``, if it cannot be read or parsed."""
+    ``lead``, if it cannot be read or parsed, or (unless ``follow``) if it is a symbolic link."""
     file = Path(file)
     where = repr(str(file))
     try:
-        if file.stat().st_size > MAX_JSON_BYTES:
-            raise _err(f"{lead}{where} is larger than {MAX_JSON_BYTES} bytes")
-        return json.loads(file.read_bytes())
+        with open_file(file, follow) as fh:
+            if os.fstat(fh.fileno()).st_size > MAX_JSON_BYTES:
+                raise _err(f"{lead}{where} is larger than {MAX_JSON_BYTES} bytes")
+            return json.loads(fh.read(MAX_JSON_BYTES + 1))
     except ResultsError:
         raise
     except OSError as exc:
@@ -286,9 +279,9 @@ def read_json(file: str | Path, lead: str = "") -> Any:
         raise _err(f"{lead}{where} is not valid JSON ({str(exc):.100})") from None
 
 
-def read_record(file: str | Path) -> dict[str, Any]:
+def read_record(file: str | Path, follow: bool = True) -> dict[str, Any]:
     """A run.json, parsed and checked (check_record)."""
-    return check_record(read_json(file), repr(str(file)))
+    return check_record(read_json(file, follow=follow), repr(str(file)))
 
 
 def check_results_dir(path: str | Path, what: str | None = None) -> Path:
@@ -307,12 +300,13 @@ def check_results_dir(path: str | Path, what: str | None = None) -> Path:
     return path
 
 
-def load(path: str | Path, what: str | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+def load(path: str | Path, what: str | None = None, follow: bool = True) -> tuple[np.ndarray, dict[str, Any]]:
     """(cells, run record) of a results directory, both validated (check_results_dir, read_cells,
-    check_cells, read_record); every failure is a ResultsError."""
+    check_cells, read_record); every failure is a ResultsError. ``follow`` False: a results file
+    that is a symbolic link is refused (the results store reads the directory it writes so)."""
     path = check_results_dir(path, what)
-    record = read_record(path / RUN_FILE)
-    cells = read_cells(path / CELLS_FILE)
+    record = read_record(path / RUN_FILE, follow)
+    cells = read_cells(path / CELLS_FILE, follow)
     check_cells(cells, repr(str(path / CELLS_FILE)))
     return cells, record
 
@@ -334,27 +328,3 @@ def check_cells_match(cells: np.ndarray, record: Mapping[str, Any], where: str =
 
 def load_config(record: Mapping[str, Any]) -> RunConfig:
     return config_from_dict(record["config"])
-
-
-def check_resumable(record: Mapping[str, Any], *, condition: str, seed: int, cfg: RunConfig,
-                    cell_indices: list[int] | None) -> None:
-    """Raise ResultsError naming every difference between a recorded run and the requested one."""
-    diffs = []
-    if record.get("condition") != condition:
-        diffs.append(f"condition {record.get('condition')!r} != {condition!r}")
-    if record.get("seed") != seed:
-        diffs.append(f"seed {record.get('seed')} != {seed}")
-    if record.get("cells") != cell_indices:
-        diffs.append("cell selection differs")
-    new = cfg.flat()
-    try:  # canonical names (an ABI-3 record's flat names map through the alias table)
-        old_cfg = config_from_dict(record.get("config", {}))
-    except B.ConfigError as exc:
-        raise _err(f"recorded configuration: {exc}") from None
-    old = old_cfg.flat()
-    diffs += [f"{key} {old[key]!r} != {new[key]!r}" for key in new if old[key] != new[key]]
-    if old_cfg.to_dict()["prior"] != cfg.to_dict()["prior"]:
-        diffs.append("prior differs")
-    if diffs:
-        raise ResultsError("recorded run does not match the requested configuration (" + "; ".join(diffs)
-                           + "); use another --out directory")

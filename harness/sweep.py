@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import io
 import itertools
 import json
 import math
@@ -19,10 +20,10 @@ from typing import Any, Sequence
 import numpy as np
 
 from . import _binding as B
-from . import geometry, grid, metrics, results
+from . import geometry, grid, metrics, results, store
 from . import prior as P
 from ._binding import ConfigError
-from .config import build_config, canonical, parse_sets, parse_value
+from .config import build_config, canonical, command_overrides, given_twice, named_sets, parse_sets, parse_value
 from .errors import SweepError, UsageError
 from .metrics import percent
 from .options import CONTROL_OF, FRAME_NAMES, RL_COV_NAMES, SWEEP_MAX_TRIALS
@@ -105,7 +106,7 @@ def subset_cells(n: int) -> list[int]:
     return sorted(set(int(round(v)) for v in np.linspace(0, geometry.CELLS - 1, n)))
 
 
-def _write_md(path: Path, rows: list[dict[str, str]], names: list[str], meta: dict[str, Any]) -> None:
+def _write_md(path: Path, rows: list[dict[str, str]], names: list[str], meta: dict[str, Any], dir_fd: int) -> None:
     lines = [f"# Sweep ({meta['condition']}, {meta['n_cells']} cells, seeds {meta['seeds']}, "
              f"max_trials {meta['max_trials']})", "",
              "| " + " | ".join(names) + " | success (mean ± sd) | success where ICO failed | median trials | "
@@ -127,7 +128,7 @@ def _write_md(path: Path, rows: list[dict[str, str]], names: list[str], meta: di
                      + f" | {f(r['success_rate_mean'], True)} ± {f(r['success_rate_sd'], True)}"
                      + f" | {f(r['success_rate_ico_failed'], True)} of {r['n_ico_failed']}"
                      + f" | {f(r['median_trials'])} | {f(r['mean_elapsed_time'])} |")
-    path.write_text("\n".join(lines) + "\n")
+    store.write_text(path, "\n".join(lines) + "\n", dir_fd=dir_fd)
 
 
 @dataclass
@@ -142,8 +143,9 @@ class SweepOptions:
     subset: int | None = None
     seed: int = 0
     seeds: int = 1
-    max_trials: int = SWEEP_MAX_TRIALS
+    max_trials: int | None = None     # None: --set max_trials, else SWEEP_MAX_TRIALS
     success_steps: int | None = None
+    configuration: str = "default"    # a named configuration (config.NAMED_CONFIGURATIONS), then sets
     sets: Sequence[str] = ()
     one_at_a_time: bool = False
     threads: int = 0
@@ -152,22 +154,33 @@ class SweepOptions:
     dask: Any = None              # a harness.cluster.DaskSpec: every grid on that Dask cluster (None: threads)
 
 
-def _read_table(csv_path: Path) -> tuple[list[str] | None, list[dict[str, str]]]:
-    """(header, rows with canonical keys) of an existing sweep.csv, (None, []) if there is none."""
+def _read_table(csv_path: Path) -> tuple[list[str] | None, list[dict[str, str]], str]:
+    """(header, rows with canonical keys, text) of an existing sweep.csv (read through no link),
+    (None, [], "") if there is none."""
     if not csv_path.is_file():
-        return None, []
+        return None, [], ""
     try:
-        with open(csv_path, newline="") as fh:
-            reader = csv.DictReader(fh)
-            rows = list(reader)
-            header = list(reader.fieldnames or [])
+        with results.open_file(csv_path, follow=False) as fh:
+            text = fh.read().decode()
+        reader = csv.DictReader(io.StringIO(text, newline=""))
+        rows = list(reader)
+        header = list(reader.fieldnames or [])
     except (OSError, ValueError, csv.Error) as exc:
         raise UsageError(f"cannot read {str(csv_path)!r}: {exc}; use another --out")
     if any(not isinstance(r.get("key"), str) for r in rows) or (rows and "key" not in header):
         raise UsageError(f"{str(csv_path)!r} is not a sweep table (no key column); use another --out")
     for r in rows:
         r["key"] = canonical_key(r["key"])
-    return header, rows
+    return header, rows, text
+
+
+def _csv_lines(header: list[str], rows: list[dict[str, Any]], with_header: bool) -> str:
+    buf = io.StringIO(newline="")
+    writer = csv.DictWriter(buf, fieldnames=header, extrasaction="ignore")
+    if with_header:
+        writer.writeheader()
+    writer.writerows(rows)
+    return buf.getvalue()
 
 
 def _param_columns(header: list[str]) -> dict[str, str]:
@@ -186,8 +199,6 @@ def _param_columns(header: list[str]) -> dict[str, str]:
 def run_sweep(opt: SweepOptions) -> int:
     """Run every setting not yet in OUT/sweep.csv; 130 if interrupted. With ``opt.dask`` one Dask
     session (harness.cluster), opened after every check, runs every grid."""
-    from .cluster import open_backend
-
     ico_dir = results.check_results_dir(opt.prior_from, "--prior-from")
     params = parse_params(opt.params)
     names = list(params)
@@ -210,34 +221,15 @@ def run_sweep(opt: SweepOptions) -> int:
     ico_failed = np.array([(int(r), int(c)) in ico_known and (int(r), int(c)) not in ico_rc
                            for r, c in zip(pr, pc)], dtype=bool)
 
-    fixed = parse_sets(opt.sets)
-    fixed["max_trials"] = opt.max_trials
-    if opt.success_steps is not None:
-        fixed["success_steps"] = opt.success_steps
-    out = results.check_out_dir(opt.out)
-    meta = {"condition": opt.condition, "prior_from": str(ico_dir.resolve()), "cells": indices,
-            "n_cells": len(indices), "seeds": seeds, "max_trials": opt.max_trials,
-            "success_steps": opt.success_steps, "set": list(opt.sets), "rl_cov": opt.rl_cov}
-    meta_path = out / "sweep.json"
-    csv_path = out / "sweep.csv"
-    runs: list = []  # provenance of each invocation that ran settings (not compared on resume)
-    if meta_path.is_file() and csv_path.is_file():
-        try:
-            old = json.loads(meta_path.read_bytes())
-        except (OSError, ValueError, RecursionError) as exc:
-            raise UsageError(f"cannot read {str(meta_path)!r}: {exc}; use another --out")
-        if not isinstance(old, dict):
-            raise UsageError(f"{str(meta_path)!r} is not a sweep record; use another --out")
-        diff = [k for k in meta if old.get(k) != meta[k]]
-        if diff:
-            raise UsageError(f"{str(out)!r} holds a sweep with other {', '.join(diff)}; use another --out")
-        runs = old.get("runs") if isinstance(old.get("runs"), list) else []
-    header, rows = _read_table(csv_path)
-    if header is not None:
-        missing = [n for n in names if n not in _param_columns(header)]
-        if missing:
-            raise UsageError(f"{csv_path} has other parameter columns (no {', '.join(missing)}); use another --out")
-    done = {r["key"] for r in rows}
+    flags = {"--max-trials": ("max_trials", opt.max_trials), "--success-steps": ("success_steps", opt.success_steps)}
+    fixed = command_overrides(opt.configuration, opt.sets, flags)
+    explicit = {name: f"--set {name}" for name in parse_sets(opt.sets)}
+    explicit.update({name: option for option, (name, value) in flags.items() if value is not None})
+    for name in params:
+        if name in explicit:
+            raise given_twice(name, f"--param {name}", explicit[name])
+    fixed.setdefault("max_trials", SWEEP_MAX_TRIALS)
+    out = store.check_out_dir(opt.out)
 
     def prior_for(setting):
         frame = P.parse_frame(str(setting.get("prior_frame", FRAME_NAMES[0])))
@@ -258,12 +250,37 @@ def run_sweep(opt: SweepOptions) -> int:
 
     for setting in todo:  # every setting valid before the first grid runs (and before any write)
         config_for(setting)
-    results.check_writable(out)
+    meta = {"condition": opt.condition, "prior_from": str(ico_dir.resolve()), "cells": indices,
+            "n_cells": len(indices), "seeds": seeds,
+            "max_trials": int(build_config({"max_trials": fixed["max_trials"]}, check=False).run.max_trials),
+            "success_steps": opt.success_steps, "set": named_sets(opt.configuration, opt.sets), "rl_cov": opt.rl_cov}
+    with store.DirectoryLock(out) as held:
+        return _run_settings(opt, out, held, meta, todo, names, seeds, indices, ico_failed, config_for)
+
+
+def _run_settings(opt: SweepOptions, out: Path, held: store.DirectoryLock, meta: dict[str, Any], todo, names,
+                  seeds, indices, ico_failed, config_for) -> int:
+    """The settings not yet in OUT/sweep.csv, in the held directory ``out``."""
+    from .cluster import open_backend
+
+    meta_path = out / "sweep.json"
+    csv_path = out / "sweep.csv"
+    runs: list = []  # provenance of each invocation that ran settings (not compared on resume)
+    if meta_path.is_file() and csv_path.is_file():
+        old = results.read_json(meta_path, follow=False)
+        store.check_same_settings(old, meta, out, "a sweep")
+        runs = old.get("runs") if isinstance(old.get("runs"), list) else []
+    header, rows, table = _read_table(csv_path)
+    if header is not None:
+        missing = [n for n in names if n not in _param_columns(header)]
+        if missing:
+            raise UsageError(f"{csv_path} has other parameter columns (no {', '.join(missing)}); use another --out")
+    done = {r["key"] for r in rows}
     pending = [key_of(st) for st in todo if key_of(st) not in done]
     if pending or not runs:
         runs = runs + [{"git": results.git_info(), "library": str(B.LIBRARY_PATH), "settings": pending,
                         **({"dask": dataclasses.asdict(opt.dask)} if opt.dask is not None else {})}]
-    meta_path.write_text(json.dumps({**meta, "runs": runs}, indent=2) + "\n")
+    store.write_json(meta_path, {**meta, "runs": runs}, dir_fd=held.dir_fd)
 
     with open_backend(opt.dask if pending else None) as session:
         t_all = time.monotonic()
@@ -300,18 +317,17 @@ def run_sweep(opt: SweepOptions) -> int:
                    "wall_time": f"{wall:.3f}"}
             if header is None:
                 header = names + list(COLUMNS)
-                with open(csv_path, "w", newline="") as fh:
-                    csv.DictWriter(fh, fieldnames=header).writeheader()
+                table = _csv_lines(header, [], with_header=True)
             columns = _param_columns(header)
             for n in names:
                 row[columns[n]] = setting.get(n, "")
-            with open(csv_path, "a", newline="") as fh:
-                csv.DictWriter(fh, fieldnames=header, extrasaction="ignore").writerow(row)
+            table += _csv_lines(header, [row], with_header=False)
+            store.write_text(csv_path, table, dir_fd=held.dir_fd)
             rows.append({k: str(v) for k, v in row.items()})
             done.add(key)
             rf = f", ICO-failed cells {percent(np.mean(rates_failed))}" if rates_failed else ""
             print(f"[sweep] ({i}/{len(todo)}) {label}: success {percent(np.mean(rates))}{rf}, "
                   f"{wall:.1f} s", file=sys.stderr, flush=True)
-    _write_md(out / "sweep.md", rows, names, meta)
+    _write_md(out / "sweep.md", rows, names, meta, held.dir_fd)
     print(f"[sweep] {len(todo)} settings, wall time {time.monotonic() - t_all:.1f} s -> {csv_path}")
     return 0

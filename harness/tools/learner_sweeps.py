@@ -21,8 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import results
-from ..config import named_sets
+from .. import results, store
 from ..sweep import SweepOptions, run_sweep
 
 SEEDS = 2
@@ -143,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.report:
         path = args.out / "summary.md"
-        path.write_text(report(args.out))
+        store.write_text(path, report(args.out))
         print(path)
         return 0
     selections = {"spread": dict(subset=SPREAD_CELLS), "ico-failed": dict(cells=ico_failed_cells(args.prior_from))}
@@ -155,7 +154,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"[learner_sweeps] {name} on {label} cells", file=sys.stderr, flush=True)
             code = run_sweep(SweepOptions(prior_from=args.prior_from, out=args.out / f"{name}-{label}",
                                           params=params, condition=condition, seeds=SEEDS,
-                                          max_trials=MAX_TRIALS, sets=named_sets("literal", args.base),
+                                          max_trials=MAX_TRIALS, configuration="literal", sets=args.base,
                                           one_at_a_time=one_at_a_time, threads=args.threads, quiet=True,
                                           **selection))
             if code:

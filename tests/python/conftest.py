@@ -55,11 +55,11 @@ ICO_CELLS = [0, 610, 611, 612, 613, 1224]
 
 @pytest.fixture(scope="session")
 def ico_dir(tmp_path_factory):
-    from harness import grid, results
+    from harness import grid, store
     from harness.config import build_config
     out = tmp_path_factory.mktemp("ico")
     cfg = build_config(SMALL)
     cells = grid.make_cells(0, ICO_CELLS)
     grid.run_grid(cfg, cells, threads=2, progress=False)
-    results.save(out, cells, cfg, condition="ico", seed=0, wall_time=0.0, threads=2, cell_indices=ICO_CELLS)
+    store.save(out, cells, cfg, condition="ico", seed=0, wall_time=0.0, threads=2, cell_indices=ICO_CELLS)
     return out

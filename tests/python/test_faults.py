@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from harness import _binding as B
-from harness import cli, grid, metrics, results
+from harness import cli, grid, metrics, results, store
 from harness.config import build_config
 
 CELLS = [610, 611, 612, 613]
@@ -53,7 +53,7 @@ def partial_dir(tmp_path_factory):
     cells = grid.make_cells(SEED, CELLS)
     grid.run_grid(cfg, cells, threads=2, progress=False)
     grid.reset_pending(cells, np.arange(cells.size) >= 2)
-    results.save(out, cells, cfg, condition="ico", seed=SEED, wall_time=0.5, threads=2, cell_indices=CELLS)
+    store.save(out, cells, cfg, condition="ico", seed=SEED, wall_time=0.5, threads=2, cell_indices=CELLS)
     return out
 
 
@@ -409,18 +409,18 @@ def test_write_probe_failure_is_one_line(capsys, tmp_path, monkeypatch):
 
 
 def test_checkpoint_write_failure_is_one_line(capsys, tmp_path, monkeypatch):
-    real_save = results.save
+    real_save = store.ResultsStore.save
     calls = []
 
     def save(*a, **k):
         calls.append(1)
         if len(calls) > 1:
-            raise OSError(errno.ENOSPC, "No space left on device", str(tmp_path / "o" / "cells.npz.tmp"))
+            raise OSError(errno.ENOSPC, "No space left on device", str(tmp_path / "o" / "cells.npz"))
         return real_save(*a, **k)
 
-    monkeypatch.setattr(results, "save", save)
+    monkeypatch.setattr(store.ResultsStore, "save", save)
     rc, _, err = main(capsys, "grid", "--out", tmp_path / "o", "--cells", "611", *TINY_ARGS)
-    assert_one_line_error(rc, err, "No space left on device", "cells.npz.tmp")
+    assert_one_line_error(rc, err, "No space left on device", "cells.npz")
     assert len(calls) == 2
     results.load(tmp_path / "o")  # the first (all PENDING) save is intact
 
@@ -451,3 +451,77 @@ def test_help_documents_bounds(capsys):
     with pytest.raises(SystemExit):
         cli.main(["figures", "--help"])
     assert "1e6 plant steps" in " ".join(capsys.readouterr().out.split())
+
+
+# -- strict parsing: numbers in ASCII digits that survive rounding, no parameter given twice ----------------
+STRICT = [
+    (["--set", "gain=1e-400"], ["policy.gain", "'1e-400'", "rounds to 0"]),
+    (["--set", "dt=1e-400"], ["dt", "rounds to 0"]),
+    (["--set", "input_range=[1e-400,3.5,0.2,2]"], ["input_range", "rounds to 0"]),
+    (["--prior-ridge", "1e-400"], ["--prior-ridge", "rounds to 0"]),
+    (["--max-trials", "50", "--set", "max_trials=true"], ["--max-trials 50", "--set max_trials", "both set"]),
+    (["--max-trials", "50", "--set", "max_trials=-3"], ["--max-trials 50", "--set max_trials", "both set"]),
+    (["--success-steps", "50", "--set", "success_steps=60"], ["--success-steps", "--set success_steps"]),
+    (["--set", "gain=3", "--set", "policy.gain=4"], ["gain=3", "policy.gain=4", "both set policy.gain"]),
+    (["--set", "max_trials=５０"], ["max_trials", "ASCII"]),
+    (["--set", "gain=１"], ["policy.gain", "ASCII"]),
+    (["--cells", "６１１"], ["bad cell index", "ASCII"]),
+    (["--max-trials", "５０"], ["--max-trials"]),
+    (["--seed", "１"], ["--seed"]),
+    (["--max-trials", "1_000"], ["--max-trials"]),
+    (["--set", "max_trials=1_000"], ["max_trials"]),
+    (["--checkpoint-every", "１"], ["--checkpoint-every"]),
+]
+
+
+@pytest.mark.parametrize("args, words", STRICT, ids=[" ".join(a)[:40] for a, _ in STRICT])
+def test_strict_parsing(capsys, tmp_path, args, words):
+    out = tmp_path / "out"
+    caps = [a for field, cap in (("max_trials", ["--max-trials", "50"]), ("success_steps", ["--success-steps", "200"]))
+            if not any(field in arg or field.replace("_", "-") in arg for arg in args) for a in cap]
+    rc, _, err = main(capsys, "grid", "--out", out, "--cells", "611", "--quiet", *caps, *args)
+    assert_one_line_error(rc, err, *words)
+    assert not out.exists()
+
+
+def test_zero_and_small_normal_values_pass(capsys, tmp_path):
+    rc, _, err = main(capsys, "grid", "--out", tmp_path / "o", "--cells", "611", *TINY_ARGS,
+                      "--set", "critic.threshold=0.0e-400", "--set", "ico_rate=2.5e-38", "--set", "zone_x=2.35")
+    assert rc == 0, err
+    controller = results.load(tmp_path / "o")[1]["config"]["controller"]
+    assert controller["critic"]["threshold"] == 0.0 and controller["ico"]["rate"] == pytest.approx(2.5e-38)
+
+
+SWEEP = ["sweep", "--out", "{tmp}/w", "--cells", "611"]
+BENCH = ["bench", "--profile", "quick", "--seeds", "1", "--out", "{tmp}/b"]
+CEILING = ["ceiling", "--out", "{tmp}/c", "--cells", "611", "--protocol", "first", "--success-steps", "200", "--quiet"]
+STRICT_COMMANDS = [
+    ([*SWEEP, "--param", "noise_std=1", "--max-trials", "50", "--set", "max_trials=60"],
+     ["--max-trials 50", "--set max_trials"]),
+    ([*SWEEP, "--param", "noise_std=1,2", "--set", "noise_std=3"], ["--param actor.noise_std", "--set"]),
+    ([*SWEEP, "--param", "max_trials=10,20", "--max-trials", "50"], ["--param max_trials", "--max-trials"]),
+    ([*SWEEP, "--param", "noise_std=1", "--set", "gain=1e-400"], ["gain", "rounds to 0"]),
+    ([*BENCH, "--rl-max-trials", "5", "--set", "max_trials=6"], ["--rl-max-trials 5", "--set max_trials"]),
+    ([*BENCH, "--set", "max_trials=3", "--set", "noise_std=1", "--set", "actor.noise_std=2"],
+     ["both set actor.noise_std"]),
+    ([*CEILING, "--w", "1e-400,1,1,1"], ["--w", "rounds to 0"]),
+    ([*CEILING, "--w", "１,1,1,1"], ["--w", "ASCII"]),
+]
+
+
+@pytest.mark.parametrize("args, words", STRICT_COMMANDS,
+                         ids=[" ".join(a[:1] + a[-4:])[:50] for a, _ in STRICT_COMMANDS])
+def test_strict_parsing_of_sweep_bench_ceiling(capsys, ico_dir, tmp_path, args, words):
+    args = [a.format(tmp=tmp_path) for a in args] + (["--prior-from", ico_dir] if args[0] == "sweep" else [])
+    rc, _, err = main(capsys, *args)
+    assert_one_line_error(rc, err, *words)
+    assert not [p for p in tmp_path.iterdir() if p.name in ("w", "b", "c")]
+
+
+def test_configuration_then_set_is_no_duplicate(capsys, tmp_path):
+    """--set replaces an item of the named configuration: that is its purpose, not a field given twice."""
+    rc, _, err = main(capsys, "grid", "--out", tmp_path / "o", "--cells", "611", *TINY_ARGS,
+                      "--configuration", "literal", "--set", "actor.noise_std=2")
+    assert rc == 0, err
+    assert results.load(tmp_path / "o")[1]["config"]["controller"]["actor"]["noise_std"] == 2.0
+

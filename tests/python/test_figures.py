@@ -1,6 +1,6 @@
 import numpy as np
 
-from harness import figures, metrics, results
+from harness import figures, metrics, results, store
 from harness.config import build_config
 from harness.grid import make_cells, run_grid
 
@@ -13,7 +13,7 @@ def test_figures_from_small_run(tmp_path):
     cfg = build_config({"max_trials": 6000, "success_steps": 2000})
     cells = make_cells(0, idx)
     run_grid(cfg, cells, progress=False)
-    results.save(tmp_path / "res", cells, cfg, condition="ico", seed=0, wall_time=0.0, threads=1, cell_indices=idx)
+    store.save(tmp_path / "res", cells, cfg, condition="ico", seed=0, wall_time=0.0, threads=1, cell_indices=idx)
     cells, record = results.load(tmp_path / "res")
     paths = figures.make_figures(cells, record, tmp_path / "fig", duration=3.0)
     names = sorted(p.name for p in paths)

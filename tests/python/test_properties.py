@@ -15,7 +15,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from harness import _binding as B
-from harness import config, grid, metrics, options, results
+from harness import config, grid, metrics, options, results, store
 from harness.config import (ALIASES, ALL_FIELDS, BOOLS, ENUMS, RunConfig, build_config, canonical, config_from_dict,
                             parse_sets, parse_value)
 from harness.errors import HarnessError
@@ -213,7 +213,7 @@ def valid_dir(tmp_path_factory):
     cfg = build_config({"max_trials": 20, "success_steps": 100})
     cells = grid.make_cells(1, [0, 611, 612])
     grid.run_grid(cfg, cells, threads=1, progress=False)
-    results.save(out, cells, cfg, condition="ico", seed=1, wall_time=0.1, threads=1, cell_indices=[0, 611, 612])
+    store.save(out, cells, cfg, condition="ico", seed=1, wall_time=0.1, threads=1, cell_indices=[0, 611, 612])
     return out
 
 

@@ -4,14 +4,14 @@ import numpy as np
 import pytest
 
 from harness import _binding as B
-from harness import results
+from harness import results, store
 from harness.config import build_config, make_prior
 
 from conftest import SMALL, SMALL_CELLS
 
 
 def test_save_load_round_trip(tmp_path, small_cfg, small_run):
-    rec = results.save(tmp_path / "r", small_run, small_cfg, condition="ico", seed=7, wall_time=1.5,
+    rec = store.save(tmp_path / "r", small_run, small_cfg, condition="ico", seed=7, wall_time=1.5,
                        threads=2, cell_indices=SMALL_CELLS)
     cells, record = results.load(tmp_path / "r")
     assert cells.dtype == B.CELL_DTYPE
@@ -26,17 +26,17 @@ def test_save_load_round_trip(tmp_path, small_cfg, small_run):
     assert record["summary"]["n_success"] == int((small_run["outcome"] == B.SUCCESS).sum())
     cfg = results.load_config(record)
     assert cfg.to_dict() == small_cfg.to_dict()
-    results.check_resumable(record, condition="ico", seed=7, cfg=cfg, cell_indices=SMALL_CELLS)
+    store.check_resumable(record, condition="ico", seed=7, cfg=cfg, cell_indices=SMALL_CELLS)
     with pytest.raises(results.ResultsError, match="policy.gain 10.0 != 5.0"):
-        results.check_resumable(record, condition="ico", seed=7, cfg=build_config(dict(SMALL, gain=5)),
+        store.check_resumable(record, condition="ico", seed=7, cfg=build_config(dict(SMALL, gain=5)),
                                 cell_indices=SMALL_CELLS)
     with pytest.raises(results.ResultsError, match="seed"):
-        results.check_resumable(record, condition="ico", seed=8, cfg=cfg, cell_indices=SMALL_CELLS)
+        store.check_resumable(record, condition="ico", seed=8, cfg=cfg, cell_indices=SMALL_CELLS)
 
 
 def test_prior_recorded(tmp_path, small_run):
     cfg = build_config(SMALL, prior=make_prior([0.1, 0.05, 0.3, 0.08], np.eye(4) * 0.5))
-    results.save(tmp_path, small_run, cfg, condition="rl", seed=0, wall_time=0, threads=1)
+    store.save(tmp_path, small_run, cfg, condition="rl", seed=0, wall_time=0, threads=1)
     _, record = results.load(tmp_path)
     assert record["config"]["prior"]["mean"] == pytest.approx([0.1, 0.05, 0.3, 0.08])
     assert results.load_config(record).to_dict() == cfg.to_dict()
