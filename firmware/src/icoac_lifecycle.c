@@ -28,7 +28,8 @@ static void derive(icoac_priv_state_t *st)
 }
 
 /* 1 when the state holds what the library writes: a configuration icoac_config_check accepts,
- * slots 0 or 1, finite weights, covariance and generator, and (search) a recorded count inside
+ * slots 0 or 1, finite weights and covariance, a cached normal the generator can draw (the RL
+ * tick's force is finite only for such noise), and (search) a recorded count inside
  * the batch arrays and a positive prior variance. Derived values are not checked: reset derives
  * them again. The 162 critic weights are not either (a per-trial cost the size of a tick's): the
  * library never writes a non-finite one, and a corrupted one makes the ticks that read it
@@ -38,7 +39,7 @@ static int state_ok(const icoac_priv_state_t *st)
     const icoac_priv_search_t *search = &st->search;
     int i;
     if (icoac_config_check(&st->config) != ICOAC_OK || (st->cov_slot & ~1) != 0 || (st->active_slot & ~1) != 0 ||
-        (st->rng.has_spare & ~1) != 0 || !icoac_priv_finite(st->rng.spare_normal)) {
+        (st->rng.has_spare & ~1) != 0 || !(ICOAC_PRIV_FABS(st->rng.spare_normal) <= ICOAC_PRIV_NORMAL_MAX)) {
         return 0;
     }
     if (!icoac_priv_all_finite(st->w, ICOAC_N_INPUTS) || !icoac_priv_finite(st->weight_norm) ||

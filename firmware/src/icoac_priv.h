@@ -208,6 +208,11 @@ static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_rea
  * its scratch (the spare covariance buffer and the spare kept-unit list, never read before a
  * commit). */
 
+/* A bound on every standard normal the generator draws (the polar method's values stay below
+ * about 6 in float): the RL tick relies on |eps| <= ICOAC_PRIV_NORMAL_MAX * sigma_u for a finite
+ * force, and icoac_reset refuses a state whose cached normal exceeds it. */
+#define ICOAC_PRIV_NORMAL_MAX ICOAC_R(1.0e8)
+
 /* What a mode's tick returns. */
 #define ICOAC_PRIV_TICK_NUMERIC 0   /* a staged value was not finite: nothing committed */
 #define ICOAC_PRIV_TICK_OK 1        /* committed */

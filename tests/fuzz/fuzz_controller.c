@@ -20,9 +20,12 @@
  *           b & 128 also sets cov[j][i]) and a value.
  *   seed    8 bytes, little endian.
  *   ops     until the input ends, at most FZ_MAX_OPS ops and FZ_MAX_STEPS steps. Op byte o:
- *           o & 3: 0 or 1 step, 2 terminal step (ICOAC_INPUT_TERMINAL), 3 icoac_reset.
+ *           o & 3: 0 or 1 step, 2 terminal step (ICOAC_INPUT_TERMINAL), 3 icoac_reset or retune.
  *           A step runs ((o >> 2) & 7) + 1 times; o & 0x20 keeps the previous s, else the
- *           4 values s[0..3] follow. Bits 6 and 7 are ignored.
+ *           4 values s[0..3] follow; bits 6 and 7 are ignored. o & 3 == 3: o & 0x40 clear:
+ *           icoac_reset (bit 7 ignored); set: icoac_retune with a config section (as above)
+ *           laid over the configuration in force (o & 0x80 clear) or over the default
+ *           (o & 0x80 set: the config section exactly as at the start).
  *   value   real: selector byte k % 40. k < 28: special value (table in fuzz_input.c: 0, -0,
  *           1e-39, 1e-45, REAL_MIN, REAL_MAX, 1e30, 1e-20, NaN, +Inf, -Inf, -1, 1, 0.5,
  *           -1e30, 1e38, -REAL_MAX, 2, 0.25, 2.4, -2.4, 10, 1e-5, -0.25, REAL_TRUE_MIN,
@@ -41,8 +44,13 @@
  *           critic, actor; search: policy, search); after OK the learned state (w, |w|, cov,
  *           w_act, v) is finite and holds the prior (search: cov = cov_scale * the prior's,
  *           the floor search.floor * its diagonal, no trial recorded).
- *   step    returned status = out.status, a known status; non-finite s <=> NONFINITE_INPUT;
- *           the counters count the tick and its rejection.
+ *   step    returned status = out.status, a known status; the counters count the tick and its
+ *           rejection; the configuration copy in the state never changes. After a terminal step
+ *           that returned OK (the trial ended; the state's header word is the ended one), every
+ *           step until icoac_reset returns ICOAC_ERR_TRIAL_ENDED, whatever s, with the output
+ *           cleared but weight_norm = |w| and the state bytewise unchanged but counters.ticks + 1.
+ *           In a trial: never TRIAL_ENDED or CORRUPT_STATE; non-finite s <=> NONFINITE_INPUT; an OK
+ *           terminal step ends the trial, any other step leaves the header word as it was.
  *           OK: every real output written (out is NaN-filled before the call) and finite, the
  *           learned state finite, cov exactly symmetric, out.weight_norm = |w|; the trial's
  *           tick count + 1 on a non-terminal RL or search step (ICO does not count); force and
@@ -53,13 +61,25 @@
  *           change cov; per-trial batches (actor.batch) change w and cov only at a terminal
  *           step; noise 0 from tick actor.explore_ticks of a trial on. Search: w, cov and the
  *           record change only at a terminal step, which records the trial (count + 1) or,
- *           with the batch full, updates (count 0, every cov_ii >= its floor).
+ *           with at least batch - 1 trials recorded (more after a retune to a smaller batch),
+ *           updates (count 0, every cov_ii >= its floor); after a terminal step count < batch.
  *           Not OK: every real output 0 but weight_norm = |w|, learned state (batch sums,
  *           trial record and the trial's tick count included) bytewise unchanged (the spare
  *           kept-unit slot, covariance buffer and staged batch shift are scratch, not learned).
- *   reset   OK or ICOAC_ERR_NUMERIC; w, |w|, cov, v and the search's record unchanged, the
- *           actor's batch sums cleared; w_act = w unless acting with a sample (RL with
- *           act_with_sample, search) (and always after ICOAC_ERR_NUMERIC); w_act finite after OK.
+ *   reset   OK (a state the library wrote passes its state check); the trial is open again
+ *           (header word); w, |w|, cov, v and the search's record unchanged, the actor's batch
+ *           sums cleared; w_act = w unless acting with a sample (RL with act_with_sample,
+ *           search); w_act finite.
+ *   retune  status = icoac_config_check when that fails, else ICOAC_ERR_RETUNE_MODE when the
+ *           mode differs from the one in force, else OK. On an error the state is bytewise
+ *           unchanged. On OK icoac_get_config returns the new configuration (every field
+ *           bitwise), 1 / policy.input_range and (search) the floors search.floor *
+ *           (prior variance * search.cov_scale) are re-derived, and every other byte of the
+ *           state is unchanged: w, |w|, cov, v, w_act, the batch sums, the search's record and
+ *           factor, the trial's caches, the RNG, the counters and the header word. The
+ *           configuration in force is then the new one for every later check.
+ *   end     icoac_get_posterior returns w and cov; icoac_get_config the configuration in force.
+ *   Also: a zeroed state and NULL pointers are refused by every entry point.
  */
 #include <math.h>
 #include <stdint.h>
@@ -459,8 +479,12 @@ static void check_search_step(const icoac_config_t *cfg, const learned_t *before
              "op %d: a search step changed the trial's weights", op);
     FZ_CHECK(memcmp(before->search_floor, after->search_floor, sizeof before->search_floor) == 0,
              "op %d: a search step changed the floor", op);
-    FZ_CHECK(after->search_count >= 0 && after->search_count < cfg->search.batch,
-             "op %d: %d trials recorded, batch %d", op, (int)after->search_count, (int)cfg->search.batch);
+    /* a retune to a smaller batch may leave more trials recorded than the new batch holds, until
+     * the batch in progress closes at the next terminal step */
+    FZ_CHECK(after->search_count >= 0 && after->search_count < ICOAC_SEARCH_BATCH_MAX &&
+                 (after->search_count < cfg->search.batch || after->search_count == before->search_count),
+             "op %d: %d trials recorded (%d before), batch %d", op, (int)after->search_count,
+             (int)before->search_count, (int)cfg->search.batch);
     if (!terminal || !cfg->learn) {
         field = learned_changed(before, after, FZ_RECORD);
         FZ_CHECK(field == 0, "op %d: a non-learning search step changed the learned %s", op, field);
@@ -487,6 +511,22 @@ static void check_search_step(const icoac_config_t *cfg, const learned_t *before
     }
 }
 
+/* The trial ended by a terminal step that returned OK, until the next icoac_reset: what the
+ * harness expects, kept apart from the state's header word (which is checked against it). */
+static int trial_ended;
+
+/* The state's bytes, as they were before the call being checked. */
+static icoac_state_t state_before;
+
+/* The state bytewise equal to state_before, but for counters.ticks, which counted one tick. */
+static int unchanged_but_ticks(const icoac_state_t *state)
+{
+    icoac_state_t expect;
+    memcpy(&expect, &state_before, sizeof expect);
+    icoac_priv_state(&expect)->counters.ticks++;
+    return memcmp(&expect, state, sizeof expect) == 0;
+}
+
 static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in, int op)
 {
     learned_t before;
@@ -497,8 +537,12 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
     const char *field;
     int32_t status;
     const int terminal = (in->flags & ICOAC_INPUT_TERMINAL) != 0u;
+    const uint32_t magic = icoac_priv_state_c(state)->magic;
     int finite_in = 1;
     int i;
+    FZ_CHECK(magic == (trial_ended ? ICOAC_PRIV_STATE_ENDED : ICOAC_PRIV_STATE_MAGIC),
+             "op %d: header word 0x%08x, trial ended %d", op, (unsigned)magic, trial_ended);
+    memcpy(&state_before, state, sizeof state_before);
     learned_take(state, &before);
     counted = counters_of(state);
     memset(&out, 0xff, sizeof out); /* NaN in every real: each must be written */
@@ -507,6 +551,26 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
     counted_after = counters_of(state);
     for (i = 0; i < N; ++i) {
         finite_in = finite_in && isfinite(in->s[i]);
+    }
+    FZ_CHECK(memcmp(&icoac_priv_state_c(state)->config, &icoac_priv_state_c(&state_before)->config,
+                    sizeof(icoac_config_t)) == 0,
+             "op %d: icoac_step (status %d) changed the state's configuration copy", op, (int)status);
+    if (trial_ended) {
+        /* every tick after an ended trial is refused until icoac_reset, whatever s */
+        FZ_CHECK(status == ICOAC_ERR_TRIAL_ENDED, "op %d: a step after the trial's terminal step returned %d (%s)", op,
+                 (int)status, status_name(status));
+        FZ_CHECK(unchanged_but_ticks(state), "op %d: ICOAC_ERR_TRIAL_ENDED changed the state beyond counters.ticks", op);
+    } else {
+        FZ_CHECK(status != ICOAC_ERR_TRIAL_ENDED && status != ICOAC_ERR_CORRUPT_STATE,
+                 "op %d: icoac_step in a trial of a state the library wrote returned %d (%s)", op, (int)status,
+                 status_name(status));
+        FZ_CHECK(finite_in == (status != ICOAC_ERR_NONFINITE_INPUT),
+                 "op %d: s = (%g, %g, %g, %g) gave status %d (%s)", op, (double)in->s[0], (double)in->s[1],
+                 (double)in->s[2], (double)in->s[3], (int)status, status_name(status));
+        trial_ended = terminal && status == ICOAC_OK;
+        FZ_CHECK(icoac_priv_state_c(state)->magic == (trial_ended ? ICOAC_PRIV_STATE_ENDED : ICOAC_PRIV_STATE_MAGIC),
+                 "op %d: status %d (%s), terminal %d: header word 0x%08x", op, (int)status, status_name(status),
+                 terminal, (unsigned)icoac_priv_state_c(state)->magic);
     }
     FZ_CHECK(counted_after.ticks == counted.ticks + 1u &&
                  counted_after.nonfinite == counted.nonfinite + (status == ICOAC_ERR_NONFINITE_INPUT ? 1u : 0u) &&
@@ -517,9 +581,6 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
     FZ_CHECK(status == out.status, "op %d: icoac_step returned %d, out.status %d", op, (int)status,
              (int)out.status);
     FZ_CHECK(known_status(status), "op %d: icoac_step returned unknown status %d", op, (int)status);
-    FZ_CHECK(finite_in == (status != ICOAC_ERR_NONFINITE_INPUT),
-             "op %d: s = (%g, %g, %g, %g) gave status %d (%s)", op, (double)in->s[0], (double)in->s[1],
-             (double)in->s[2], (double)in->s[3], (int)status, status_name(status));
     if (status == ICOAC_OK) {
         FZ_CHECK(output_finite(&out),
                  "op %d: ICOAC_OK with a non-finite output: force %g z %g reflex %g penalty %g q %g "
@@ -573,23 +634,82 @@ static void check_reset(const icoac_config_t *cfg, icoac_state_t *state, int op)
     learned_t after;
     const char *field;
     int32_t status;
+    memcpy(&state_before, state, sizeof state_before);
     learned_take(state, &before);
     status = (int32_t)icoac_reset(state);
     learned_take(state, &after);
-    FZ_CHECK(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC, "op %d: icoac_reset returned %d (%s)", op,
-             (int)status, status_name(status));
+    /* a state the library wrote passes the reset's state check; no other error exists */
+    FZ_CHECK(status == ICOAC_OK, "op %d: icoac_reset returned %d (%s)", op, (int)status, status_name(status));
+    trial_ended = 0;
+    FZ_CHECK(icoac_priv_state_c(state)->magic == ICOAC_PRIV_STATE_MAGIC && icoac_priv_state_c(state)->has_prev == 0,
+             "op %d: icoac_reset left header word 0x%08x, has_prev %d", op, (unsigned)icoac_priv_state_c(state)->magic,
+             (int)icoac_priv_state_c(state)->has_prev);
+    FZ_CHECK(memcmp(&icoac_priv_state_c(state)->config, &icoac_priv_state_c(&state_before)->config,
+                    sizeof(icoac_config_t)) == 0 &&
+                 memcmp(&icoac_priv_state_c(state)->counters, &icoac_priv_state_c(&state_before)->counters,
+                        sizeof(icoac_counters_t)) == 0,
+             "op %d: icoac_reset changed the configuration copy or the counters", op);
     /* a batch not ended by a terminal step is dropped */
     field = learned_changed(&before, &after, FZ_RECORD);
     FZ_CHECK(field == 0, "op %d: icoac_reset changed the learned %s", op, field);
     FZ_CHECK(all_zero(after.batch_shift, N) && all_zero(&after.batch_info[0][0], N * N) && after.trial_ticks == 0u,
              "op %d: icoac_reset kept the trial's batch sums or tick count (%u)", op, (unsigned)after.trial_ticks);
-    if (status == ICOAC_OK) {
-        FZ_CHECK(finite_n(after.w_act, N), "op %d: icoac_reset OK with a non-finite w_act", op);
+    FZ_CHECK(finite_n(after.w_act, N), "op %d: icoac_reset OK with a non-finite w_act", op);
+    if (!sampled) {
+        FZ_CHECK(memcmp(after.w_act, after.w, sizeof after.w) == 0, "op %d: icoac_reset left w_act != w", op);
     }
-    if (!sampled || status == ICOAC_ERR_NUMERIC) {
-        FZ_CHECK(memcmp(after.w_act, after.w, sizeof after.w) == 0,
-                 "op %d: icoac_reset (%s, sampled %d) left w_act != w", op, status_name(status), sampled);
+}
+
+/* icoac_retune(state, next): the status of its checks; on an error the state bytewise unchanged;
+ * on OK the new configuration in force and nothing but what it derives changed. Returns 1 when
+ * next is the configuration in force now. */
+static int check_retune(const icoac_config_t *in_force, icoac_state_t *state, const icoac_config_t *next, int op)
+{
+    const int32_t config_status = (int32_t)icoac_config_check(next);
+    const icoac_priv_state_t *st = icoac_priv_state_c(state);
+    icoac_state_t expect;
+    icoac_priv_state_t *ex = icoac_priv_state(&expect);
+    icoac_config_t got;
+    int32_t status;
+    int i;
+    memcpy(&state_before, state, sizeof state_before);
+    status = (int32_t)icoac_retune(state, next);
+    if (config_status != ICOAC_OK) {
+        FZ_CHECK(status == config_status, "op %d: icoac_retune returned %d, icoac_config_check %d", op, (int)status,
+                 (int)config_status);
+    } else if (next->mode != in_force->mode) {
+        FZ_CHECK(status == ICOAC_ERR_RETUNE_MODE, "op %d: icoac_retune from mode %d to %d returned %d (%s)", op,
+                 (int)in_force->mode, (int)next->mode, (int)status, status_name(status));
+    } else {
+        FZ_CHECK(status == ICOAC_OK, "op %d: icoac_retune of a valid configuration returned %d (%s)", op, (int)status,
+                 status_name(status));
     }
+    if (status != ICOAC_OK) {
+        FZ_CHECK(memcmp(&state_before, state, sizeof state_before) == 0,
+                 "op %d: icoac_retune returned %d (%s) and changed the state", op, (int)status, status_name(status));
+        return 0;
+    }
+    FZ_CHECK(icoac_get_config(state, &got) == ICOAC_OK && fz_config_equal(&got, next),
+             "op %d: icoac_get_config after icoac_retune is not the new configuration", op);
+    for (i = 0; i < N; ++i) {
+        const icoac_real_t inv = ICOAC_R(1.0) / next->policy.input_range[i];
+        FZ_CHECK(memcmp(&st->inv_range[i], &inv, sizeof inv) == 0, "op %d: icoac_retune: inv_range[%d] = %g, 1/%g", op,
+                 i, (double)st->inv_range[i], (double)next->policy.input_range[i]);
+        if (next->mode == ICOAC_MODE_SEARCH) {
+            const icoac_real_t floor = next->search.floor * (st->search.prior_var[i] * next->search.cov_scale);
+            FZ_CHECK(memcmp(&st->search.floor[i], &floor, sizeof floor) == 0,
+                     "op %d: icoac_retune: search floor[%d] = %g, expected %g", op, i, (double)st->search.floor[i],
+                     (double)floor);
+        }
+    }
+    /* every other byte as it was: the learned values, the trial in progress, RNG, counters */
+    memcpy(&expect, &state_before, sizeof expect);
+    memcpy(&ex->config, &st->config, sizeof ex->config);
+    memcpy(ex->inv_range, st->inv_range, sizeof ex->inv_range);
+    memcpy(ex->search.floor, st->search.floor, sizeof ex->search.floor);
+    FZ_CHECK(memcmp(&expect, state, sizeof expect) == 0,
+             "op %d: icoac_retune changed more than the configuration and what it derives", op);
+    return 1;
 }
 
 /* An uninitialised (zeroed) state and NULL pointers are refused with a zero force. */
@@ -608,6 +728,15 @@ static void check_refusals(const icoac_config_t *cfg)
              "icoac_step on a zeroed state: %d / out.status %d / force %g", (int)status, (int)out.status,
              (double)out.force);
     FZ_CHECK(icoac_reset(&blank) == ICOAC_ERR_NOT_INITIALISED, "icoac_reset on a zeroed state");
+    FZ_CHECK(icoac_retune(&blank, cfg) == ICOAC_ERR_NOT_INITIALISED, "icoac_retune on a zeroed state");
+    {
+        icoac_config_t got;
+        FZ_CHECK(icoac_get_config(&blank, &got) == ICOAC_ERR_NOT_INITIALISED, "icoac_get_config on a zeroed state");
+        FZ_CHECK(icoac_get_config(0, &got) == ICOAC_ERR_NULL && icoac_get_config(&blank, 0) == ICOAC_ERR_NULL &&
+                     icoac_retune(0, cfg) == ICOAC_ERR_NULL && icoac_retune(&blank, 0) == ICOAC_ERR_NULL &&
+                     icoac_reset(0) == ICOAC_ERR_NULL,
+                 "NULL argument of icoac_get_config, icoac_retune or icoac_reset not refused with ICOAC_ERR_NULL");
+    }
     FZ_CHECK(icoac_get_posterior(&blank, &posterior) == ICOAC_ERR_NOT_INITIALISED,
              "icoac_get_posterior on a zeroed state");
     {
@@ -682,8 +811,8 @@ static int check_init(const icoac_config_t *cfg, icoac_state_t *state, const ico
         /* cov_scale * the prior covariance lost positive definiteness in rounding */
         return 0;
     }
-    FZ_CHECK(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC, "icoac_init returned %d (%s) for a valid setup",
-             (int)status, status_name(status));
+    /* icoac_init ends with icoac_reset, whose state check a fresh state passes */
+    FZ_CHECK(status == ICOAC_OK, "icoac_init returned %d (%s) for a valid setup", (int)status, status_name(status));
     learned_take(state, &l);
     field = learned_nonfinite(&l, status == ICOAC_OK);
     FZ_CHECK(field == 0, "icoac_init (%s) left a non-finite learned %s (w = %g %g %g %g)", status_name(status),
@@ -725,7 +854,9 @@ static void check_posterior(const icoac_state_t *state)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     fz_reader_t r;
-    icoac_config_t cfg;
+    icoac_config_t cfg; /* the configuration in force: icoac_init's, then the last retune's */
+    icoac_config_t next;
+    icoac_config_t got;
     icoac_prior_t prior_storage;
     const icoac_prior_t *prior;
     icoac_state_t state; /* on the stack: ASan reports overruns past it */
@@ -740,15 +871,30 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     prior = fz_prior(&r, &prior_storage);
     seed = fz_u64(&r);
     check_refusals(&cfg);
+    trial_ended = 0;
     if (!check_init(&cfg, &state, prior, seed)) {
         return 0;
     }
+    FZ_CHECK(icoac_get_config(&state, &got) == ICOAC_OK && fz_config_equal(&got, &cfg),
+             "icoac_get_config after icoac_init is not the configuration given");
     memset(&in, 0, sizeof in);
     for (ops = 0; ops < FZ_MAX_OPS && steps < FZ_MAX_STEPS && !fz_done(&r); ++ops) {
         const uint8_t op = fz_u8(&r);
         int repeat;
         if ((op & 3u) == 3u) {
-            check_reset(&cfg, &state, ops);
+            if ((op & 0x40u) == 0u) {
+                check_reset(&cfg, &state, ops);
+                continue;
+            }
+            if (op & 0x80u) {
+                fz_config(&r, &next);
+            } else {
+                next = cfg;
+                fz_config_over(&r, &next);
+            }
+            if (check_retune(&cfg, &state, &next, ops)) {
+                cfg = next;
+            }
             continue;
         }
         if ((op & 0x20u) == 0u) {
@@ -762,5 +908,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
     }
     check_posterior(&state);
+    FZ_CHECK(icoac_get_config(&state, &got) == ICOAC_OK && fz_config_equal(&got, &cfg),
+             "icoac_get_config is not the configuration in force");
     return 0;
 }

@@ -201,9 +201,14 @@ ICOAC_STATIC_ASSERT(sizeof config_fields / sizeof config_fields[0] == FZ_CONFIG_
 
 void fz_config(fz_reader_t *r, icoac_config_t *cfg)
 {
+    icoac_config_default(cfg);
+    fz_config_over(r, cfg);
+}
+
+void fz_config_over(fz_reader_t *r, icoac_config_t *cfg)
+{
     const uint8_t c = fz_u8(r);
     int n;
-    icoac_config_default(cfg);
     if (c & 1u) {
         fz_overlay(r, cfg, sizeof *cfg);
         return;
@@ -252,4 +257,17 @@ const icoac_prior_t *fz_prior(fz_reader_t *r, icoac_prior_t *prior)
         }
     }
     return prior;
+}
+
+int fz_config_equal(const icoac_config_t *a, const icoac_config_t *b)
+{
+    size_t i;
+    for (i = 0; i < FZ_CONFIG_FIELDS; ++i) {
+        const size_t size = config_fields[i].is_int ? sizeof(int32_t) : sizeof(icoac_real_t);
+        if (memcmp((const unsigned char *)a + config_fields[i].offset, (const unsigned char *)b + config_fields[i].offset,
+                   size) != 0) {
+            return 0;
+        }
+    }
+    return 1;
 }

@@ -39,6 +39,10 @@ int64_t fz_i64(fz_reader_t *r);       /* selector (mod 12): see fuzz_input.c, 11
  * padding included) over the default; c even: the default with (c >> 1) % 8 mutations (field
  * byte % FZ_CONFIG_FIELDS, value). */
 void fz_config(fz_reader_t *r, icoac_config_t *cfg);
+/* The same section laid over *cfg instead of the default (raw bytes or mutations of cfg). */
+void fz_config_over(fz_reader_t *r, icoac_config_t *cfg);
+/* Every field of a and b bitwise equal (NaN equals the same NaN; padding ignored). */
+int fz_config_equal(const icoac_config_t *a, const icoac_config_t *b);
 
 /* Prior section: a byte p; p % 3 == 0: NULL, 1: mean 0 and cov I, 2: that with (p / 3) % 8
  * mutations (field byte b: (b & 127) % 20, b & 128 also sets cov[j][i]; value). */

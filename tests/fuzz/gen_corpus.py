@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
 """Write the committed seed corpus of the fuzz targets, tests/fuzz/corpus/<target>/.
 
-Inputs follow the formats documented at the top of fuzz_controller.c and fuzz_sim.c; the
-value tables below mirror fuzz_input.c. Files named repro-* are known reproducers.
+Inputs follow the formats documented at the top of fuzz_controller.c, fuzz_state.c and
+fuzz_sim.c; the value tables below mirror fuzz_input.c, the state fields fuzz_state.c. Files
+named repro-* are known reproducers.
 
     python3 tests/fuzz/gen_corpus.py          # (re)write the corpus
     python3 tests/fuzz/gen_corpus.py --check  # exit 1 unless the committed corpus is current
 """
 import argparse
 import math
+import random
 import struct
 import sys
 from pathlib import Path
@@ -226,6 +228,12 @@ def steps(s, n, terminal=False):
 RESET = b"\x03"
 ZERO = ("0", "0", "0", "0")
 
+
+def retune(fields=None, over_default=False, fmt="f"):
+    """icoac_retune with a config section laid over the configuration in force, or (over_default)
+    over the default."""
+    return bytes([0xC3 if over_default else 0x43]) + config(fields, fmt)
+
 # A trial through the middle, the reflex / penalty zones, a failure and a new trial.
 EXERCISE = (steps(ZERO, 2) + steps((0.5, 0.3, 0.05, 0.2), 4) + steps((2.5, 1.0, "0.25", 1.0), 2)
             + steps(("-2.4", -1.0, "-0.25", -1.0), 2) + step((2.5, 1.0, "0.25", 1.0), terminal=True)
@@ -366,6 +374,29 @@ def controller_seeds(fmt):
                                       + step(("nan", "0", "0", "0"), terminal=True) + SEARCH_TRIALS),
         "config-raw-search": config_raw(fmt, {**search, "search.batch": 2, "search.step": 0.25}) + prior() + seed(39)
                              + SEARCH_TRIALS,
+        # Live tuning (icoac_retune) and ended trials (ICOAC_ERR_TRIAL_ENDED until icoac_reset).
+        "rl-retune": (config(rl) + NO_PRIOR + seed(47) + EXERCISE
+                      + retune({"actor.update": 0, "actor.batch": 1, "policy.input_range[2]": 0.5}) + EXERCISE
+                      + retune({"mode": 2}) + retune(over_default=True) + retune({"critic.threshold": "nan"})
+                      + retune({"actor.explore_ticks": 3, "learn": 0, "critic.quirks": 1}) + EXERCISE),
+        "ico-retune": (config() + NO_PRIOR + seed(48) + EXERCISE
+                       + retune({"ico.timing": 1, "policy.input_range[0]": 1.0, "ico.rate": 0.01}) + EXERCISE
+                       + retune({"ico.rate": "nan"}) + retune({"mode": 1}) + retune({"learn": 0}) + EXERCISE),
+        # a retune to a batch smaller than the trials recorded: the next terminal tick closes it
+        "search-retune-batch": (config(search) + NO_PRIOR + seed(49) + SEARCH_TRIALS
+                                + retune({"search.batch": 2, "search.floor": 0.5, "search.cov_scale": 2.0})
+                                + SEARCH_TRIALS + retune({"search.batch": 16, "search.elite_fraction": "1"})
+                                + retune({"search.batch": 17}) + SEARCH_TRIALS),
+        "config-raw-retune": (config_raw(fmt, {**rl, "actor.noise_std": 0.5}) + NO_PRIOR + seed(50) + EXERCISE
+                              + bytes([0x43]) + config_raw(fmt, {**rl, "actor.update": 1}) + EXERCISE),
+    }
+    for mode, name in ((0, "ico"), (1, "rl"), (2, "search")):
+        # the same terminal tick again and again: one trial recorded, then refused until reset
+        s[f"{name}-terminal-repeated"] = (config({"mode": mode, "search.batch": 2}) + NO_PRIOR + seed(51 + mode)
+                                          + steps((0.1, 0.0, 0.01, 0.0), 5)
+                                          + steps((2.5, 1.0, "0.25", 1.0), 16, terminal=True)
+                                          + steps(ZERO, 3) + step(("nan", "0", "0", "0")) + RESET + EXERCISE)
+    s.update({
         # Known reproducers (issue 8).
         "repro-rl-critic-range0-1e-39": config({**rl, "critic.range[0]": "1e-39"}) + NO_PRIOR + seed(1) + step(ZERO),
         "repro-rl-noise-std-1e-20": (config({**rl, "actor.noise_std": "1e-20"}) + NO_PRIOR + seed(1) + steps(ZERO, 3)
@@ -376,11 +407,257 @@ def controller_seeds(fmt):
                                 + steps(("1e30", "0", "0", "0"), 3)),
         # Found by fuzzing the fixed firmware: a finite prior mean whose |w| overflows.
         "repro-prior-mean-1e30": config() + prior(("mean0", "1e30")) + seed(1) + EXERCISE,
-    }
+    })
     for label, field, v in (("gain", "policy.gain", "1e30"), ("reflex-force", "policy.reflex_force", "1e38"),
                             ("ico-rate", "ico.rate", "1e30"), ("noise-std", "actor.noise_std", "1e30")):
         s[f"repro-ico-{label}-{v}"] = config({field: v}) + NO_PRIOR + seed(1) + EXERCISE
         s[f"repro-rl-{label}-{v}"] = config({**rl, field: v}) + NO_PRIOR + seed(1) + EXERCISE
+    return s
+
+
+# ---- fuzz_state ----
+
+# The named fields of icoac_priv_state_t a patch sets (state_fields in fuzz_state.c, in its
+# order): (name, kind) with kind "i" int32, "u" uint32, "b" uint8, "q" uint64, "r" real.
+STATE_FIELDS = [
+    ("has_prev", "i"), ("inv_range", "r"), ("w", "r"), ("weight_norm", "r"), ("w_act", "r"), ("cov_slot", "i"),
+    ("active_slot", "i"), ("x_prev", "r"), ("penalty_prev", "r"), ("value_prev", "r"), ("noise_prev", "r"),
+    ("trial_ticks", "u"), ("rng.state", "q"), ("rng.increment", "q"), ("rng.spare_normal", "r"),
+    ("rng.has_spare", "i"), ("counters", "u"), ("cov_buffer", "r"), ("active.sparse.pair_product", "r"),
+    ("active.sparse.cell_product", "r"), ("active.sparse.pair_cells", "b"), ("active.sparse.cell", "b"),
+    ("active.sparse.cells", "b"), ("active.dense.cell_product", "r"), ("active.dense.cell_begin", "b"),
+    ("active.dense.cell_end", "b"), ("v", "r"), ("batch.info", "r"), ("batch.shift", "r"),
+    ("batch.staged_shift", "r"), ("search.w", "r"), ("search.ticks", "u"), ("search.lower", "r"),
+    ("search.floor", "r"), ("search.prior_var", "r"), ("search.count", "i"),
+]
+STATE_FIELD_NAMES = [name for name, _ in STATE_FIELDS]
+PATCH_HEADER, PATCH_CONFIG, PATCH_RAW = len(STATE_FIELDS), len(STATE_FIELDS) + 1, len(STATE_FIELDS) + 2
+# sizeof(icoac_state_t) with float and with double reals (ICOAC_STATE_SIZE).
+STATE_SIZES = {"f": 2048, "d": 4096}
+
+
+def patch(field, v, index=0, fmt="f"):
+    """Set element index of a named state field to v (int32 fields: a table value or any int32;
+    uint8: 0..255; uint64: an int; real: as real())."""
+    k = STATE_FIELD_NAMES.index(field)
+    kind = STATE_FIELDS[k][1]
+    if kind in "iu":
+        value_bytes = int32(v - 2**32 if kind == "u" and v >= 2**31 else v)
+    elif kind == "b":
+        value_bytes = bytes([v])
+    elif kind == "q":
+        value_bytes = struct.pack("<Q", v)
+    else:
+        value_bytes = real(v, fmt)
+    return bytes([k, index]) + value_bytes
+
+
+def patch_header(ended):
+    return bytes([PATCH_HEADER, 1 if ended else 0])
+
+
+def patch_config(fields, fmt="f"):
+    return bytes([PATCH_CONFIG]) + config(fields, fmt)
+
+
+def patch_raw(offset, data):
+    return bytes([PATCH_RAW]) + struct.pack("<H", offset) + bytes([len(data)]) + data
+
+
+def state_setup(kind, mode, init_fields=None, prior_section=NO_PRIOR, seed_value=1, warm_ticks=10, warm_trials=1,
+                fmt="f"):
+    """Kind byte (0 raw configuration, 1 raw state), then a valid state of the mode: config
+    mutations init_fields (its mode is replaced), prior, seed and the warm-up byte."""
+    assert 0 <= warm_ticks < 32 and 1 <= warm_trials <= 8
+    return (bytes([kind, mode]) + config(init_fields, fmt) + prior_section + seed(seed_value)
+            + bytes([(warm_trials - 1) << 5 | warm_ticks]))
+
+
+def raw_config(mode, fields=None, fmt="f", **setup):
+    """Kind A: fields written into the state's configuration copy (no check)."""
+    return state_setup(0, mode, fmt=fmt, **setup) + config(fields, fmt)
+
+
+def raw_state(mode, patches=(), ended=False, fmt="f", **setup):
+    """Kind B: named-field patches of a valid state, then the header word."""
+    assert len(patches) < 64
+    return state_setup(1, mode, fmt=fmt, **setup) + bytes([len(patches) << 2 | (1 if ended else 0)]) + b"".join(patches)
+
+
+def filled_state(mode, data, ended=False, fmt="f", **setup):
+    """Kind B: the whole state from data (sizeof(icoac_state_t) bytes), then the header word."""
+    assert len(data) == STATE_SIZES[fmt]
+    return state_setup(1, mode, fmt=fmt, **setup) + bytes([2 | (1 if ended else 0)]) + data
+
+
+def tick(s=None, repeat=1, terminal=False):
+    """repeat (1..8) ticks on s (4 values), or on the previous s when None."""
+    assert 1 <= repeat <= 8
+    op = (1 if terminal else 0) | ((repeat - 1) << 3) | (0x40 if s is None else 0)
+    return bytes([op]) + (b"".join(real(x) for x in s) if s is not None else b"")
+
+
+def ticks(s, n, terminal=False):
+    out = tick(s, min(n, 8), terminal)
+    n -= min(n, 8)
+    while n > 0:
+        out += tick(None, min(n, 8), terminal)
+        n -= min(n, 8)
+    return out
+
+
+S_RESET = b"\x02"
+S_RETUNE_SETUP = b"\x04"
+S_GET = b"\x05"
+
+
+def s_retune(fields=None, over_setup=False, fmt="f"):
+    """icoac_retune with a config section over the state's configuration (or the setup one)."""
+    return bytes([0x0B if over_setup else 0x03]) + config(fields, fmt)
+
+
+def s_edit(fields, fmt="f"):
+    """Fields written into the state's configuration copy, no check."""
+    return b"\x06" + config(fields, fmt)
+
+
+def s_patch(p):
+    return b"\x07" + p
+
+
+FAIL = (2.5, 1.0, "0.25", 1.0)
+# Ticks, a non-finite one, a terminal one, ticks after it, a new trial, the retunes and getters.
+STATE_EXERCISE = (S_GET + ticks((0.1, 0.0, 0.01, 0.0), 4) + tick(("nan", "0", "0", "0")) + tick(FAIL, terminal=True)
+                  + ticks(None, 2) + S_GET + S_RESET + ticks((-0.3, 0.2, -0.1, 0.5), 8) + S_RETUNE_SETUP
+                  + s_retune({"policy.gain": 5.0}) + s_retune({"mode": 1, "learn": 0}) + S_GET
+                  + tick(FAIL, terminal=True) + S_RESET + ticks(ZERO, 3) + S_GET)
+
+
+def trials(n, length, s=(0.1, -0.2, 0.02, 0.3), before_terminal=b"", after_reset=b""):
+    """n trials: reset, after_reset, length ticks, before_terminal, a terminal tick."""
+    return (S_RESET + after_reset + ticks(s, length) + before_terminal + tick(FAIL, terminal=True)) * n
+
+
+def state_seeds(fmt):
+    """Seeds of the fuzz_state targets; fmt is the real type's struct code."""
+    size = STATE_SIZES[fmt]
+    noise = random.Random(20261202)
+    s = {}
+    for mode, name in ((0, "ico"), (1, "rl"), (2, "search")):
+        s[f"config-{name}-unchanged"] = raw_config(mode, fmt=fmt) + STATE_EXERCISE
+        s[f"config-{name}-raw"] = (state_setup(0, mode, fmt=fmt, warm_trials=2)
+                                   + config_raw(fmt, {"mode": mode, "search.batch": 2, "actor.update": 0})
+                                   + STATE_EXERCISE)
+        s[f"state-{name}-unchanged"] = raw_state(mode, fmt=fmt, warm_trials=3) + STATE_EXERCISE
+        s[f"state-{name}-ended"] = raw_state(mode, ended=True, fmt=fmt) + STATE_EXERCISE
+        s[f"state-{name}-zeros"] = filled_state(mode, bytes(size), fmt=fmt) + STATE_EXERCISE
+        s[f"state-{name}-ones"] = filled_state(mode, b"\xff" * size, fmt=fmt) + STATE_EXERCISE
+        s[f"state-{name}-random"] = (filled_state(mode, bytes(noise.randrange(256) for _ in range(size)), fmt=fmt)
+                                     + STATE_EXERCISE)
+    s.update({
+        "config-raw-garbage": (state_setup(0, 1, fmt=fmt) + b"\x01"
+                               + bytes(noise.randrange(256) for _ in range(CONFIG_SIZES[fmt])) + STATE_EXERCISE),
+        "config-bad-groups": (raw_config(1, {"critic.range[0]": "0", "critic.threshold": "nan", "actor.noise_std": "inf",
+                                             "critic.td_clip": "-1", "critic.discount": "1e30", "actor.forgetting": "0",
+                                             "actor.likelihood_std": "-1"}, fmt=fmt) + STATE_EXERCISE),
+        "config-search-bad-groups": (raw_config(2, {"search.step": "nan", "search.floor": "-1", "search.cov_scale": "0",
+                                                    "search.batch": 0}, fmt=fmt, init_fields={"search.batch": 2})
+                                     + trials(4, 3) + STATE_EXERCISE),
+        "rl-actor-update-9": raw_config(1, {"actor.update": 9}, fmt=fmt) + ticks(ZERO, 3) + STATE_EXERCISE,
+        "rl-actor-update-9-batch": (raw_config(1, {"actor.update": 9}, fmt=fmt, init_fields={"actor.batch": 1})
+                                    + ticks(ZERO, 3) + tick(FAIL, terminal=True) + STATE_EXERCISE),
+        "rl-explore-negative": (raw_config(1, {"actor.explore_ticks": -1}, fmt=fmt) + ticks(ZERO, 4)
+                                + s_patch(patch("trial_ticks", 2**32 - 1)) + ticks(ZERO, 3) + STATE_EXERCISE),
+        # the kept-unit lists of both critic kernels, and the slots, hold anything
+        "rl-kept-units-corrupt": (raw_state(1, [patch("active.sparse.pair_cells", 255, i) for i in range(18)]
+                                            + [patch("active.sparse.cell", 255, i) for i in range(0, 62, 5)]
+                                            + [patch("active.sparse.cells", 255, 0), patch("active.sparse.cells", 255, 1),
+                                               patch("active.dense.cell_begin", 0, 0), patch("active.dense.cell_end", 255, 0),
+                                               patch("active.dense.cell_begin", 0, 1), patch("active.dense.cell_end", 255, 1)],
+                                            fmt=fmt, init_fields={"critic.threshold": "0"}) + ticks(ZERO, 4)
+                                  + STATE_EXERCISE),
+        "rl-dense-range-inverted": (raw_state(1, [patch("active.dense.cell_begin", 200, 0),
+                                                  patch("active.dense.cell_end", 3, 0),
+                                                  patch("active.dense.cell_begin", 17, 1),
+                                                  patch("active.dense.cell_end", 18, 1)], fmt=fmt) + ticks(ZERO, 3)),
+        "rl-sparse-products-nan": (raw_state(1, [patch("active.sparse.pair_product", "nan", i) for i in range(18)]
+                                             + [patch("active.sparse.cell_product", "inf", i) for i in range(0, 62, 7)],
+                                             fmt=fmt) + ticks(ZERO, 3) + STATE_EXERCISE),
+        "rl-learned-nonfinite": (raw_state(1, [patch("w", "nan", 1), patch("weight_norm", "inf"),
+                                               patch("cov_buffer", "nan", 5), patch("v", "nan", 80),
+                                               patch("x_prev", "1e30", 2), patch("value_prev", "-inf"),
+                                               patch("noise_prev", "max")], fmt=fmt) + STATE_EXERCISE),
+        # critic weights are not checked by icoac_reset: the ticks reading them fail instead
+        "rl-critic-weights-nan": (raw_state(1, [patch("v", "nan", i) for i in range(0, 176, 3)], fmt=fmt)
+                                  + S_RESET + ticks(ZERO, 4) + ticks((0.1, 0.0, 0.01, 0.0), 4) + STATE_EXERCISE),
+        "rl-batch-sums": (raw_state(1, [patch("batch.info", "nan", 0), patch("batch.shift", "max", 1),
+                                        patch("batch.staged_shift", "-inf", 2)], fmt=fmt,
+                                    init_fields={"actor.batch": 1, "actor.update": 0}) + ticks(ZERO, 3)
+                          + tick(FAIL, terminal=True) + STATE_EXERCISE),
+        "rl-rng-stalled": (raw_state(1, [patch("rng.state", 0), patch("rng.increment", 0), patch("rng.has_spare", 0)],
+                                     fmt=fmt, init_fields={"actor.act_with_sample": 1}) + S_RESET + ticks(ZERO, 8)
+                           + STATE_EXERCISE),
+        "rl-rng-spare": (raw_state(1, [patch("rng.has_spare", 7), patch("rng.spare_normal", "nan")], fmt=fmt)
+                         + ticks(ZERO, 2) + S_RESET + STATE_EXERCISE),
+        "rl-counters-wrap": (raw_state(1, [patch("counters", 2**32 - 1, 0), patch("counters", 2**32 - 1, 1),
+                                           patch("counters", 2**32 - 1, 2), patch("trial_ticks", 2**32 - 1)], fmt=fmt,
+                                       init_fields={"actor.explore_ticks": 0}) + ticks(ZERO, 2)
+                             + tick(("nan", "0", "0", "0")) + STATE_EXERCISE),
+        "ico-timing-literal-caches": (raw_state(0, [patch("has_prev", 5), patch("penalty_prev", "nan"),
+                                                    patch("x_prev", "inf", 0), patch("inv_range", "max", 3)],
+                                                fmt=fmt, init_fields={"ico.timing": 1}) + ticks(FAIL, 2) + STATE_EXERCISE),
+        "search-record-corrupt": (raw_state(2, [patch("search.count", 15), patch("search.ticks", 2**32 - 1, 3),
+                                                patch("search.w", "nan", 7), patch("search.lower", "inf", 5),
+                                                patch("search.floor", "-1", 0), patch("search.prior_var", "0", 2)],
+                                            fmt=fmt) + tick(FAIL, terminal=True) + trials(3, 2) + STATE_EXERCISE),
+        "search-count-negative": (raw_state(2, [patch("search.count", -1)], fmt=fmt, init_fields={"search.batch": 3})
+                                  + trials(2, 2) + tick(FAIL, terminal=True) + S_RESET
+                                  + s_patch(patch("search.count", -2**31)) + tick(FAIL, terminal=True)),
+        "header-flips": (raw_state(2, [], fmt=fmt, init_fields={"search.batch": 2}) + tick(FAIL, terminal=True)
+                         + s_patch(patch_header(False)) + tick(FAIL, terminal=True) + s_patch(patch_header(False))
+                         + tick(FAIL, terminal=True) + s_patch(patch_header(True)) + ticks(ZERO, 2) + S_GET),
+        "raw-patches": (raw_state(1, [patch_raw(0, b"\xff" * 64), patch_raw(size - 3, b"\x01\x02\x03\x04\x05"),
+                                      patch_config({"mode": 2, "search.batch": 1}, fmt)], fmt=fmt)
+                        + STATE_EXERCISE),
+        # Known reproducers (the issue): (i) search.batch = 1000 in the copy wrote past the batch
+        # arrays (search.w[16], search.ticks[16]) after 16 trials
+        "repro-search-batch-1000": (raw_config(2, {"search.batch": 1000}, fmt=fmt) + trials(40, 20)),
+        # ... the copy rewritten after each (checked) reset, so the trials are recorded
+        "repro-search-batch-1000-after-reset": (raw_config(2, fmt=fmt)
+                                                + trials(40, 20, after_reset=s_edit({"search.batch": 1000}))),
+        "repro-search-count-1000-after-reset": (raw_state(2, [], fmt=fmt)
+                                                + trials(20, 3, after_reset=s_patch(patch("search.count", 1000)))),
+        # (ii) cov_slot read unmasked: icoac_get_posterior read far outside the state
+        "repro-cov-slot-huge": (raw_state(1, [patch("cov_slot", 2**31 - 1), patch("active_slot", -2**31)], fmt=fmt)
+                                + S_GET + ticks(ZERO, 3) + S_GET + tick(FAIL, terminal=True) + S_RESET + S_GET
+                                + s_patch(patch("cov_slot", 1000001)) + S_GET + ticks(ZERO, 2) + S_GET),
+        # (iii) elite_fraction out of range in the copy when a full batch closes: the conversion of
+        # round(rho K) to int was undefined
+        "repro-search-elite-1e30": (raw_config(2, {"search.elite_fraction": "1e30"}, fmt=fmt,
+                                               init_fields={"search.batch": 2})
+                                    + tick(FAIL, terminal=True)
+                                    + trials(4, 3, before_terminal=s_edit({"search.elite_fraction": "1e30"}),
+                                             after_reset=s_edit({"search.elite_fraction": 0.25}))),
+        "repro-search-elite-nan": (raw_config(2, {"search.elite_fraction": "nan"}, fmt=fmt, init_fields={"search.batch": 2})
+                                   + tick(FAIL, terminal=True)
+                                   + trials(2, 3, before_terminal=s_edit({"search.elite_fraction": "nan"}),
+                                            after_reset=s_edit({"search.elite_fraction": 0.25}))
+                                   + trials(2, 3, before_terminal=s_edit({"search.elite_fraction": "-inf"}),
+                                            after_reset=s_edit({"search.elite_fraction": 0.25}))
+                                   + trials(2, 3, before_terminal=s_edit({"search.elite_fraction": "max",
+                                                                          "search.batch": 16}),
+                                            after_reset=s_edit({"search.elite_fraction": 0.25, "search.batch": 2}))),
+        # (iv) a repeated terminal tick recorded the same trial again
+        "repro-terminal-1000": raw_config(2, fmt=fmt) + ticks((0.1, 0.0, 0.01, 0.0), 10) + ticks(FAIL, 1000, True),
+        "repro-terminal-1000-rl": raw_config(1, fmt=fmt) + ticks((0.1, 0.0, 0.01, 0.0), 10) + ticks(FAIL, 1000, True),
+        # Found by this target (open): icoac_reset accepts any finite rng.spare_normal, and the RL
+        # tick that draws a huge one as its noise returns ICOAC_OK with an infinite force.
+        "repro-rl-spare-normal-huge": (raw_state(1, [patch("rng.has_spare", 1), patch("rng.spare_normal", "max")],
+                                                 fmt=fmt) + S_RESET + ticks(ZERO, 2)),
+        # (v) an unknown mode or ICO timing in the copy fell back to a default with ICOAC_OK
+        "repro-mode-99": raw_config(0, {"mode": 99}, fmt=fmt) + STATE_EXERCISE,
+        "repro-ico-timing-7": raw_config(0, {"ico.timing": 7}, fmt=fmt) + STATE_EXERCISE,
+    })
     return s
 
 
@@ -479,6 +756,9 @@ def corpus():
         "fuzz_controller": float_seeds,
         "fuzz_controller_fast_exp": float_seeds,
         "fuzz_controller_double": controller_seeds("d"),
+        "fuzz_state": state_seeds("f"),
+        "fuzz_state_mcu": state_seeds("f"),
+        "fuzz_state_double": state_seeds("d"),
         "fuzz_sim": sim_seeds(),
     }
 
