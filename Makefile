@@ -15,6 +15,8 @@ BENCH_PROFILE ?= default
 BENCH_SUFFIX = $(if $(filter default,$(BENCH_PROFILE)),,/$(BENCH_PROFILE))
 BENCH_OUT ?= results/$(if $(BENCH_SUFFIX),$(BENCH_PROFILE),bench)
 BENCH_FIGURES ?= docs/figures$(BENCH_SUFFIX)
+# The summary docs/results.md's tables come from (python -m harness.tools.results_tables --update).
+BENCH_DATA ?= docs/data/bench-$(BENCH_PROFILE).json
 # `make fuzz`: seconds per target, targets run at once, extra libFuzzer options.
 FUZZ_TIME ?= 600
 FUZZ_JOBS ?= 2
@@ -97,7 +99,8 @@ bench-speed: build
 # bench, which shows it in summary.md and Fig. 3a.
 bench: build venv bench-speed
 	$(VPY) -m harness ceiling --out $(BENCH_OUT)/ceiling --quiet
-	$(VPY) -m harness bench --profile $(BENCH_PROFILE) --out $(BENCH_OUT) --figures $(BENCH_FIGURES) $(BENCH_ARGS)
+	$(VPY) -m harness bench --profile $(BENCH_PROFILE) --out $(BENCH_OUT) --figures $(BENCH_FIGURES) \
+	  --data $(BENCH_DATA) $(BENCH_ARGS)
 
 # The learner sweeps that chose the defaults (docs/results.md), on the ICO grid of seed 0 of a
 # bench (make bench first); resumable, summary in $(SWEEP_OUT)/summary.md.

@@ -1,10 +1,10 @@
 """The paper's comparison (Fig. 2b, 3): ICO grids per seed, priors, ICO->RL, RL, ICO->search and
-search grids with their no-learning controls (spec L1), summary, figures.
+search grids with their no-learning controls (method.md, L1), summary, figures.
 
 Layout: OUT/<condition>/seed-<n>/ (results directories), OUT/bench.json (wall time per stage),
 OUT/summary.md and OUT/summary.json (mean and sd over seeds next to the paper's numbers).
 
-The linear-policy ceiling (spec L5) is not a bench stage: `python -m harness ceiling --out
+The linear-policy ceiling (method.md, L5) is not a bench stage: `python -m harness ceiling --out
 OUT/ceiling` measures it, and the bench shows it (a section of summary.md, reference lines in
 Fig. 3a) when OUT/ceiling/ceiling.json exists or --ceiling names one.
 """
@@ -20,13 +20,13 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from . import ceiling as C
-from . import figures, geometry, grid, metrics, results, store
+from . import figures, geometry, grid, metrics, results, store, tables
 from . import prior as P
 from .conditions import run_condition
 from .config import build_config, command_overrides, named_sets
 from .errors import ResultsError
 from .metrics import percent
-from .options import CONDITION_LABELS as LABELS, CONDITIONS, CONTROL_OF, PROFILE_NAMES
+from .options import CONDITION_LABELS as LABELS, CONDITIONS, CONTROL_OF, PRIOR_RULES, PROFILE_NAMES
 
 # Paper (Fig. 1b, 2b, 3a): ~68 % ICO, ~84 % ICO->RL; RL alone only "smaller" and "very slow" (Fig. 3 bars).
 PAPER = {
@@ -76,6 +76,30 @@ STATS = (
 )
 
 
+def _per_k(rows: Sequence[Sequence[float | None]]) -> dict[str, list[float | None]]:
+    """Mean and sd over seeds (rows) of each column (a budget k, or a quantile)."""
+    columns = list(zip(*rows))
+    stats = [_mean_sd(list(col)) for col in columns]
+    return {"mean": [m for m, _, _ in stats], "sd": [s for _, s, _ in stats]}
+
+
+def _curves_and_quantiles(recs: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """The learning curve (success within k trials, all cells and interior) and the quantiles of
+    trials and simulated time to success, mean and sd over seeds; empty for records written before
+    the summaries had them."""
+    summaries = [r["summary"] for r in recs]
+    out: dict[str, Any] = {}
+    if all(s.get("success_within") for s in summaries):
+        out["success_within"] = {"k": summaries[0]["success_within"]["k"],
+                                 **{part: _per_k([s["success_within"][part] for s in summaries])
+                                    for part in ("all", "interior")}}
+    for key in ("trials_to_success_quantiles", "elapsed_time_quantiles"):
+        if all(s.get(key) for s in summaries):
+            qs = list(summaries[0][key])
+            out[key] = {"q": qs, **_per_k([[s[key][q] for q in qs] for s in summaries])}
+    return out
+
+
 def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, Any]:
     """{condition: [run.json records over seeds]} -> mean/sd per statistic and condition."""
     out: dict[str, Any] = {}
@@ -92,6 +116,7 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, A
             values = [r["summary"].get(key) for r in recs]
             mean, sd, n = _mean_sd(values)
             entry[key] = {"mean": mean, "sd": sd, "n": n, "per_seed": values}
+        entry.update(_curves_and_quantiles(recs))
         if cond == "ico-rl":
             t = [(r.get("prior_info") or {}).get("ico_phase_simulated_time") for r in recs]
             mean, sd, n = _mean_sd(t)
@@ -134,7 +159,7 @@ def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
         cap = "one trial per cell" if p == "first" else f"retries up to {s.get('max_trials', st['max_trials']):g} trials"
         parts.append(f"{cap}: {percent(s['success_rate'])} of {s['n_cells']} cells, "
                      f"{percent(s['success_rate_interior'])} of {s['n_interior']} interior")
-    lines = ["", f"Linear-policy ceiling (spec L5; no learning, the best single w = {C.format_w(best['w'])} "
+    lines = ["", f"Linear-policy ceiling (method.md, L5; no learning, the best single w = {C.format_w(best['w'])} "
              f"of `python -m harness ceiling`, seed {st['seed']}, horizon {st['success_steps']:g} steps): "
              + "; ".join(parts) + "."]
     b = record.get("first_step_bound") or {}
@@ -174,6 +199,7 @@ def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None =
                   f"{_fmt(agg['ico-rl']['ico_phase_simulated_time'])} s of simulated time (whole ICO grid)."]
     if ceiling is not None:
         lines += ceiling_markdown(ceiling)
+    lines += tables.curve_tables(agg, ceiling)
     lines += ["", f"Success rates use the cells run as denominator ({geometry.CELLS} / {geometry.N_INTERIOR} on "
               f"the full grid). The paper's ~{percent(PAPER['ico']['success_rate'], 0)} / "
               f"~{percent(PAPER['ico-rl']['success_rate'], 0)} are read as fractions of all {geometry.CELLS} cells."]
@@ -187,6 +213,18 @@ def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] 
     store.write_text(md, summary_markdown(agg, ceiling))
     store.write_json(js, agg)
     return md, js
+
+
+def write_data(opt: "BenchOptions", agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None) -> Path:
+    """The summary docs/results.md's tables are written from (harness.tools.results_tables): the
+    aggregate, the ceiling's best w with its protocols, and what produced them."""
+    record = {"profile": opt.profile, "seeds": opt.seed_list(), "configuration": opt.configuration,
+              "set": list(opt.sets), "prior_std": opt.prior_std, "git": results.git_info(),
+              "timestamp": results.timestamp(), "aggregate": agg,
+              "ceiling": None if ceiling is None else {"settings": ceiling["settings"], "best": ceiling["best"]}}
+    Path(opt.data).parent.mkdir(parents=True, exist_ok=True)
+    store.write_json(Path(opt.data), record, indent=1)
+    return Path(opt.data)
 
 
 def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarray | None,
@@ -211,6 +249,20 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
                                           ceiling=C.reference_lines(ceiling)))
         written.append(figures.plot_fig3b(figdir / "fig3b_elapsed_time.png", [LABELS[c] for c in conds],
                                           [agg[c]["mean_elapsed_time_success"] for c in conds]))
+        curved = [c for c in conds if agg[c].get("success_within")]
+        if curved:
+            bases = [c for c in CONDITIONS if c not in CONTROL_OF]
+            curves = [{"label": LABELS[c], "mean": agg[c]["success_within"]["all"]["mean"],
+                       "sd": agg[c]["success_within"]["all"]["sd"], "control": c in CONTROL_OF,
+                       "color": bases.index(CONTROL_OF.get(c, c))} for c in curved]
+            retries = ((ceiling or {}).get("best", {}).get("protocols", {}) or {}).get("retries") or {}
+            line = None
+            if retries.get("success_within"):
+                line = {"label": f"linear-policy ceiling (retries, cap {retries.get('max_trials', 0):g})",
+                        "rate": retries["success_within"]["all"]}
+            written.append(figures.plot_fig3c(figdir / "fig3c_learning_curves.png",
+                                              agg[curved[0]]["success_within"]["k"], curves,
+                                              cap=max(agg[c]["max_trials"] for c in curved), ceiling=line))
     return written
 
 
@@ -262,6 +314,7 @@ class BenchOptions:
     profile: str
     out: Path
     figures: Path | None = None
+    data: Path | None = None      # the summary for docs (docs/data/*.json): aggregate, ceiling, provenance
     seed: int = 0
     seeds: int | None = None
     rl_max_trials: int | None = None
@@ -272,7 +325,7 @@ class BenchOptions:
     quiet: bool = False
     frame: tuple[float, float] | None = P.DEFAULT_FRAME
     ridge: float = P.DEFAULT_RIDGE
-    rl_cov: str = "ico"
+    prior_std: float = P.DEFAULT_STD
     ceiling: Path | None = None   # a ceiling.json (or its directory); default OUT/ceiling/ceiling.json
     dask: Any = None              # a harness.cluster.DaskSpec: every grid on that Dask cluster (None: threads)
 
@@ -317,10 +370,8 @@ def stages(opt: BenchOptions) -> list[Stage]:
     def prior_stage(seed: int):
         def run(ctx):
             info = P.from_results(seed_dir(out, "ico", seed), opt.frame, opt.ridge)
-            ctx[("prior", "ico-rl", seed)] = info
-            ctx[("prior", "rl", seed)] = P.rl_prior(info, opt.rl_cov)
-            ctx[("prior", "ico-search", seed)] = info
-            ctx[("prior", "search", seed)] = P.rl_prior(info, "identity")
+            for condition in PRIOR_RULES:
+                ctx[("prior", condition, seed)] = P.condition_prior(condition, info, opt.prior_std)
             for control, condition in CONTROL_OF.items():
                 ctx[("prior", control, seed)] = ctx[("prior", condition, seed)]
             progress(f"  prior seed {seed}: {info.n_cells} cells, mean "
@@ -358,6 +409,9 @@ def stages(opt: BenchOptions) -> list[Stage]:
                     {s: ctx[(control, s)][0] for s in seeds if (control, s) in ctx})
         ctx["aggregate"] = agg
         md, js = write_summary(out, agg, ceiling_record())
+        if opt.data is not None:
+            write_data(opt, agg, ceiling_record())
+            progress(f"  wrote {opt.data}")
         print(md.read_text(), end="")
         progress(f"  wrote {md} and {js}")
 

@@ -1,5 +1,5 @@
 """`ceiling`: what the policy class F = G * w^T x~ + U can reach on the paper grid, with no
-learning (spec L5, "the linear-policy ceiling"). Every simulation runs in C through the engine.
+learning (method.md, L5, "the linear-policy ceiling"). Every simulation runs in C through the engine.
 
 Fixed-w evaluation. A controller in mode ICO with ``learn = 0`` and a prior whose mean is w (and
 covariance I, which ICO mode does not read) acts with exactly w in every cell and every trial;
@@ -771,7 +771,7 @@ def summary_markdown(record: Mapping[str, Any]) -> str:
     st = record["settings"]
     best = record["best"]
     pol = record.get("policy", {})
-    lines = ["# Linear-policy ceiling (spec L5)", "",
+    lines = ["# Linear-policy ceiling (method.md, L5)", "",
              f"Policy F = G·wᵀx̃ + U with G = {pol.get('gain', 'n/a'):g} N, reflex {pol.get('reflex_mode')} "
              f"({pol.get('reflex_force', 'n/a'):g} N), no learning (learn = 0); seed {st['seed']}, "
              f"{st['n_cells']} cells{'' if st['cells'] is None else ' (subset)'}, horizon {st['success_steps']:g} "

@@ -100,7 +100,7 @@ SET_HELP = ("override a parameter (repeatable): NAME is group.field (policy.gain
             "their C type, ranges are checked by the C library")
 
 
-def _add_prior_args(parser, rl_cov: bool = True) -> None:
+def _add_prior_args(parser, prior_std: bool = True) -> None:
     parser.add_argument("--prior-frame", choices=O.FRAME_NAMES, default=O.FRAME_NAMES[0],
                         help="ICO cells for the prior: central frame (default) or all successful cells")
     parser.add_argument("--prior-x", type=_real, default=None,
@@ -109,13 +109,14 @@ def _add_prior_args(parser, rl_cov: bool = True) -> None:
                         help=f"frame half-height |theta0| (deg), default {O.PRIOR_FRAME[1]:g}")
     parser.add_argument("--prior-ridge", type=_real, default=O.PRIOR_RIDGE,
                         help=f"ridge added to the prior covariance (default {O.PRIOR_RIDGE:g})")
-    if rl_cov:
-        _add_rl_cov(parser)
+    if prior_std:
+        _add_prior_std(parser)
 
 
-def _add_rl_cov(parser) -> None:
-    parser.add_argument("--rl-cov", choices=O.RL_COV_NAMES, default=O.RL_COV_NAMES[0],
-                        help="RL-alone prior covariance: that of ICO->RL (default) or 1*I")
+def _add_prior_std(parser) -> None:
+    parser.add_argument("--prior-std", type=_real, default=O.PRIOR_STD,
+                        help=f"sigma_w of the isotropic prior covariance sigma_w^2 I of the conditions rl and "
+                             f"ico-mean-rl (default {O.PRIOR_STD:g})")
 
 
 THREADS_HELP = (f"C threads of the local engine, in [0, {O.MAX_THREADS}] (0, the default: all cores); "
@@ -213,6 +214,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "paper: 5 seeds, all at 1e5/1e5; quick: smoke test")
     b.add_argument("--out", required=True, help="bench directory (one results directory per condition and seed)")
     b.add_argument("--figures", default=None, help="figure directory")
+    b.add_argument("--data", default=None,
+                   help="also write the summary that docs/results.md's tables come from (e.g. docs/data/bench-default.json)")
     _add_seeds(b, "default: the profile's")
     b.add_argument("--rl-max-trials", type=_positive_int, default=None,
                    help="trial cap of the RL and ICO->RL grids (overrides the profile)")
@@ -251,13 +254,13 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--one-at-a-time", action="store_true",
                    help="vary one parameter at a time around the first value of each")
     w.add_argument("--threads", type=_threads, default=None, help=THREADS_HELP)
-    _add_rl_cov(w)
+    _add_prior_std(w)
     w.add_argument("--quiet", action="store_true")
     _add_backend(w)
     w.set_defaults(func=cmd_sweep)
 
     c = sub.add_parser(
-        "ceiling", help="the linear-policy ceiling (spec L5): fixed-w evaluation, search for the best w, "
+        "ceiling", help="the linear-policy ceiling (method.md, L5): fixed-w evaluation, search for the best w, "
                         "first-step bound",
         epilog="Without --w: a seeded search (typical ICO weights - the mean of --prior-from - and LQR gains "
                "as starting points, random search over magnitudes and signs, local refinement), screened "
@@ -340,7 +343,7 @@ def cmd_grid(args) -> int:
     condition = args.condition or O.CONDITIONS[0]
     info = None
     if explicit or not args.resume:
-        info = conditions.condition_prior(condition, args.prior_from, _frame(args), args.prior_ridge, args.rl_cov)
+        info = conditions.condition_prior(condition, args.prior_from, _frame(args), args.prior_ridge, args.prior_std)
     spec = _dask_spec(args)
     cells, record, cancelled = conditions.run_condition(
         condition=condition, out=Path(args.out), seed=args.seed or 0, threads=_threads_arg(args),
@@ -373,9 +376,10 @@ def cmd_bench(args) -> int:
 
     opt = bench.BenchOptions(
         profile=args.profile, out=Path(args.out), figures=Path(args.figures) if args.figures else None,
+        data=Path(args.data) if args.data else None,
         seed=args.seed, seeds=args.seeds, rl_max_trials=args.rl_max_trials, threads=_threads_arg(args),
         configuration=args.configuration, sets=args.set or [], resume=args.resume, quiet=args.quiet,
-        frame=_frame(args), ridge=args.prior_ridge, rl_cov=args.rl_cov,
+        frame=_frame(args), ridge=args.prior_ridge, prior_std=args.prior_std,
         ceiling=Path(args.ceiling) if args.ceiling else None, dask=_dask_spec(args))
     return bench.run_bench(opt, argv=sys.argv[1:])
 
@@ -387,7 +391,7 @@ def cmd_sweep(args) -> int:
         prior_from=Path(args.prior_from), out=Path(args.out), params=args.param, condition=args.condition,
         cells=args.cells, subset=args.subset, seed=args.seed, seeds=1 if args.seeds is None else args.seeds,
         max_trials=args.max_trials, success_steps=args.success_steps, configuration=args.configuration,
-        sets=args.set or [], one_at_a_time=args.one_at_a_time, threads=_threads_arg(args), rl_cov=args.rl_cov,
+        sets=args.set or [], one_at_a_time=args.one_at_a_time, threads=_threads_arg(args), prior_std=args.prior_std,
         quiet=args.quiet, dask=_dask_spec(args))
     return sweep.run_sweep(opt)
 

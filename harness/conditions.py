@@ -17,7 +17,7 @@ from . import grid, results, store
 from . import prior as P
 from .config import RunConfig, build_config
 from .errors import UsageError
-from .options import CONDITIONS, CONTROL_OF, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY
+from .options import CONDITIONS, CONTROL_OF, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, PRIOR_RULES
 
 
 def check_condition(condition: Any) -> str:
@@ -26,22 +26,19 @@ def check_condition(condition: Any) -> str:
     return condition
 
 
-def condition_prior(condition: str, prior_from, frame, ridge: float, rl_cov: str = "ico") -> P.PriorInfo | None:
-    """PriorInfo of a condition (None for ico): ico-rl and ico-search from an ICO results dir, rl
-    with mean 0 (A16), search N(0, I) (L4); a no-learning control has the prior of its condition."""
+def condition_prior(condition: str, prior_from, frame, ridge: float, std: float = P.DEFAULT_STD) -> P.PriorInfo | None:
+    """PriorInfo of a condition (None for ico) by its rule (options.PRIOR_RULES); a no-learning
+    control has the prior of its condition. --prior-from is required exactly when the rule takes
+    the mean or the covariance from ICO: a condition that takes nothing from ICO refuses it."""
     condition = CONTROL_OF.get(check_condition(condition), condition)
-    if condition == "ico":
+    rule = PRIOR_RULES.get(condition)
+    if rule is None or "ico" not in rule:
         if prior_from is not None:
-            raise UsageError("--prior-from applies to the conditions rl and ico-rl")
-        return None
-    base = P.from_results(prior_from, frame, ridge) if prior_from is not None else None
-    if condition in ("ico-rl", "ico-search"):
-        if base is None:
-            raise UsageError(f"condition {condition} needs --prior-from ICO_RESULTS_DIR")
-        return base
-    if condition == "search":
-        return P.rl_prior(base, "identity")
-    return P.rl_prior(base, rl_cov)
+            raise UsageError(f"condition {condition} takes nothing from ICO; drop --prior-from")
+        return None if rule is None else P.condition_prior(condition, None, std)
+    if prior_from is None:
+        raise UsageError(f"condition {condition} needs --prior-from ICO_RESULTS_DIR")
+    return P.condition_prior(condition, P.from_results(prior_from, frame, ridge), std)
 
 
 def prior_extra(info: P.PriorInfo | None) -> dict | None:

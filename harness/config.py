@@ -75,12 +75,16 @@ _BOOL_NAMES = {"true": 1, "false": 0, "on": 1, "off": 0, "yes": 1, "no": 0, "1":
 # condition's overrides plus learn = 0.
 _LEARNER_OVERRIDES: dict[str, dict[str, Any]] = {
     "ico": {"mode": "ico"},
-    "ico-rl": {"mode": "rl"},   # prior from an ICO grid (spec 7); the C defaults' reading
-    # prior mean 0 (spec A16); its reading chosen by the learner sweeps (docs/results.md)
+    "ico-rl": {"mode": "rl"},   # prior from an ICO grid (method.md, priors); the C defaults' reading
+    "ico-mean-rl": {"mode": "rl"},  # the ICO mean with sigma_w^2 I: ICO->RL's reading
+    # mean 0 with the ICO covariance (method.md, A16): the reading the learner sweeps chose for it
+    "rl-ico-cov": {"mode": "rl", "actor.update": "mean", "actor.likelihood_std": 0.1, "actor.noise_std": 5,
+                   "actor.scale": 0.1, "actor.explore_ticks": 1000},
+    # RL alone, N(0, sigma_w^2 I): the reading of its own sweep (docs/sweeps.md)
     "rl": {"mode": "rl", "actor.update": "mean", "actor.likelihood_std": 0.1, "actor.noise_std": 5,
            "actor.scale": 0.1, "actor.explore_ticks": 1000},
     "ico-search": {"mode": "search"},  # prior from an ICO grid, Sigma0 = search.cov_scale * its covariance
-    "search": {"mode": "search", "search.cov_scale": 4},  # prior N(0, I) (spec L4); Sigma0 = 4 I by the sweeps
+    "search": {"mode": "search", "search.cov_scale": 4},  # prior N(0, I) (method.md, L4); Sigma0 = 4 I by the sweeps
 }
 CONDITION_OVERRIDES: dict[str, dict[str, Any]] = {
     c: {**_LEARNER_OVERRIDES[options.CONTROL_OF[c]], "learn": 0} if c in options.CONTROL_OF else _LEARNER_OVERRIDES[c]

@@ -320,3 +320,35 @@ def plot_fig3b(path: str | Path, labels: Sequence[str], stats: Sequence[Mapping]
         ax.set_title("(b) time to success, mean ± sd over seeds")
         fig.tight_layout()
         return save_figure(fig, path)
+
+
+def plot_fig3c(path: str | Path, budgets: Sequence[int], curves: Sequence[Mapping], cap: float | None = None,
+               ceiling: Mapping | None = None, title: str = "(c) success within k trials") -> Path:
+    """Fig. 3c: success rate (all cells) against the trial budget k, log axis, one curve per
+    condition (mean over seeds, the band +- sd), a no-learning control dashed in its condition's
+    colour. ``curves``: {"label", "mean", "sd", "control": bool, "color": index}. ``ceiling``:
+    {"label", "rate"} (one curve, the linear-policy ceiling's retries at the same cap)."""
+    k = np.asarray(budgets, dtype=float)
+    keep = k <= (cap if cap is not None else k.max())
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    with plt.rc_context(STYLE):
+        fig, ax = plt.subplots(figsize=(8.4, 4.4))
+        for c in curves:
+            m = np.array([np.nan if v is None else 100 * v for v in c["mean"]], dtype=float)[keep]
+            sd = np.array([0.0 if v is None else 100 * v for v in c["sd"]], dtype=float)[keep]
+            color = colors[c["color"] % len(colors)]
+            ax.plot(k[keep], m, color=color, linestyle="--" if c["control"] else "-", linewidth=1.3,
+                    label=c["label"])
+            ax.fill_between(k[keep], m - sd, m + sd, color=color, alpha=0.15, linewidth=0)
+        if ceiling is not None:
+            r = np.array([np.nan if v is None else 100 * v for v in ceiling["rate"]], dtype=float)[keep]
+            ax.plot(k[keep], r, color="black", linestyle=":", linewidth=1.3, label=ceiling["label"])
+        ax.set_xscale("log")
+        ax.set_xlim(1, k[keep].max())
+        ax.set_ylim(0, 102)
+        ax.set_xlabel("trial budget k")
+        ax.set_ylabel("success within k trials (% of all cells)")
+        ax.set_title(title)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, fontsize=7)
+        fig.tight_layout()
+        return save_figure(fig, path)

@@ -1,4 +1,4 @@
-"""Benchmark metrics (spec sections 9-10) from a cell array."""
+"""Benchmark metrics (method.md, benchmark protocol) from a cell array."""
 from __future__ import annotations
 
 import math
@@ -19,6 +19,30 @@ def trials_to_success(cells: np.ndarray) -> np.ndarray:
     out = cells["trials"].astype(float)
     out[~success_mask(cells)] = np.nan
     return out
+
+
+# Trial budgets k of the learning curves (success within k trials): 1, 2, 3, 5 per decade up to
+# 1e5, the paper's cap. A budget beyond a run's cap repeats its final rate.
+CURVE_BUDGETS = tuple(m * 10 ** e for e in range(6) for m in (1, 2, 3, 5) if m * 10 ** e <= 100_000)
+# Quantiles of the distributions of trials and simulated time to success.
+QUANTILES = (0.1, 0.25, 0.5, 0.75, 0.9)
+
+
+def success_within(cells: np.ndarray, budgets=CURVE_BUDGETS, interior: bool = False) -> list[float | None]:
+    """Fraction of the cells (all, or the interior ones) that succeeded within k trials, per budget
+    k: the learning curve of a run, read from the recorded trials to success (no rerun). None
+    when there is no such cell."""
+    mask = interior_mask(cells) if interior else np.ones(cells.size, dtype=bool)
+    trials = cells["trials"][success_mask(cells) & mask]
+    n = int(np.count_nonzero(mask))
+    return [float(np.count_nonzero(trials <= k)) / n if n else None for k in budgets]
+
+
+def quantiles(values: np.ndarray) -> dict[str, float] | None:
+    """{"0.1": ..., "0.5": ..., ...} of values (None when there are none)."""
+    if values.size == 0:
+        return None
+    return {f"{q:g}": float(v) for q, v in zip(QUANTILES, np.quantile(values.astype(float), QUANTILES))}
 
 
 def weights(cells: np.ndarray, successful_only: bool = False) -> np.ndarray:
@@ -72,6 +96,10 @@ def summary(cells: np.ndarray) -> dict[str, Any]:
         "total_trials": int(np.sum(cells["trials"])),
         # ERROR cells (e.g. status 4, ICOAC_ERR_NUMERIC) are neither successes nor failures.
         "error_statuses": error_statuses(cells),
+        "trials_to_success_quantiles": quantiles(trials),
+        "elapsed_time_quantiles": quantiles(elapsed),
+        "success_within": {"k": list(CURVE_BUDGETS), "all": success_within(cells),
+                           "interior": success_within(cells, interior=True)},
     }
     if trials.size:
         w = cells["weights"][ok]

@@ -3,24 +3,35 @@ builds its parser from them without loading the shared library). Everything the 
 defines - enum values, statuses, sizes, grid geometry - comes from the binding instead."""
 from __future__ import annotations
 
-# Learning conditions, in the order of the benchmark and its tables.
-CONDITIONS = ("ico", "ico-rl", "ico-rl-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
+# Learning conditions, in the order of the benchmark and its tables. The actor-critic runs from
+# the four priors of PRIOR_RULES: ICO->RL, and the prior taken apart (method.md, L6).
+CONDITIONS = ("ico", "ico-rl", "ico-rl-control", "ico-mean-rl", "ico-mean-rl-control", "rl-ico-cov",
+              "rl-ico-cov-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
               "search-control")
 # The conditions that run the actor-critic from a prior.
-RL_CONDITIONS = ("ico-rl", "ico-rl-control", "rl", "rl-control")
-# No-learning control (spec L1) -> its condition: the same prior, acting weights, noise stream,
+RL_CONDITIONS = ("ico-rl", "ico-rl-control", "ico-mean-rl", "ico-mean-rl-control", "rl-ico-cov", "rl-ico-cov-control",
+                 "rl", "rl-control")
+# No-learning control (method.md, L1) -> its condition: the same prior, acting weights, noise stream,
 # resets and caps, with every update off (the controller's `learn = 0`).
-CONTROL_OF = {"ico-rl-control": "ico-rl", "rl-control": "rl", "ico-search-control": "ico-search",
-              "search-control": "search"}
-# The conditions of the episodic search (spec L4): ico-search from the ICO prior, search from N(0, I).
+CONTROL_OF = {"ico-rl-control": "ico-rl", "ico-mean-rl-control": "ico-mean-rl", "rl-ico-cov-control": "rl-ico-cov",
+              "rl-control": "rl", "ico-search-control": "ico-search", "search-control": "search"}
+# The prior of every learning condition that starts from one: (mean, covariance). "ico": from the
+# final weights of an ICO grid (--prior-from); "zero": mean 0; "isotropic": sigma_w^2 I with sigma_w
+# = --prior-std; "identity": I (the search, whose Sigma0 = search.cov_scale * I). A condition
+# whose rule names no "ico" takes nothing that ICO produced.
+PRIOR_RULES = {"ico-rl": ("ico", "ico"), "ico-mean-rl": ("ico", "isotropic"), "rl-ico-cov": ("zero", "ico"),
+               "rl": ("zero", "isotropic"), "ico-search": ("ico", "ico"), "search": ("zero", "identity")}
+# The conditions of the episodic search (method.md, L4): ico-search from the ICO prior, search from N(0, I).
 SEARCH_CONDITIONS = ("ico-search", "ico-search-control", "search", "search-control")
-CONDITION_LABELS = {"ico": "ICO", "ico-rl": "ICO->RL", "ico-rl-control": "ICO->RL control", "rl": "RL",
-                    "rl-control": "RL control", "ico-search": "ICO->search", "ico-search-control": "ICO->search control",
-                    "search": "search", "search-control": "search control"}
+CONDITION_LABELS = {"ico": "ICO", "ico-rl": "ICO->RL", "ico-rl-control": "ICO->RL control",
+                    "ico-mean-rl": "ICO mean->RL", "ico-mean-rl-control": "ICO mean->RL control",
+                    "rl-ico-cov": "RL, ICO cov.", "rl-ico-cov-control": "RL, ICO cov. control",
+                    "rl": "RL alone", "rl-control": "RL alone control", "ico-search": "ICO->search",
+                    "ico-search-control": "ICO->search control", "search": "search", "search-control": "search control"}
 
 PROFILE_NAMES = ("default", "paper", "quick")   # bench profiles (harness.bench.PROFILES)
 # Named configurations (harness.config.NAMED_CONFIGURATIONS): the defaults, or the paper's literal
-# reading of the actor-critic (spec 7, A10, A14; L2, L3), one option away (--configuration literal).
+# reading of the actor-critic (method.md: A10, A14; L2, L3), one option away (--configuration literal).
 CONFIGURATION_NAMES = ("default", "literal")
 
 # Integer limits of the command line and of the Python API.
@@ -52,16 +63,16 @@ DASK_PROGRESS_EVERY = 0.5        # s between progress events of a running chunk
 TRAJECTORY_DURATION = 30.0      # s
 MAX_TRAJECTORY_STEPS = 1_000_000
 
-# Priors of the RL conditions (spec 7, A15/A16).
+# Priors of the RL conditions (method.md, A15, A16).
 FRAME_NAMES = ("central", "all")
 PRIOR_FRAME = (1.2, 6.0)        # the central frame: |x0| <= 1.2 m, |theta0| <= 6 deg
 PRIOR_RIDGE = 1e-6              # added to the prior covariance (times I)
-RL_COV_NAMES = ("ico", "identity")  # RL-alone prior covariance: that of ICO->RL, or 1*I
+PRIOR_STD = 1.0                 # sigma_w of the isotropic priors (--prior-std)
 
 # sweep: trial cap of every setting unless --max-trials says otherwise.
 SWEEP_MAX_TRIALS = 2000
 
-# ceiling (spec L5): fixed-w evaluation of the policy class F = G * w^T x~ + U and the search for
+# ceiling (method.md, L5): fixed-w evaluation of the policy class F = G * w^T x~ + U and the search for
 # the best single w. Protocols: one trial per cell ("first"), or fresh initial velocities every
 # trial up to a trial cap ("retries"); "both" runs the two.
 CEILING_PROTOCOLS = ("first", "retries")

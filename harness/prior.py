@@ -1,8 +1,9 @@
-"""Priors of the RL conditions (spec 7, A15/A16/A17) from the final weights of an ICO grid.
+"""Priors of the RL conditions (method.md, A15-A17) from the final weights of an ICO grid.
 
 ICO->RL: mean and 4x4 sample covariance (ddof 1) of the final ICO weights of the ICO-successful cells
 inside a frame (default |x0| <= 1.2 m, |theta0| <= 6 deg; or every successful cell), plus ridge * I.
-RL alone: mean 0 and the same covariance (A16), or 1*I (``rl_cov="identity"``).
+The other actor-critic priors take the ICO mean, the ICO covariance, both or neither
+(options.PRIOR_RULES; method.md, A16 and L6); the search's is N(0, I) or the ICO prior.
 """
 from __future__ import annotations
 
@@ -17,7 +18,8 @@ from . import _binding as B
 from . import metrics, results
 from .config import make_prior
 from .errors import PriorError
-from .options import FRAME_NAMES, PRIOR_FRAME as DEFAULT_FRAME, PRIOR_RIDGE as DEFAULT_RIDGE, RL_COV_NAMES
+from .options import FRAME_NAMES, PRIOR_FRAME as DEFAULT_FRAME, PRIOR_RIDGE as DEFAULT_RIDGE, PRIOR_RULES
+from .options import PRIOR_STD as DEFAULT_STD
 
 _TOL = 1e-9
 
@@ -30,7 +32,7 @@ class PriorInfo:
     frame: tuple[float, float] | None      # None: every ICO-successful cell
     n_cells: int
     ridge: float
-    kind: str = "ico-rl"                   # "ico-rl", "rl" (mean 0) or "rl-identity"
+    kind: str = "ico-rl"                   # the condition it is the prior of
     source: str | None = None
     source_commit: str | None = None
     source_seed: int | None = None
@@ -42,7 +44,8 @@ class PriorInfo:
             "kind": self.kind,
             "mean": [float(v) for v in self.mean],
             "cov": [[float(v) for v in row] for row in self.cov],
-            "frame": "all" if self.frame is None else {"x0_abs_max": self.frame[0],
+            "frame": None if self.source is None and self.n_cells == 0 else
+                     "all" if self.frame is None else {"x0_abs_max": self.frame[0],
                                                         "theta0_abs_max_deg": self.frame[1]},
             "n_cells": int(self.n_cells),
             "ridge": float(self.ridge),
@@ -106,23 +109,28 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | None = DEFAULT_FRAME
     return PriorInfo(mean=mean, cov=cov, frame=frame, n_cells=n, ridge=float(ridge))
 
 
-def rl_prior(ico_rl: PriorInfo | None, rl_cov: str = "ico") -> PriorInfo:
-    """RL-alone prior: mean 0, covariance of the ICO->RL prior (A16) or identity."""
-    if rl_cov == "identity":
-        base = ico_rl
-        return PriorInfo(mean=np.zeros(B.N_INPUTS), cov=np.eye(B.N_INPUTS),
-                         frame=base.frame if base else None, n_cells=base.n_cells if base else 0,
-                         ridge=0.0, kind="rl-identity",
-                         source=base.source if base else None,
-                         source_commit=base.source_commit if base else None,
-                         source_seed=base.source_seed if base else None)
-    if rl_cov not in RL_COV_NAMES:
-        raise PriorError(f"bad --rl-cov {rl_cov!r}; valid: {', '.join(RL_COV_NAMES)}")
-    if ico_rl is None:
-        raise PriorError("condition rl needs --prior-from (or --rl-cov identity)")
-    return PriorInfo(mean=np.zeros(B.N_INPUTS), cov=ico_rl.cov.copy(), frame=ico_rl.frame,
-                     n_cells=ico_rl.n_cells, ridge=ico_rl.ridge, kind="rl", source=ico_rl.source,
-                     source_commit=ico_rl.source_commit, source_seed=ico_rl.source_seed)
+def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_STD) -> PriorInfo:
+    """The prior of a condition by its rule (options.PRIOR_RULES): the mean and the covariance each
+    from the ICO prior ``ico`` or not ("zero" mean, "isotropic" std^2 I, "identity" I). Provenance is
+    recorded only for what came from ICO: a prior that takes nothing from it carries no source."""
+    mean_rule, cov_rule = PRIOR_RULES[condition]
+    from_ico = mean_rule == "ico" or cov_rule == "ico"
+    if from_ico and ico is None:
+        raise PriorError(f"condition {condition} needs an ICO prior (--prior-from ICO_RESULTS_DIR)")
+    if cov_rule == "isotropic" and not (math.isfinite(std) and std > 0):
+        raise PriorError(f"--prior-std must be a finite number > 0, got {std!r}")
+    n = B.N_INPUTS
+    mean = ico.mean.copy() if mean_rule == "ico" else np.zeros(n)
+    cov = {"ico": lambda: ico.cov.copy(), "isotropic": lambda: std ** 2 * np.eye(n),
+           "identity": lambda: np.eye(n)}[cov_rule]()
+    extra = {"mean_from": mean_rule, "cov_from": cov_rule}
+    if cov_rule == "isotropic":
+        extra["prior_std"] = float(std)
+    if not from_ico:
+        return PriorInfo(mean=mean, cov=cov, frame=None, n_cells=0, ridge=0.0, kind=condition, extra=extra)
+    return PriorInfo(mean=mean, cov=cov, frame=ico.frame, n_cells=ico.n_cells, ridge=ico.ridge, kind=condition,
+                     source=ico.source, source_commit=ico.source_commit, source_seed=ico.source_seed,
+                     ico_phase_simulated_time=ico.ico_phase_simulated_time, extra=extra)
 
 
 def from_results(path: str | Path, frame: tuple[float, float] | None = DEFAULT_FRAME,

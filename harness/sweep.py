@@ -26,9 +26,9 @@ from ._binding import ConfigError
 from .config import build_config, canonical, command_overrides, given_twice, named_sets, parse_sets, parse_value
 from .errors import SweepError, UsageError
 from .metrics import percent
-from .options import CONTROL_OF, FRAME_NAMES, RL_COV_NAMES, SWEEP_MAX_TRIALS
+from .options import CONTROL_OF, FRAME_NAMES, PRIOR_RULES, PRIOR_STD, SWEEP_MAX_TRIALS
 
-PRIOR_PARAMS = ("prior_frame", "prior_ridge")
+PRIOR_PARAMS = ("prior_frame", "prior_ridge", "prior_std")
 DEFAULT_CELLS = list(range(0, geometry.CELLS, 25))  # 49 cells spread over the grid
 COLUMNS = ("key", "n_seeds", "n_cells", "success_rate_mean", "success_rate_sd", "success_rate_ico_failed",
            "n_ico_failed", "median_trials", "mean_elapsed_time", "wall_time")
@@ -41,7 +41,7 @@ def _name(name: str) -> str:
 
 def parse_params(items: Sequence[str]) -> dict[str, list[Any]]:
     """['noise_std=0.5,1', ...] -> {'actor.noise_std': [0.5, 1.0]}: canonical names (aliases
-    accepted) of configuration fields, or prior_frame / prior_ridge."""
+    accepted) of configuration fields, or prior_frame / prior_ridge / prior_std."""
     out: dict[str, list[Any]] = {}
     for item in items:
         if "=" not in item:
@@ -59,6 +59,9 @@ def parse_params(items: Sequence[str]) -> dict[str, list[Any]]:
         if name == "prior_ridge" and any(isinstance(v, bool) or not isinstance(v, (int, float))
                                          or not math.isfinite(v) or v < 0 for v in vals):
             raise SweepError("--param prior_ridge: values must be finite numbers >= 0")
+        if name == "prior_std" and any(isinstance(v, bool) or not isinstance(v, (int, float))
+                                       or not math.isfinite(v) or v <= 0 for v in vals):
+            raise SweepError("--param prior_std: values must be finite numbers > 0")
         if name in out:
             raise SweepError(f"--param {name} given twice")
         out[name] = vals
@@ -149,7 +152,7 @@ class SweepOptions:
     sets: Sequence[str] = ()
     one_at_a_time: bool = False
     threads: int = 0
-    rl_cov: str = RL_COV_NAMES[0]
+    prior_std: float = PRIOR_STD
     quiet: bool = False
     dask: Any = None              # a harness.cluster.DaskSpec: every grid on that Dask cluster (None: threads)
 
@@ -232,16 +235,18 @@ def run_sweep(opt: SweepOptions) -> int:
     out = store.check_out_dir(opt.out)
 
     def prior_for(setting):
+        """The condition's prior; the ICO grid of --prior-from reaches it only when its rule takes
+        the mean or the covariance from ICO (options.PRIOR_RULES)."""
+        condition = CONTROL_OF.get(opt.condition, opt.condition)
+        std = float(setting.get("prior_std", opt.prior_std))
+        if "ico" not in PRIOR_RULES[condition]:
+            return P.condition_prior(condition, None, std)
         frame = P.parse_frame(str(setting.get("prior_frame", FRAME_NAMES[0])))
         ridge = float(setting.get("prior_ridge", P.DEFAULT_RIDGE))
         k = (frame, ridge)
         if k not in priors:
             priors[k] = P.from_results(ico_dir, frame, ridge)
-        info = priors[k]
-        condition = CONTROL_OF.get(opt.condition, opt.condition)
-        if condition in ("ico-rl", "ico-search"):
-            return info
-        return P.rl_prior(info, "identity" if condition == "search" else opt.rl_cov)
+        return P.condition_prior(condition, priors[k], std)
 
     def config_for(setting):
         over = dict(fixed)
@@ -253,7 +258,7 @@ def run_sweep(opt: SweepOptions) -> int:
     meta = {"condition": opt.condition, "prior_from": str(ico_dir.resolve()), "cells": indices,
             "n_cells": len(indices), "seeds": seeds,
             "max_trials": int(build_config({"max_trials": fixed["max_trials"]}, check=False).run.max_trials),
-            "success_steps": opt.success_steps, "set": named_sets(opt.configuration, opt.sets), "rl_cov": opt.rl_cov}
+            "success_steps": opt.success_steps, "set": named_sets(opt.configuration, opt.sets), "prior_std": opt.prior_std}
     with store.DirectoryLock(out) as held:
         return _run_settings(opt, out, held, meta, todo, names, seeds, indices, ico_failed, config_for)
 

@@ -1,4 +1,4 @@
-"""The sweeps that chose the learners' defaults (issue 10, spec L2-L4), as one command:
+"""The sweeps that chose the learners' defaults (method.md, L2-L4), as one command:
 
     python -m harness.tools.learner_sweeps --prior-from results/bench/ico/seed-0 --out results/sweeps
 
@@ -35,10 +35,10 @@ STAGE_1 = (
     ("ico-rl-mean", "ico-rl", ["actor.update=mean", "actor.likelihood_std=0.03,0.1,0.3,1,3,10"], False),
     ("ico-rl-gradient", "ico-rl", ["actor.update=gradient",
                                      "actor.rate=0.0001,0.0003,0.001,0.003,0.01,0.03,0.1"], False),
-    ("rl-control", "rl-control", ["actor.update=posterior"], False),
-    ("rl-posterior", "rl", ["actor.update=posterior", "actor.likelihood_std=1,10"], False),
-    ("rl-mean", "rl", ["actor.update=mean", "actor.likelihood_std=0.1,0.3,1,10"], False),
-    ("rl-gradient", "rl", ["actor.update=gradient", "actor.rate=0.001,0.003,0.01,0.03,0.1"], False),
+    ("rl-control", "rl-ico-cov-control", ["actor.update=posterior"], False),
+    ("rl-posterior", "rl-ico-cov", ["actor.update=posterior", "actor.likelihood_std=1,10"], False),
+    ("rl-mean", "rl-ico-cov", ["actor.update=mean", "actor.likelihood_std=0.1,0.3,1,10"], False),
+    ("rl-gradient", "rl-ico-cov", ["actor.update=gradient", "actor.rate=0.001,0.003,0.01,0.03,0.1"], False),
     ("ico-search-control", "ico-search-control", ["search.cov_scale=1,16,256"], False),
     ("ico-search", "ico-search", ["search.batch=2,4,8", "search.elite_fraction=0.25,0.5",
                                   "search.step=0.5,1", "search.floor=0.01,0.1,1",
@@ -61,12 +61,38 @@ STAGE_2 = (
     ("ico-rl-noise-grid", "ico-rl", ["actor.explore_ticks=1000", "actor.noise_std=1,2,3,5",
                                         "actor.rate=0.0003,0.001,0.003,0.01"],
      False),
-    ("rl-stage2", "rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
+    ("rl-stage2", "rl-ico-cov", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
                          "actor.noise_std=1,0.3,0.5,2", "actor.scale=0.5,0.25,2"], True),
-    ("rl-schedule-grid", "rl", ["actor.explore_ticks=30,100,300", "actor.likelihood_std=0.03,0.1,0.3"], False),
-    ("rl-noise-grid", "rl", ["actor.noise_std=1,2,3", "actor.scale=0.5,2,8"], False),
-    ("rl-noise-grid2", "rl", ["actor.noise_std=3,5", "actor.scale=0.25,0.5", "actor.explore_ticks=0,1000"], False),
-    ("rl-noise-grid3", "rl", ["actor.explore_ticks=1000", "actor.noise_std=5,8", "actor.scale=0.1,0.25"], False),
+    ("rl-schedule-grid", "rl-ico-cov", ["actor.explore_ticks=30,100,300", "actor.likelihood_std=0.03,0.1,0.3"], False),
+    ("rl-noise-grid", "rl-ico-cov", ["actor.noise_std=1,2,3", "actor.scale=0.5,2,8"], False),
+    ("rl-noise-grid2", "rl-ico-cov", ["actor.noise_std=3,5", "actor.scale=0.25,0.5", "actor.explore_ticks=0,1000"], False),
+    ("rl-noise-grid3", "rl-ico-cov", ["actor.explore_ticks=1000", "actor.noise_std=5,8", "actor.scale=0.1,0.25"], False),
+)
+
+
+# RL alone from N(0, sigma_w^2 I) (--stage rl-alone): nothing from ICO reaches it; the ICO grid
+# of --prior-from only names the ICO-failed cells, the same selection every condition is chosen
+# on. The criterion is the one above, fixed before these runs: the highest success on the
+# ICO-failed cells, ties (within one point) broken by the spread cells, then by fewer median
+# trials. Stage 1 varies the reading with its rate and the prior's sigma_w; stage 2 (``--base``
+# the stage-1 choice) the exploration schedule, the batch, the critic quirks, sigma_u, alpha and
+# sigma_w around it, then grids. At least the settings ICO->RL was given (63 rows).
+RL_ALONE_1 = (
+    ("rl-alone-control", "rl-control", ["actor.update=posterior"], False),
+    ("rl-alone-posterior", "rl", ["actor.update=posterior", "actor.likelihood_std=1,10", "prior_std=0.1,1,10"],
+     False),
+    ("rl-alone-mean", "rl", ["actor.update=mean", "actor.likelihood_std=0.1,0.3,1,10", "prior_std=0.1,0.3,1,3,10"],
+     False),
+    ("rl-alone-gradient", "rl", ["actor.update=gradient", "actor.rate=0.0003,0.001,0.003,0.01,0.03,0.1"], False),
+)
+RL_ALONE_2 = (
+    ("rl-alone-stage2", "rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
+                               "actor.noise_std=1,0.5,2,3,5", "actor.scale=0.5,0.1,0.25,2", "prior_std=1,0.3,3"],
+     True),
+    ("rl-alone-noise-grid", "rl", ["actor.explore_ticks=1000", "actor.noise_std=2,3,5,8", "actor.scale=0.1,0.25,0.5"],
+     False),
+    ("rl-alone-schedule-grid", "rl", ["actor.noise_std=3", "actor.explore_ticks=100,300,1000",
+                                      "prior_std=0.3,1,3"], False),
 )
 
 
@@ -78,6 +104,7 @@ def ico_failed_cells(prior_from: Path) -> str:
 
 
 SELECTIONS = ("spread", "ico-failed")
+PLANS = {"1": STAGE_1, "2": STAGE_2, "rl-alone": RL_ALONE_1, "rl-alone-2": RL_ALONE_2}
 
 
 def _pct(row: dict | None, key: str) -> str:
@@ -93,7 +120,7 @@ def report(out: Path) -> str:
              "Success in % of the selection's cells, mean ± sd over the seeds; median trials to success. "
              "Spread: 49 cells evenly over the grid; ICO-failed: the cells where the ICO grid of --prior-from failed.",
              ""]
-    for name, condition, _params, _one in STAGE_1 + STAGE_2:
+    for name, condition, _params, _one in STAGE_1 + STAGE_2 + RL_ALONE_1 + RL_ALONE_2:
         tables = {}
         for sel in SELECTIONS:
             path = out / f"{name}-{sel}" / "sweep.csv"
@@ -133,7 +160,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m harness.tools.learner_sweeps", description=__doc__.split("\n")[0])
     ap.add_argument("--prior-from", required=True, type=Path, help="ICO results directory (one seed)")
     ap.add_argument("--out", required=True, type=Path, help="one subdirectory per sweep and selection")
-    ap.add_argument("--stage", type=int, choices=(1, 2), default=1)
+    ap.add_argument("--stage", choices=tuple(PLANS), default="1",
+                    help="1, 2: the sweeps that chose ICO->RL's, RL with the ICO covariance's and the search's "
+                         "defaults; rl-alone, rl-alone-2: RL alone from N(0, sigma_w^2 I)")
     ap.add_argument("--base", action="append", default=[], metavar="NAME=VALUE",
                     help="stage 2: the stage-1 choice, fixed in every setting (repeatable)")
     ap.add_argument("--only", action="append", default=[], help="run only the sweeps of these names")
@@ -146,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
         print(path)
         return 0
     selections = {"spread": dict(subset=SPREAD_CELLS), "ico-failed": dict(cells=ico_failed_cells(args.prior_from))}
-    plan = STAGE_1 if args.stage == 1 else STAGE_2
+    plan = PLANS[args.stage]
     for name, condition, params, one_at_a_time in plan:
         if args.only and name not in args.only:
             continue

@@ -198,7 +198,7 @@ def test_config_defaults_match_spec():
     assert cri["discount"] == pytest.approx(0.95)
     assert act["noise_std"] == 3.0 and act["scale"] == 0.5 and act["forgetting"] == 1.0
     assert pol["clip_inputs"] is True and act["reflex"] is True and act["act_with_sample"] is False
-    # spec L2-L4, A10: the literal critic, per-tick updates and sigma_L = sigma_u (0); the actor
+    # method.md, L2-L4, A10: the literal critic, per-tick updates and sigma_L = sigma_u (0); the actor
     # reading, its exploration schedule and the search group chosen by the learner sweeps
     assert cri["quirks"] is False
     assert act["update"] == "gradient" and act["rate"] == pytest.approx(0.001) and act["likelihood_std"] == 0.0
@@ -212,26 +212,34 @@ def test_config_defaults_match_spec():
 
 
 def test_condition_overrides():
-    """The nine conditions over the C defaults: each learner's mode, its control the same with
+    """Every condition over the C defaults: each learner's mode, its control the same with
     learn = 0; search from N(0, I) with Sigma0 = 4 I (search.cov_scale 4), ico-search with the C
-    default c = 64; RL alone with its own reading (mean, sigma_L 0.1, sigma_u 5, alpha 0.1,
-    exploration until tick 1000); nothing else overridden."""
+    default c = 64; ICO->RL and the ICO mean with sigma_w^2 I on the C defaults' reading; the
+    two RL conditions with a zero mean on the readings their sweeps chose (mean reading, sigma_L
+    0.1, sigma_u 5, alpha 0.1, exploration until tick 1000); nothing else overridden. Each
+    actor-critic and search condition has its prior rule."""
     assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS) and options.CONDITIONS == (
-        "ico", "ico-rl", "ico-rl-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
-        "search-control")
-    assert options.CONTROL_OF == {"ico-rl-control": "ico-rl", "rl-control": "rl",
+        "ico", "ico-rl", "ico-rl-control", "ico-mean-rl", "ico-mean-rl-control", "rl-ico-cov", "rl-ico-cov-control",
+        "rl", "rl-control", "ico-search", "ico-search-control", "search", "search-control")
+    assert options.CONTROL_OF == {"ico-rl-control": "ico-rl", "ico-mean-rl-control": "ico-mean-rl",
+                                  "rl-ico-cov-control": "rl-ico-cov", "rl-control": "rl",
                                   "ico-search-control": "ico-search", "search-control": "search"}
+    assert options.PRIOR_RULES == {"ico-rl": ("ico", "ico"), "ico-mean-rl": ("ico", "isotropic"),
+                                   "rl-ico-cov": ("zero", "ico"), "rl": ("zero", "isotropic"),
+                                   "ico-search": ("ico", "ico"), "search": ("zero", "identity")}
     default = build_config().flat()
-    modes = {"ico": "ico", "ico-rl": "rl", "rl": "rl", "ico-search": "search", "search": "search"}
+    modes = {"ico": "ico", "ico-rl": "rl", "ico-mean-rl": "rl", "rl-ico-cov": "rl", "rl": "rl",
+             "ico-search": "search", "search": "search"}
+    zero_mean = ("rl-ico-cov", "rl")
     for condition in options.CONDITIONS:
         flat = build_config(condition=condition).flat()
         base = options.CONTROL_OF.get(condition, condition)
         assert flat["mode"] == modes[base] and flat["learn"] is (condition not in options.CONTROL_OF)
         assert flat["search.cov_scale"] == (4.0 if base == "search" else 64.0)
         changed = {n for n in flat if flat[n] != default[n]}
-        rl_alone = {"actor.update", "actor.likelihood_std", "actor.noise_std", "actor.scale"}
-        assert changed <= {"mode", "learn", "search.cov_scale"} | (rl_alone if base == "rl" else set()), condition
-        if base == "rl":
+        reading = {"actor.update", "actor.likelihood_std", "actor.noise_std", "actor.scale"}
+        assert changed <= {"mode", "learn", "search.cov_scale"} | (reading if base in zero_mean else set()), condition
+        if base in zero_mean:
             assert (flat["actor.update"], flat["actor.likelihood_std"], flat["actor.noise_std"], flat["actor.scale"],
                     flat["actor.explore_ticks"]) == ("mean", pytest.approx(0.1), 5.0, pytest.approx(0.1), 1000)
         if condition in options.CONTROL_OF:  # a control is its condition with every update off

@@ -1,4 +1,4 @@
-"""The linear-policy ceiling (spec L5, harness.ceiling): fixed-w evaluation, the search, the
+"""The linear-policy ceiling (method.md, L5, harness.ceiling): fixed-w evaluation, the search, the
 first-step bound, the command and its files, the bench's reference lines."""
 import json
 import shutil

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from harness import _binding as B
-from harness import _worker, cli, cluster, grid, results
+from harness import _worker, cli, cluster, grid, options, results
 from harness import prior as P
 from harness.conditions import condition_prior, run_condition
 from harness.config import build_config
@@ -81,7 +81,8 @@ def test_session_checked_every_worker(session):
 def test_condition_same_cells_npz_as_threads(session, ico_dir, tmp_path, condition):
     """run_condition with the Dask session writes the cells.npz of the threaded engine."""
     caps = SMALL if condition == "ico" else RL_CAPS
-    info = condition_prior(condition, None if condition == "ico" else ico_dir, P.DEFAULT_FRAME, P.DEFAULT_RIDGE)
+    takes_ico = "ico" in options.PRIOR_RULES.get(condition, ())
+    info = condition_prior(condition, ico_dir if takes_ico else None, P.DEFAULT_FRAME, P.DEFAULT_RIDGE)
     common = dict(condition=condition, seed=3, overrides=caps, cell_spec=CELL_SPEC, progress=False, info=info)
     ref, ref_record, _ = run_condition(out=tmp_path / "threads", threads=2, **common)
     got, record, cancelled = run_condition(out=tmp_path / "dask", threads=0, dask=session, **common)

@@ -68,7 +68,7 @@ def test_documented_command_parses(where, command):
 
 
 def test_learner_sweep_plans_build():
-    """Every setting of the learner sweeps (harness.tools.learner_sweeps, spec L2-L4) builds a
+    """Every setting of the learner sweeps (harness.tools.learner_sweeps, method.md, L2-L4) builds a
     configuration of its condition, in the mode of that condition."""
     from harness import _binding as B
     from harness.tools import learner_sweeps

@@ -1,5 +1,5 @@
 """Every harness fault is one line `icoac-harness: error: ...` on stderr, exit status 2, and nothing
-on disk is rewritten (issue 8). The CLI runs in-process through harness.cli.main."""
+on disk is rewritten. The CLI runs in-process through harness.cli.main."""
 import errno
 import json
 import shutil

@@ -33,7 +33,7 @@ def test_small_grid_outcomes(small_run):
     assert np.all(cells["total_steps"] >= cells["trials"])
     assert np.all(cells["total_steps"][~ok] < SMALL["max_trials"] * SMALL["success_steps"])
     assert np.allclose(cells["elapsed_time"], 0.01 * cells["total_steps"])
-    # Learned ICO weights are positive, of the magnitude the spec quotes, and w_theta dominates.
+    # Learned ICO weights are positive, of the magnitude the paper reports, and w_theta dominates.
     w = cells["weights"][ok]
     assert np.all(w > 0) and np.all(w < 1)
     assert np.all(w[:, 2] == w.max(axis=1))

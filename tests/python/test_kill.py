@@ -21,7 +21,7 @@ from harness.config import build_config
 
 REPO = Path(__file__).resolve().parents[2]
 CELLS = "539-685"          # rows theta0 = -1, 0, +1 deg: 147 cells, about 4 s on 2 threads
-CAPS = {"max_trials": 100000, "success_steps": 5000}  # sized for the engine with lanes (issue 11)
+CAPS = {"max_trials": 100000, "success_steps": 5000}  # sized for the engine with lanes
 GRID_ARGS = ["--cells", CELLS, "--seed", "5", "--threads", "2", "--max-trials", str(CAPS["max_trials"]),
              "--success-steps", str(CAPS["success_steps"]), "--quiet"]
 KILL_SEED = int(os.environ.get("ICOAC_KILL_SEED", "8"))

@@ -34,7 +34,7 @@ def test_alias_table_covers_the_abi3_names():
     old = json.loads((ABI3_ICO / "run.json").read_text())["config"]["controller"]
     assert set(old) - {"mode"} == set(ALIASES) == set(VALUES)
     # every ABI-3 field has its alias; "learn" (the no-learning control) and the learners' fields of
-    # ABI 6 (spec L2-L4, A10) came after ABI 3 and have canonical names only
+    # ABI 6 (method.md, L2-L4, A10) came after ABI 3 and have canonical names only
     after_abi3 = {"mode", "learn", "critic.quirks", "actor.update", "actor.rate", "actor.likelihood_std",
                   "actor.batch", "actor.explore_ticks", "search.batch", "search.elite_fraction", "search.step",
                   "search.floor", "search.cov_scale"}

@@ -69,9 +69,25 @@ def test_prior_exact_mean_cov_and_frame():
     assert narrow.n_cells == 2 and narrow.ridge == P.DEFAULT_RIDGE
     d = narrow.to_dict()
     assert d["frame"] == {"x0_abs_max": 0.6, "theta0_abs_max_deg": 3.0} and d["n_cells"] == 2
-    rl = P.rl_prior(info)
-    assert np.all(rl.mean == 0) and np.array_equal(rl.cov, info.cov)
-    assert np.array_equal(P.rl_prior(info, "identity").cov, np.eye(4))
+    # the prior taken apart: each condition's mean and covariance, and its provenance
+    both = P.condition_prior("ico-rl", info)
+    assert np.array_equal(both.mean, info.mean) and np.array_equal(both.cov, info.cov)
+    ico_mean = P.condition_prior("ico-mean-rl", info, std=0.5)
+    assert np.array_equal(ico_mean.mean, info.mean) and np.array_equal(ico_mean.cov, 0.25 * np.eye(4))
+    ico_cov = P.condition_prior("rl-ico-cov", info)
+    assert np.all(ico_cov.mean == 0) and np.array_equal(ico_cov.cov, info.cov)
+    alone = P.condition_prior("rl", info, std=2.0)
+    assert np.all(alone.mean == 0) and np.array_equal(alone.cov, 4.0 * np.eye(4))
+    # nothing that ICO produced reaches RL alone: no source, no frame, no cell count
+    d = alone.to_dict()
+    assert (d["source"], d["frame"], d["n_cells"], d["mean_from"], d["cov_from"]) == (None, None, 0, "zero",
+                                                                                      "isotropic")
+    assert P.condition_prior("rl", None, std=2.0).to_dict() == d
+    assert np.array_equal(P.condition_prior("search", None).cov, np.eye(4))
+    with pytest.raises(P.PriorError, match="needs an ICO prior"):
+        P.condition_prior("rl-ico-cov", None)
+    with pytest.raises(P.PriorError, match="prior-std"):
+        P.condition_prior("rl", None, std=0.0)
 
 
 def test_prior_errors():
@@ -127,23 +143,21 @@ def test_rl_grid_deterministic_records_posterior(ico_dir, configuration):
             assert np.trace(cov) < 0.99 * np.trace(prior_cov)  # no forgetting: Sigma_w shrinks
         else:
             assert np.array_equal(cov, prior_cov)  # the gradient reading moves mu_w only
-    rl = build_config(TINY_RL, condition="rl", prior=P.rl_prior(info).prior())
+    rl = build_config(TINY_RL, condition="rl", prior=P.condition_prior("rl", None).prior())
     c = grid.make_cells(5, [611])
     grid.run_grid(rl, c, progress=False)
     assert c["outcome"][0] != B.PENDING
 
 
-# -- the no-learning controls (spec L1) -----------------------------------------------------------------
+# -- the no-learning controls (method.md, L1) -----------------------------------------------------------------
 @pytest.mark.parametrize("configuration", ["default", "literal"])
-@pytest.mark.parametrize("condition", ["ico-rl-control", "rl-control"])
+@pytest.mark.parametrize("condition", ["ico-rl-control", "rl-ico-cov-control", "rl-control"])
 def test_control_learns_nothing_and_equals_zero_rates(ico_dir, condition, configuration):
     """A control keeps the prior exactly (mu_w and Sigma_w of every cell), and its outcomes equal
     those of its condition with the learning rates at 0: the critic rate and the actor's, the
     rate beta of the gradient reading (ICO->RL's default), the scale alpha of the mean (RL
     alone's default) and posterior (literal) ones."""
-    info = P.from_results(ico_dir)
-    if condition == "rl-control":
-        info = P.rl_prior(info)
+    info = P.condition_prior(options.CONTROL_OF[condition], P.from_results(ico_dir))
     prior = info.prior()
     named = LITERAL if configuration == "literal" else {}
     control = build_config({**TINY_RL, **named}, condition=condition, prior=prior)
@@ -210,7 +224,7 @@ def closed_form(cfg, mu, sigma, s_t, delta, eps):
     rng = np.array(c.policy.input_range, dtype=float)
     h = c.policy.gain * np.clip(s_t / rng, -1.0, 1.0)
     y = h @ mu + c.actor.scale * delta * eps  # u_ob = mu_u + alpha * delta * eps
-    # the likelihood std sigma_L (spec L2), not sigma_u; but sigma_u when likelihood_std is 0
+    # the likelihood std sigma_L (method.md, L2), not sigma_u; but sigma_u when likelihood_std is 0
     sigma_l = c.actor.likelihood_std if c.actor.likelihood_std != 0 else c.actor.noise_std
     S = h @ sigma @ h + sigma_l ** 2
     return mu + sigma @ h * (y - h @ mu) / S, sigma - np.outer(sigma @ h, sigma @ h) / S
@@ -350,11 +364,13 @@ def test_bench_quick_writes_comparison(tmp_path):
                   "--rl-max-trials", "100", timeout=120)
     assert res.returncode == 0, res.stderr
     for name in ("fig2b_icorl_success_map.png", "fig3a_success_rate.png", "fig3b_elapsed_time.png",
-                 "fig1b_success_map.png"):
+                 "fig3c_learning_curves.png", "fig1b_success_map.png"):
         data = (fig / name).read_bytes()
         assert data[:8] == PNG and len(data) > 5000
-    # all nine conditions: ICO, then ICO->RL, RL, ICO->search and search, each with its control
-    conds = ("ico", "ico-rl", "ico-rl-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
+    # every condition: ICO, the actor-critic from the four priors, ICO->search and search, each
+    # learner with its control
+    conds = ("ico", "ico-rl", "ico-rl-control", "ico-mean-rl", "ico-mean-rl-control", "rl-ico-cov",
+             "rl-ico-cov-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
              "search-control")
     assert options.CONDITIONS == conds
     for cond in conds:
@@ -376,6 +392,26 @@ def test_bench_quick_writes_comparison(tmp_path):
             assert gain["cells_gained"]["per_seed"][i] == np.count_nonzero(sa & ~sb)
             assert gain["cells_lost"]["per_seed"][i] == np.count_nonzero(~sa & sb)
         assert "gain_over_control" not in summary[control]
+    # the learning curve of every condition: its cells' trials to success, averaged over the seeds
+    for cond in conds:
+        curve = summary[cond]["success_within"]
+        per_seed = []
+        for seed in (0, 1):
+            a, _ = results.load(out / cond / f"seed-{seed}")
+            ok = a["outcome"] == B.SUCCESS
+            per_seed.append([np.count_nonzero(ok & (a["trials"] <= k)) / a.size for k in curve["k"]])
+        np.testing.assert_allclose(curve["all"]["mean"], np.mean(per_seed, axis=0), rtol=1e-12)
+        assert all(np.diff(curve["all"]["mean"]) >= 0)
+    assert "prior mean | prior covariance" in text and "k = 100 |" in text
+    # RL alone takes nothing from ICO; under the default (gradient) reading the prior covariance
+    # plays no part, so the ICO mean with sigma_w^2 I gives ICO->RL's cells bit for bit
+    for seed in (0, 1):
+        record = json.loads((out / "rl" / f"seed-{seed}" / "run.json").read_text())
+        assert record["prior_info"]["source"] is None and record["prior_info"]["cov_from"] == "isotropic"
+        a, _ = results.load(out / "ico-rl" / f"seed-{seed}")
+        b, _ = results.load(out / "ico-mean-rl" / f"seed-{seed}")
+        for f in ("outcome", "trials", "weights"):
+            assert np.array_equal(a[f], b[f]), f
     bench = json.loads((out / "bench.json").read_text())
     assert bench["complete"] and len(bench["stages"]) == 2 * len(conds) + 2 + 2  # grids, priors, summary, figures
     # the search conditions: Sigma0 = 64 x the ICO prior's covariance (ico-search), 4 I (search)

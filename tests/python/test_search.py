@@ -1,4 +1,4 @@
-"""The episodic search (mode search, spec L4; conditions ico-search and search) through the binding:
+"""The episodic search (mode search, method.md, L4; conditions ico-search and search) through the binding:
 the update after each batch of trials against a numpy reference of the same step (with its
 fallback: when Sigma' is not positive definite, the floor is added to the whole diagonal), a step
 of 1 with small elites over many updates, the per-trial draws in distribution, determinism, and
@@ -145,7 +145,7 @@ def test_update_matches_numpy(setting, condition):
     batch, rho, step, floor_f, cov_scale = setting
     rng = np.random.default_rng(batch * 100 + int(10 * step))
     if condition == "search":
-        mean0, cov0 = np.zeros(4), np.eye(4)  # spec L4: search starts from N(0, I)
+        mean0, cov0 = np.zeros(4), np.eye(4)  # method.md, L4: search starts from N(0, I)
     else:
         mean0, cov0 = random_prior(rng, 0.3)
     cfg = build_config({"search.batch": batch, "search.elite_fraction": rho, "search.step": step,
@@ -268,7 +268,7 @@ def test_deterministic_for_a_seed():
 
 @pytest.mark.parametrize("condition", ["ico-search", "search"])
 def test_no_learning_control_learns_nothing(condition):
-    """The condition with learn = 0 (its no-learning control, spec L1): over a grid every cell ends
+    """The condition with learn = 0 (its no-learning control, method.md, L1): over a grid every cell ends
     with mu_w = the prior mean and Sigma_w = Sigma0 = c Sigma_prior exactly; tick by tick, full
     batches of failures change neither; the learning condition does change them."""
     info = conditions.condition_prior(condition, ABI3_ICO if condition == "ico-search" else None,
