@@ -290,3 +290,46 @@ def test_paper_grid_layout():
     rows, cols = geometry.grid_index(cells)
     assert np.array_equal(geometry.cell_index(rows, cols), np.arange(cells.size))
     assert geometry.THETA_STEP_DEG == 1.0 and geometry.map_extent() == (-2.45, 2.45, -12.5, 12.5)
+
+
+def test_retune_and_the_configuration_in_force():
+    """The state keeps its configuration: an edit of the caller's struct changes nothing,
+    icoac_retune applies a checked one (a bad field: ConfigError, a mode change:
+    ICOAC_ERR_RETUNE_MODE, the state unchanged either way), icoac_get_config reads it back; a
+    tick after a terminal tick is ICOAC_ERR_TRIAL_ENDED and a corrupted state's reset
+    ICOAC_ERR_CORRUPT_STATE, each a named IcoacError."""
+    cfg = build_config(condition="rl")
+    state = B.State()
+    B.check_status(B.lib.icoac_init(ctypes.byref(cfg.controller), ctypes.byref(state), None, 1))
+    in_force = B.Config()
+
+    def config_in_force():
+        B.check_status(B.lib.icoac_get_config(ctypes.byref(state), ctypes.byref(in_force)))
+        return bytes(in_force)
+
+    kept = config_in_force()
+    cfg.controller.actor.noise_std = 2.0
+    assert config_in_force() == kept  # an edit alone changes nothing
+    B.check_status(B.lib.icoac_retune(ctypes.byref(state), ctypes.byref(cfg.controller)))
+    assert config_in_force() == bytes(cfg.controller)
+    before = bytes(state)
+    bad = build_config(condition="rl")
+    bad.controller.actor.noise_std = math.nan
+    with pytest.raises(B.ConfigError, match="actor"):
+        B.check_status(B.lib.icoac_retune(ctypes.byref(state), ctypes.byref(bad.controller)))
+    other = build_config(condition="search")
+    with pytest.raises(B.IcoacError, match="mode") as err:
+        B.check_status(B.lib.icoac_retune(ctypes.byref(state), ctypes.byref(other.controller)))
+    assert err.value.status == B.CONSTANTS["ICOAC_ERR_RETUNE_MODE"] and bytes(state) == before
+    inp, out = B.Input(), B.Output()
+    inp.flags = B.INPUT_TERMINAL
+    B.check_status(B.lib.icoac_step(ctypes.byref(state), ctypes.byref(inp), ctypes.byref(out)))
+    inp.flags = 0
+    status = B.lib.icoac_step(ctypes.byref(state), ctypes.byref(inp), ctypes.byref(out))
+    assert status == out.status == B.CONSTANTS["ICOAC_ERR_TRIAL_ENDED"] and out.force == 0
+    assert "icoac_reset" in B.status_str(status)
+    raw = bytearray(bytes(state))
+    raw[8:12] = (99).to_bytes(4, "little")  # the configuration copy's mode (the state's layout is private:
+    ctypes.memmove(ctypes.addressof(state), bytes(raw), len(raw))  # it follows a 4-byte magic and has_prev)
+    with pytest.raises(B.IcoacError, match="corrupted"):
+        B.check_status(B.lib.icoac_reset(ctypes.byref(state)))
