@@ -24,7 +24,7 @@ FUZZ_FLAGS ?=
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim
 
 .PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz bench \
-  bench-speed clean target-report sweeps
+  bench-speed clean target-report sweeps sweeps-rl-alone
 
 all: build
 
@@ -115,6 +115,17 @@ sweeps: build venv
 	  --only rl-noise-grid3 --base actor.update=mean --base actor.likelihood_std=0.1
 	$(SWEEP) --report
 	cp $(SWEEP_OUT)/summary.md docs/sweeps.md
+
+# RL alone's own sweep (N(0, sigma_w^2 I), nothing from ICO; the ICO grid only names the
+# ICO-failed cells): stage 1, readings x sigma_w; stage 2 around its choice (RL_ALONE_BASE).
+RL_ALONE_OUT ?= results/sweeps-rl-alone
+RL_ALONE_BASE ?= --base actor.update=mean --base actor.likelihood_std=0.1
+RL_ALONE_SWEEP = $(VPY) -m harness.tools.learner_sweeps --prior-from $(SWEEP_ICO) --out $(RL_ALONE_OUT)
+sweeps-rl-alone: build venv
+	$(RL_ALONE_SWEEP) --stage rl-alone
+	$(RL_ALONE_SWEEP) --stage rl-alone-2 $(RL_ALONE_BASE)
+	$(RL_ALONE_SWEEP) --report
+	cp $(RL_ALONE_OUT)/summary.md docs/sweeps-rl-alone.md
 
 # Microcontroller resource report: cross builds, QEMU runs, table in docs/porting.md.
 target-report: deps

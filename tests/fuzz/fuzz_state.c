@@ -4,7 +4,7 @@
  * (icoac_double) and fuzz_state_mcu (float, ICOAC_FAST_EXP and the sparse critic kernel: the
  * microcontroller presets' build, whose kept-unit list the host libraries do not use).
  *
- * The promise under test (issue text): no configuration reaching icoac_step or icoac_reset,
+ * The promise under test: no configuration reaching icoac_step or icoac_reset,
  * checked or not, and no state content, corrupted or not, makes the library read or write
  * outside the objects it was given or reach undefined behaviour. ASan and UBSan (every report
  * fatal) watch the library; the state, input, output and every result buffer are heap blocks of

@@ -311,13 +311,13 @@ def controller_seeds(fmt):
         "nonfinite-input": (config(rl) + NO_PRIOR + seed(16) + steps(ZERO, 2)
                             + step(("nan", "0", "0", "0")) + step(("0", "inf", "0", "0"))
                             + step(("0", "0", "-inf", "0"), terminal=True) + steps(ZERO, 2)),
-        # Issue 9: a mode ignores the groups it does not use, even when they are bad.
+        # A mode ignores the groups it does not use, even when they are bad.
         "config-ico-ignores-rl-groups": (config({"critic.range[0]": "1e-39", "critic.threshold": "nan",
                                                  "actor.noise_std": "1e-20", "actor.reflex": 2})
                                          + NO_PRIOR + seed(17) + EXERCISE),
         "config-rl-ignores-ico-group": (config({**rl, "ico.rate": "nan", "ico.timing": 2}) + NO_PRIOR + seed(18)
                                         + EXERCISE),
-        # The learners (spec L2-L4, A10): actor readings, per-trial batches, the exploration
+        # The learners (docs/method.md, L2-L4, A10): actor readings, per-trial batches, the exploration
         # schedule, the critic quirks, and the episodic search over several batches.
         "rl-mean": config({**rl, "actor.update": 1, "actor.likelihood_std": 0.25}) + NO_PRIOR + seed(19) + EXERCISE * 2,
         "rl-gradient": config({**rl, "actor.update": 2, "actor.rate": 0.1}) + NO_PRIOR + seed(20) + EXERCISE * 2,
@@ -397,7 +397,7 @@ def controller_seeds(fmt):
                                           + steps((2.5, 1.0, "0.25", 1.0), 16, terminal=True)
                                           + steps(ZERO, 3) + step(("nan", "0", "0", "0")) + RESET + EXERCISE)
     s.update({
-        # Known reproducers (issue 8).
+        # Known reproducers of the tick contract.
         "repro-rl-critic-range0-1e-39": config({**rl, "critic.range[0]": "1e-39"}) + NO_PRIOR + seed(1) + step(ZERO),
         "repro-rl-noise-std-1e-20": (config({**rl, "actor.noise_std": "1e-20"}) + NO_PRIOR + seed(1) + steps(ZERO, 3)
                                      + EXERCISE),
@@ -738,7 +738,7 @@ def sim_seeds():
                            + op_plant(("0", "0", "3.2", "1e300"), "-max")),
         "trajectory-fall": (plant() + run() + config({"policy.gain": "0"}) + NO_PRIOR
                             + op_trajectory(0.0, 0.2, "0.01", 9, 64)),
-        # Known reproducer (issue 8): a subnormal dt passes the plant check.
+        # Known reproducer of the tick contract: a subnormal dt passes the plant check.
         "repro-plant-dt-1e-310": plant(dt="1e-310") + run() + config() + NO_PRIOR + SIM_OPS,
         # Found by fuzzing the fixed engine: float subnormals in the configuration or prior are
         # checked as given, then flushed to 0 in the run (FTZ/DAZ), so the verdicts differ.

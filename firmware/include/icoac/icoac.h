@@ -252,8 +252,9 @@ icoac_status_t icoac_reset(icoac_state_t *state);
  *   every tick is refused until icoac_reset, so a repeated terminal tick cannot record a trial
  *   twice (a terminal tick that failed leaves the trial open).
  * Whatever bytes the state holds (corrupted memory), a tick reads and writes only inside
- * state, in and out, with no undefined behaviour; a corrupted mode or switch gives
- * ICOAC_ERR_CORRUPT_STATE, and icoac_reset checks the rest. */
+ * state, in and out, with no undefined behaviour; a corrupted mode, ico.timing or actor.update
+ * gives ICOAC_ERR_CORRUPT_STATE, and icoac_reset checks the rest (every other field of the copy,
+ * the slots, the learned values but the critic weights). */
 icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out);
 
 /* Current weights (ICO w or actor mean mu_w) and covariance Sigma_w. */
