@@ -1,6 +1,7 @@
-/* Failure report of FZ_CHECK. */
+/* Failure report of FZ_CHECK, and the checks' shared helpers. */
 #include "fuzz_check.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,4 +16,15 @@ void fz_fail(const char *file, int line, const char *cond, const char *fmt, ...)
     fprintf(stderr, "\n");
     fflush(stderr);
     abort();
+}
+
+int fz_all_finite(const icoac_real_t *p, int n)
+{
+    int i;
+    for (i = 0; i < n; ++i) {
+        if (!isfinite(p[i])) {
+            return 0;
+        }
+    }
+    return 1;
 }

@@ -3,6 +3,8 @@
 #ifndef ICOAC_FUZZ_CHECK_H
 #define ICOAC_FUZZ_CHECK_H
 
+#include "icoac/icoac_types.h"
+
 /* FZ_CHECK(condition, printf format, arguments...): abort with a message unless condition. */
 #define FZ_CHECK(cond, ...)                                    \
     do {                                                       \
@@ -18,5 +20,8 @@
 #endif
 
 void fz_fail(const char *file, int line, const char *cond, const char *fmt, ...) FZ_NORETURN;
+
+/* 1 when the n reals at p are all finite. */
+int fz_all_finite(const icoac_real_t *p, int n);
 
 #endif /* ICOAC_FUZZ_CHECK_H */

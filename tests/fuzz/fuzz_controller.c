@@ -165,36 +165,25 @@ static icoac_counters_t counters_of(const icoac_state_t *state)
     return c;
 }
 
-static int finite_n(const icoac_real_t *p, int n)
-{
-    int i;
-    for (i = 0; i < n; ++i) {
-        if (!isfinite(p[i])) {
-            return 0;
-        }
-    }
-    return 1;
-}
-
 /* Name of the first non-finite learned field, or NULL. */
 static const char *learned_nonfinite(const learned_t *l, int with_w_act)
 {
     int i;
-    if (!finite_n(l->w, N)) {
+    if (!fz_all_finite(l->w, N)) {
         return "w";
     }
     if (!isfinite(l->weight_norm)) {
         return "weight_norm";
     }
     for (i = 0; i < N; ++i) {
-        if (!finite_n(l->cov[i], N)) {
+        if (!fz_all_finite(l->cov[i], N)) {
             return "cov";
         }
     }
-    if (!finite_n(l->v, ICOAC_CRITIC_UNITS)) {
+    if (!fz_all_finite(l->v, ICOAC_CRITIC_UNITS)) {
         return "v";
     }
-    if (with_w_act && !finite_n(l->w_act, N)) {
+    if (with_w_act && !fz_all_finite(l->w_act, N)) {
         return "w_act";
     }
     return 0;
@@ -413,7 +402,7 @@ static int prior_documented(const icoac_prior_t *prior)
 {
     int i;
     for (i = 0; i < N; ++i) {
-        if (!isfinite(prior->mean[i]) || !finite_n(prior->cov[i], N) || !(prior->cov[i][i] > ICOAC_R(0.0))) {
+        if (!isfinite(prior->mean[i]) || !fz_all_finite(prior->cov[i], N) || !(prior->cov[i][i] > ICOAC_R(0.0))) {
             return 0;
         }
     }
@@ -654,7 +643,7 @@ static void check_reset(const icoac_config_t *cfg, icoac_state_t *state, int op)
     FZ_CHECK(field == 0, "op %d: icoac_reset changed the learned %s", op, field);
     FZ_CHECK(all_zero(after.batch_shift, N) && all_zero(&after.batch_info[0][0], N * N) && after.trial_ticks == 0u,
              "op %d: icoac_reset kept the trial's batch sums or tick count (%u)", op, (unsigned)after.trial_ticks);
-    FZ_CHECK(finite_n(after.w_act, N), "op %d: icoac_reset OK with a non-finite w_act", op);
+    FZ_CHECK(fz_all_finite(after.w_act, N), "op %d: icoac_reset OK with a non-finite w_act", op);
     if (!sampled) {
         FZ_CHECK(memcmp(after.w_act, after.w, sizeof after.w) == 0, "op %d: icoac_reset left w_act != w", op);
     }

@@ -196,17 +196,6 @@ static const char *status_name(int32_t status)
     return icoac_status_str((icoac_status_t)status);
 }
 
-static int finite_n(const icoac_real_t *p, int n)
-{
-    int i;
-    for (i = 0; i < n; ++i) {
-        if (!isfinite(p[i])) {
-            return 0;
-        }
-    }
-    return 1;
-}
-
 /* a and b the same value: bitwise, or both NaN (a NaN's payload may depend on operand order). */
 static int same_real(icoac_real_t a, icoac_real_t b)
 {
@@ -350,7 +339,7 @@ static int32_t check_step(run_t *run)
     const icoac_priv_state_t *st = st_of(run);
     const icoac_priv_state_t *was = icoac_priv_state_c(&before);
     const int terminal = (run->in->flags & ICOAC_INPUT_TERMINAL) != 0u;
-    const int finite_in = finite_n(run->in->s, N);
+    const int finite_in = fz_all_finite(run->in->s, N);
     int32_t status;
     int ended;
     memcpy(&before, run->state, sizeof before);
@@ -426,7 +415,7 @@ static const char *must_refuse(const icoac_priv_state_t *st)
     }
     /* the critic weights are not checked (icoac_lifecycle.c): a non-finite one makes the ticks
      * that read it ICOAC_ERR_NUMERIC */
-    if (!finite_n(st->w, N) || !isfinite(st->weight_norm) || !finite_n(&st->cov_buffer[st->cov_slot][0][0], N * N) ||
+    if (!fz_all_finite(st->w, N) || !isfinite(st->weight_norm) || !fz_all_finite(&st->cov_buffer[st->cov_slot][0][0], N * N) ||
         !isfinite(st->rng.spare_normal)) {
         return "learned value";
     }
@@ -434,7 +423,7 @@ static const char *must_refuse(const icoac_priv_state_t *st)
         return 0;
     }
     if (st->search.count < 0 || st->search.count >= ICOAC_SEARCH_BATCH_MAX ||
-        !finite_n(&st->search.lower[0][0], N * N)) {
+        !fz_all_finite(&st->search.lower[0][0], N * N)) {
         return "search count or factor";
     }
     for (i = 0; i < N; ++i) {

@@ -45,16 +45,19 @@ def snapshot(root: Path) -> dict:
             for p in sorted(root.rglob("*"))}
 
 
-@pytest.fixture(scope="module")
-def partial_dir(tmp_path_factory):
-    """A 4-cell results directory, two cells finished and two PENDING (a resume would run them)."""
-    out = tmp_path_factory.mktemp("partial") / "res"
+def write_partial(out: Path) -> Path:
+    """A 4-cell results directory at out, two cells finished and two PENDING (a resume would run them)."""
     cfg = build_config(TINY)
     cells = grid.make_cells(SEED, CELLS)
     grid.run_grid(cfg, cells, threads=2, progress=False)
     grid.reset_pending(cells, np.arange(cells.size) >= 2)
     store.save(out, cells, cfg, condition="ico", seed=SEED, wall_time=0.5, threads=2, cell_indices=CELLS)
     return out
+
+
+@pytest.fixture(scope="module")
+def partial_dir(tmp_path_factory):
+    return write_partial(tmp_path_factory.mktemp("partial") / "res")
 
 
 @pytest.fixture

@@ -20,7 +20,7 @@ from harness import conditions, grid, results, store
 from harness.config import build_config
 from harness.errors import ResultsError
 
-from test_faults import CELLS, SEED, TINY, TINY_ARGS, assert_one_line_error, main, snapshot
+from test_faults import CELLS, SEED, TINY, TINY_ARGS, assert_one_line_error, main, snapshot, write_partial
 
 REPO = Path(__file__).resolve().parents[2]
 GRID = ["--cells", "611", *TINY_ARGS]
@@ -219,13 +219,7 @@ def test_every_command_holds_its_out(capsys, ico_dir, tmp_path, command):
 @pytest.fixture
 def partial(tmp_path):
     """A 4-cell results directory of the current build, two cells finished, two PENDING."""
-    out = tmp_path / "res"
-    cfg = build_config(TINY)
-    cells = grid.make_cells(SEED, CELLS)
-    grid.run_grid(cfg, cells, threads=2, progress=False)
-    grid.reset_pending(cells, np.arange(cells.size) >= 2)
-    store.save(out, cells, cfg, condition="ico", seed=SEED, wall_time=0.5, threads=2, cell_indices=CELLS)
-    return out
+    return write_partial(tmp_path / "res")
 
 
 def edit(d: Path, fn) -> None:
