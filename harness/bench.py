@@ -315,6 +315,7 @@ class BenchOptions:
     out: Path
     figures: Path | None = None
     data: Path | None = None      # the summary for docs (docs/data/*.json): aggregate, ceiling, provenance
+    summary_only: bool = False    # only the summary and figures of the grids OUT holds complete; nothing runs
     seed: int = 0
     seeds: int | None = None
     rl_max_trials: int | None = None
@@ -415,6 +416,21 @@ def stages(opt: BenchOptions) -> list[Stage]:
         print(md.read_text(), end="")
         progress(f"  wrote {md} and {js}")
 
+    def finished_stage(ctx):
+        found = []
+        for condition in CONDITIONS:
+            for seed in seeds:
+                d = seed_dir(out, condition, seed)
+                if results.exists(d):
+                    cells, record = results.load(d)
+                    if record.get("complete"):
+                        ctx[(condition, seed)] = (cells, record)
+                        found.append(f"{condition}/seed-{seed}")
+        progress(f"  {len(found)} complete grids: " + ", ".join(found))
+
+    if opt.summary_only:
+        return [Stage("complete grids", finished_stage), Stage("summary", summary_stage),
+                Stage("figures", figures_stage)]
     for condition in CONDITIONS:  # every override valid before the first grid runs
         build_config(overrides(condition), condition=condition)
     if opt.ceiling is not None:

@@ -214,6 +214,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "paper: 5 seeds, all at 1e5/1e5; quick: smoke test")
     b.add_argument("--out", required=True, help="bench directory (one results directory per condition and seed)")
     b.add_argument("--figures", default=None, help="figure directory")
+    b.add_argument("--summary-only", action="store_true",
+                   help="run nothing: the summary, --data and figures of the grids OUT holds complete")
     b.add_argument("--data", default=None,
                    help="also write the summary that docs/results.md's tables come from (e.g. docs/data/bench-default.json)")
     _add_seeds(b, "default: the profile's")
@@ -376,7 +378,7 @@ def cmd_bench(args) -> int:
 
     opt = bench.BenchOptions(
         profile=args.profile, out=Path(args.out), figures=Path(args.figures) if args.figures else None,
-        data=Path(args.data) if args.data else None,
+        data=Path(args.data) if args.data else None, summary_only=args.summary_only,
         seed=args.seed, seeds=args.seeds, rl_max_trials=args.rl_max_trials, threads=_threads_arg(args),
         configuration=args.configuration, sets=args.set or [], resume=args.resume, quiet=args.quiet,
         frame=_frame(args), ridge=args.prior_ridge, prior_std=args.prior_std,

@@ -436,3 +436,9 @@ def test_bench_quick_writes_comparison(tmp_path):
     cells_after, record = results.load(out / "rl" / "seed-1")
     assert np.array_equal(cells_before, cells_after) and record["complete"]
     assert json.loads((out / "bench.json").read_text())["meta"]["resume"] is True
+    # --summary-only runs nothing and summarises the grids OUT holds: the same summary as the bench's
+    res = run_cli("bench", "--profile", "quick", "--out", str(out), "--summary-only", "--quiet",
+                  "--data", str(tmp_path / "data.json"), timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert json.loads((out / "summary.json").read_text()) == summary
+    assert json.loads((tmp_path / "data.json").read_text())["aggregate"] == summary
