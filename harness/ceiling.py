@@ -247,7 +247,7 @@ def evaluate_into(out: Path, w: Sequence[float], protocol: str, *, seed: int, in
 
 SUMMARY_KEYS = ("n_cells", "n_interior", "n_success", "n_success_interior", "success_rate",
                 "success_rate_interior", "median_trials_to_success", "max_trials_to_success", "total_trials",
-                "outcomes")
+                "outcomes", "success_within")
 
 
 def protocol_summary(cells: np.ndarray, record: Mapping[str, Any] | None = None,
