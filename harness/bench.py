@@ -267,10 +267,11 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
 
 
 class BenchLog:
-    """OUT/bench.json: wall time per stage and of the whole bench, rewritten after every stage."""
+    """OUT/bench.json (a --summary-only run: OUT/bench-summary.json, so the grids' log stays):
+    wall time per stage and of the whole bench, rewritten after every stage."""
 
-    def __init__(self, out: Path, meta: Mapping[str, Any]):
-        self.path = Path(out) / "bench.json"
+    def __init__(self, out: Path, meta: Mapping[str, Any], name: str = "bench.json"):
+        self.path = Path(out) / name
         self.t0 = time.monotonic()
         self.data: dict[str, Any] = {"meta": dict(meta), "stages": [], "total_wall_time": 0.0,
                                      "complete": False}
@@ -460,7 +461,8 @@ def _run_stages(opt: BenchOptions, todo: list[Stage], ctx: dict, argv: Sequence[
         "profile": opt.profile, "seeds": opt.seed_list(),
         "rl_max_trials": opt.rl_max_trials, "resume": bool(opt.resume), "threads": opt.threads,
         "set": named_sets(opt.configuration, opt.sets), "argv": list(argv),
-        **({"backend": session.describe()} if session is not None else {})})
+        **({"backend": session.describe()} if session is not None else {})},
+        "bench-summary.json" if opt.summary_only else "bench.json")
     for i, stage in enumerate(todo, 1):
         progress(f"({i}/{len(todo)}) {stage.name}")
         t0 = time.monotonic()

@@ -442,3 +442,4 @@ def test_bench_quick_writes_comparison(tmp_path):
     assert res.returncode == 0, res.stderr
     assert json.loads((out / "summary.json").read_text()) == summary
     assert json.loads((tmp_path / "data.json").read_text())["aggregate"] == summary
+    assert json.loads((out / "bench.json").read_text())["meta"]["resume"] is True  # the grids' log stays
