@@ -134,7 +134,7 @@ static void test_nonneg_at_least(void **unused)
     }
 }
 
-static void test_centres_of_spec(void **unused)
+static void test_grid_centres(void **unused)
 {
     /* the centres listed in method.md: x {-1.6, 0, 1.6}; theta +-2, +-6, +-10 deg (to 4 digits) */
     const double x_c[3] = {-1.6, 0.0, 1.6};
@@ -442,7 +442,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_nonneg_at_least),
-        cmocka_unit_test(test_centres_of_spec),
+        cmocka_unit_test(test_grid_centres),
         cmocka_unit_test(test_separable_equals_direct),
         cmocka_unit_test(test_value_is_weighted_sum),
         cmocka_unit_test(test_threshold_drops_small_activations),
