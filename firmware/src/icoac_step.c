@@ -30,11 +30,11 @@ static icoac_status_t rejected(const icoac_priv_state_t *st, icoac_output_t *out
 /* The slow path of a state that is not in a trial: ended by a terminal tick, or never set up. */
 ICOAC_PRIV_NOINLINE static icoac_status_t not_in_trial(icoac_priv_state_t *st, icoac_output_t *out)
 {
-    clear_output(out);
     if (st->magic == ICOAC_PRIV_STATE_ENDED) {
         st->counters.ticks++;
         return rejected(st, out, ICOAC_ERR_TRIAL_ENDED);
     }
+    clear_output(out);
     out->status = ICOAC_ERR_NOT_INITIALISED;
     return ICOAC_ERR_NOT_INITIALISED;
 }
