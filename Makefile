@@ -119,7 +119,7 @@ sweeps: build venv
 # RL alone's own sweep (N(0, sigma_w^2 I), nothing from ICO; the ICO grid only names the
 # ICO-failed cells): stage 1, readings x sigma_w; stage 2 around its choice (RL_ALONE_BASE).
 RL_ALONE_OUT ?= results/sweeps-rl-alone
-RL_ALONE_BASE ?= --base actor.update=mean --base actor.likelihood_std=0.1
+RL_ALONE_BASE ?= --base actor.update=gradient --base actor.rate=0.03
 RL_ALONE_SWEEP = $(VPY) -m harness.tools.learner_sweeps --prior-from $(SWEEP_ICO) --out $(RL_ALONE_OUT)
 sweeps-rl-alone: build venv
 	$(RL_ALONE_SWEEP) --stage rl-alone
