@@ -1,0 +1,153 @@
+"""Bit-for-bit comparison of grid cells against committed reference cells.
+
+Runs a spread subset of the paper grid's cells (CELLS, failing and successful ones) for every
+learning condition and its no-learning control, with small caps, through the harness and the
+library it loads, and compares every result field of every cell (outcome, status, trials, steps,
+elapsed time, final weights and covariance) bit for bit with the reference.
+
+    python -m tests.tools.compare_cells            # compare (exit 1 on any difference)
+    python -m tests.tools.compare_cells --generate # rewrite the reference (from the checkout's library)
+
+The reference (tests/python/fixtures/reference_cells.npz) records the commit it was generated
+from. The ICO prior of the conditions that take one is part of the reference: the ICO->RL prior
+of a default-profile ICO grid (seed 0), stored as numbers, so the comparison needs no ICO grid.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+REFERENCE = ROOT / "tests" / "python" / "fixtures" / "reference_cells.npz"
+
+# 39 cells: every 41st of the 1225 (corners and edges included) and a run through the centre.
+CELLS = sorted(set(range(0, 1225, 41)) | set(range(596, 630, 4)))
+SEED = 3
+CAPS = {"max_trials": 100, "success_steps": 5000}
+ICO_CAPS = {"max_trials": 3000, "success_steps": 5000}
+RESULT_FIELDS = ("outcome", "status", "trials", "total_steps", "last_trial_steps", "elapsed_time", "weights",
+                 "cov")
+CART_POLE_INPUTS = 4
+
+# The ICO prior: the ICO->RL prior (default frame and ridge) of an ICO grid of the default profile
+# (results/ico-seed0: seed 0, 1e5 trials, at ad0bc3e), stored in the reference by --generate.
+
+
+def _run_condition(condition: str, ico_prior) -> np.ndarray:
+    from harness import _binding as B
+    from harness import grid
+    from harness import prior as P
+    from harness.config import CONDITION_OVERRIDES, build_config, make_prior
+    caps = ICO_CAPS if condition == "ico" else CAPS
+    info = None
+    base = {"ico-rl-control": "ico-rl", "ico-mean-rl-control": "ico-mean-rl", "rl-ico-cov-control": "rl-ico-cov",
+            "rl-control": "rl", "ico-search-control": "ico-search", "search-control": "search"}.get(condition, condition)
+    if base != "ico":
+        info = P.condition_prior(base, ico_prior)
+    prior = None
+    if info is not None:
+        n = B.N_INPUTS
+        mean = np.zeros(n)
+        cov = np.eye(n)
+        mean[:CART_POLE_INPUTS] = info.mean[:CART_POLE_INPUTS]
+        cov[:CART_POLE_INPUTS, :CART_POLE_INPUTS] = info.cov[:CART_POLE_INPUTS, :CART_POLE_INPUTS]
+        prior = make_prior(mean, cov)
+    cfg = build_config({**CONDITION_OVERRIDES[condition], **caps}, prior=prior)
+    cells = grid.make_cells(SEED, CELLS)
+    grid.run_grid(cfg, cells, threads=2, progress=False)
+    out = np.zeros(cells.size, dtype=[(f, np.float64 if f in ("elapsed_time",) else np.int64)
+                                      for f in RESULT_FIELDS if f not in ("weights", "cov")]
+                   + [("weights", np.float64, (CART_POLE_INPUTS,)),
+                      ("cov", np.float64, (CART_POLE_INPUTS, CART_POLE_INPUTS))])
+    for f in RESULT_FIELDS:
+        if f == "weights":
+            out[f] = cells[f][:, :CART_POLE_INPUTS]
+        elif f == "cov":
+            out[f] = cells[f][:, :CART_POLE_INPUTS, :CART_POLE_INPUTS]
+        else:
+            out[f] = cells[f]
+    return out
+
+
+def _ico_prior_from_reference(data):
+    from harness import prior as P
+    return P.PriorInfo(mean=np.asarray(data["ico_prior_mean"]), cov=np.asarray(data["ico_prior_cov"]),
+                       frame=None, n_cells=0, ridge=0.0)
+
+
+def _commit() -> str:
+    try:
+        return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True,
+                              check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def generate(ico_prior_from: Path) -> None:
+    from harness import options
+    from harness import prior as P
+    ico = P.from_results(ico_prior_from)
+    arrays = {"ico_prior_mean": ico.mean[:CART_POLE_INPUTS],
+              "ico_prior_cov": ico.cov[:CART_POLE_INPUTS, :CART_POLE_INPUTS]}
+    for condition in options.CONDITIONS:
+        arrays[condition] = _run_condition(condition, ico)
+    meta = {"commit": _commit(), "cells": CELLS, "seed": SEED, "caps": CAPS, "ico_caps": ICO_CAPS,
+            "command": f"python -m tests.tools.compare_cells --generate --ico-prior-from {ico_prior_from}"}
+    arrays["meta"] = np.array(json.dumps(meta))
+    np.savez_compressed(REFERENCE, **arrays)
+    print(f"wrote {REFERENCE} ({meta['commit']})")
+
+
+def load_conditions() -> list[str]:
+    """The conditions of the reference."""
+    return [name for name in np.load(REFERENCE).files if name not in ("meta", "ico_prior_mean", "ico_prior_cov")]
+
+
+def compare(conditions=None) -> dict[str, dict[str, int]]:
+    """{condition: {"cells": compared, "identical": bit-identical cells, "outcome_or_trials": cells
+    whose outcome or trial count differs}}."""
+    from harness import options
+    data = np.load(REFERENCE)
+    ico = _ico_prior_from_reference(data)
+    report = {}
+    for condition in conditions or options.CONDITIONS:
+        ref = data[condition]
+        new = _run_condition(condition, ico)
+        same = np.ones(ref.size, dtype=bool)
+        for f in RESULT_FIELDS:
+            a = np.ascontiguousarray(ref[f]).view(np.uint8).reshape(ref.size, -1)
+            b = np.ascontiguousarray(new[f]).view(np.uint8).reshape(new.size, -1)
+            same &= (a == b).all(axis=1)
+        coarse = (ref["outcome"] != new["outcome"]) | (ref["trials"] != new["trials"])
+        report[condition] = {"cells": int(ref.size), "identical": int(same.sum()),
+                             "outcome_or_trials": int(coarse.sum()),
+                             "successes": int((ref["outcome"] == 1).sum())}
+    return report
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--generate", action="store_true", help="rewrite the reference cells")
+    parser.add_argument("--ico-prior-from", type=Path, default=ROOT / "results" / "ico-seed0",
+                        help="ICO results directory of the prior (--generate only)")
+    parser.add_argument("--condition", action="append", help="compare only these conditions")
+    args = parser.parse_args(argv)
+    if args.generate:
+        generate(args.ico_prior_from)
+        return 0
+    report = compare(args.condition)
+    meta = json.loads(str(np.load(REFERENCE)["meta"]))
+    print(f"reference: commit {meta['commit']}, {len(meta['cells'])} cells, seed {meta['seed']}")
+    for condition, row in report.items():
+        print(f"{condition:22s} {row['identical']:3d} / {row['cells']} bit-identical, "
+              f"{row['outcome_or_trials']} differ in outcome or trials ({row['successes']} reference successes)")
+    return 0 if all(r["identical"] == r["cells"] for r in report.values()) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
