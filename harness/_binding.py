@@ -30,7 +30,7 @@ BUILD_INFO = PACKAGE_LIBRARY.parent / "build_info.json"   # the commit the packa
 DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.so"
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
-ABI_VERSION = 7
+ABI_VERSION = 8
 SIM_ABI_VERSION = 2
 
 
@@ -174,8 +174,15 @@ def enum(prefix: str, members: tuple[str, ...] | None = None) -> dict[str, int]:
     return out
 
 
-N_INPUTS = int(constant("ICOAC_N_INPUTS"))
-CRITIC_UNITS = int(constant("ICOAC_CRITIC_UNITS"))
+# The engine's plant is the cart-pole (the controller's cart-pole task): its 4 state variables
+# are the inputs, the weights and the prior; the C structs have room for the build maxima.
+N_INPUTS = int(constant("ICOAC_CARTPOLE_INPUTS"))
+CRITIC_UNITS = int(constant("ICOAC_CARTPOLE_CRITIC_UNITS"))
+MAX_INPUTS = int(constant("ICOAC_MAX_INPUTS"))
+MAX_RULES = int(constant("ICOAC_MAX_RULES"))
+INPUT_LATE = int(constant("ICOAC_INPUT_LATE"))
+LATE_SOURCES = enum("ICOAC_LATE_", ("RULES", "SENSOR"))  # rules, sensor
+RULE_SIDES = enum("ICOAC_RULE_", ("BELOW", "ABOVE"))     # below, above
 STATE_SIZE = int(constant("ICOAC_STATE_SIZE"))
 INPUT_TERMINAL = int(constant("ICOAC_INPUT_TERMINAL"))
 
@@ -204,6 +211,7 @@ ERR_BAD_CRITIC = int(constant("ICOAC_ERR_BAD_CRITIC"))
 ERR_BAD_ACTOR = int(constant("ICOAC_ERR_BAD_ACTOR"))
 ERR_BAD_PRIOR = int(constant("ICOAC_ERR_BAD_PRIOR"))
 ERR_BAD_SEARCH = int(constant("ICOAC_ERR_BAD_SEARCH"))
+ERR_BAD_TASK = int(constant("ICOAC_ERR_BAD_TASK"))
 SIM_OK = int(constant("ICOAC_SIM_OK"))
 SIM_ERR_BAD_PLANT = int(constant("ICOAC_SIM_ERR_BAD_PLANT"))
 SIM_ERR_BAD_RUN = int(constant("ICOAC_SIM_ERR_BAD_RUN"))
@@ -247,20 +255,31 @@ elif _SIZEOF_REAL == 8:
 else:  # pragma: no cover
     raise LibraryError(f"unsupported icoac_real_t size {_SIZEOF_REAL}")
 
-_R4 = c_real * N_INPUTS
-_R44 = (c_real * N_INPUTS) * N_INPUTS
+_RN = c_real * MAX_INPUTS
+_RNN = (c_real * MAX_INPUTS) * MAX_INPUTS
+
+
+class TaskConfig(ctypes.Structure):
+    """icoac_task_config_t: the plant's inputs and late signal (every mode)."""
+    _fields_ = [
+        ("n_inputs", ctypes.c_int32),
+        ("late_source", ctypes.c_int32),
+        ("n_rules", ctypes.c_int32),
+        ("rule_input", ctypes.c_int32 * MAX_RULES),
+        ("rule_side", ctypes.c_int32 * MAX_RULES),
+        ("rule_threshold", c_real * MAX_RULES),
+        ("rule_reflex", c_real * MAX_RULES),
+    ]
 
 
 class PolicyConfig(ctypes.Structure):
     """icoac_policy_config_t: state -> feature z -> force (every mode)."""
     _fields_ = [
-        ("input_range", _R4),
+        ("input_range", _RN),
         ("clip_inputs", ctypes.c_int32),
         ("gain", c_real),
         ("reflex_mode", ctypes.c_int32),
         ("reflex_force", c_real),
-        ("zone_theta", c_real),
-        ("zone_x", c_real),
     ]
 
 
@@ -275,7 +294,8 @@ class CriticConfig(ctypes.Structure):
         ("rate", c_real),
         ("discount", c_real),
         ("td_clip", c_real),
-        ("range", _R4),
+        ("range", _RN),
+        ("units", ctypes.c_int32 * MAX_INPUTS),
         ("threshold", c_real),
         ("quirks", ctypes.c_int32),
     ]
@@ -313,6 +333,7 @@ class Config(ctypes.Structure):
     _fields_ = [
         ("mode", ctypes.c_int32),
         ("learn", ctypes.c_int32),
+        ("task", TaskConfig),
         ("policy", PolicyConfig),
         ("ico", IcoConfig),
         ("critic", CriticConfig),
@@ -322,8 +343,9 @@ class Config(ctypes.Structure):
 
 
 class Prior(ctypes.Structure):
-    """icoac_prior_t: mean and covariance of (w_x, w_xdot, w_theta, w_thetadot)."""
-    _fields_ = [("mean", _R4), ("cov", _R44)]
+    """icoac_prior_t: mean and covariance of the weights (the cart-pole's: w_x, w_xdot, w_theta,
+    w_thetadot in the leading 4 entries)."""
+    _fields_ = [("mean", _RN), ("cov", _RNN)]
 
 
 class Counters(ctypes.Structure):
@@ -339,7 +361,7 @@ class State(ctypes.Structure):
 
 class Input(ctypes.Structure):
     """icoac_input_t."""
-    _fields_ = [("s", _R4), ("flags", ctypes.c_uint32)]
+    _fields_ = [("s", _RN), ("flags", ctypes.c_uint32), ("reflex", c_real)]
 
 
 class Output(ctypes.Structure):
@@ -520,7 +542,7 @@ _PROTOTYPES = {
     "icoac_get_config": ([_P(State), _P(Config)], ctypes.c_int),
     "icoac_get_posterior": ([_P(State), _P(Prior)], ctypes.c_int),
     "icoac_get_counters": ([_P(State), _P(Counters)], ctypes.c_int),
-    "icoac_prior_check": ([_P(Prior)], ctypes.c_int),
+    "icoac_prior_check": ([_P(Prior), ctypes.c_int32], ctypes.c_int),
     "icoac_mix_seed": ([ctypes.c_uint64, ctypes.c_uint64], ctypes.c_uint64),
     "icoac_sim_status_str": ([ctypes.c_int32], ctypes.c_char_p),
     "icoac_sim_plant_default": ([_P(Plant)], None),

@@ -430,7 +430,7 @@ def lqr_starts(cfg: RunConfig) -> list[tuple[str, tuple[float, ...]]]:
     gain = float(cfg.controller.policy.gain)
     if gain <= 0:
         return []
-    ranges = np.array(list(cfg.controller.policy.input_range), dtype=np.float64)
+    ranges = np.array(list(cfg.controller.policy.input_range)[:B.N_INPUTS], dtype=np.float64)
     a, b = linearise(cfg)
     q = np.diag(1.0 / ranges ** 2)
     out = []

@@ -43,8 +43,6 @@ ALIASES: dict[str, str] = {
     "gain": "policy.gain",
     "reflex_mode": "policy.reflex_mode",
     "reflex_force": "policy.reflex_force",
-    "zone_theta": "policy.zone_theta",
-    "zone_x": "policy.zone_x",
     "ico_rate": "ico.rate",
     "ico_timing": "ico.timing",
     "critic_rate": "critic.rate",
@@ -60,12 +58,22 @@ ALIASES: dict[str, str] = {
 }
 assert set(ALIASES.values()) <= set(CONTROLLER_FIELDS) and not set(ALIASES) & set(ALL_FIELDS), ALIASES
 
+# The cart-pole's penalty zone (method.md, Eq. 4) by the names of the versions before the task
+# description: each sets two thresholds of the cart-pole task's rule table (icoac_task_cartpole:
+# rules 0 and 2 on theta at +v and -v, rules 1 and 3 on x at -v and +v). Not recorded (the
+# record holds task.rule_threshold); accepted by --set, sweep --param and old run.json files.
+ZONE_RULES: dict[str, tuple[tuple[int, float], ...]] = {"policy.zone_theta": ((0, 1.0), (2, -1.0)),
+                                                        "policy.zone_x": ((1, -1.0), (3, 1.0))}
+ZONE_ALIASES = {"zone_theta": "policy.zone_theta", "zone_x": "policy.zone_x"}
+
 # Symbolic values of the switches (values from the C constant table) and the 0/1 flags.
 ENUMS: dict[str, dict[str, int]] = {
     "mode": B.MODES,
     "policy.reflex_mode": B.REFLEX_MODES,
     "ico.timing": B.ICO_TIMINGS,
     "actor.update": B.ACTOR_UPDATES,
+    "task.late_source": B.LATE_SOURCES,
+    "task.rule_side": B.RULE_SIDES,
     "integrator": B.INTEGRATORS,
 }
 BOOLS = ("learn", "policy.clip_inputs", "critic.quirks", "actor.reflex", "actor.act_with_sample", "actor.batch")
@@ -126,10 +134,12 @@ def canonical(name: Any) -> str:
     """The canonical name of a parameter given by its canonical name or an alias; ConfigError
     (listing the valid names) for anything else."""
     if isinstance(name, str):
-        if name in _GROUP_OF:
+        if name in _GROUP_OF or name in ZONE_RULES:
             return name
         if name in ALIASES:
             return ALIASES[name]
+        if name in ZONE_ALIASES:
+            return ZONE_ALIASES[name]
     hint = ""
     if isinstance(name, str):
         close = difflib.get_close_matches(name, list(ALL_FIELDS) + list(ALIASES), n=1)
@@ -141,7 +151,7 @@ def canonical(name: Any) -> str:
 
 def group_of(name: str) -> str:
     """'controller', 'plant' or 'run' of a canonical name."""
-    return _GROUP_OF[name]
+    return "controller" if name in ZONE_RULES else _GROUP_OF[name]
 
 
 # -- fields of the ctypes structures, by canonical name ------------------------------------------------
@@ -244,7 +254,8 @@ _FIELD_STATUS = _probe_statuses()
 
 
 def _bad(name: str, message: str) -> ConfigError:
-    return ConfigError(_FIELD_STATUS[name], f"{group_of(name)} parameter {name}: {message}")
+    status = B.ERR_BAD_ZONE if name in ZONE_RULES else _FIELD_STATUS[name]
+    return ConfigError(status, f"{group_of(name)} parameter {name}: {message}")
 
 
 def _is_number(value: Any) -> bool:
@@ -324,6 +335,13 @@ def _parse_scalar(name: str, ctype, value: Any):
 
 def _set_field(struct: ctypes.Structure, name: str, value: Any) -> None:
     """Set a field by canonical name (relative to struct), parsing and range-checking the value."""
+    if name in ZONE_RULES:
+        half_width = _parse_real(name, B.c_real, value)
+        if not half_width > 0:
+            raise _bad(name, f"value {_short(value)} must be > 0 (a zone half-width)")
+        for rule, sign in ZONE_RULES[name]:
+            struct.task.rule_threshold[rule] = sign * half_width
+        return
     owner, leaf = _owner(struct, name)
     ctype = dict(owner._fields_)[leaf]
     if issubclass(ctype, ctypes.Array):
@@ -333,9 +351,16 @@ def _set_field(struct: ctypes.Structure, name: str, value: Any) -> None:
                 [v for v in value.replace("[", "").replace("]", "").split(",") if v.strip()]
         if isinstance(value, np.ndarray):
             value = value.tolist()
-        if not isinstance(value, (list, tuple)) or len(value) != ctype._length_:
-            raise _bad(name, f"bad value {_short(value)}; expected {ctype._length_} numbers")
-        setattr(owner, leaf, ctype(*[_parse_scalar(name, ctype._type_, v) for v in value]))
+        # every entry, or the leading ones a task uses (the others keep their values): the
+        # cart-pole's N_INPUTS of an input array, any number of a rule array (task.n_rules)
+        sizes = (set(range(1, ctype._length_ + 1)) if name.startswith("task.rule_") else
+                 {B.N_INPUTS, ctype._length_})
+        if not isinstance(value, (list, tuple)) or len(value) not in sizes:
+            expected = " or ".join(str(n) for n in sorted(sizes)) if len(sizes) < 3 else f"1 to {ctype._length_}"
+            raise _bad(name, f"bad value {_short(value)}; expected {expected} numbers")
+        array = getattr(owner, leaf)
+        for i, v in enumerate(value):
+            array[i] = _parse_scalar(name, ctype._type_, v)
     else:
         setattr(owner, leaf, _parse_scalar(name, ctype, value))
 
@@ -483,8 +508,10 @@ def _same(a, b) -> bool:
 
 # -- priors --------------------------------------------------------------------------------------------
 def prior_to_dict(prior: B.Prior) -> dict[str, Any]:
-    return {"mean": [_real_out(v) for v in prior.mean],
-            "cov": [[_real_out(v) for v in row] for row in prior.cov]}
+    """The cart-pole prior's leading N_INPUTS entries (the others are unused, 0)."""
+    n = B.N_INPUTS
+    return {"mean": [_real_out(v) for v in prior.mean[:n]],
+            "cov": [[_real_out(v) for v in row[:n]] for row in prior.cov[:n]]}
 
 
 def _prior_array(value: Any, shape: tuple[int, ...], what: str) -> np.ndarray:
@@ -532,7 +559,7 @@ def prior_from_dict(data: Mapping[str, Any] | None) -> B.Prior | None:
 
 def check_prior(prior: B.Prior) -> None:
     """Prior validation is the C library's (icoac_prior_check, also run by icoac_init)."""
-    B.check_status(B.lib.icoac_prior_check(ctypes.byref(prior)), "prior")
+    B.check_status(B.lib.icoac_prior_check(ctypes.byref(prior), B.N_INPUTS), "prior")
 
 
 # -- building and reading configurations ---------------------------------------------------------------

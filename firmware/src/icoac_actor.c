@@ -1,8 +1,10 @@
 /* Actor (method.md: the Bayesian actor, L2): the posterior, mean and gradient readings of one
- * observation, per tick or summed over a trial (batch, A14), and the per-trial sample of w. */
+ * observation, per tick or summed over a trial (batch, A14), and the per-trial sample of w.
+ * Vectors and matrices run over all ICOAC_MAX_INPUTS entries: those past the task's n are 0 and
+ * stay 0 (h, w and Sigma_w are 0 there), only the factorizations take n. */
 #include "icoac_priv.h"
 
-#define N ICOAC_N_INPUTS
+#define N ICOAC_MAX_INPUTS
 
 /* sigma_L^2: actor.likelihood_std, or sigma_u^2 when it is 0 (the literal reading). */
 static inline icoac_real_t likelihood_var(const icoac_actor_config_t *actor)
@@ -13,19 +15,20 @@ static inline icoac_real_t likelihood_var(const icoac_actor_config_t *actor)
 
 void icoac_priv_actor_sample(icoac_priv_state_t *st)
 {
+    const int n = icoac_priv_inputs(&st->config);
     icoac_real_t lower[N][N];
     icoac_real_t sample[N];
-    if (!icoac_priv_cholesky4(icoac_priv_cov_c(st), lower)) {
+    int i;
+    if (!icoac_priv_cholesky(icoac_priv_cov_c(st), lower, n)) {
         /* the draw is made anyway, so the stream does not depend on the factor */
-        (void)icoac_rng_normal(&st->rng);
-        (void)icoac_rng_normal(&st->rng);
-        (void)icoac_rng_normal(&st->rng);
-        (void)icoac_rng_normal(&st->rng);
-        icoac_priv_copy4(st->w_act, st->w);
+        for (i = 0; i < n; ++i) {
+            (void)icoac_rng_normal(&st->rng);
+        }
+        icoac_priv_copy(st->w_act, st->w);
         return;
     }
-    icoac_priv_sample_lower(&st->rng, st->w, ICOAC_PRIV_CONST_MAT4(lower), sample);
-    icoac_priv_copy4(st->w_act, sample);
+    icoac_priv_sample_lower(&st->rng, st->w, ICOAC_PRIV_CONST_MAT(lower), sample, n);
+    icoac_priv_copy(st->w_act, sample);
 }
 
 /* Posterior reading: Sigma' = A Sigma A^T + sigma_L^2 k k^T with A = I - k h^T (Joseph form),
@@ -52,12 +55,12 @@ static inline void posterior_step(const icoac_actor_config_t *actor, const icoac
                 cov[i][j] = prior[i][j] * inflate;
             }
         }
-        prior = ICOAC_PRIV_CONST_MAT4(cov);
+        prior = ICOAC_PRIV_CONST_MAT(cov);
     }
     for (i = 0; i < N; ++i) {
-        cov_h[i] = icoac_priv_dot4(prior[i], h);
+        cov_h[i] = icoac_priv_dot(prior[i], h);
     }
-    inv_innovation_var = ICOAC_R(1.0) / (icoac_priv_dot4(h, cov_h) + noise_var);
+    inv_innovation_var = ICOAC_R(1.0) / (icoac_priv_dot(h, cov_h) + noise_var);
     for (i = 0; i < N; ++i) {
         gain[i] = cov_h[i] * inv_innovation_var;
         w[i] = st->w[i] + gain[i] * innovation;
@@ -68,7 +71,7 @@ static inline void posterior_step(const icoac_actor_config_t *actor, const icoac
         }
     }
     for (i = 0; i < N; ++i) {
-        a_cov_h[i] = icoac_priv_dot4(a_cov[i], h);
+        a_cov_h[i] = icoac_priv_dot(a_cov[i], h);
     }
     /* written last: cov may be the prior it was computed from */
     for (i = 0; i < N; ++i) {
@@ -96,9 +99,9 @@ ICOAC_PRIV_NOINLINE static void mean_step(const icoac_actor_config_t *actor, con
     icoac_real_t step;
     int i;
     for (i = 0; i < N; ++i) {
-        cov_h[i] = icoac_priv_dot4(prior[i], h);
+        cov_h[i] = icoac_priv_dot(prior[i], h);
     }
-    step = innovation / (icoac_priv_dot4(h, cov_h) + likelihood_var(actor));
+    step = innovation / (icoac_priv_dot(h, cov_h) + likelihood_var(actor));
     for (i = 0; i < N; ++i) {
         w[i] = st->w[i] + cov_h[i] * step;
     }
@@ -152,7 +155,7 @@ ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, cons
             }
         }
     }
-    if (!icoac_priv_spd_inverse4(ICOAC_PRIV_CONST_MAT4(cov), precision)) {
+    if (!icoac_priv_spd_inverse(ICOAC_PRIV_CONST_MAT(cov), precision, icoac_priv_inputs(&st->config))) {
         return -1;
     }
     for (i = 0; i < N; ++i) {
@@ -163,11 +166,11 @@ ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, cons
     if (h_last != 0) {
         add_info(actor, h_last, precision);
     }
-    if (!icoac_priv_spd_inverse4(ICOAC_PRIV_CONST_MAT4(precision), cov)) {
+    if (!icoac_priv_spd_inverse(ICOAC_PRIV_CONST_MAT(precision), cov, icoac_priv_inputs(&st->config))) {
         return -1;
     }
     for (i = 0; i < N; ++i) {
-        w[i] = st->w[i] + icoac_priv_dot4(cov[i], shift);
+        w[i] = st->w[i] + icoac_priv_dot(cov[i], shift);
     }
     return actor->update == ICOAC_ACTOR_POSTERIOR;
 }
@@ -183,12 +186,12 @@ ICOAC_PRIV_NOINLINE static icoac_real_t batch_shift(const icoac_actor_config_t *
     int i;
     if (actor->update != ICOAC_ACTOR_GRADIENT) {
         scale = ICOAC_R(1.0) / likelihood_var(actor);
-        trace = icoac_priv_trace4(st->batch.info) + icoac_priv_dot4(h, h) * scale;
+        trace = icoac_priv_trace(st->batch.info) + icoac_priv_dot(h, h) * scale;
     }
     for (i = 0; i < N; ++i) {
         shift[i] = st->batch.shift[i] + h[i] * (observation * scale);
     }
-    return trace + icoac_priv_dot4(shift, shift);
+    return trace + icoac_priv_dot(shift, shift);
 }
 
 int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t *st, const icoac_real_t h[N],
@@ -199,11 +202,11 @@ int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t 
      * w_act is mu_w bit for bit and the first term is exactly 0 */
     icoac_real_t innovation = actor->scale * delta * st->noise_prev;
     if (actor->act_with_sample) {
-        innovation += icoac_priv_dot4(h, st->w_act) - icoac_priv_dot4(h, st->w);
+        innovation += icoac_priv_dot(h, st->w_act) - icoac_priv_dot(h, st->w);
     }
     if (actor->batch) {
         icoac_real_t *shift = st->batch.staged_shift;
-        icoac_priv_copy4(shift, st->batch.shift);
+        icoac_priv_copy(shift, st->batch.shift);
         if (observed) {
             const icoac_real_t observation =
                 actor->update == ICOAC_ACTOR_GRADIENT ? delta * st->noise_prev : innovation;
@@ -212,13 +215,13 @@ int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t 
             }
         }
         if (!trial_end) {
-            icoac_priv_copy4(w, st->w);
+            icoac_priv_copy(w, st->w);
             return 0;
         }
         return batch_end(actor, st, observed ? h : 0, shift, w, cov);
     }
     if (!observed) {
-        icoac_priv_copy4(w, st->w);
+        icoac_priv_copy(w, st->w);
         return 0;
     }
     switch (actor->update) {
@@ -258,5 +261,5 @@ void icoac_priv_actor_commit_batch(const icoac_actor_config_t *actor, icoac_priv
     if (observed && actor->update != ICOAC_ACTOR_GRADIENT) {
         add_info(actor, h, st->batch.info);
     }
-    icoac_priv_copy4(st->batch.shift, st->batch.staged_shift);
+    icoac_priv_copy(st->batch.shift, st->batch.staged_shift);
 }

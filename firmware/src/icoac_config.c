@@ -1,4 +1,5 @@
-/* Configuration: defaults and checks of every group, the prior check, status names. */
+/* Configuration: defaults (the cart-pole task) and checks of every group, the prior check,
+ * status names. */
 #include "icoac_priv.h"
 
 const char *icoac_status_str(icoac_status_t status)
@@ -11,35 +12,79 @@ const char *icoac_status_str(icoac_status_t status)
     case ICOAC_ERR_NUMERIC: return "numeric failure: a value derived in this tick was not finite (force 0, nothing learned)";
     case ICOAC_ERR_TRIAL_ENDED: return "trial ended by a terminal tick: call icoac_reset before the next tick";
     case ICOAC_ERR_CORRUPT_STATE: return "state corrupted (not as the library left it): call icoac_init";
-    case ICOAC_ERR_RETUNE_MODE: return "icoac_retune cannot change the mode: icoac_init with the posterior as the prior";
+    case ICOAC_ERR_RETUNE_MODE: return "icoac_retune cannot change the mode, task.n_inputs or critic.units: icoac_init with the posterior as the prior";
     case ICOAC_ERR_BAD_MODE: return "invalid switch (mode, policy.reflex_mode, ico.timing, actor.update or a 0/1 flag)";
     case ICOAC_ERR_BAD_SCALE: return "invalid policy.input_range (must be in [1e-6, 1e6])";
     case ICOAC_ERR_BAD_GAIN: return "invalid policy.gain or policy.reflex_force (must be in [0, 1e4])";
-    case ICOAC_ERR_BAD_ZONE: return "invalid policy.zone_theta or policy.zone_x (must be in [1e-6, pi] rad and [1e-6, 1e6] m)";
+    case ICOAC_ERR_BAD_ZONE: return "invalid late-signal rule (task.rule_threshold: |t| <= 1e6; task.rule_reflex: [-1, 1])";
     case ICOAC_ERR_BAD_ICO_RATE: return "invalid ico.rate (must be in [0, 1])";
     case ICOAC_ERR_BAD_CRITIC: return "invalid critic parameter (rate [0, 10], discount [0, 1], td_clip [1e-6, 1e3], range [1e-6, 1e6], threshold [0, 1))";
     case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std [1e-3, 1e3], scale [0, 1e3], forgetting [0.5, 1], update 0-2, rate [0, 1e3], likelihood_std 0 or [1e-3, 1e3], explore_ticks [0, 1e8])";
     case ICOAC_ERR_BAD_SEARCH: return "invalid search parameter (batch [1, 16], elite_fraction (0, 1], step (0, 1], floor [1e-6, 1e3], cov_scale [1, 1e3])";
+    case ICOAC_ERR_BAD_TASK: return "invalid task (n_inputs [1, max], late_source 0-1, n_rules [0, max], rule_input [0, n_inputs), rule_side 0-1)";
     case ICOAC_ERR_BAD_PRIOR: return "invalid prior (|mean| <= 1e6, covariance entries |c| <= 1e12, zero or normal, symmetric positive definite)";
     default: return "unknown status";
     }
 }
 
+/* The cart-pole task (x, x_dot, theta, theta_dot): its input and critic ranges, its critic grid
+ * and its penalty zone, |theta| > 11.5 deg or |x| > 2.35 m; entries past its inputs are 0. */
+static const icoac_real_t cartpole_range[ICOAC_MAX_INPUTS] = {ICOAC_R(2.4), ICOAC_R(3.5), ICOAC_R(0.2094384),
+                                                              ICOAC_R(2.0)};
+static const int32_t cartpole_units[ICOAC_MAX_INPUTS] = {ICOAC_CRITIC_N_X, ICOAC_CRITIC_N_X_DOT, ICOAC_CRITIC_N_THETA,
+                                                         ICOAC_CRITIC_N_THETA_DOT};
+#define CARTPOLE_ZONE_THETA ICOAC_R(0.20071286397934788) /* 11.5 deg */
+#define CARTPOLE_ZONE_X ICOAC_R(2.35)
+
+static void task_cartpole(icoac_task_config_t *task)
+{
+    /* Eq. (4), first match wins: leaning or pushed past the zone on one side pushes back */
+    static const int32_t input[ICOAC_CARTPOLE_RULES] = {ICOAC_IDX_THETA, ICOAC_IDX_X, ICOAC_IDX_THETA, ICOAC_IDX_X};
+    static const int32_t side[ICOAC_CARTPOLE_RULES] = {ICOAC_RULE_ABOVE, ICOAC_RULE_BELOW, ICOAC_RULE_BELOW,
+                                                       ICOAC_RULE_ABOVE};
+    static const icoac_real_t threshold[ICOAC_CARTPOLE_RULES] = {CARTPOLE_ZONE_THETA, -CARTPOLE_ZONE_X,
+                                                                 -CARTPOLE_ZONE_THETA, CARTPOLE_ZONE_X};
+    static const icoac_real_t reflex[ICOAC_CARTPOLE_RULES] = {ICOAC_R(1.0), ICOAC_R(1.0), ICOAC_R(-1.0), ICOAC_R(-1.0)};
+    int k;
+    memset(task, 0, sizeof *task);
+    task->n_inputs = ICOAC_CARTPOLE_INPUTS;
+    task->late_source = ICOAC_LATE_RULES;
+    task->n_rules = ICOAC_CARTPOLE_RULES;
+    for (k = 0; k < ICOAC_CARTPOLE_RULES; ++k) {
+        task->rule_input[k] = input[k];
+        task->rule_side[k] = side[k];
+        task->rule_threshold[k] = threshold[k];
+        task->rule_reflex[k] = reflex[k];
+    }
+}
+
+void icoac_task_cartpole(icoac_config_t *cfg)
+{
+    int i;
+    if (cfg == 0) {
+        return;
+    }
+    task_cartpole(&cfg->task);
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
+        cfg->policy.input_range[i] = cartpole_range[i];
+        cfg->critic.range[i] = cartpole_range[i];
+        cfg->critic.units[i] = cartpole_units[i];
+    }
+}
+
 void icoac_policy_config_default(icoac_policy_config_t *policy)
 {
+    int i;
     if (policy == 0) {
         return;
     }
-    policy->input_range[ICOAC_IDX_X] = ICOAC_R(2.4);
-    policy->input_range[ICOAC_IDX_X_DOT] = ICOAC_R(3.5);
-    policy->input_range[ICOAC_IDX_THETA] = ICOAC_R(0.2094384);
-    policy->input_range[ICOAC_IDX_THETA_DOT] = ICOAC_R(2.0);
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
+        policy->input_range[i] = cartpole_range[i];
+    }
     policy->clip_inputs = 1;
     policy->gain = ICOAC_R(10.0);
     policy->reflex_mode = ICOAC_REFLEX_UNIT;
     policy->reflex_force = ICOAC_R(1.0);
-    policy->zone_theta = ICOAC_R(0.20071286397934788); /* 11.5 deg */
-    policy->zone_x = ICOAC_R(2.35);
 }
 
 void icoac_ico_config_default(icoac_ico_config_t *ico)
@@ -53,16 +98,17 @@ void icoac_ico_config_default(icoac_ico_config_t *ico)
 
 void icoac_critic_config_default(icoac_critic_config_t *critic)
 {
+    int i;
     if (critic == 0) {
         return;
     }
     critic->rate = ICOAC_R(0.6);
     critic->discount = ICOAC_R(0.95);
     critic->td_clip = ICOAC_R(1.0);
-    critic->range[ICOAC_IDX_X] = ICOAC_R(2.4);
-    critic->range[ICOAC_IDX_X_DOT] = ICOAC_R(3.5);
-    critic->range[ICOAC_IDX_THETA] = ICOAC_R(0.2094384);
-    critic->range[ICOAC_IDX_THETA_DOT] = ICOAC_R(2.0);
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
+        critic->range[i] = cartpole_range[i];
+        critic->units[i] = cartpole_units[i];
+    }
     critic->threshold = ICOAC_R(0.001);
     critic->quirks = 0;
 }
@@ -106,6 +152,7 @@ void icoac_config_default(icoac_config_t *cfg)
     }
     cfg->mode = ICOAC_MODE_ICO;
     cfg->learn = 1;
+    task_cartpole(&cfg->task);
     icoac_policy_config_default(&cfg->policy);
     icoac_ico_config_default(&cfg->ico);
     icoac_critic_config_default(&cfg->critic);
@@ -137,15 +184,62 @@ typedef struct {
         return 0;                   \
     } while (0)
 
-static const char *const input_range_names[ICOAC_N_INPUTS] = {
-    "policy.input_range[0]", "policy.input_range[1]", "policy.input_range[2]", "policy.input_range[3]"};
-static const char *const critic_range_names[ICOAC_N_INPUTS] = {
-    "critic.range[0]", "critic.range[1]", "critic.range[2]", "critic.range[3]"};
+/* The names of an array's first 16 entries (both maxima are at most 16). */
+#define NAMES16(a)                                                                                          \
+    {a "[0]", a "[1]", a "[2]", a "[3]", a "[4]", a "[5]", a "[6]", a "[7]", a "[8]", a "[9]", a "[10]", \
+     a "[11]", a "[12]", a "[13]", a "[14]", a "[15]"}
+static const char *const input_range_names[16] = NAMES16("policy.input_range");
+static const char *const critic_range_names[16] = NAMES16("critic.range");
+static const char *const critic_units_names[16] = NAMES16("critic.units");
+static const char *const rule_input_names[16] = NAMES16("task.rule_input");
+static const char *const rule_side_names[16] = NAMES16("task.rule_side");
+static const char *const rule_threshold_names[16] = NAMES16("task.rule_threshold");
+static const char *const rule_reflex_names[16] = NAMES16("task.rule_reflex");
 
-static int policy_ok(const icoac_policy_config_t *p, bad_field_t *bad)
+/* The task group; n_inputs first, as the other groups' arrays are checked up to it. */
+static int task_ok(const icoac_task_config_t *t, bad_field_t *bad)
+{
+    int k;
+    if (t->n_inputs < 1 || t->n_inputs > ICOAC_MAX_INPUTS) {
+        ICOAC_PRIV_FAIL("task.n_inputs", ICOAC_ERR_BAD_TASK);
+    }
+    if (t->late_source != ICOAC_LATE_RULES && t->late_source != ICOAC_LATE_SENSOR) {
+        ICOAC_PRIV_FAIL("task.late_source", ICOAC_ERR_BAD_TASK);
+    }
+    if (t->n_rules < 0 || t->n_rules > ICOAC_MAX_RULES) {
+        ICOAC_PRIV_FAIL("task.n_rules", ICOAC_ERR_BAD_TASK);
+    }
+    if (t->late_source != ICOAC_LATE_RULES) {
+        return 1; /* the table is not used */
+    }
+    /* in struct order: every rule's input, then every side, threshold, reflex */
+    for (k = 0; k < t->n_rules; ++k) {
+        if (t->rule_input[k] < 0 || t->rule_input[k] >= t->n_inputs) {
+            ICOAC_PRIV_FAIL(rule_input_names[k], ICOAC_ERR_BAD_TASK);
+        }
+    }
+    for (k = 0; k < t->n_rules; ++k) {
+        if (t->rule_side[k] != ICOAC_RULE_BELOW && t->rule_side[k] != ICOAC_RULE_ABOVE) {
+            ICOAC_PRIV_FAIL(rule_side_names[k], ICOAC_ERR_BAD_TASK);
+        }
+    }
+    for (k = 0; k < t->n_rules; ++k) {
+        if (!within(t->rule_threshold[k], -ICOAC_RULE_THRESHOLD_MAX, ICOAC_RULE_THRESHOLD_MAX)) {
+            ICOAC_PRIV_FAIL(rule_threshold_names[k], ICOAC_ERR_BAD_ZONE);
+        }
+    }
+    for (k = 0; k < t->n_rules; ++k) {
+        if (!within(t->rule_reflex[k], ICOAC_R(-1.0), ICOAC_R(1.0))) {
+            ICOAC_PRIV_FAIL(rule_reflex_names[k], ICOAC_ERR_BAD_ZONE);
+        }
+    }
+    return 1;
+}
+
+static int policy_ok(const icoac_policy_config_t *p, int n, bad_field_t *bad)
 {
     int i;
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < n; ++i) {
         if (!within(p->input_range[i], ICOAC_RANGE_MIN, ICOAC_RANGE_MAX)) {
             ICOAC_PRIV_FAIL(input_range_names[i], ICOAC_ERR_BAD_SCALE);
         }
@@ -162,12 +256,6 @@ static int policy_ok(const icoac_policy_config_t *p, bad_field_t *bad)
     if (!within(p->reflex_force, ICOAC_R(0.0), ICOAC_FORCE_MAX)) {
         ICOAC_PRIV_FAIL("policy.reflex_force", ICOAC_ERR_BAD_GAIN);
     }
-    if (!within(p->zone_theta, ICOAC_ZONE_MIN, ICOAC_ZONE_THETA_MAX)) {
-        ICOAC_PRIV_FAIL("policy.zone_theta", ICOAC_ERR_BAD_ZONE);
-    }
-    if (!within(p->zone_x, ICOAC_ZONE_MIN, ICOAC_ZONE_X_MAX)) {
-        ICOAC_PRIV_FAIL("policy.zone_x", ICOAC_ERR_BAD_ZONE);
-    }
     return 1;
 }
 
@@ -182,8 +270,9 @@ static int ico_ok(const icoac_ico_config_t *ico, bad_field_t *bad)
     return 1;
 }
 
-static int critic_ok(const icoac_critic_config_t *c, bad_field_t *bad)
+static int critic_ok(const icoac_critic_config_t *c, int n, bad_field_t *bad)
 {
+    int32_t units = 1;
     int i;
     if (!within(c->rate, ICOAC_R(0.0), ICOAC_CRITIC_RATE_MAX)) {
         ICOAC_PRIV_FAIL("critic.rate", ICOAC_ERR_BAD_CRITIC);
@@ -194,10 +283,22 @@ static int critic_ok(const icoac_critic_config_t *c, bad_field_t *bad)
     if (!within(c->td_clip, ICOAC_TD_CLIP_MIN, ICOAC_TD_CLIP_MAX)) {
         ICOAC_PRIV_FAIL("critic.td_clip", ICOAC_ERR_BAD_CRITIC);
     }
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < n; ++i) {
         if (!within(c->range[i], ICOAC_RANGE_MIN, ICOAC_RANGE_MAX)) {
             ICOAC_PRIV_FAIL(critic_range_names[i], ICOAC_ERR_BAD_CRITIC);
         }
+    }
+    for (i = 0; i < n; ++i) {
+        if (c->units[i] < 1 || c->units[i] > ICOAC_CRITIC_UNITS_PER_INPUT_MAX) {
+            ICOAC_PRIV_FAIL(critic_units_names[i], ICOAC_ERR_BAD_CRITIC);
+        }
+        units *= c->units[i]; /* at most 16 times the maximum before the check stops it */
+        if (units > ICOAC_MAX_CRITIC_UNITS) {
+            ICOAC_PRIV_FAIL("critic.units", ICOAC_ERR_BAD_CRITIC);
+        }
+    }
+    if (icoac_priv_critic_split(c->units, n) == 0) {
+        ICOAC_PRIV_FAIL("critic.units", ICOAC_ERR_BAD_CRITIC);
     }
     if (!within(c->threshold, ICOAC_R(0.0), ICOAC_R(1.0)) || !(c->threshold < ICOAC_R(1.0))) {
         ICOAC_PRIV_FAIL("critic.threshold", ICOAC_ERR_BAD_CRITIC);
@@ -272,7 +373,7 @@ static int config_ok(const icoac_config_t *cfg, bad_field_t *bad)
     if (!is_flag(cfg->learn)) {
         ICOAC_PRIV_FAIL("learn", ICOAC_ERR_BAD_MODE);
     }
-    if (!policy_ok(&cfg->policy, bad)) {
+    if (!task_ok(&cfg->task, bad) || !policy_ok(&cfg->policy, cfg->task.n_inputs, bad)) {
         return 0;
     }
     if (cfg->mode == ICOAC_MODE_ICO) {
@@ -281,7 +382,7 @@ static int config_ok(const icoac_config_t *cfg, bad_field_t *bad)
     if (cfg->mode == ICOAC_MODE_SEARCH) {
         return search_ok(&cfg->search, bad);
     }
-    return critic_ok(&cfg->critic, bad) && actor_ok(&cfg->actor, bad);
+    return critic_ok(&cfg->critic, cfg->task.n_inputs, bad) && actor_ok(&cfg->actor, bad);
 }
 
 icoac_status_t icoac_config_check_field(const icoac_config_t *cfg, const char **field)
@@ -307,25 +408,29 @@ icoac_status_t icoac_config_check(const icoac_config_t *cfg)
     return icoac_config_check_field(cfg, 0);
 }
 
-icoac_status_t icoac_prior_check(const icoac_prior_t *prior)
+icoac_status_t icoac_prior_check(const icoac_prior_t *prior, int32_t n_inputs)
 {
-    icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
+    icoac_real_t lower[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS];
+    const int n = (int)n_inputs;
     int i;
     int j;
     if (prior == 0) {
         return ICOAC_ERR_NULL;
     }
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    if (n_inputs < 1 || n_inputs > ICOAC_MAX_INPUTS) {
+        return ICOAC_ERR_BAD_TASK;
+    }
+    for (i = 0; i < n; ++i) {
         const icoac_real_t m = prior->mean[i];
         if (!(ICOAC_PRIV_FABS(m) <= ICOAC_PRIOR_MEAN_MAX) || !icoac_priv_zero_or_normal(m)) {
             return ICOAC_ERR_BAD_PRIOR;
         }
-        for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+        for (j = 0; j < n; ++j) {
             const icoac_real_t c = prior->cov[i][j];
             if (!(ICOAC_PRIV_FABS(c) <= ICOAC_PRIOR_COV_MAX) || !icoac_priv_zero_or_normal(c) || c != prior->cov[j][i]) {
                 return ICOAC_ERR_BAD_PRIOR;
             }
         }
     }
-    return icoac_priv_cholesky4(prior->cov, lower) ? ICOAC_OK : ICOAC_ERR_BAD_PRIOR;
+    return icoac_priv_cholesky(prior->cov, lower, n) ? ICOAC_OK : ICOAC_ERR_BAD_PRIOR;
 }

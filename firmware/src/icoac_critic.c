@@ -1,24 +1,65 @@
-/* Normalized Gaussian critic on the 3x3x6x3 grid (method.md, critic), evaluated separably:
- * a_k = prod_i f_i(k_i) and sum_k a_k = prod_i sum_j f_i(j), so the normalized
- * activation is b_k = prod_i g_i(k_i) with per-dimension normalized factors g.
- * Units with b_k below critic->threshold count as 0 (method.md, A10). This file: the factors and the
- * sparse kernel (the dense one is icoac_critic_dense.c); its value pass lists the units it
- * kept, and the TD update of the next tick walks that list.
- * Layout: k = pair * 18 + cell with pair = a*3 + b over (x, x_dot) and cell = c*3 + d over
- * (theta, theta_dot); b_k is evaluated as (g_x[a] g_xd[b]) * (g_th[c] g_thd[d]).
- * All factors are <= 1, so a pair or cell product below the threshold rules out every unit it
- * belongs to. The surviving cells are sorted by product, largest first; the kept units of a
- * pair are then a leading run of that order, and V sums over them in that order. */
+/* Normalized Gaussian critic on a grid of critic.units[i] units along each input i (method.md,
+ * critic), evaluated separably: a_k = prod_i f_i(k_i) and sum_k a_k = prod_i sum_j f_i(j), so the
+ * normalized activation is b_k = prod_i g_i(k_i) with per-input normalized factors g.
+ * Units with b_k below critic->threshold count as 0 (method.md, A10). This file: the grid's
+ * geometry, the factors and the sparse kernel (the dense one is icoac_critic_dense.c); its value
+ * pass lists the units it kept, and the TD update of the next tick walks that list.
+ * Layout: k = row * cells + cell, row-major over the row inputs [0, split) and the cell inputs
+ * [split, n) (the cart-pole: rows over (x, x_dot), cells over (theta, theta_dot)); b_k is
+ * evaluated as (row product) * (cell product), each a left-to-right product of its factors.
+ * All factors are <= 1, so a row or cell product below the threshold rules out every unit it
+ * belongs to. The surviving cells are sorted by product, largest first; the kept units of a row
+ * are then a leading run of that order, and V sums over them in that order. */
 #include "icoac_priv.h"
 
 #include <float.h>
 
-/* Normalized 1-D Gaussian factors of one coordinate. With centres c_j = -R + (2j+1)R/n and
+int icoac_priv_critic_split(const int32_t *units, int n)
+{
+    int cells = 1;
+    int rows = 1;
+    int m = n;
+    int i;
+    for (i = 0; i < n; ++i) {
+        if (units[i] < 1 || units[i] > ICOAC_CRITIC_UNITS_PER_INPUT_MAX) {
+            return 0;
+        }
+    }
+    while (m > 0 && cells * units[m - 1] <= ICOAC_CRITIC_BLOCK_MAX) {
+        cells *= units[m - 1];
+        --m;
+    }
+    for (i = 0; i < m; ++i) {
+        rows *= units[i];
+        if (rows > ICOAC_CRITIC_BLOCK_MAX) {
+            return 0;
+        }
+    }
+    return m + 1;
+}
+
+void icoac_priv_critic_grid(const icoac_config_t *cfg, icoac_priv_grid_t *grid)
+{
+    const int n = icoac_priv_inputs(cfg);
+    const int split = icoac_priv_critic_split(cfg->critic.units, n) - 1;
+    int i;
+    memset(grid, 0, sizeof *grid);
+    if (cfg->mode != ICOAC_MODE_RL) {
+        return; /* no critic: its group is not checked, nothing derived from it */
+    }
+    grid->n = (uint8_t)n;
+    grid->split = (uint8_t)(split > 0 ? split : 0);
+    for (i = 0; i < n; ++i) {
+        grid->units[i] = (uint8_t)cfg->critic.units[i];
+    }
+}
+
+/* Normalized 1-D Gaussian factors of one input. With centres c_j = -R + (2j+1)R/n and
  * width sigma = R/n, (s - c_j)/sigma = d_j = o - 2j with o = s*n/R + n - 1. Relative to the
  * nearest centre j* (distance d), a_{j*+1}/a_{j*} = exp(2d - 2) =: up, a_{j*-1}/a_{j*} =
  * exp(-2d - 2) = e^-4 / up, and each further step out multiplies the ratio by e^-4: one
  * exponential per dimension instead of n. a_{j*} = 1, so far-away states never give 0/0. */
-static inline void dimension_factors(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
+static inline void factors_of(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
 {
     const icoac_real_t exp_minus_4 = ICOAC_R(0.018315638888734180294);
     const icoac_real_t offset = value * ((icoac_real_t)n / range) + (icoac_real_t)(n - 1);
@@ -72,20 +113,16 @@ static inline void dimension_factors(icoac_real_t value, icoac_real_t range, int
     }
 }
 
-void icoac_priv_critic_factors(const icoac_critic_config_t *critic, const icoac_real_t s[ICOAC_N_INPUTS],
-                               icoac_real_t factors[ICOAC_CRITIC_FACTORS])
+/* The common counts get loops of a constant length (unrolled), the others the general ones. */
+void icoac_priv_critic_factors(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
 {
-    dimension_factors(s[ICOAC_IDX_X], critic->range[ICOAC_IDX_X], ICOAC_CRITIC_N_X, factors);
-    factors += ICOAC_CRITIC_N_X;
-    dimension_factors(s[ICOAC_IDX_X_DOT], critic->range[ICOAC_IDX_X_DOT], ICOAC_CRITIC_N_X_DOT, factors);
-    factors += ICOAC_CRITIC_N_X_DOT;
-    dimension_factors(s[ICOAC_IDX_THETA], critic->range[ICOAC_IDX_THETA], ICOAC_CRITIC_N_THETA, factors);
-    factors += ICOAC_CRITIC_N_THETA;
-    dimension_factors(s[ICOAC_IDX_THETA_DOT], critic->range[ICOAC_IDX_THETA_DOT],
-                      ICOAC_CRITIC_N_THETA_DOT, factors);
+    switch (n) {
+    case 2: factors_of(value, range, 2, g); break;
+    case 3: factors_of(value, range, 3, g); break;
+    case 6: factors_of(value, range, 6, g); break;
+    default: factors_of(value, range, n, g); break;
+    }
 }
-
-#define ICOAC_CELLS ICOAC_CRITIC_CELLS
 
 /* With threshold 0 the floor is the smallest normal number: b_k below it is 0 under
  * flush-to-zero and adds nothing to V either way. */
@@ -113,98 +150,129 @@ static inline void kept_range(const icoac_real_t *g, int n, icoac_real_t thresho
     *end = j;
 }
 
-/* Cells with g_th g_thd >= threshold, sorted by product (largest first, ties in cell order). */
-static int sorted_cells(const icoac_real_t *gth, const icoac_real_t *gthd, icoac_real_t threshold,
-                        icoac_priv_critic_list_t *active)
+/* A unit count from the state's geometry, bounded to the factor array. */
+static inline int bounded_units(uint8_t units)
 {
+    return units <= ICOAC_CRITIC_UNITS_PER_INPUT_MAX ? (int)units : ICOAC_CRITIC_UNITS_PER_INPUT_MAX;
+}
+
+/* The kept cells' products and indices, sorted by product (largest first, ties in cell order),
+ * then a 0 sentinel; the list's stride and rows; the row products in row_product. */
+static int sorted_cells(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                        const icoac_real_t s[ICOAC_MAX_INPUTS], icoac_real_t threshold,
+                        icoac_priv_critic_list_t *list)
+{
+    icoac_real_t g[ICOAC_CRITIC_UNITS_PER_INPUT_MAX];
+    const int n = grid->n <= ICOAC_MAX_INPUTS ? (int)grid->n : ICOAC_MAX_INPUTS;
+    const int split = grid->split < n ? (int)grid->split : n;
+    int rows = 1;
+    int stride = 1;
+    int entries = 1;
     int cells = 0;
-    int c_begin, c_end, d_begin, d_end;
-    int c;
-    int d;
-    kept_range(gth, ICOAC_CRITIC_N_THETA, threshold, &c_begin, &c_end);
-    kept_range(gthd, ICOAC_CRITIC_N_THETA_DOT, threshold, &d_begin, &d_end);
-    for (c = c_begin; c < c_end; ++c) {
-        for (d = d_begin; d < d_end; ++d) {
-            const icoac_real_t product = gth[c] * gthd[d];
-            int i = cells;
-            if (!icoac_priv_nonneg_at_least(product, threshold)) {
-                continue;
-            }
-            while (i > 0 && !icoac_priv_nonneg_at_least(active->cell_product[i - 1], product)) {
-                active->cell_product[i] = active->cell_product[i - 1];
-                active->cell[i] = active->cell[i - 1];
-                --i;
-            }
-            active->cell_product[i] = product;
-            active->cell[i] = (uint8_t)(c * ICOAC_CRITIC_N_THETA_DOT + d);
-            ++cells;
-        }
+    int i;
+    int k;
+    list->row_product[0] = ICOAC_R(1.0);
+    for (i = 0; i < split; ++i) {
+        const int count = bounded_units(grid->units[i]);
+        icoac_priv_critic_factors(s[i], critic->range[i], count, g);
+        rows = icoac_priv_critic_expand(list->row_product, 0, g, count, 0, count, rows);
     }
-    /* sentinel: at most 6 x 3 cells pass, so it always fits; with a pair product in
-     * [threshold, 1] it ends every scan of the list (threshold >= the smallest normal) */
-    active->cell_product[cells] = ICOAC_R(0.0);
+    list->cell_product[0] = ICOAC_R(1.0);
+    list->cell[0] = 0u;
+    for (i = split; i < n; ++i) {
+        const int count = bounded_units(grid->units[i]);
+        int begin;
+        int end;
+        icoac_priv_critic_factors(s[i], critic->range[i], count, g);
+        kept_range(g, count, threshold, &begin, &end);
+        entries = icoac_priv_critic_expand(list->cell_product, list->cell, g, count, begin, end, entries);
+        stride *= count;
+    }
+    /* a geometry the configuration check would refuse (a corrupted state) keeps no unit */
+    if (stride > ICOAC_PRIV_CELL_MASK || rows * stride > ICOAC_MAX_CRITIC_UNITS) {
+        rows = 0;
+        entries = 0;
+    }
+    for (k = 0; k < entries; ++k) {
+        const icoac_real_t product = list->cell_product[k];
+        const uint8_t cell = list->cell[k];
+        int j = cells;
+        if (!icoac_priv_nonneg_at_least(product, threshold)) {
+            continue;
+        }
+        while (j > 0 && !icoac_priv_nonneg_at_least(list->cell_product[j - 1], product)) {
+            list->cell_product[j] = list->cell_product[j - 1];
+            list->cell[j] = list->cell[j - 1];
+            --j;
+        }
+        list->cell_product[j] = product;
+        list->cell[j] = cell;
+        ++cells;
+    }
+    /* sentinel: at most 31 cells are listed; with a row product in [threshold, 1] it ends every
+     * scan of the list (threshold >= the smallest normal) */
+    list->cell_product[cells] = ICOAC_R(0.0);
+    list->rows = (uint8_t)rows;
+    list->stride = (uint8_t)stride;
     return cells;
 }
 
-icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic,
-                                            const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                                            const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
-                                            icoac_priv_critic_list_t *active)
+icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                                            const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
+                                            icoac_priv_critic_list_t *list)
 {
     const icoac_real_t threshold = icoac_priv_critic_floor(critic);
-    const icoac_real_t *gx = factors;
-    const icoac_real_t *gxd = gx + ICOAC_CRITIC_N_X;
-    const icoac_real_t *gth = gxd + ICOAC_CRITIC_N_X_DOT;
-    const icoac_real_t *gthd = gth + ICOAC_CRITIC_N_THETA;
-    const int cells = sorted_cells(gth, gthd, threshold, active);
+    const int cells = sorted_cells(critic, grid, s, threshold, list);
+    const int rows = list->rows;
+    const int stride = list->stride;
     icoac_real_t value = ICOAC_R(0.0);
-    int a;
-    int b;
-    for (a = 0; a < ICOAC_CRITIC_N_X; ++a) {
-        for (b = 0; b < ICOAC_CRITIC_N_X_DOT; ++b) {
-            const icoac_real_t pair_product = gx[a] * gxd[b];
-            const int pair = a * ICOAC_CRITIC_N_X_DOT + b;
-            const icoac_real_t *u = v + pair * ICOAC_CELLS;
-            const icoac_real_t *product = active->cell_product;
-            const uint8_t *cell = active->cell;
-            icoac_real_t unit_b;
-            active->pair_product[pair] = pair_product;
-            active->pair_cells[pair] = 0u;
-            /* threshold <= pair_product <= 1 as bit patterns: false for NaN, Inf and negative
-             * values, so pair_product * 0 = 0 and the sentinel ends the scan below */
-            if (!icoac_priv_nonneg_at_least(pair_product, threshold) ||
-                !icoac_priv_nonneg_at_least(ICOAC_R(1.0), pair_product)) {
-                continue;
-            }
-            unit_b = pair_product * *product;
-            while (icoac_priv_nonneg_at_least(unit_b, threshold)) {
-                value += u[*cell++] * unit_b;
-                unit_b = pair_product * *++product;
-            }
-            active->pair_cells[pair] = (uint8_t)(cell - active->cell);
+    int r;
+    for (r = 0; r < rows; ++r) {
+        const icoac_real_t row_product = list->row_product[r];
+        const icoac_real_t *u = v + r * stride;
+        const icoac_real_t *product = list->cell_product;
+        const uint8_t *cell = list->cell;
+        icoac_real_t unit_b;
+        list->row_cells[r] = 0u;
+        /* threshold <= row_product <= 1 as bit patterns: false for NaN, Inf and negative
+         * values, so row_product * 0 = 0 and the sentinel ends the scan below */
+        if (!icoac_priv_nonneg_at_least(row_product, threshold) ||
+            !icoac_priv_nonneg_at_least(ICOAC_R(1.0), row_product)) {
+            continue;
         }
+        unit_b = row_product * *product;
+        while (icoac_priv_nonneg_at_least(unit_b, threshold)) {
+            value += u[*cell++] * unit_b;
+            unit_b = row_product * *++product;
+        }
+        list->row_cells[r] = (uint8_t)(cell - list->cell);
     }
-    active->cells = (uint8_t)cells;
+    list->cells = (uint8_t)cells;
     return value;
 }
 
 /* v_k += step * b_k over the units listed by icoac_priv_critic_value_sparse. The list lives in
- * the state between ticks, so what it holds is bounded here without a test: the pairs are the
- * loop's, and a count or a cell index is masked (the list's arrays and the weights have room for
- * a masked value: icoac_state.h). A list the value pass wrote is unchanged by the masks. */
-void icoac_priv_critic_update_sparse(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_list_t *active,
-                                     icoac_real_t step)
+ * the state between ticks, so what it holds is bounded here: rows and stride must describe a
+ * grid of at most ICOAC_MAX_CRITIC_UNITS units (else nothing is updated), and a count or a cell
+ * index is masked (the list's arrays and the weights have room for a masked value:
+ * icoac_state.h). A list the value pass wrote passes unchanged. */
+void icoac_priv_critic_update_sparse(icoac_real_t *v, const icoac_priv_critic_list_t *list, icoac_real_t step)
 {
-    int p;
-    for (p = 0; p < ICOAC_CRITIC_PAIRS; ++p) {
-        const icoac_real_t pair_step = step * active->pair_product[p];
-        const uint8_t *cell = active->cell;
-        const uint8_t *const end = cell + (active->pair_cells[p] & ICOAC_PRIV_CELL_MASK);
-        const icoac_real_t *product = active->cell_product;
-        icoac_real_t *u = v + p * ICOAC_CELLS;
+    const int rows = list->rows;
+    const int stride = list->stride;
+    int r;
+    if (rows > ICOAC_PRIV_BLOCK || stride > ICOAC_PRIV_CELL_MASK || rows * stride > ICOAC_MAX_CRITIC_UNITS) {
+        return;
+    }
+    for (r = 0; r < rows; ++r) {
+        const icoac_real_t row_step = step * list->row_product[r];
+        const uint8_t *cell = list->cell;
+        const uint8_t *const end = cell + (list->row_cells[r] & ICOAC_PRIV_CELL_MASK);
+        const icoac_real_t *product = list->cell_product;
+        icoac_real_t *u = v + r * stride;
         ICOAC_PRIV_OPAQUE(u);
         while (cell != end) {
-            u[*cell++ & ICOAC_PRIV_CELL_MASK] += pair_step * *product++;
+            u[*cell++ & ICOAC_PRIV_CELL_MASK] += row_step * *product++;
         }
     }
 }

@@ -1,12 +1,12 @@
-/* Features of a tick (method.md: input scaling, zone, force; A2): input scaling, the penalty
- * zone with its reflex, and the reflex force. Private; static inline, as they run on every tick
+/* Features of a tick (method.md: input scaling, late signal, force; A2): the task's inputs and
+ * their scaling, the late signal (penalty and reflex) of the rule table, and the reflex force. Private; static inline, as they run on every tick
  * of every mode. */
 #ifndef ICOAC_FEATURES_H
 #define ICOAC_FEATURES_H
 
 #include "icoac_priv.h"
 
-/* Reflex U and penalty r of one observation (Eq. 4). */
+/* Reflex U and penalty r of one observation (Eq. 4; the task's late signal). */
 typedef struct {
     icoac_real_t reflex;
     icoac_real_t penalty;
@@ -17,33 +17,47 @@ static inline icoac_real_t icoac_priv_clip_unit(icoac_real_t a)
     return a > ICOAC_R(1.0) ? ICOAC_R(1.0) : (a < ICOAC_R(-1.0) ? ICOAC_R(-1.0) : a);
 }
 
-/* x~_i = clip(s_i / range_i), with 1 / range_i precomputed by icoac_init. */
-static inline void icoac_priv_scale_inputs(const icoac_policy_config_t *policy, const icoac_priv_state_t *st,
-                                           const icoac_real_t s[ICOAC_N_INPUTS],
-                                           icoac_real_t scaled[ICOAC_N_INPUTS])
+/* The task's inputs: s_i for i < n, 0 past n (never read there). */
+static inline void icoac_priv_task_inputs(int n, const icoac_real_t s[ICOAC_MAX_INPUTS],
+                                          icoac_real_t inputs[ICOAC_MAX_INPUTS])
 {
     int i;
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
+        inputs[i] = i < n ? s[i] : ICOAC_R(0.0);
+    }
+}
+
+/* x~_i = clip(s_i / range_i), with 1 / range_i precomputed by icoac_init (0 past n). */
+static inline void icoac_priv_scale_inputs(const icoac_policy_config_t *policy, const icoac_priv_state_t *st,
+                                           const icoac_real_t s[ICOAC_MAX_INPUTS],
+                                           icoac_real_t scaled[ICOAC_MAX_INPUTS])
+{
+    int i;
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
         const icoac_real_t a = s[i] * st->inv_range[i];
         scaled[i] = policy->clip_inputs ? icoac_priv_clip_unit(a) : a;
     }
 }
 
-/* Eq. (4); the first branch wins when both apply. */
-static inline icoac_priv_zone_t icoac_priv_zone(const icoac_policy_config_t *policy,
-                                                const icoac_real_t s[ICOAC_N_INPUTS])
+/* The late signal of the rule table (icoac.h, task): the first matching rule gives r = -1 and
+ * its reflex; none gives 0, 0. The table's size and input indices are bounded to the arrays. */
+static inline icoac_priv_zone_t icoac_priv_zone(const icoac_task_config_t *task,
+                                                const icoac_real_t s[ICOAC_MAX_INPUTS])
 {
+    const int rules = (uint32_t)task->n_rules <= (uint32_t)ICOAC_MAX_RULES ? (int)task->n_rules : ICOAC_MAX_RULES;
     icoac_priv_zone_t zone;
-    const icoac_real_t x = s[ICOAC_IDX_X];
-    const icoac_real_t theta = s[ICOAC_IDX_THETA];
+    int k;
     zone.reflex = ICOAC_R(0.0);
     zone.penalty = ICOAC_R(0.0);
-    if (theta > policy->zone_theta || x < -policy->zone_x) {
-        zone.reflex = ICOAC_R(1.0);
-        zone.penalty = ICOAC_R(-1.0);
-    } else if (theta < -policy->zone_theta || x > policy->zone_x) {
-        zone.reflex = ICOAC_R(-1.0);
-        zone.penalty = ICOAC_R(-1.0);
+    for (k = 0; k < rules; ++k) {
+        const uint32_t input = (uint32_t)task->rule_input[k];
+        const icoac_real_t value = s[input < (uint32_t)ICOAC_MAX_INPUTS ? input : 0u];
+        const icoac_real_t threshold = task->rule_threshold[k];
+        if (task->rule_side[k] == ICOAC_RULE_ABOVE ? value > threshold : value < threshold) {
+            zone.reflex = task->rule_reflex[k];
+            zone.penalty = ICOAC_R(-1.0);
+            break;
+        }
     }
     return zone;
 }

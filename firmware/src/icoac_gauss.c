@@ -2,9 +2,9 @@
  * draw through the factor. */
 #include "icoac_priv.h"
 
-#define N ICOAC_N_INPUTS
+#define N ICOAC_MAX_INPUTS
 
-int icoac_priv_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
+int icoac_priv_cholesky(const icoac_real_t m[N][N], icoac_real_t lower[N][N], int n)
 {
     int i;
     int j;
@@ -14,7 +14,7 @@ int icoac_priv_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
             lower[i][j] = ICOAC_R(0.0);
         }
     }
-    for (j = 0; j < N; ++j) {
+    for (j = 0; j < n; ++j) {
         icoac_real_t diag = m[j][j];
         for (k = 0; k < j; ++k) {
             diag -= lower[j][k] * lower[j][k];
@@ -23,7 +23,7 @@ int icoac_priv_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
             return 0;
         }
         lower[j][j] = ICOAC_PRIV_SQRT(diag);
-        for (i = j + 1; i < N; ++i) {
+        for (i = j + 1; i < n; ++i) {
             icoac_real_t sum = m[i][j];
             for (k = 0; k < j; ++k) {
                 sum -= lower[i][k] * lower[j][k];
@@ -34,39 +34,44 @@ int icoac_priv_cholesky4(const icoac_real_t m[N][N], icoac_real_t lower[N][N])
     return 1;
 }
 
-int icoac_priv_spd_inverse4(const icoac_real_t m[N][N], icoac_real_t inverse[N][N])
+int icoac_priv_spd_inverse(const icoac_real_t m[N][N], icoac_real_t inverse[N][N], int n)
 {
     icoac_real_t lower[N][N];
     icoac_real_t column[N];
     int i;
     int j;
     int k;
-    if (!icoac_priv_cholesky4(m, lower)) {
+    if (!icoac_priv_cholesky(m, lower, n)) {
         return 0;
     }
-    for (k = 0; k < N; ++k) {
+    for (i = 0; i < N; ++i) {
+        for (j = 0; j < N; ++j) {
+            inverse[i][j] = ICOAC_R(0.0);
+        }
+    }
+    for (k = 0; k < n; ++k) {
         /* L y = e_k, then L^T x = y: x is column k of the inverse */
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < n; ++i) {
             icoac_real_t sum = i == k ? ICOAC_R(1.0) : ICOAC_R(0.0);
             for (j = 0; j < i; ++j) {
                 sum -= lower[i][j] * column[j];
             }
             column[i] = sum / lower[i][i];
         }
-        for (i = N - 1; i >= 0; --i) {
+        for (i = n - 1; i >= 0; --i) {
             icoac_real_t sum = column[i];
-            for (j = i + 1; j < N; ++j) {
+            for (j = i + 1; j < n; ++j) {
                 sum -= lower[j][i] * column[j];
             }
             column[i] = sum / lower[i][i];
         }
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < n; ++i) {
             inverse[i][k] = column[i];
         }
     }
     /* exactly symmetric */
-    for (i = 0; i < N; ++i) {
-        for (j = i + 1; j < N; ++j) {
+    for (i = 0; i < n; ++i) {
+        for (j = i + 1; j < n; ++j) {
             inverse[j][i] = inverse[i][j];
         }
     }
@@ -74,19 +79,19 @@ int icoac_priv_spd_inverse4(const icoac_real_t m[N][N], icoac_real_t inverse[N][
 }
 
 void icoac_priv_sample_lower(icoac_rng_t *rng, const icoac_real_t mean[N], const icoac_real_t lower[N][N],
-                             icoac_real_t sample[N])
+                             icoac_real_t sample[N], int n)
 {
     icoac_real_t normal[N];
     int i;
     int j;
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < n; ++i) {
         normal[i] = icoac_rng_normal(rng);
     }
     for (i = 0; i < N; ++i) {
         icoac_real_t sum = mean[i];
-        for (j = 0; j <= i; ++j) {
+        for (j = 0; j <= i && j < n; ++j) {
             sum += lower[i][j] * normal[j];
         }
-        sample[i] = sum;
+        sample[i] = i < n ? sum : ICOAC_R(0.0);
     }
 }

@@ -4,20 +4,20 @@
 
 /* ICO weights after a penalty onset of size drop > 0 (Eq. 2-3), and their norm. */
 static icoac_real_t learn_weights(const icoac_config_t *cfg, const icoac_priv_state_t *st,
-                                  const icoac_real_t trace[ICOAC_N_INPUTS], icoac_real_t drop,
-                                  icoac_real_t w[ICOAC_N_INPUTS])
+                                  const icoac_real_t trace[ICOAC_MAX_INPUTS], icoac_real_t drop,
+                                  icoac_real_t w[ICOAC_MAX_INPUTS])
 {
     const icoac_real_t step = cfg->ico.rate * drop;
     int i;
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
         w[i] = st->w[i] + step * ICOAC_PRIV_FABS(trace[i]);
     }
-    return ICOAC_PRIV_SQRT(icoac_priv_dot4(w, w));
+    return ICOAC_PRIV_SQRT(icoac_priv_dot(w, w));
 }
 
-static void commit_weights(icoac_priv_state_t *st, const icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t norm)
+static void commit_weights(icoac_priv_state_t *st, const icoac_real_t w[ICOAC_MAX_INPUTS], icoac_real_t norm)
 {
-    icoac_priv_copy4(st->w, w);
+    icoac_priv_copy(st->w, w);
     st->weight_norm = norm;
 }
 
@@ -25,11 +25,11 @@ static void commit_weights(icoac_priv_state_t *st, const icoac_real_t w[ICOAC_N_
  * states are not seen. The force and the new weights' norm (finite only if every w_i is) are
  * checked before anything is stored; returns 0, with the state untouched, when one is not. */
 static int code_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
-                       const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
+                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], icoac_real_t penalty, int terminal,
                        icoac_output_t *out)
 {
     const icoac_real_t drop = cfg->learn ? st->penalty_prev - penalty : ICOAC_R(0.0);
-    icoac_real_t w[ICOAC_N_INPUTS];
+    icoac_real_t w[ICOAC_MAX_INPUTS];
     icoac_real_t norm = ICOAC_R(0.0);
     icoac_real_t z;
     icoac_real_t force;
@@ -39,7 +39,7 @@ static int code_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
         out->force = ICOAC_R(0.0);
         return 1;
     }
-    z = icoac_priv_dot4(st->w, scaled);
+    z = icoac_priv_dot(st->w, scaled);
     force = cfg->policy.gain * z + icoac_priv_reflex_force(&cfg->policy, out->reflex);
     if (drop > ICOAC_R(0.0)) {
         norm = learn_weights(cfg, st, scaled, drop, w);
@@ -62,19 +62,19 @@ static int code_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
  * terminal tick learns and outputs no force. Checked like the code timing (z stands for the
  * force on a terminal tick). */
 static int literal_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
-                          const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty,
+                          const icoac_real_t scaled[ICOAC_MAX_INPUTS], icoac_real_t penalty,
                           int terminal, icoac_output_t *out)
 {
     const icoac_real_t drop = st->penalty_prev - penalty;
     const int learn = cfg->learn && st->has_prev && drop > ICOAC_R(0.0);
-    icoac_real_t w[ICOAC_N_INPUTS];
+    icoac_real_t w[ICOAC_MAX_INPUTS];
     icoac_real_t norm = ICOAC_R(0.0);
     icoac_real_t z;
     icoac_real_t force = ICOAC_R(0.0);
     if (learn) {
         norm = learn_weights(cfg, st, st->x_prev, drop, w);
     }
-    z = icoac_priv_dot4(learn ? w : st->w, scaled);
+    z = icoac_priv_dot(learn ? w : st->w, scaled);
     if (!terminal) {
         force = cfg->policy.gain * z + icoac_priv_reflex_force(&cfg->policy, out->reflex);
     }
@@ -95,7 +95,7 @@ static int literal_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
 
 /* Writes every output field but reflex, penalty, weight_norm and status. */
 int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
-                        const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
+                        const icoac_real_t scaled[ICOAC_MAX_INPUTS], icoac_real_t penalty, int terminal,
                         icoac_output_t *out)
 {
     out->value = ICOAC_R(0.0);

@@ -15,13 +15,15 @@ static void clear_trial(icoac_priv_state_t *st)
 }
 
 /* What the tick takes from the configuration in force, derived once: 1 / policy.input_range
- * and the search's floors. */
+ * (0 past the task's inputs), the critic's geometry and the search's floors. */
 static void derive(icoac_priv_state_t *st)
 {
+    const int n = icoac_priv_inputs(&st->config);
     int i;
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-        st->inv_range[i] = ICOAC_R(1.0) / st->config.policy.input_range[i];
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
+        st->inv_range[i] = i < n ? ICOAC_R(1.0) / st->config.policy.input_range[i] : ICOAC_R(0.0);
     }
+    icoac_priv_critic_grid(&st->config, &st->grid);
     if (st->config.mode == ICOAC_MODE_SEARCH) {
         icoac_priv_search_floors(&st->config.search, &st->search);
     }
@@ -37,23 +39,24 @@ static void derive(icoac_priv_state_t *st)
 static int state_ok(const icoac_priv_state_t *st)
 {
     const icoac_priv_search_t *search = &st->search;
+    const int n = icoac_priv_inputs(&st->config);
     int i;
     if (icoac_config_check(&st->config) != ICOAC_OK || (st->cov_slot & ~1) != 0 || (st->active_slot & ~1) != 0 ||
         (st->rng.has_spare & ~1) != 0 || !(ICOAC_PRIV_FABS(st->rng.spare_normal) <= ICOAC_PRIV_NORMAL_MAX)) {
         return 0;
     }
-    if (!icoac_priv_all_finite(st->w, ICOAC_N_INPUTS) || !icoac_priv_finite(st->weight_norm) ||
-        !icoac_priv_all_finite(&icoac_priv_cov_c(st)[0][0], ICOAC_N_INPUTS * ICOAC_N_INPUTS)) {
+    if (!icoac_priv_all_finite(st->w, ICOAC_MAX_INPUTS) || !icoac_priv_finite(st->weight_norm) ||
+        !icoac_priv_all_finite(&icoac_priv_cov_c(st)[0][0], ICOAC_MAX_INPUTS * ICOAC_MAX_INPUTS)) {
         return 0;
     }
     if (st->config.mode != ICOAC_MODE_SEARCH) {
         return 1;
     }
     if (search->count < 0 || search->count >= ICOAC_SEARCH_BATCH_MAX ||
-        !icoac_priv_all_finite(&search->lower[0][0], ICOAC_N_INPUTS * ICOAC_N_INPUTS)) {
+        !icoac_priv_all_finite(&search->lower[0][0], ICOAC_MAX_INPUTS * ICOAC_MAX_INPUTS)) {
         return 0;
     }
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < n; ++i) {
         if (!(search->prior_var[i] > ICOAC_R(0.0)) || !icoac_priv_finite(search->prior_var[i])) {
             return 0;
         }
@@ -66,40 +69,44 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const
 {
     icoac_priv_state_t *st = icoac_priv_state(state);
     icoac_status_t status;
+    icoac_real_t mean[ICOAC_MAX_INPUTS] = {ICOAC_R(0.0)};
+    icoac_real_t cov[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS] = {{ICOAC_R(0.0)}};
+    int n;
     int i;
+    int j;
     if (cfg == 0 || state == 0) {
         return ICOAC_ERR_NULL;
     }
     status = icoac_config_check(cfg);
-    if (status == ICOAC_OK && prior != 0) {
-        status = icoac_prior_check(prior);
+    if (status != ICOAC_OK) {
+        return status;
     }
-    if (status == ICOAC_OK && cfg->mode == ICOAC_MODE_SEARCH) {
-        icoac_real_t identity[ICOAC_N_INPUTS][ICOAC_N_INPUTS] = {{ICOAC_R(0.0)}};
-        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-            identity[i][i] = ICOAC_R(1.0);
+    n = (int)cfg->task.n_inputs;
+    if (prior != 0) {
+        status = icoac_prior_check(prior, cfg->task.n_inputs);
+    }
+    /* the prior's leading n entries (N(0, I) without one), 0 past them */
+    for (i = 0; i < n; ++i) {
+        mean[i] = prior != 0 ? prior->mean[i] : ICOAC_R(0.0);
+        for (j = 0; j < n; ++j) {
+            cov[i][j] = prior != 0 ? prior->cov[i][j] : (i == j ? ICOAC_R(1.0) : ICOAC_R(0.0));
         }
-        if (!icoac_priv_search_prior_ok(&cfg->search, prior != 0 ? prior->cov : ICOAC_PRIV_CONST_MAT4(identity))) {
-            status = ICOAC_ERR_BAD_PRIOR;
-        }
+    }
+    if (status == ICOAC_OK && cfg->mode == ICOAC_MODE_SEARCH &&
+        !icoac_priv_search_prior_ok(&cfg->search, ICOAC_PRIV_CONST_MAT(cov), n)) {
+        status = ICOAC_ERR_BAD_PRIOR;
     }
     if (status != ICOAC_OK) {
         return status;
     }
     memset(state, 0, sizeof *state);
     st->config = *cfg;
-    if (prior != 0) {
-        memcpy(st->w, prior->mean, sizeof st->w);
-        memcpy(st->cov_buffer[0], prior->cov, sizeof st->cov_buffer[0]);
-    } else {
-        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
-            st->cov_buffer[0][i][i] = ICOAC_R(1.0);
-        }
-    }
+    memcpy(st->w, mean, sizeof st->w);
+    memcpy(st->cov_buffer[0], cov, sizeof st->cov_buffer[0]);
     if (cfg->mode == ICOAC_MODE_SEARCH) {
         icoac_priv_search_init(&st->config.search, st);
     }
-    st->weight_norm = ICOAC_PRIV_SQRT(icoac_priv_dot4(st->w, st->w));
+    st->weight_norm = ICOAC_PRIV_SQRT(icoac_priv_dot(st->w, st->w));
     icoac_rng_seed(&st->rng, seed, 0x1C0ACu);
     st->magic = ICOAC_PRIV_STATE_MAGIC;
     return icoac_reset(state);
@@ -119,7 +126,8 @@ icoac_status_t icoac_retune(icoac_state_t *state, const icoac_config_t *cfg)
     if (status != ICOAC_OK) {
         return status;
     }
-    if (cfg->mode != st->config.mode) {
+    if (cfg->mode != st->config.mode || cfg->task.n_inputs != st->config.task.n_inputs ||
+        memcmp(cfg->critic.units, st->config.critic.units, sizeof cfg->critic.units) != 0) {
         return ICOAC_ERR_RETUNE_MODE;
     }
     st->config = *cfg;
@@ -147,7 +155,7 @@ icoac_status_t icoac_reset(icoac_state_t *state)
     } else if (st->config.mode == ICOAC_MODE_SEARCH) {
         icoac_priv_search_sample(st);
     } else {
-        icoac_priv_copy4(st->w_act, st->w);
+        icoac_priv_copy(st->w_act, st->w);
     }
     return ICOAC_OK;
 }

@@ -37,8 +37,8 @@
 #define ICOAC_PRIV_NOINLINE
 #endif
 
-/* C99 will not pass T[4][4] to const T[4][4] implicitly. */
-#define ICOAC_PRIV_CONST_MAT4(m) ((const icoac_real_t(*)[ICOAC_N_INPUTS])(m))
+/* C99 will not pass T[N][N] to const T[N][N] implicitly. */
+#define ICOAC_PRIV_CONST_MAT(m) ((const icoac_real_t(*)[ICOAC_MAX_INPUTS])(m))
 
 /* exp(a) for the critic and ln(a) for the exploration noise. Default: the C library's. With
  * ICOAC_FAST_EXP=1 (float builds; the microcontroller presets turn it on), icoac's own. exp:
@@ -175,31 +175,59 @@ static inline int icoac_priv_all_finite(const icoac_real_t *values, int n)
     return finite;
 }
 
-/* dst = src for 4-vectors; inline, as newlib-nano's memcpy copies byte by byte. */
-static inline void icoac_priv_copy4(icoac_real_t dst[ICOAC_N_INPUTS], const icoac_real_t src[ICOAC_N_INPUTS])
+/* Vectors and matrices have ICOAC_MAX_INPUTS entries per dimension, of which a task uses the
+ * first n; the library keeps the others 0 (icoac_init clears them, nothing writes them), so the
+ * fixed-size helpers below give the n-entry results. */
+
+/* The task's n, bounded to the arrays whatever the state's copy holds. */
+static inline int icoac_priv_inputs(const icoac_config_t *cfg)
 {
-    dst[0] = src[0];
-    dst[1] = src[1];
-    dst[2] = src[2];
-    dst[3] = src[3];
+    return (uint32_t)cfg->task.n_inputs <= (uint32_t)ICOAC_MAX_INPUTS ? (int)cfg->task.n_inputs : ICOAC_MAX_INPUTS;
 }
 
-/* Fixed pairwise order: the same result on every target. */
-static inline icoac_real_t icoac_priv_dot4(const icoac_real_t a[ICOAC_N_INPUTS],
-                                           const icoac_real_t b[ICOAC_N_INPUTS])
+/* dst = src; inline, as newlib-nano's memcpy copies byte by byte. */
+static inline void icoac_priv_copy(icoac_real_t dst[ICOAC_MAX_INPUTS], const icoac_real_t src[ICOAC_MAX_INPUTS])
 {
-    return (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
+    int i;
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
+        dst[i] = src[i];
+    }
 }
 
-static inline icoac_real_t icoac_priv_trace4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS])
+/* Fixed pairwise order, the same on every target: (a0 b0 + a1 b1) + (a2 b2 + a3 b3), then each
+ * further pair (and a last odd term) added in turn. Zero entries add +-0, which leaves every
+ * nonzero sum unchanged. */
+static inline icoac_real_t icoac_priv_dot(const icoac_real_t a[ICOAC_MAX_INPUTS], const icoac_real_t b[ICOAC_MAX_INPUTS])
 {
-    return (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
+    icoac_real_t sum = (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
+    int i;
+    for (i = 4; i + 1 < ICOAC_MAX_INPUTS; i += 2) {
+        sum += a[i] * b[i] + a[i + 1] * b[i + 1];
+    }
+    if ((ICOAC_MAX_INPUTS & 1) != 0) {
+        sum += a[ICOAC_MAX_INPUTS - 1] * b[ICOAC_MAX_INPUTS - 1];
+    }
+    return sum;
+}
+
+/* The trace, in the dot product's order. */
+static inline icoac_real_t icoac_priv_trace(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS])
+{
+    icoac_real_t sum = (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
+    int i;
+    for (i = 4; i + 1 < ICOAC_MAX_INPUTS; i += 2) {
+        sum += m[i][i] + m[i + 1][i + 1];
+    }
+    if ((ICOAC_MAX_INPUTS & 1) != 0) {
+        sum += m[ICOAC_MAX_INPUTS - 1][ICOAC_MAX_INPUTS - 1];
+    }
+    return sum;
 }
 
 /* The tick's per-trial cache: this tick's scaled observation is the next one's previous. */
-static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_real_t scaled[ICOAC_N_INPUTS])
+static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_real_t scaled[ICOAC_MAX_INPUTS])
 {
-    icoac_priv_copy4(st->x_prev, scaled);
+    icoac_priv_copy(st->x_prev, scaled);
     st->has_prev = 1;
 }
 
@@ -220,40 +248,71 @@ static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_rea
 
 /* ICO rule, both timings (icoac_ico.c). */
 int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
-                        const icoac_real_t scaled[ICOAC_N_INPUTS], icoac_real_t penalty, int terminal,
+                        const icoac_real_t scaled[ICOAC_MAX_INPUTS], icoac_real_t penalty, int terminal,
                         icoac_output_t *out);
 
 /* Actor-critic tick: critic and actor on the transition into s, then act (icoac_rl.c). */
-int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_N_INPUTS],
-                       const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out);
+int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_MAX_INPUTS],
+                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out);
 
-/* Critic: per-dimension normalized factors of s (icoac_critic.c), V(s) with the units it kept,
- * and the TD update v_k += step * b_k over such units. Two kernels compute the same units:
+/* Critic (method.md, critic): V(s) with the units it kept, and the TD update v_k += step * b_k
+ * over such units. Two kernels compute the same units:
  * - sparse (icoac_critic.c), for microcontrollers: a sorted list of the kept cells, walked in
- *   leading runs per pair; V sums in that order.
- * - dense (icoac_critic_dense.c), for hosts: a mask over every pair and the cells of one range,
- *   in loops without data-dependent branches that a compiler vectorizes; V sums per cell over
- *   the pairs, then over the cells.
+ *   leading runs per row; V sums in that order.
+ * - dense (icoac_critic_dense.c), for hosts: every row and the cells of one range, in loops
+ *   without data-dependent branches that a compiler vectorizes; V sums per cell over the rows,
+ *   then over the cells.
  * The update adds the same step to the same units in both; V differs by the rounding of the
  * sum's order. ICOAC_CRITIC_DENSE=1 (the host build's default, CMake ICOAC_CRITIC_KERNEL)
- * selects the dense kernel in icoac_priv_critic_value / _update; both are always built. */
-void icoac_priv_critic_factors(const icoac_critic_config_t *critic, const icoac_real_t s[ICOAC_N_INPUTS],
-                               icoac_real_t factors[ICOAC_CRITIC_FACTORS]);
+ * selects the dense kernel in icoac_priv_critic_value / _update; both are always built.
+ * v has ICOAC_PRIV_CRITIC_WEIGHTS entries (the state's). */
+
+/* Derive the geometry of a checked configuration (icoac_config_check accepted it). */
+void icoac_priv_critic_grid(const icoac_config_t *cfg, icoac_priv_grid_t *grid);
+/* The rows x cells split of a grid of n inputs with these unit counts: the first input m from
+ * which the counts multiply to at most ICOAC_CRITIC_BLOCK_MAX cells; 0 when the rows do not fit
+ * that bound (or a count is not in [1, ICOAC_CRITIC_UNITS_PER_INPUT_MAX]), else m + 1. */
+int icoac_priv_critic_split(const int32_t *units, int n);
 /* b_k below this floor counts as 0: the threshold, or with threshold 0 the smallest normal number. */
 icoac_real_t icoac_priv_critic_floor(const icoac_critic_config_t *critic);
-icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic,
-                                            const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                                            const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+/* The normalized 1-D factors g_0 .. g_{count-1} of one input (count in [1, 16]). */
+void icoac_priv_critic_factors(icoac_real_t value, icoac_real_t range, int count, icoac_real_t *g);
+/* The products of the factors of inputs [first, last) over their index ranges [begin_i, end_i),
+ * row-major (input last-1 fastest), left to right; index = the units' row-major index within
+ * those inputs. Returns the number of products, 0 when it would exceed ICOAC_PRIV_BLOCK. */
+static inline int icoac_priv_critic_expand(icoac_real_t product[ICOAC_PRIV_BLOCK], uint8_t *index, const icoac_real_t *g,
+                             int count, int begin, int end, int entries)
+{
+    const int width = end > begin ? end - begin : 0;
+    int e;
+    int j;
+    if (entries * width > ICOAC_PRIV_CELL_MASK) {
+        return 0;
+    }
+    /* from the back, so that each entry is read before its slots are written */
+    for (e = entries - 1; e >= 0; --e) {
+        const icoac_real_t p = product[e];
+        const int first = e * width - begin;
+        if (index != 0) {
+            const int base = index[e] * count;
+            for (j = end - 1; j >= begin; --j) {
+                index[first + j] = (uint8_t)(base + j);
+            }
+        }
+        for (j = end - 1; j >= begin; --j) {
+            product[first + j] = p * g[j];
+        }
+    }
+    return entries * width;
+}
+icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                                            const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
                                             icoac_priv_critic_list_t *list);
-/* v: ICOAC_PRIV_CRITIC_WEIGHTS entries (the state's) when the list may be corrupted; a list the
- * value pass wrote touches the first ICOAC_CRITIC_UNITS only. */
-void icoac_priv_critic_update_sparse(icoac_real_t v[ICOAC_CRITIC_UNITS], const icoac_priv_critic_list_t *list,
-                                     icoac_real_t step);
-icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic,
-                                           const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                                           const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+void icoac_priv_critic_update_sparse(icoac_real_t *v, const icoac_priv_critic_list_t *list, icoac_real_t step);
+icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                                           const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
                                            icoac_priv_critic_products_t *products);
-void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, icoac_real_t v[ICOAC_CRITIC_UNITS],
+void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, icoac_real_t *v,
                                     const icoac_priv_critic_products_t *products, icoac_real_t step);
 
 /* No unit kept: the empty eligibility of a trial's start. */
@@ -263,23 +322,22 @@ static inline void icoac_priv_critic_clear(icoac_priv_critic_active_t *active)
     active->dense.cell_begin = 0u;
     active->dense.cell_end = 0u;
 #else
-    memset(active->sparse.pair_cells, 0, sizeof active->sparse.pair_cells);
+    memset(active->sparse.row_cells, 0, sizeof active->sparse.row_cells);
 #endif
 }
 
-static inline icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic,
-                                                   const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                                                   const icoac_real_t factors[ICOAC_CRITIC_FACTORS],
+static inline icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                                                   const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
                                                    icoac_priv_critic_active_t *active)
 {
 #if defined(ICOAC_CRITIC_DENSE) && ICOAC_CRITIC_DENSE
-    return icoac_priv_critic_value_dense(critic, v, factors, &active->dense);
+    return icoac_priv_critic_value_dense(critic, grid, v, s, &active->dense);
 #else
-    return icoac_priv_critic_value_sparse(critic, v, factors, &active->sparse);
+    return icoac_priv_critic_value_sparse(critic, grid, v, s, &active->sparse);
 #endif
 }
 
-static inline void icoac_priv_critic_update(const icoac_critic_config_t *critic, icoac_real_t v[ICOAC_CRITIC_UNITS],
+static inline void icoac_priv_critic_update(const icoac_critic_config_t *critic, icoac_real_t *v,
                                             const icoac_priv_critic_active_t *active, icoac_real_t step)
 {
 #if defined(ICOAC_CRITIC_DENSE) && ICOAC_CRITIC_DENSE
@@ -296,40 +354,41 @@ static inline void icoac_priv_critic_update(const icoac_critic_config_t *critic,
  * tick. Returns 1 when cov holds a new Sigma_w, 0 when Sigma_w stays, -1 when the batch sums
  * or its closed form failed, -2 for an unknown actor.update (a corrupted state). icoac_priv_actor_commit_batch follows the tick's checks. */
 int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t *st,
-                          const icoac_real_t h[ICOAC_N_INPUTS], icoac_real_t delta, int observed, int trial_end,
-                          icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+                          const icoac_real_t h[ICOAC_MAX_INPUTS], icoac_real_t delta, int observed, int trial_end,
+                          icoac_real_t w[ICOAC_MAX_INPUTS], icoac_real_t cov[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS]);
 void icoac_priv_actor_commit_batch(const icoac_actor_config_t *actor, icoac_priv_state_t *st,
-                                   const icoac_real_t h[ICOAC_N_INPUTS], int observed, int trial_end);
+                                   const icoac_real_t h[ICOAC_MAX_INPUTS], int observed, int trial_end);
 /* The posterior reading's step for innovation (in place allowed: w, cov may be st's own). */
 void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
-                                const icoac_real_t h[ICOAC_N_INPUTS], icoac_real_t innovation,
-                                icoac_real_t w[ICOAC_N_INPUTS], icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+                                const icoac_real_t h[ICOAC_MAX_INPUTS], icoac_real_t innovation,
+                                icoac_real_t w[ICOAC_MAX_INPUTS], icoac_real_t cov[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS]);
 /* w_act = mu_w + L n (L L^T = Sigma_w), or mu_w when Sigma_w is not positive definite. Always
  * finite: |L_ij| <= sqrt(Sigma_ii) <= sqrt(REAL_MAX) and the polar normals are below 1e8. */
 void icoac_priv_actor_sample(icoac_priv_state_t *st);
 
 /* Episodic search (icoac_search.c): the tick, the trial's draw, and the setup at init. */
 int icoac_priv_search_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
-                           const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out);
+                           const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out);
 void icoac_priv_search_sample(icoac_priv_state_t *st);
 /* Sigma0 = search.cov_scale * cov finite and positive definite (checked before icoac_init
  * clears the state), then the setup of a cleared state holding the prior. */
 int icoac_priv_search_prior_ok(const icoac_search_config_t *search,
-                               const icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+                               const icoac_real_t cov[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS], int n);
 void icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st);
 /* The floors search.floor * Sigma0_ii of the recorded prior variances (icoac_retune, icoac_reset). */
 void icoac_priv_search_floors(const icoac_search_config_t *search, icoac_priv_search_t *recorded);
 
-/* Gaussian helpers (icoac_gauss.c). */
+/* Gaussian helpers (icoac_gauss.c), on the leading n x n block (n in [1, ICOAC_MAX_INPUTS]);
+ * the entries of the outputs past n are 0. */
 /* m = L L^T; returns 0 when m is not positive definite. */
-int icoac_priv_cholesky4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS],
-                         icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
+int icoac_priv_cholesky(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS],
+                        icoac_real_t lower[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS], int n);
 /* inverse = m^-1 (exactly symmetric) through the Cholesky factor; 0 when m is not PD. */
-int icoac_priv_spd_inverse4(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS],
-                            icoac_real_t inverse[ICOAC_N_INPUTS][ICOAC_N_INPUTS]);
-/* sample = mean + L n, n four standard normals drawn from rng. */
-void icoac_priv_sample_lower(icoac_rng_t *rng, const icoac_real_t mean[ICOAC_N_INPUTS],
-                             const icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS],
-                             icoac_real_t sample[ICOAC_N_INPUTS]);
+int icoac_priv_spd_inverse(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS],
+                           icoac_real_t inverse[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS], int n);
+/* sample = mean + L z, z n standard normals drawn from rng. */
+void icoac_priv_sample_lower(icoac_rng_t *rng, const icoac_real_t mean[ICOAC_MAX_INPUTS],
+                             const icoac_real_t lower[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS],
+                             icoac_real_t sample[ICOAC_MAX_INPUTS], int n);
 
 #endif /* ICOAC_PRIV_H */

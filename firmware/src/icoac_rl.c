@@ -9,10 +9,15 @@ static icoac_real_t clip_td(icoac_real_t delta, icoac_real_t td_clip)
     return delta > td_clip ? td_clip : (delta < -td_clip ? -td_clip : delta);
 }
 
-/* Off-diagonal entries of a symmetric 4x4 matrix finite (its trace covers the diagonal). */
-static int off_diagonal_finite(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPUTS])
+/* Off-diagonal entries of a symmetric matrix finite (its trace covers the diagonal). */
+static int off_diagonal_finite(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS])
 {
-    return icoac_priv_all_finite(&m[0][1], 3) && icoac_priv_all_finite(&m[1][2], 2) && icoac_priv_all_finite(&m[2][3], 1);
+    int finite = 1;
+    int i;
+    for (i = 0; i + 1 < ICOAC_MAX_INPUTS; ++i) {
+        finite &= icoac_priv_all_finite(&m[i][i + 1], ICOAC_MAX_INPUTS - 1 - i);
+    }
+    return finite;
 }
 
 /* Actor-critic tick: learn from the transition s_t -> s (method.md, one tick), then act on s.
@@ -24,13 +29,12 @@ static int off_diagonal_finite(const icoac_real_t m[ICOAC_N_INPUTS][ICOAC_N_INPU
  * (|eps| < 1e8 sigma_u), hence the force G z + eps + reflex; and the critic weights, which move
  * by at most critic_rate * td_clip <= 1e4 per tick. Writes every output field but reflex,
  * penalty, weight_norm and status. */
-int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_N_INPUTS],
-                       const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out)
+int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_MAX_INPUTS],
+                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out)
 {
-    icoac_real_t factors[ICOAC_CRITIC_FACTORS];
-    icoac_real_t w[ICOAC_N_INPUTS];
-    icoac_real_t h[ICOAC_N_INPUTS];
-    icoac_real_t (*cov)[ICOAC_N_INPUTS] = icoac_priv_cov_spare(st);
+    icoac_real_t w[ICOAC_MAX_INPUTS];
+    icoac_real_t h[ICOAC_MAX_INPUTS];
+    icoac_real_t (*cov)[ICOAC_MAX_INPUTS] = icoac_priv_cov_spare(st);
     /* Staged and checked. Named values, not an array: a compiler vectorizes the check of an
      * array into one load of what was just stored value by value, which x86 cannot forward
      * from the stores (it waits until they retire: measured, about 10 ns a tick). */
@@ -51,9 +55,8 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     icoac_real_t noise = ICOAC_R(0.0);
     int i;
     if (!terminal || cfg->critic.quirks) {
-        icoac_priv_critic_factors(&cfg->critic, s, factors);
         /* fills the spare slot: the current one stays the eligibility of this update */
-        value = icoac_priv_critic_value(&cfg->critic, st->v, factors, &st->active[slot_prev ^ 1]);
+        value = icoac_priv_critic_value(&cfg->critic, &st->grid, st->v, s, &st->active[slot_prev ^ 1]);
         if (terminal) {
             value = ICOAC_R(0.0); /* quirks: only the kept units of s_t+1 were wanted */
         }
@@ -63,27 +66,27 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
         delta = clip_td(reward + cfg->critic.discount * value - st->value_prev, cfg->critic.td_clip);
     }
     if (update) {
-        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
             h[i] = cfg->policy.gain * st->x_prev[i];
         }
         cov_changed = icoac_priv_actor_step(&cfg->actor, st, h, delta, observed, terminal, w, cov);
         if (cov_changed < 0) {
             return cov_changed == -1 ? ICOAC_PRIV_TICK_NUMERIC : ICOAC_PRIV_TICK_CORRUPT;
         }
-        norm = ICOAC_PRIV_SQRT(icoac_priv_dot4(w, w));
+        norm = ICOAC_PRIV_SQRT(icoac_priv_dot(w, w));
         if (cov_changed) {
-            trace = icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov));
-            if (!off_diagonal_finite(ICOAC_PRIV_CONST_MAT4(cov))) {
+            trace = icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov));
+            if (!off_diagonal_finite(ICOAC_PRIV_CONST_MAT(cov))) {
                 return 0;
             }
         } else {
-            trace = icoac_priv_trace4(icoac_priv_cov_c(st));
+            trace = icoac_priv_trace(icoac_priv_cov_c(st));
         }
     } else {
-        trace = icoac_priv_trace4(icoac_priv_cov_c(st));
+        trace = icoac_priv_trace(icoac_priv_cov_c(st));
     }
     if (!terminal) {
-        z = icoac_priv_dot4(w_act, scaled);
+        z = icoac_priv_dot(w_act, scaled);
         policy_force = cfg->policy.gain * z;
     }
     if (!(icoac_priv_finite(value) & icoac_priv_finite(delta) & icoac_priv_finite(norm) & icoac_priv_finite(trace) &
@@ -94,11 +97,11 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     if (update) {
         icoac_priv_critic_update(&cfg->critic, st->v, &st->active[cfg->critic.quirks ? slot_prev ^ 1 : slot_prev],
                                  cfg->critic.rate * delta);
-        icoac_priv_copy4(st->w, w);
+        icoac_priv_copy(st->w, w);
         st->cov_slot = (st->cov_slot & 1) ^ cov_changed;
         st->weight_norm = norm;
         if (!cfg->actor.act_with_sample) {
-            icoac_priv_copy4(st->w_act, w);
+            icoac_priv_copy(st->w_act, w);
         }
         if (cfg->actor.batch) {
             icoac_priv_actor_commit_batch(&cfg->actor, st, h, observed, terminal);

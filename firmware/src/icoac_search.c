@@ -3,7 +3,7 @@
  * search.batch trials the elite moves mu_w and Sigma_w (cross-entropy step with a floor). */
 #include "icoac_features.h"
 
-#define N ICOAC_N_INPUTS
+#define N ICOAC_MAX_INPUTS
 
 /* floor_i = f * (c * prior variance_i), the arithmetic of Sigma0's diagonal. */
 static icoac_real_t floor_of(const icoac_search_config_t *search, icoac_real_t prior_var)
@@ -13,7 +13,7 @@ static icoac_real_t floor_of(const icoac_search_config_t *search, icoac_real_t p
 
 /* Sigma0 = c * cov, its floors and its Cholesky factor; 0 when not finite or not PD. */
 static int scaled_prior(const icoac_search_config_t *search, const icoac_real_t cov[N][N], icoac_real_t sigma0[N][N],
-                        icoac_real_t floor[N], icoac_real_t lower[N][N])
+                        icoac_real_t floor[N], icoac_real_t lower[N][N], int n)
 {
     int i;
     int j;
@@ -24,15 +24,15 @@ static int scaled_prior(const icoac_search_config_t *search, const icoac_real_t 
         }
     }
     return icoac_priv_all_finite(&sigma0[0][0], N * N) && icoac_priv_all_finite(floor, N) &&
-           icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(sigma0), lower);
+           icoac_priv_cholesky(ICOAC_PRIV_CONST_MAT(sigma0), lower, n);
 }
 
-int icoac_priv_search_prior_ok(const icoac_search_config_t *search, const icoac_real_t cov[N][N])
+int icoac_priv_search_prior_ok(const icoac_search_config_t *search, const icoac_real_t cov[N][N], int n)
 {
     icoac_real_t sigma0[N][N];
     icoac_real_t floor[N];
     icoac_real_t lower[N][N];
-    return scaled_prior(search, cov, sigma0, floor, lower);
+    return scaled_prior(search, cov, sigma0, floor, lower, n);
 }
 
 void icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st)
@@ -43,7 +43,8 @@ void icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_stat
     for (i = 0; i < N; ++i) {
         st->search.prior_var[i] = cov[i][i];
     }
-    (void)scaled_prior(search, ICOAC_PRIV_CONST_MAT4(cov), cov, st->search.floor, st->search.lower);
+    (void)scaled_prior(search, ICOAC_PRIV_CONST_MAT(cov), cov, st->search.floor, st->search.lower,
+                       icoac_priv_inputs(&st->config));
 }
 
 void icoac_priv_search_floors(const icoac_search_config_t *search, icoac_priv_search_t *recorded)
@@ -57,8 +58,9 @@ void icoac_priv_search_floors(const icoac_search_config_t *search, icoac_priv_se
 void icoac_priv_search_sample(icoac_priv_state_t *st)
 {
     icoac_real_t sample[N];
-    icoac_priv_sample_lower(&st->rng, st->w, ICOAC_PRIV_CONST_MAT4(st->search.lower), sample);
-    icoac_priv_copy4(st->w_act, sample);
+    icoac_priv_sample_lower(&st->rng, st->w, ICOAC_PRIV_CONST_MAT(st->search.lower), sample,
+                            icoac_priv_inputs(&st->config));
+    icoac_priv_copy(st->w_act, sample);
 }
 
 /* The batch being closed: the recorded trials 0..count-1, then the trial ending now. */
@@ -114,13 +116,13 @@ static int elite_size(const icoac_search_config_t *search, int batch)
 #define SEARCH_MIN_PIVOT_FRACTION ICOAC_R(1.0e-4)
 
 /* lower = the Cholesky factor of cov, and every pivot a fair fraction of its diagonal entry. */
-static int well_conditioned(const icoac_real_t cov[N][N], icoac_real_t lower[N][N])
+static int well_conditioned(const icoac_real_t cov[N][N], icoac_real_t lower[N][N], int n)
 {
     int j;
-    if (!icoac_priv_cholesky4(cov, lower)) {
+    if (!icoac_priv_cholesky(cov, lower, n)) {
         return 0;
     }
-    for (j = 0; j < N; ++j) {
+    for (j = 0; j < n; ++j) {
         if (!(lower[j][j] * lower[j][j] >= SEARCH_MIN_PIVOT_FRACTION * cov[j][j])) {
             return 0;
         }
@@ -169,14 +171,14 @@ static int search_update(const icoac_search_config_t *search, const icoac_priv_s
     if (!icoac_priv_all_finite(w, N) || !icoac_priv_all_finite(&cov[0][0], N * N)) {
         return 0;
     }
-    if (!well_conditioned(ICOAC_PRIV_CONST_MAT4(cov), lower)) {
-        /* A rank-deficient elite (n_e <= 4) with a step near 1 leaves Sigma' singular or nearly
+    if (!well_conditioned(ICOAC_PRIV_CONST_MAT(cov), lower, icoac_priv_inputs(&st->config))) {
+        /* A rank-deficient elite (n_e <= n) with a step near 1 leaves Sigma' singular or nearly
          * so, which a diagonal floor need not repair: add the floor to the diagonal instead, a
          * positive definite bound below Sigma' (Sigma' is positive semidefinite up to rounding). */
         for (i = 0; i < N; ++i) {
             cov[i][i] += st->search.floor[i];
         }
-        if (!icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov), lower)) {
+        if (!icoac_priv_cholesky(ICOAC_PRIV_CONST_MAT(cov), lower, icoac_priv_inputs(&st->config))) {
             return 0;
         }
     }
@@ -208,7 +210,7 @@ ICOAC_PRIV_NOINLINE static int end_trial(const icoac_config_t *cfg, icoac_priv_s
         return 1;
     }
     if (count + 1 < batch) {
-        icoac_priv_copy4(recorded->w[count], st->w_act);
+        icoac_priv_copy(recorded->w[count], st->w_act);
         recorded->ticks[count] = st->trial_ticks;
         recorded->count = count + 1;
         return 1;
@@ -221,21 +223,21 @@ ICOAC_PRIV_NOINLINE static int end_trial(const icoac_config_t *cfg, icoac_priv_s
     if (!search_update(&cfg->search, st, &b, elite_size(&cfg->search, batch), w, cov, lower)) {
         return 0;
     }
-    icoac_priv_copy4(st->w, w);
+    icoac_priv_copy(st->w, w);
     st->cov_slot = (st->cov_slot & 1) ^ 1;
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
             recorded->lower[i][j] = lower[i][j];
         }
     }
-    st->weight_norm = ICOAC_PRIV_SQRT(icoac_priv_dot4(w, w));
+    st->weight_norm = ICOAC_PRIV_SQRT(icoac_priv_dot(w, w));
     recorded->count = 0;
     return 1;
 }
 
 /* Writes every output field but reflex, penalty, weight_norm and status. */
 int icoac_priv_search_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
-                           const icoac_real_t scaled[ICOAC_N_INPUTS], int terminal, icoac_output_t *out)
+                           const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out)
 {
     icoac_real_t z;
     icoac_real_t force;
@@ -249,17 +251,17 @@ int icoac_priv_search_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
         }
         out->z = ICOAC_R(0.0);
         out->force = ICOAC_R(0.0);
-        out->cov_trace = icoac_priv_trace4(icoac_priv_cov_c(st));
+        out->cov_trace = icoac_priv_trace(icoac_priv_cov_c(st));
         return 1;
     }
-    z = icoac_priv_dot4(st->w_act, scaled);
+    z = icoac_priv_dot(st->w_act, scaled);
     force = cfg->policy.gain * z + icoac_priv_reflex_force(&cfg->policy, out->reflex);
     if (!icoac_priv_finite(force)) {
         return 0;
     }
     out->z = z;
     out->force = force;
-    out->cov_trace = icoac_priv_trace4(icoac_priv_cov_c(st));
+    out->cov_trace = icoac_priv_trace(icoac_priv_cov_c(st));
     st->trial_ticks++;
     return 1;
 }

@@ -18,35 +18,48 @@
 #define ICOAC_PRIV_STATE_MAGIC 0x1C0AC070u
 #define ICOAC_PRIV_STATE_ENDED 0x1C0AC07Eu
 
-/* The sparse kernel's TD update indexes a pair's units with cell & ICOAC_PRIV_CELL_MASK and the
- * critic weights have room for the last pair's masked index: whatever bytes the kept-unit list
- * holds, the update stays inside them (an index from a valid list is below ICOAC_CRITIC_CELLS,
- * so the mask changes nothing). */
+/* Critic blocks (icoac.h, critic): unit k = row * cells + cell with rows, cells <=
+ * ICOAC_CRITIC_BLOCK_MAX. The kernels' arrays have ICOAC_PRIV_BLOCK slots, so a count or index
+ * masked with ICOAC_PRIV_CELL_MASK stays inside them whatever the state holds, and the critic
+ * weights have room for the last row's masked index. */
 #define ICOAC_PRIV_CELL_MASK 31
-#define ICOAC_PRIV_CRITIC_WEIGHTS ((ICOAC_CRITIC_PAIRS - 1) * ICOAC_CRITIC_CELLS + ICOAC_PRIV_CELL_MASK + 1)
-ICOAC_STATIC_ASSERT(ICOAC_CRITIC_CELLS <= ICOAC_PRIV_CELL_MASK + 1, cell_index_fits_its_mask);
+#define ICOAC_PRIV_BLOCK (ICOAC_PRIV_CELL_MASK + 1)
+#define ICOAC_PRIV_CRITIC_WEIGHTS (ICOAC_MAX_CRITIC_UNITS + ICOAC_PRIV_CELL_MASK)
+ICOAC_STATIC_ASSERT(ICOAC_CRITIC_BLOCK_MAX <= ICOAC_PRIV_CELL_MASK, block_fits_its_mask);
+ICOAC_STATIC_ASSERT(ICOAC_CRITIC_UNITS_PER_INPUT_MAX <= ICOAC_CRITIC_BLOCK_MAX, an_input_fits_a_block);
+
+/* The critic's geometry, derived from the configuration by icoac_init / icoac_retune /
+ * icoac_reset: inputs [0, split) index the rows, [split, n) the cells. */
+typedef struct {
+    uint8_t n;                       /* task.n_inputs */
+    uint8_t split;                   /* first cell input, < n */
+    uint8_t units[ICOAC_MAX_INPUTS]; /* critic.units */
+} icoac_priv_grid_t;
 
 /* Critic units kept (b_k >= critic.threshold) at one state: the eligibility of the next TD
  * update, in the layout of the critic kernel that found them (icoac_priv.h).
- * Sparse kernel: pair p = a*3 + b keeps the units of the first pair_cells[p] cells of the
- * list, in the listed order (0: none). The list's arrays have ICOAC_PRIV_CELL_MASK + 1 slots, so
- * a count or index masked with it stays inside them whatever the state holds. */
+ * Sparse kernel: row r keeps the units of the first row_cells[r] cells of the list, in the
+ * listed order (0: none). */
 typedef struct {
-    icoac_real_t pair_product[ICOAC_CRITIC_PAIRS];           /* g_x * g_xdot of each pair */
-    icoac_real_t cell_product[ICOAC_PRIV_CELL_MASK];         /* g_theta * g_thetadot, largest first; 0 */
-    uint8_t pair_cells[ICOAC_CRITIC_PAIRS];                  /* leading cells kept by each pair */
-    uint8_t cell[ICOAC_PRIV_CELL_MASK];                      /* c*3 + d */
-    uint8_t cells;                                           /* cells listed */
+    icoac_real_t row_product[ICOAC_PRIV_BLOCK];  /* product of a row's factors */
+    icoac_real_t cell_product[ICOAC_PRIV_BLOCK]; /* product of a cell's factors, largest first; then 0 */
+    uint8_t row_cells[ICOAC_PRIV_BLOCK];         /* leading cells kept by each row */
+    uint8_t cell[ICOAC_PRIV_BLOCK];              /* the cell's index */
+    uint8_t cells;                               /* cells listed */
+    uint8_t rows;                                /* rows of the grid */
+    uint8_t stride;                              /* cells of the grid: a row's units */
 } icoac_priv_critic_list_t;
 
-/* Dense kernel: the products of every pair and every cell; unit pair * 18 + cell is kept when
- * pair_product[pair] * cell_product[cell] reaches the threshold. Only cells in
+/* Dense kernel: the products of every row and every cell; unit row * stride + cell is kept when
+ * row_product[row] * cell_product[cell] reaches the threshold. Only cells in
  * [cell_begin, cell_end) can be (the others have a product below it). */
 typedef struct {
-    icoac_real_t pair_product[ICOAC_CRITIC_PAIRS]; /* g_x[a] * g_xdot[b], pair = a*3 + b */
-    icoac_real_t cell_product[ICOAC_CRITIC_CELLS]; /* g_theta[c] * g_thetadot[d], cell = c*3 + d */
+    icoac_real_t row_product[ICOAC_PRIV_BLOCK];
+    icoac_real_t cell_product[ICOAC_PRIV_BLOCK];
     uint8_t cell_begin;
     uint8_t cell_end; /* <= cell_begin: no unit kept */
+    uint8_t rows;
+    uint8_t stride;
 } icoac_priv_critic_products_t;
 
 typedef union {
@@ -56,18 +69,18 @@ typedef union {
 
 /* Per-trial sums of the actor's batch granularity (actor.batch), over the explored ticks. */
 typedef struct {
-    icoac_real_t info[ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* sum h h^T / sigma_L^2 (posterior, mean) */
-    icoac_real_t shift[ICOAC_N_INPUTS];                /* sum h * innovation / sigma_L^2; gradient: sum delta eps h */
-    icoac_real_t staged_shift[ICOAC_N_INPUTS];         /* scratch: shift after this tick, until its commit */
+    icoac_real_t info[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS]; /* sum h h^T / sigma_L^2 (posterior, mean) */
+    icoac_real_t shift[ICOAC_MAX_INPUTS];                /* sum h * innovation / sigma_L^2; gradient: sum delta eps h */
+    icoac_real_t staged_shift[ICOAC_MAX_INPUTS];         /* scratch: shift after this tick, until its commit */
 } icoac_priv_actor_batch_t;
 
 /* Episodic search (ICOAC_MODE_SEARCH): the batch of trials since the last update. */
 typedef struct {
-    icoac_real_t w[ICOAC_SEARCH_BATCH_MAX][ICOAC_N_INPUTS]; /* each trial's sampled weights */
+    icoac_real_t w[ICOAC_SEARCH_BATCH_MAX][ICOAC_MAX_INPUTS]; /* each trial's sampled weights */
     uint32_t ticks[ICOAC_SEARCH_BATCH_MAX];                 /* its length (the return) */
-    icoac_real_t lower[ICOAC_N_INPUTS][ICOAC_N_INPUTS];     /* Cholesky factor of Sigma_w */
-    icoac_real_t floor[ICOAC_N_INPUTS];                     /* search.floor * Sigma0_ii */
-    icoac_real_t prior_var[ICOAC_N_INPUTS];                 /* the prior's variances: Sigma0_ii / cov_scale */
+    icoac_real_t lower[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS];     /* Cholesky factor of Sigma_w */
+    icoac_real_t floor[ICOAC_MAX_INPUTS];                     /* search.floor * Sigma0_ii */
+    icoac_real_t prior_var[ICOAC_MAX_INPUTS];                 /* the prior's variances: Sigma0_ii / cov_scale */
     int32_t count;                                          /* trials recorded, [0, search.batch) */
 } icoac_priv_search_t;
 
@@ -79,28 +92,30 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
     int32_t has_prev;                                 /* a previous tick of this trial is cached */
     icoac_config_t config;                            /* in force: checked by icoac_init / icoac_retune,
                                                          checked again by icoac_reset */
-    icoac_real_t inv_range[ICOAC_N_INPUTS];           /* 1 / policy.input_range, derived by icoac_init */
-    icoac_real_t w[ICOAC_N_INPUTS];                   /* ICO weights, or actor mean mu_w */
+    icoac_priv_grid_t grid;                           /* the critic's geometry, derived */
+    icoac_real_t inv_range[ICOAC_MAX_INPUTS];           /* 1 / policy.input_range (0 past n), derived by icoac_init */
+    icoac_real_t w[ICOAC_MAX_INPUTS];                   /* ICO weights, or actor mean mu_w */
     icoac_real_t weight_norm;                         /* |w|, refreshed when w changes */
-    icoac_real_t w_act[ICOAC_N_INPUTS];               /* weights used to act (mu_w or a sample) */
+    icoac_real_t w_act[ICOAC_MAX_INPUTS];               /* weights used to act (mu_w or a sample) */
     int32_t cov_slot;                                 /* index of Sigma_w in cov_buffer (read & 1) */
     int32_t active_slot;                              /* index of s_t's entry in active (read & 1) */
-    icoac_real_t x_prev[ICOAC_N_INPUTS];              /* scaled observation of the previous tick */
+    icoac_real_t x_prev[ICOAC_MAX_INPUTS];              /* scaled observation of the previous tick */
     icoac_real_t penalty_prev;                        /* r of the previous ICO observation */
     icoac_real_t value_prev;                          /* V(s_t) */
     icoac_real_t noise_prev;                          /* exploration noise eps_t (N) */
     uint32_t trial_ticks;                             /* RL and search: non-terminal ticks of this trial so far (wraps at 2^32) */
     icoac_rng_t rng;                                  /* exploration noise; search: the samples */
     icoac_counters_t counters;
-    icoac_real_t cov_buffer[2][ICOAC_N_INPUTS][ICOAC_N_INPUTS]; /* Sigma_w, and the spare the RL tick stages into */
+    icoac_real_t cov_buffer[2][ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS]; /* Sigma_w, and the spare the RL tick stages into */
     icoac_priv_critic_active_t active[2];             /* kept critic units of s_t and of s */
-    icoac_real_t v[ICOAC_PRIV_CRITIC_WEIGHTS];        /* critic weights: ICOAC_CRITIC_UNITS, then room
-                                                         for the masked index (never read) */
+    icoac_real_t v[ICOAC_PRIV_CRITIC_WEIGHTS];        /* critic weights: the grid's units, then room
+                                                         for a masked index (never read) */
     icoac_priv_actor_batch_t batch;                   /* RL, actor.batch: this trial's sums */
     icoac_priv_search_t search;                       /* search mode */
 } icoac_priv_state_t;
 
 ICOAC_STATIC_ASSERT(sizeof(icoac_priv_state_t) <= sizeof(icoac_state_t), state_fits_its_storage);
+ICOAC_STATIC_ASSERT(sizeof(icoac_priv_state_t) + 128 > sizeof(icoac_state_t), state_storage_not_oversized);
 ICOAC_STATIC_ASSERT(sizeof(icoac_state_t) == ICOAC_STATE_SIZE, state_size_as_documented);
 
 /* The layout of a caller's state. */
@@ -116,17 +131,17 @@ static inline const icoac_priv_state_t *icoac_priv_state_c(const icoac_state_t *
 
 /* The actor covariance Sigma_w, and the spare buffer a tick stages a new one into. The slot is
  * masked, so any state content indexes inside the buffer. */
-static inline icoac_real_t (*icoac_priv_cov(icoac_priv_state_t *st))[ICOAC_N_INPUTS]
+static inline icoac_real_t (*icoac_priv_cov(icoac_priv_state_t *st))[ICOAC_MAX_INPUTS]
 {
     return st->cov_buffer[st->cov_slot & 1];
 }
 
-static inline const icoac_real_t (*icoac_priv_cov_c(const icoac_priv_state_t *st))[ICOAC_N_INPUTS]
+static inline const icoac_real_t (*icoac_priv_cov_c(const icoac_priv_state_t *st))[ICOAC_MAX_INPUTS]
 {
-    return (const icoac_real_t(*)[ICOAC_N_INPUTS])st->cov_buffer[st->cov_slot & 1];
+    return (const icoac_real_t(*)[ICOAC_MAX_INPUTS])st->cov_buffer[st->cov_slot & 1];
 }
 
-static inline icoac_real_t (*icoac_priv_cov_spare(icoac_priv_state_t *st))[ICOAC_N_INPUTS]
+static inline icoac_real_t (*icoac_priv_cov_spare(icoac_priv_state_t *st))[ICOAC_MAX_INPUTS]
 {
     return st->cov_buffer[(st->cov_slot & 1) ^ 1];
 }

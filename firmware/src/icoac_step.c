@@ -27,6 +27,20 @@ static icoac_status_t rejected(const icoac_priv_state_t *st, icoac_output_t *out
     return status;
 }
 
+/* The late signal of a sensor (icoac.h, task): r = -1 and U = in->reflex, clipped to [-1, 1], on
+ * a tick with ICOAC_INPUT_LATE; 0, 0 otherwise. A NaN or Inf reflex stays so (a non-finite input). */
+ICOAC_PRIV_NOINLINE static icoac_priv_zone_t sensor_zone(const icoac_input_t *in)
+{
+    icoac_priv_zone_t zone;
+    zone.reflex = ICOAC_R(0.0);
+    zone.penalty = ICOAC_R(0.0);
+    if ((in->flags & ICOAC_INPUT_LATE) != 0u) {
+        zone.reflex = icoac_priv_finite(in->reflex) ? icoac_priv_clip_unit(in->reflex) : in->reflex;
+        zone.penalty = ICOAC_R(-1.0);
+    }
+    return zone;
+}
+
 /* The slow path of a state that is not in a trial: ended by a terminal tick, or never set up. */
 ICOAC_PRIV_NOINLINE static icoac_status_t not_in_trial(icoac_priv_state_t *st, icoac_output_t *out)
 {
@@ -41,11 +55,11 @@ ICOAC_PRIV_NOINLINE static icoac_status_t not_in_trial(icoac_priv_state_t *st, i
 
 icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
 {
-    static const icoac_real_t zeros[ICOAC_N_INPUTS] = {ICOAC_R(0.0), ICOAC_R(0.0), ICOAC_R(0.0),
-                                                        ICOAC_R(0.0)};
+    static const icoac_real_t zeros[ICOAC_MAX_INPUTS] = {ICOAC_R(0.0)};
     icoac_priv_state_t *st = icoac_priv_state(state);
     const icoac_config_t *cfg;
-    icoac_real_t scaled[ICOAC_N_INPUTS];
+    icoac_real_t inputs[ICOAC_MAX_INPUTS];
+    icoac_real_t scaled[ICOAC_MAX_INPUTS];
     icoac_priv_zone_t zone;
     int terminal;
     int ok;
@@ -61,18 +75,27 @@ icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_o
     }
     cfg = &st->config;
     st->counters.ticks++;
-    /* s_i * 0 is 0 for finite s_i and NaN for NaN or Inf: one test for all four. */
-    if (!(icoac_priv_dot4(in->s, zeros) == ICOAC_R(0.0))) {
+    icoac_priv_task_inputs(icoac_priv_inputs(cfg), in->s, inputs);
+    /* s_i * 0 is 0 for finite s_i and NaN for NaN or Inf: one test for all n. */
+    if (!(icoac_priv_dot(inputs, zeros) == ICOAC_R(0.0))) {
         st->counters.nonfinite++;
         return rejected(st, out, ICOAC_ERR_NONFINITE_INPUT);
     }
     terminal = (in->flags & ICOAC_INPUT_TERMINAL) != 0u;
-    icoac_priv_scale_inputs(&cfg->policy, st, in->s, scaled);
-    zone = icoac_priv_zone(&cfg->policy, in->s);
+    icoac_priv_scale_inputs(&cfg->policy, st, inputs, scaled);
+    if (cfg->task.late_source == ICOAC_LATE_RULES) {
+        zone = icoac_priv_zone(&cfg->task, inputs);
+    } else {
+        zone = sensor_zone(in);
+        if (!icoac_priv_finite(zone.reflex)) {
+            st->counters.nonfinite++;
+            return rejected(st, out, ICOAC_ERR_NONFINITE_INPUT);
+        }
+    }
     out->reflex = zone.reflex;
     out->penalty = zone.penalty;
     if (cfg->mode == ICOAC_MODE_RL) {
-        ok = icoac_priv_rl_tick(cfg, st, in->s, scaled, terminal, out);
+        ok = icoac_priv_rl_tick(cfg, st, inputs, scaled, terminal, out);
     } else if (cfg->mode == ICOAC_MODE_SEARCH) {
         ok = icoac_priv_search_tick(cfg, st, scaled, terminal, out);
     } else if (cfg->mode == ICOAC_MODE_ICO) {

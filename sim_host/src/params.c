@@ -78,6 +78,10 @@ int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
     status = (int32_t)icoac_config_check(cfg);
+    /* the plant is the cart-pole: the controller's task must read its four state variables */
+    if (status == ICOAC_SIM_OK && cfg->task.n_inputs != ICOAC_CARTPOLE_INPUTS) {
+        status = ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
     if (status == ICOAC_SIM_OK) {
         status = icoac_sim_plant_check(plant);
     }

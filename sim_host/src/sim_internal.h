@@ -10,7 +10,7 @@
  * Non-finite velocities fail too (icoac_sim_failed contract: "or not finite"); otherwise the
  * next tick hands them to the controller, which rejects the observation and the cell ends
  * as ICOAC_SIM_ERROR instead of a failed trial. */
-static inline int32_t sim_failed(const icoac_sim_plant_t *plant, const double s[ICOAC_N_INPUTS])
+static inline int32_t sim_failed(const icoac_sim_plant_t *plant, const double s[ICOAC_CARTPOLE_INPUTS])
 {
     return !(s[0] >= -plant->x_limit && s[0] <= plant->x_limit && s[2] >= -plant->theta_limit &&
              s[2] <= plant->theta_limit && isfinite(s[1]) && isfinite(s[3]));
@@ -24,10 +24,10 @@ int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
 int sim_velocity_noise_valid(double a);
 
 /* Start state of a trial from cell (x0, theta0) with velocities U(-noise, noise) (trial.c). */
-void sim_start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t *rng, double s[ICOAC_N_INPUTS]);
+void sim_start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t *rng, double s[ICOAC_CARTPOLE_INPUTS]);
 
 /* The plant state as the controller's input; values outside its real range become NaN. */
-void sim_to_input(const double s[ICOAC_N_INPUTS], uint32_t flags, icoac_input_t *in);
+void sim_to_input(const double s[ICOAC_CARTPOLE_INPUTS], uint32_t flags, icoac_input_t *in);
 
 /* What every cell of a run shares. */
 typedef struct {
@@ -46,7 +46,7 @@ typedef struct {
 typedef struct {
     icoac_state_t ctrl;
     icoac_rng_t rng; /* the plant's: start velocities */
-    double s[ICOAC_N_INPUTS];
+    double s[ICOAC_CARTPOLE_INPUTS];
     icoac_sim_cell_t *cell;
     int64_t trials; /* finished trials */
     int64_t total;  /* their steps */

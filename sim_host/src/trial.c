@@ -55,11 +55,12 @@ void sim_to_input(const double s[4], uint32_t flags, icoac_input_t *in)
     _mm_storeu_ps(in->s, _mm_movelh_ps(low_real, high_real));
 #else
     int i;
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
         in->s[i] = fabs(s[i]) <= SIM_REAL_MAX ? (icoac_real_t)s[i] : (icoac_real_t)NAN;
     }
 #endif
     in->flags = flags;
+    in->reflex = (icoac_real_t)0; /* the late signal comes from the task's rules */
 }
 
 static void store_posterior(const icoac_state_t *ctrl, icoac_sim_cell_t *cell)
@@ -67,9 +68,9 @@ static void store_posterior(const icoac_state_t *ctrl, icoac_sim_cell_t *cell)
     icoac_prior_t post;
     int i, j;
     (void)icoac_get_posterior(ctrl, &post);
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
         cell->weights[i] = (double)post.mean[i];
-        for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+        for (j = 0; j < ICOAC_CARTPOLE_INPUTS; ++j) {
             cell->cov[i][j] = (double)post.cov[i][j];
         }
     }

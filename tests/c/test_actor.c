@@ -4,11 +4,12 @@
 
 #include "icoac_priv.h"
 
-#define N ICOAC_N_INPUTS
+#define N ICOAC_CARTPOLE_INPUTS /* the cart-pole task's inputs */
+#define M ICOAC_MAX_INPUTS      /* the library's vectors: entries past N are 0 */
 
 /* The update writes its candidate posterior over the state's own (mu_w, Sigma_w): the
  * outputs alias what it reads. */
-static void actor_update_in_place(const icoac_config_t *cfg, icoac_state_t *state, const icoac_real_t h[N],
+static void actor_update_in_place(const icoac_config_t *cfg, icoac_state_t *state, const icoac_real_t h[M],
                                   icoac_real_t innovation)
 {
     icoac_priv_state_t *st = icoac_priv_state(state);
@@ -21,7 +22,7 @@ static icoac_real_t *mean_of(icoac_state_t *state)
     return icoac_priv_state(state)->w;
 }
 
-static icoac_real_t (*cov_of(icoac_state_t *state))[N]
+static icoac_real_t (*cov_of(icoac_state_t *state))[M]
 {
     return icoac_priv_cov(icoac_priv_state(state));
 }
@@ -78,7 +79,7 @@ static void random_gauss(test_rng_t *rng, double scale, gauss_t *g)
 static void load_state(icoac_state_t *state, gauss_t *g)
 {
     icoac_real_t *w = mean_of(state);
-    icoac_real_t(*cov)[N] = cov_of(state);
+    icoac_real_t(*cov)[M] = cov_of(state);
     int i, j;
     for (i = 0; i < N; ++i) {
         w[i] = (icoac_real_t)g->mean[i];
@@ -118,7 +119,7 @@ static void compare_with_closed_form(const icoac_config_t *cfg, test_rng_t *rng,
     icoac_config_t c2;
     icoac_state_t state = rl_state(&c2);
     gauss_t prior, post;
-    icoac_real_t h[N];
+    icoac_real_t h[M] = {0};
     double hd[N], innovation, r, tol;
     int i, j;
     random_gauss(rng, test_uniform(rng, 0.01, 2.0), &prior);
@@ -167,18 +168,18 @@ static void test_zero_innovation_keeps_mean(void **unused)
     icoac_state_t state = rl_state(&cfg);
     test_rng_t rng = {3u};
     gauss_t prior;
-    icoac_real_t h[N] = {(icoac_real_t)3.0, (icoac_real_t)-7.0, (icoac_real_t)10.0, (icoac_real_t)0.5};
-    icoac_real_t mean_before[N];
+    icoac_real_t h[M] = {(icoac_real_t)3.0, (icoac_real_t)-7.0, (icoac_real_t)10.0, (icoac_real_t)0.5};
+    icoac_real_t mean_before[M] = {0};
     double trace_before;
     (void)unused;
     random_gauss(&rng, 1.0, &prior);
     load_state(&state, &prior);
     memcpy(mean_before, mean_of(&state), sizeof mean_before);
-    trace_before = (double)icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov_of(&state)));
+    trace_before = (double)icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov_of(&state)));
     actor_update_in_place(&cfg, &state, h, (icoac_real_t)0.0);
     assert_memory_equal(mean_of(&state), mean_before, sizeof mean_before);
     /* the covariance still shrinks */
-    assert_true((double)icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov_of(&state))) < trace_before);
+    assert_true((double)icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov_of(&state))) < trace_before);
 }
 
 static void test_forgetting_inflates_first(void **unused)
@@ -187,7 +188,7 @@ static void test_forgetting_inflates_first(void **unused)
     icoac_state_t state = rl_state(&cfg);
     test_rng_t rng = {4u};
     gauss_t prior, inflated, post;
-    icoac_real_t h[N];
+    icoac_real_t h[M] = {0};
     double hd[N];
     const double lambda = 0.9;
     int i, j;
@@ -242,8 +243,8 @@ static void test_update_staged_into_spare(void **unused)
         icoac_priv_state_t *st = icoac_priv_state(&state);
         const int spare = st->cov_slot ^ 1;
         gauss_t prior;
-        icoac_real_t h[N];
-        icoac_real_t w[N];
+        icoac_real_t h[M] = {0};
+        icoac_real_t w[M] = {0};
         const icoac_real_t innovation = (icoac_real_t)test_uniform(&rng, -3, 3);
         cfg.actor.forgetting = n % 2 ? ICOAC_R(1.0) : (icoac_real_t)0.95;
         random_gauss(&rng, test_uniform(&rng, 0.01, 2.0), &prior);
@@ -273,7 +274,7 @@ static void run_long(double forgetting, int n_updates)
 {
     icoac_config_t cfg;
     icoac_state_t state = rl_state(&cfg);
-    icoac_real_t lower[N][N];
+    icoac_real_t lower[M][M] = {{0}};
     test_rng_t rng = {0x5EEDu};
     double info[N][N];
     int n, i, j;
@@ -284,8 +285,8 @@ static void run_long(double forgetting, int n_updates)
         }
     }
     for (n = 0; n < n_updates; ++n) {
-        icoac_real_t h[N];
-        double prev_trace = (double)icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov_of(&state)));
+        icoac_real_t h[M] = {0};
+        double prev_trace = (double)icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov_of(&state)));
         for (i = 0; i < N; ++i) {
             h[i] = (icoac_real_t)(10.0 * test_uniform(&rng, -1, 1)); /* G x~, |x~| <= 1 */
         }
@@ -299,13 +300,13 @@ static void run_long(double forgetting, int n_updates)
                 info[i][j] = forgetting * info[i][j] + (double)h[i] * (double)h[j] / test_likelihood_var(&cfg.actor);
             }
         }
-        if (!icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(cov_of(&state)), lower)) {
+        if (!icoac_priv_cholesky(ICOAC_PRIV_CONST_MAT(cov_of(&state)), lower, ICOAC_CARTPOLE_INPUTS)) {
             print_error("update %d: cov not positive definite\n", n);
             fail();
         }
         if (forgetting == 1.0) {
             /* without forgetting Sigma never grows (up to rounding) */
-            assert_true((double)icoac_priv_trace4(ICOAC_PRIV_CONST_MAT4(cov_of(&state))) <=
+            assert_true((double)icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov_of(&state))) <=
                         prev_trace * (1.0 + 64.0 * REAL_EPS));
         }
     }
@@ -439,7 +440,7 @@ static void test_posterior_sample_per_trial(void **unused)
             }
         }
     }
-    /* Cholesky-Banachiewicz in double, independent of icoac_priv_cholesky4 */
+    /* Cholesky-Banachiewicz in double, independent of icoac_priv_cholesky */
     memset(lower, 0, sizeof lower);
     for (i = 0; i < N; ++i) {
         for (j = 0; j <= i; ++j) {

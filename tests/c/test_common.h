@@ -61,25 +61,25 @@ static inline double test_uniform(test_rng_t *r, double lo, double hi)
 static inline icoac_prior_t test_random_prior(test_rng_t *rng, double mean_half_width, double scale)
 {
     icoac_prior_t p;
-    double a[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
+    double a[ICOAC_CARTPOLE_INPUTS][ICOAC_CARTPOLE_INPUTS];
     int i, j, k;
     memset(&p, 0, sizeof p);
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
         p.mean[i] = (icoac_real_t)test_uniform(rng, -mean_half_width, mean_half_width);
-        for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+        for (j = 0; j < ICOAC_CARTPOLE_INPUTS; ++j) {
             a[i][j] = test_uniform(rng, -1, 1);
         }
     }
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
         for (j = 0; j <= i; ++j) {
             double sum = i == j ? 0.05 : 0.0;
-            for (k = 0; k < ICOAC_N_INPUTS; ++k) {
+            for (k = 0; k < ICOAC_CARTPOLE_INPUTS; ++k) {
                 sum += a[i][k] * a[j][k];
             }
             p.cov[i][j] = p.cov[j][i] = (icoac_real_t)(scale * sum);
         }
     }
-    assert_int_equal(icoac_prior_check(&p), ICOAC_OK);
+    assert_int_equal(icoac_prior_check(&p, ICOAC_CARTPOLE_INPUTS), ICOAC_OK);
     return p;
 }
 
@@ -134,7 +134,7 @@ static inline icoac_prior_t test_prior(double w0, double w1, double w2, double w
     p.mean[1] = (icoac_real_t)w1;
     p.mean[2] = (icoac_real_t)w2;
     p.mean[3] = (icoac_real_t)w3;
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
         p.cov[i][i] = (icoac_real_t)c;
     }
     return p;
@@ -155,7 +155,7 @@ static inline icoac_input_t test_input(double x, double xd, double th, double th
 /* Paper scaling (method.md, input scaling), written independently of the library, on the stored input. */
 static inline double test_scale(int i, double value, int clip)
 {
-    static const double range[ICOAC_N_INPUTS] = {2.4, 3.5, 0.2094384, 2.0};
+    static const double range[ICOAC_CARTPOLE_INPUTS] = {2.4, 3.5, 0.2094384, 2.0};
     double a = value / range[i];
     if (clip) {
         a = a > 1.0 ? 1.0 : (a < -1.0 ? -1.0 : a);

@@ -28,8 +28,30 @@ static void test_defaults_match_spec(void **unused)
     assert_close(cfg.policy.input_range[3], 2.0, 0.0);
     assert_close(cfg.policy.gain, 10.0, 0.0);
     assert_close(cfg.policy.reflex_force, 1.0, 0.0);
-    assert_close(cfg.policy.zone_theta, DEG(11.5), tol);
-    assert_close(cfg.policy.zone_x, 2.35, tol * 2.35);
+    /* the cart-pole task: Eq. (4)'s zone as four rules, first match wins */
+    assert_int_equal(cfg.task.n_inputs, 4);
+    assert_int_equal(cfg.task.late_source, ICOAC_LATE_RULES);
+    assert_int_equal(cfg.task.n_rules, 4);
+    assert_int_equal(cfg.task.rule_input[0], ICOAC_IDX_THETA);
+    assert_int_equal(cfg.task.rule_side[0], ICOAC_RULE_ABOVE);
+    assert_close(cfg.task.rule_threshold[0], DEG(11.5), tol);
+    assert_close(cfg.task.rule_reflex[0], 1.0, 0.0);
+    assert_int_equal(cfg.task.rule_input[1], ICOAC_IDX_X);
+    assert_int_equal(cfg.task.rule_side[1], ICOAC_RULE_BELOW);
+    assert_close(cfg.task.rule_threshold[1], -2.35, tol * 2.35);
+    assert_close(cfg.task.rule_reflex[1], 1.0, 0.0);
+    assert_int_equal(cfg.task.rule_input[2], ICOAC_IDX_THETA);
+    assert_int_equal(cfg.task.rule_side[2], ICOAC_RULE_BELOW);
+    assert_close(cfg.task.rule_threshold[2], -DEG(11.5), tol);
+    assert_close(cfg.task.rule_reflex[2], -1.0, 0.0);
+    assert_int_equal(cfg.task.rule_input[3], ICOAC_IDX_X);
+    assert_int_equal(cfg.task.rule_side[3], ICOAC_RULE_ABOVE);
+    assert_close(cfg.task.rule_threshold[3], 2.35, tol * 2.35);
+    assert_close(cfg.task.rule_reflex[3], -1.0, 0.0);
+    assert_int_equal(cfg.critic.units[0], 3);
+    assert_int_equal(cfg.critic.units[1], 3);
+    assert_int_equal(cfg.critic.units[2], 6);
+    assert_int_equal(cfg.critic.units[3], 3);
     assert_close(cfg.ico.rate, 1e-4, tol * 1e-4);
     assert_close(cfg.critic.rate, 0.6, tol);
     assert_close(cfg.critic.discount, 0.95, tol);
@@ -79,7 +101,8 @@ static void test_defaults_match_spec(void **unused)
     assert_memory_equal(&search, &filled.search, sizeof search);
     /* and the default over a 0xA5 fill equals the default over zeros, field by field */
     assert_true(memcmp(filled.policy.input_range, cfg.policy.input_range, sizeof cfg.policy.input_range) == 0);
-    assert_true(filled.policy.gain == cfg.policy.gain && filled.policy.zone_x == cfg.policy.zone_x);
+    assert_true(filled.policy.gain == cfg.policy.gain && filled.task.rule_threshold[3] == cfg.task.rule_threshold[3]);
+    assert_true(memcmp(&filled.task, &cfg.task, sizeof cfg.task) == 0);
     assert_true(filled.critic.threshold == cfg.critic.threshold && filled.actor.reflex == cfg.actor.reflex);
     assert_true(filled.actor.likelihood_std == cfg.actor.likelihood_std && filled.search.floor == cfg.search.floor);
     assert_true(filled.search.batch == cfg.search.batch && filled.actor.explore_ticks == cfg.actor.explore_ticks);
@@ -141,11 +164,23 @@ MUT(m_gain_inf, c->policy.gain = INF_R)
 RLMUT(m_rl_gain_nan, c->policy.gain = NAN_R)
 MUT(m_reflex_force_neg, c->policy.reflex_force = -0.1f)
 MUT(m_reflex_force_nan, c->policy.reflex_force = NAN_R)
-MUT(m_zone_theta_zero, c->policy.zone_theta = 0)
-MUT(m_zone_theta_nan, c->policy.zone_theta = NAN_R)
-MUT(m_zone_x_neg, c->policy.zone_x = -2.35f)
-MUT(m_zone_x_inf, c->policy.zone_x = INF_R)
-RLMUT(m_rl_zone_x_inf, c->policy.zone_x = INF_R)
+MUT(m_threshold0_nan, c->task.rule_threshold[0] = NAN_R)
+MUT(m_threshold2_inf, c->task.rule_threshold[2] = INF_R)
+MUT(m_reflex1_big, c->task.rule_reflex[1] = 1.5f)
+MUT(m_rule_input3_n, c->task.rule_input[3] = 4)
+RLMUT(m_rl_rule_side1_2, c->task.rule_side[1] = 2)
+MUT(m_rule_input0_neg, c->task.rule_input[0] = -1)
+MUT(m_late_source_2, c->task.late_source = 2)
+MUT(m_n_inputs_zero, c->task.n_inputs = 0)
+MUT(m_n_rules_neg, c->task.n_rules = -1)
+MUT(m_n_inputs_6_ranges_unset, c->task.n_inputs = 6)
+RLMUT(m_units2_17, c->critic.units[2] = 17)
+RLMUT(m_units0_zero, c->critic.units[0] = 0)
+RLMUT(m_units_too_many, { c->critic.units[0] = 16; c->critic.units[1] = 16; })
+RLMUT(m_units_rows_too_many, { c->critic.units[0] = 2; c->critic.units[1] = 16; c->critic.units[2] = 6;
+                               c->critic.units[3] = 1; })
+RLMUT(m_rl_n_inputs_6_critic_unset, { c->task.n_inputs = 6; c->policy.input_range[4] = 1; c->policy.input_range[5] = 1;
+                                      c->critic.range[4] = 1; c->critic.range[5] = 1; })
 MUT(m_ico_rate_neg, c->ico.rate = -1e-9f)
 MUT(m_ico_rate_nan, c->ico.rate = NAN_R)
 MUT(m_ico_rate_inf, c->ico.rate = INF_R)
@@ -177,8 +212,8 @@ MUT(m_range1_tiny, c->policy.input_range[1] = (icoac_real_t)9e-7)
 MUT(m_range2_huge, c->policy.input_range[2] = (icoac_real_t)1.1e6)
 MUT(m_gain_huge, c->policy.gain = (icoac_real_t)1e30)
 MUT(m_reflex_force_huge, c->policy.reflex_force = (icoac_real_t)1e38)
-MUT(m_zone_theta_big, c->policy.zone_theta = (icoac_real_t)3.2)
-MUT(m_zone_x_huge, c->policy.zone_x = (icoac_real_t)1e30)
+MUT(m_threshold1_big, c->task.rule_threshold[1] = (icoac_real_t)1.1e6)
+MUT(m_n_inputs_big, c->task.n_inputs = ICOAC_MAX_INPUTS + 1)
 MUT(m_ico_rate_huge, c->ico.rate = (icoac_real_t)1e30)
 RLMUT(m_td_clip_subnormal, c->critic.td_clip = (icoac_real_t)1e-39)
 RLMUT(m_td_clip_huge, c->critic.td_clip = (icoac_real_t)1e30)
@@ -189,8 +224,8 @@ RLMUT(m_noise_huge, c->actor.noise_std = (icoac_real_t)1e30)
 RLMUT(m_scale_huge, c->actor.scale = (icoac_real_t)1e30)
 RLMUT(m_forget_tiny, c->actor.forgetting = (icoac_real_t)1e-30)
 RLMUT(m_forget_below_half, c->actor.forgetting = (icoac_real_t)0.49)
-MUT(m_zone_theta_subnormal, c->policy.zone_theta = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
-MUT(m_zone_x_tiny, c->policy.zone_x = (icoac_real_t)9e-7)
+MUT(m_threshold3_subnormal, c->task.rule_threshold[3] = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
+MUT(m_n_rules_big, c->task.n_rules = ICOAC_MAX_RULES + 1)
 MUT(m_gain_subnormal, c->policy.gain = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
 RLMUT(m_threshold_subnormal, c->critic.threshold = (icoac_real_t)(REAL_IS_FLOAT ? 1e-39 : 1e-310))
 /* The learners' fields (method.md, L2-L4, A10), each bound from both sides. */
@@ -239,10 +274,11 @@ SMUT(m_cov_scale_inf, c->search.cov_scale = INF_R)
 SMUT(m_search_learn_2, c->learn = 2)
 SMUT(m_search_gain_nan, c->policy.gain = NAN_R)
 /* Several bad fields: the first in struct order (mode, policy, then the mode's groups) is named. */
-MUT(m_two_policy_fields, { c->policy.zone_x = INF_R; c->policy.input_range[2] = NAN_R; })
+MUT(m_two_policy_fields, { c->policy.gain = INF_R; c->policy.input_range[2] = NAN_R; })
+MUT(m_task_before_policy, { c->policy.input_range[0] = NAN_R; c->task.rule_reflex[3] = 2; })
 RLMUT(m_policy_before_critic, { c->critic.rate = NAN_R; c->policy.gain = -1.0f; })
 RLMUT(m_critic_before_actor, { c->actor.noise_std = 0; c->critic.threshold = 1.0f; })
-SMUT(m_policy_before_search, { c->search.batch = 0; c->policy.zone_x = INF_R; })
+SMUT(m_policy_before_search, { c->search.batch = 0; c->policy.gain = INF_R; })
 SMUT(m_search_in_order, { c->search.cov_scale = 0; c->search.floor = 0; c->search.step = 0;
                           c->search.elite_fraction = 0; })
 SMUT(m_search_batch_first, { c->search.cov_scale = 0; c->search.batch = 0; })
@@ -286,6 +322,17 @@ RLMUT(ok_forget, c->actor.forgetting = 0.5f)
 RLMUT(ok_scale_zero, c->actor.scale = 0)
 RLMUT(ok_rl_gain_literal, { c->policy.reflex_mode = ICOAC_REFLEX_GAIN; c->ico.timing = ICOAC_ICO_TIMING_LITERAL;
                             c->policy.clip_inputs = 0; c->actor.reflex = 0; c->actor.act_with_sample = 1; })
+MUT(ok_sensor_ignores_rules, { c->task.late_source = ICOAC_LATE_SENSOR; c->task.rule_input[0] = 99;
+                                c->task.rule_threshold[1] = NAN_R; })
+MUT(ok_no_rules, { c->task.n_rules = 0; c->task.rule_side[0] = 5; })
+MUT(ok_rule_bounds, { c->task.rule_threshold[0] = ICOAC_RULE_THRESHOLD_MAX; c->task.rule_threshold[1] = -ICOAC_RULE_THRESHOLD_MAX;
+                      c->task.rule_reflex[2] = 0; c->task.rule_reflex[3] = (icoac_real_t)0.25; })
+MUT(ok_one_input, { c->task.n_inputs = 1; c->task.n_rules = 1; c->task.rule_input[0] = 0; })
+RLMUT(ok_six_inputs, { c->task.n_inputs = 6; c->policy.input_range[4] = 1; c->policy.input_range[5] = 1;
+                       c->critic.range[4] = 1; c->critic.range[5] = 1; c->critic.units[0] = 3; c->critic.units[1] = 3;
+                       c->critic.units[2] = 3; c->critic.units[3] = 2; c->critic.units[4] = 2; c->critic.units[5] = 2; })
+RLMUT(ok_units_max_per_input, { c->critic.units[0] = 1; c->critic.units[1] = 1; c->critic.units[2] = 16;
+                                c->critic.units[3] = 13; })
 MUT(ok_ico_gain_literal, { c->policy.reflex_mode = ICOAC_REFLEX_GAIN; c->ico.timing = ICOAC_ICO_TIMING_LITERAL;
                            c->policy.clip_inputs = 0; })
 
@@ -312,11 +359,22 @@ static const config_case_t config_cases[] = {
     {"RL, policy.gain=NaN", m_rl_gain_nan, ICOAC_ERR_BAD_GAIN, "policy.gain"},
     {"policy.reflex_force<0", m_reflex_force_neg, ICOAC_ERR_BAD_GAIN, "policy.reflex_force"},
     {"policy.reflex_force=NaN", m_reflex_force_nan, ICOAC_ERR_BAD_GAIN, "policy.reflex_force"},
-    {"policy.zone_theta=0", m_zone_theta_zero, ICOAC_ERR_BAD_ZONE, "policy.zone_theta"},
-    {"policy.zone_theta=NaN", m_zone_theta_nan, ICOAC_ERR_BAD_ZONE, "policy.zone_theta"},
-    {"policy.zone_x<0", m_zone_x_neg, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
-    {"policy.zone_x=Inf", m_zone_x_inf, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
-    {"RL, policy.zone_x=Inf", m_rl_zone_x_inf, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
+    {"task.rule_threshold[0]=NaN", m_threshold0_nan, ICOAC_ERR_BAD_ZONE, "task.rule_threshold[0]"},
+    {"task.rule_threshold[2]=Inf", m_threshold2_inf, ICOAC_ERR_BAD_ZONE, "task.rule_threshold[2]"},
+    {"task.rule_reflex[1]=1.5", m_reflex1_big, ICOAC_ERR_BAD_ZONE, "task.rule_reflex[1]"},
+    {"task.rule_input[3]=n", m_rule_input3_n, ICOAC_ERR_BAD_TASK, "task.rule_input[3]"},
+    {"RL, task.rule_side[1]=2", m_rl_rule_side1_2, ICOAC_ERR_BAD_TASK, "task.rule_side[1]"},
+    {"task.rule_input[0]=-1", m_rule_input0_neg, ICOAC_ERR_BAD_TASK, "task.rule_input[0]"},
+    {"task.late_source=2", m_late_source_2, ICOAC_ERR_BAD_TASK, "task.late_source"},
+    {"task.n_inputs=0", m_n_inputs_zero, ICOAC_ERR_BAD_TASK, "task.n_inputs"},
+    {"task.n_rules=-1", m_n_rules_neg, ICOAC_ERR_BAD_TASK, "task.n_rules"},
+    {"task.n_inputs=6, ranges 4-5 unset", m_n_inputs_6_ranges_unset, ICOAC_ERR_BAD_SCALE, "policy.input_range[4]"},
+    {"RL, critic.units[2]=17", m_units2_17, ICOAC_ERR_BAD_CRITIC, "critic.units[2]"},
+    {"RL, critic.units[0]=0", m_units0_zero, ICOAC_ERR_BAD_CRITIC, "critic.units[0]"},
+    {"RL, critic.units 16x16x6x3", m_units_too_many, ICOAC_ERR_BAD_CRITIC, "critic.units"},
+    {"RL, critic.units 2x16x6x1: 32 rows", m_units_rows_too_many, ICOAC_ERR_BAD_CRITIC, "critic.units"},
+    {"RL, task.n_inputs=6, critic.units[4] unset", m_rl_n_inputs_6_critic_unset, ICOAC_ERR_BAD_CRITIC,
+     "critic.units[4]"},
     {"ico.rate<0", m_ico_rate_neg, ICOAC_ERR_BAD_ICO_RATE, "ico.rate"},
     {"ico.rate=NaN", m_ico_rate_nan, ICOAC_ERR_BAD_ICO_RATE, "ico.rate"},
     {"ico.rate=Inf", m_ico_rate_inf, ICOAC_ERR_BAD_ICO_RATE, "ico.rate"},
@@ -347,8 +405,8 @@ static const config_case_t config_cases[] = {
     {"policy.input_range[2]=1.1e6", m_range2_huge, ICOAC_ERR_BAD_SCALE, "policy.input_range[2]"},
     {"policy.gain=1e30", m_gain_huge, ICOAC_ERR_BAD_GAIN, "policy.gain"},
     {"policy.reflex_force=1e38", m_reflex_force_huge, ICOAC_ERR_BAD_GAIN, "policy.reflex_force"},
-    {"policy.zone_theta=3.2", m_zone_theta_big, ICOAC_ERR_BAD_ZONE, "policy.zone_theta"},
-    {"policy.zone_x=1e30", m_zone_x_huge, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
+    {"task.rule_threshold[1]=1.1e6", m_threshold1_big, ICOAC_ERR_BAD_ZONE, "task.rule_threshold[1]"},
+    {"task.n_inputs=max+1", m_n_inputs_big, ICOAC_ERR_BAD_TASK, "task.n_inputs"},
     {"ico.rate=1e30", m_ico_rate_huge, ICOAC_ERR_BAD_ICO_RATE, "ico.rate"},
     {"RL, critic.td_clip=1e-39", m_td_clip_subnormal, ICOAC_ERR_BAD_CRITIC, "critic.td_clip"},
     {"RL, critic.td_clip=1e30", m_td_clip_huge, ICOAC_ERR_BAD_CRITIC, "critic.td_clip"},
@@ -359,8 +417,8 @@ static const config_case_t config_cases[] = {
     {"RL, actor.scale=1e30", m_scale_huge, ICOAC_ERR_BAD_ACTOR, "actor.scale"},
     {"RL, actor.forgetting=1e-30", m_forget_tiny, ICOAC_ERR_BAD_ACTOR, "actor.forgetting"},
     {"RL, actor.forgetting=0.49", m_forget_below_half, ICOAC_ERR_BAD_ACTOR, "actor.forgetting"},
-    {"policy.zone_theta subnormal", m_zone_theta_subnormal, ICOAC_ERR_BAD_ZONE, "policy.zone_theta"},
-    {"policy.zone_x=9e-7", m_zone_x_tiny, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
+    {"task.rule_threshold[3] subnormal", m_threshold3_subnormal, ICOAC_ERR_BAD_ZONE, "task.rule_threshold[3]"},
+    {"task.n_rules=max+1", m_n_rules_big, ICOAC_ERR_BAD_TASK, "task.n_rules"},
     {"policy.gain subnormal", m_gain_subnormal, ICOAC_ERR_BAD_GAIN, "policy.gain"},
     {"RL, critic.threshold subnormal", m_threshold_subnormal, ICOAC_ERR_BAD_CRITIC, "critic.threshold"},
     {"RL, critic.quirks=2", m_quirks_2, ICOAC_ERR_BAD_MODE, "critic.quirks"},
@@ -407,10 +465,11 @@ static const config_case_t config_cases[] = {
     {"search, search.cov_scale=Inf", m_cov_scale_inf, ICOAC_ERR_BAD_SEARCH, "search.cov_scale"},
     {"search, learn=2", m_search_learn_2, ICOAC_ERR_BAD_MODE, "learn"},
     {"search, policy.gain=NaN", m_search_gain_nan, ICOAC_ERR_BAD_GAIN, "policy.gain"},
-    {"policy.zone_x and policy.input_range[2]", m_two_policy_fields, ICOAC_ERR_BAD_SCALE, "policy.input_range[2]"},
+    {"policy.gain and policy.input_range[2]", m_two_policy_fields, ICOAC_ERR_BAD_SCALE, "policy.input_range[2]"},
+    {"policy.input_range[0] and task.rule_reflex[3]", m_task_before_policy, ICOAC_ERR_BAD_ZONE, "task.rule_reflex[3]"},
     {"RL, critic.rate and policy.gain", m_policy_before_critic, ICOAC_ERR_BAD_GAIN, "policy.gain"},
     {"RL, actor.noise_std and critic.threshold", m_critic_before_actor, ICOAC_ERR_BAD_CRITIC, "critic.threshold"},
-    {"search, search.batch and policy.zone_x", m_policy_before_search, ICOAC_ERR_BAD_ZONE, "policy.zone_x"},
+    {"search, search.batch and policy.gain", m_policy_before_search, ICOAC_ERR_BAD_GAIN, "policy.gain"},
     {"search, four search fields", m_search_in_order, ICOAC_ERR_BAD_SEARCH, "search.elite_fraction"},
     {"search, search.cov_scale and search.batch", m_search_batch_first, ICOAC_ERR_BAD_SEARCH, "search.batch"},
     {"RL, five new actor fields", m_actor_new_in_order, ICOAC_ERR_BAD_MODE, "actor.update"},
@@ -439,6 +498,12 @@ static const config_case_t config_cases[] = {
     {"RL, actor.scale=0", ok_scale_zero, ICOAC_OK, NULL},
     {"RL, all switches at their alternative", ok_rl_gain_literal, ICOAC_OK, NULL},
     {"ICO, all switches at their alternative", ok_ico_gain_literal, ICOAC_OK, NULL},
+    {"sensor late signal: the rules are not checked", ok_sensor_ignores_rules, ICOAC_OK, NULL},
+    {"no rules", ok_no_rules, ICOAC_OK, NULL},
+    {"rule thresholds and reflexes at their bounds", ok_rule_bounds, ICOAC_OK, NULL},
+    {"one input, one rule", ok_one_input, ICOAC_OK, NULL},
+    {"RL, six inputs, critic 3x3x3x2x2x2", ok_six_inputs, ICOAC_OK, NULL},
+    {"RL, critic 1x1x16x13", ok_units_max_per_input, ICOAC_OK, NULL},
 };
 
 #define N_CONFIG_CASES (sizeof config_cases / sizeof config_cases[0])
@@ -451,7 +516,7 @@ static int starts_with(const char *s, const char *prefix)
 static void test_bad_configs_rejected_state_untouched(void **unused)
 {
     size_t n;
-    int seen[ICOAC_ERR_BAD_SEARCH + 1] = {0};
+    int seen[ICOAC_ERR_BAD_TASK + 1] = {0};
     int s;
     (void)unused;
     for (n = 0; n < N_CONFIG_CASES; ++n) {
@@ -489,6 +554,7 @@ static void test_bad_configs_rejected_state_untouched(void **unused)
         assert_true(seen[s]);
     }
     assert_true(seen[ICOAC_ERR_BAD_SEARCH]);
+    assert_true(seen[ICOAC_ERR_BAD_TASK]);
 }
 
 /* icoac_config_check_field names the first bad field of every case, agrees with
@@ -536,7 +602,7 @@ static void test_config_cases_name_their_field(void **unused)
 /* Every field of the configuration, in struct order, with the group that validates it: the
  * policy in every mode, ico in ICO mode only, critic and actor in RL mode only, search in
  * search mode only; and a value that is invalid in that field (NaN for a real). */
-typedef enum { G_POLICY, G_ICO, G_RL, G_SEARCH } group_t;
+typedef enum { G_POLICY, G_ICO, G_RL, G_SEARCH, G_UNUSED } group_t;
 typedef struct {
     const char *name;
     size_t offset;
@@ -555,18 +621,48 @@ typedef struct {
 /* 7 is out of range of every switch and 0/1 flag */
 #define INT_FIELD(member, group, status) INT_FIELD_BAD(member, group, status, 7)
 
+/* The table lists the default maxima's entries (6 inputs, 6 rules). */
+ICOAC_STATIC_ASSERT(ICOAC_MAX_INPUTS == 6 && ICOAC_MAX_RULES == 6, field_table_lists_the_default_maxima);
 static const config_field_t config_fields[] = {
     INT_FIELD(learn, G_POLICY, ICOAC_ERR_BAD_MODE), /* checked in every mode, like the policy */
+    /* the task: checked in every mode; entries past the cart-pole's 4 inputs and 4 rules unused */
+    INT_FIELD(task.n_inputs, G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.late_source, G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.n_rules, G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.rule_input[0], G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.rule_input[1], G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.rule_input[2], G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.rule_input[3], G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.rule_input[4], G_UNUSED, ICOAC_OK),
+    INT_FIELD(task.rule_input[5], G_UNUSED, ICOAC_OK),
+    INT_FIELD(task.rule_side[0], G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.rule_side[1], G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.rule_side[2], G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.rule_side[3], G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.rule_side[4], G_UNUSED, ICOAC_OK),
+    INT_FIELD(task.rule_side[5], G_UNUSED, ICOAC_OK),
+    REAL_FIELD(task.rule_threshold[0], G_POLICY, ICOAC_ERR_BAD_ZONE),
+    REAL_FIELD(task.rule_threshold[1], G_POLICY, ICOAC_ERR_BAD_ZONE),
+    REAL_FIELD(task.rule_threshold[2], G_POLICY, ICOAC_ERR_BAD_ZONE),
+    REAL_FIELD(task.rule_threshold[3], G_POLICY, ICOAC_ERR_BAD_ZONE),
+    REAL_FIELD(task.rule_threshold[4], G_UNUSED, ICOAC_OK),
+    REAL_FIELD(task.rule_threshold[5], G_UNUSED, ICOAC_OK),
+    REAL_FIELD(task.rule_reflex[0], G_POLICY, ICOAC_ERR_BAD_ZONE),
+    REAL_FIELD(task.rule_reflex[1], G_POLICY, ICOAC_ERR_BAD_ZONE),
+    REAL_FIELD(task.rule_reflex[2], G_POLICY, ICOAC_ERR_BAD_ZONE),
+    REAL_FIELD(task.rule_reflex[3], G_POLICY, ICOAC_ERR_BAD_ZONE),
+    REAL_FIELD(task.rule_reflex[4], G_UNUSED, ICOAC_OK),
+    REAL_FIELD(task.rule_reflex[5], G_UNUSED, ICOAC_OK),
     REAL_FIELD(policy.input_range[0], G_POLICY, ICOAC_ERR_BAD_SCALE),
     REAL_FIELD(policy.input_range[1], G_POLICY, ICOAC_ERR_BAD_SCALE),
     REAL_FIELD(policy.input_range[2], G_POLICY, ICOAC_ERR_BAD_SCALE),
     REAL_FIELD(policy.input_range[3], G_POLICY, ICOAC_ERR_BAD_SCALE),
+    REAL_FIELD(policy.input_range[4], G_UNUSED, ICOAC_OK),
+    REAL_FIELD(policy.input_range[5], G_UNUSED, ICOAC_OK),
     INT_FIELD(policy.clip_inputs, G_POLICY, ICOAC_ERR_BAD_MODE),
     REAL_FIELD(policy.gain, G_POLICY, ICOAC_ERR_BAD_GAIN),
     INT_FIELD(policy.reflex_mode, G_POLICY, ICOAC_ERR_BAD_MODE),
     REAL_FIELD(policy.reflex_force, G_POLICY, ICOAC_ERR_BAD_GAIN),
-    REAL_FIELD(policy.zone_theta, G_POLICY, ICOAC_ERR_BAD_ZONE),
-    REAL_FIELD(policy.zone_x, G_POLICY, ICOAC_ERR_BAD_ZONE),
     REAL_FIELD(ico.rate, G_ICO, ICOAC_ERR_BAD_ICO_RATE),
     INT_FIELD(ico.timing, G_ICO, ICOAC_ERR_BAD_MODE),
     REAL_FIELD(critic.rate, G_RL, ICOAC_ERR_BAD_CRITIC),
@@ -576,6 +672,14 @@ static const config_field_t config_fields[] = {
     REAL_FIELD(critic.range[1], G_RL, ICOAC_ERR_BAD_CRITIC),
     REAL_FIELD(critic.range[2], G_RL, ICOAC_ERR_BAD_CRITIC),
     REAL_FIELD(critic.range[3], G_RL, ICOAC_ERR_BAD_CRITIC),
+    REAL_FIELD(critic.range[4], G_UNUSED, ICOAC_OK),
+    REAL_FIELD(critic.range[5], G_UNUSED, ICOAC_OK),
+    INT_FIELD_BAD(critic.units[0], G_RL, ICOAC_ERR_BAD_CRITIC, 17),
+    INT_FIELD_BAD(critic.units[1], G_RL, ICOAC_ERR_BAD_CRITIC, 0),
+    INT_FIELD_BAD(critic.units[2], G_RL, ICOAC_ERR_BAD_CRITIC, -1),
+    INT_FIELD_BAD(critic.units[3], G_RL, ICOAC_ERR_BAD_CRITIC, 17),
+    INT_FIELD(critic.units[4], G_UNUSED, ICOAC_OK),
+    INT_FIELD(critic.units[5], G_UNUSED, ICOAC_OK),
     REAL_FIELD(critic.threshold, G_RL, ICOAC_ERR_BAD_CRITIC),
     INT_FIELD(critic.quirks, G_RL, ICOAC_ERR_BAD_MODE),
     REAL_FIELD(actor.noise_std, G_RL, ICOAC_ERR_BAD_ACTOR),
@@ -618,7 +722,8 @@ static int validated(const config_field_t *f, int32_t mode)
     case G_POLICY: return 1;
     case G_ICO: return mode == ICOAC_MODE_ICO;
     case G_RL: return mode == ICOAC_MODE_RL;
-    default: return mode == ICOAC_MODE_SEARCH;
+    case G_SEARCH: return mode == ICOAC_MODE_SEARCH;
+    default: return 0;
     }
 }
 
@@ -813,7 +918,7 @@ static void expect_bad_prior(const icoac_prior_t *prior, const char *name)
     icoac_state_t sentinel;
     icoac_status_t got;
     int mode;
-    assert_int_equal(icoac_prior_check(prior), ICOAC_ERR_BAD_PRIOR);
+    assert_int_equal(icoac_prior_check(prior, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_BAD_PRIOR);
     for (mode = ICOAC_MODE_ICO; mode < N_MODES; ++mode) {
         cfg.mode = mode;
         memset(&state, 0x5A, sizeof state);
@@ -870,7 +975,7 @@ static void test_init_prior_copied(void **unused)
     int i, j;
     (void)unused;
     p.cov[0][3] = p.cov[3][0] = (icoac_real_t)0.5;
-    assert_int_equal(icoac_prior_check(&p), ICOAC_OK);
+    assert_int_equal(icoac_prior_check(&p, ICOAC_CARTPOLE_INPUTS), ICOAC_OK);
     assert_int_equal(icoac_init(&cfg, &state, &p, 3u), ICOAC_OK);
     assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_OK);
     assert_memory_equal(post.mean, p.mean, sizeof p.mean);
@@ -878,15 +983,15 @@ static void test_init_prior_copied(void **unused)
     /* NULL prior: mean 0, covariance I. */
     assert_int_equal(icoac_init(&cfg, &state, NULL, 3u), ICOAC_OK);
     assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_OK);
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
         assert_true(post.mean[i] == 0);
-        for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+        for (j = 0; j < ICOAC_CARTPOLE_INPUTS; ++j) {
             assert_true(post.cov[i][j] == (i == j ? 1 : 0));
         }
     }
     {
         const icoac_priv_state_t *st = icoac_priv_state_c(&state);
-        for (i = 0; i < ICOAC_CRITIC_UNITS; ++i) {
+        for (i = 0; i < ICOAC_CARTPOLE_CRITIC_UNITS; ++i) {
             assert_true(st->v[i] == 0);
         }
         assert_true(st->penalty_prev == 0);
@@ -905,7 +1010,7 @@ static void test_null_pointers(void **unused)
     icoac_counters_t counters;
     (void)unused;
     assert_int_equal(icoac_config_check(NULL), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_prior_check(NULL), ICOAC_ERR_NULL);
+    assert_int_equal(icoac_prior_check(NULL, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_NULL);
     assert_int_equal(icoac_init(NULL, &state, NULL, 0u), ICOAC_ERR_NULL);
     assert_int_equal(icoac_init(&cfg, NULL, NULL, 0u), ICOAC_ERR_NULL);
     assert_int_equal(icoac_init(&cfg, &state, NULL, 0u), ICOAC_OK);
@@ -993,7 +1098,8 @@ static void test_sizeof_functions(void **unused)
 {
     (void)unused;
     assert_int_equal(icoac_abi_version(), ICOAC_ABI_VERSION);
-    assert_int_equal(ICOAC_ABI_VERSION, 7);
+    assert_int_equal(ICOAC_ABI_VERSION, 8);
+    assert_int_equal(ICOAC_ERR_BAD_TASK, 19);
     assert_int_equal(ICOAC_ERR_BAD_SEARCH, 18);
     assert_int_equal(ICOAC_MODE_SEARCH, 2);
     assert_int_equal(ICOAC_ACTOR_POSTERIOR, 0);

@@ -22,19 +22,19 @@ static const icoac_priv_state_t *priv(const icoac_state_t *state)
 static int state_finite(const icoac_state_t *state)
 {
     const icoac_priv_state_t *s = priv(state);
-    const icoac_real_t(*cov)[ICOAC_N_INPUTS] = icoac_priv_cov_c(s);
+    const icoac_real_t(*cov)[ICOAC_MAX_INPUTS] = icoac_priv_cov_c(s);
     int i, j;
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
         if (!finite_real(s->w[i]) || !finite_real(s->w_act[i])) {
             return 0;
         }
-        for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+        for (j = 0; j < ICOAC_CARTPOLE_INPUTS; ++j) {
             if (!finite_real(cov[i][j])) {
                 return 0;
             }
         }
     }
-    for (i = 0; i < ICOAC_CRITIC_UNITS; ++i) {
+    for (i = 0; i < ICOAC_CARTPOLE_CRITIC_UNITS; ++i) {
         if (!finite_real(s->v[i])) {
             return 0;
         }
@@ -117,57 +117,59 @@ static icoac_status_t checked_step(const icoac_config_t *cfg, icoac_state_t *sta
 /* Reproducer 1, first half: NaN critic factors (what a subnormal critic_range produced) must
  * not run the kept-unit scans off their arrays. Before the fix they read past the end of
  * cell_product (ASan: stack-buffer-overflow) and wrote through the indices they found. Here
- * NaN in every factor, then only in the (theta, theta_dot) factors, for both kernels. The
- * sparse kernel keeps nothing in the first case (V = 0) and gives NaN in the second; the dense
- * one counts a NaN product as kept, so V is NaN in both, which the tick rejects. */
-static void check_scan(const icoac_critic_config_t *critic, const icoac_real_t v[ICOAC_CRITIC_UNITS],
-                       const icoac_real_t factors[ICOAC_CRITIC_FACTORS], int sparse_nan)
+ * NaN in every factor (every input NaN), then only in the (theta, theta_dot) factors, for both
+ * kernels. The sparse kernel keeps nothing in the first case (V = 0) and gives NaN in the
+ * second; the dense one counts a NaN product as kept, so V is NaN in both, which the tick
+ * rejects. */
+static void check_scan(const icoac_config_t *cfg, const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
+                       int sparse_nan)
 {
     icoac_priv_critic_list_t list[2]; /* a neighbour to overrun into, as in the state */
     icoac_priv_critic_products_t products[2];
+    icoac_priv_grid_t grid;
     icoac_real_t value;
     int i;
+    icoac_priv_critic_grid(cfg, &grid);
     memset(list, 0, sizeof list);
-    value = icoac_priv_critic_value_sparse(critic, v, factors, &list[0]);
+    value = icoac_priv_critic_value_sparse(&cfg->critic, &grid, v, s, &list[0]);
     assert_int_equal(isnan((double)value) ? 1 : 0, sparse_nan);
-    assert_true(list[0].cells <= ICOAC_CRITIC_CELLS);
-    for (i = 0; i < ICOAC_CRITIC_PAIRS; ++i) {
-        assert_true(list[0].pair_cells[i] <= list[0].cells);
+    assert_true(list[0].cells <= list[0].stride && list[0].stride <= ICOAC_CRITIC_BLOCK_MAX);
+    for (i = 0; i < list[0].rows; ++i) {
+        assert_true(list[0].row_cells[i] <= list[0].cells);
     }
     for (i = 0; i < list[0].cells; ++i) {
-        assert_true(list[0].cell[i] < ICOAC_CRITIC_CELLS);
+        assert_true(list[0].cell[i] < list[0].stride);
     }
-    assert_true(list[1].pair_cells[0] == 0 && list[1].cells == 0);
+    assert_true(list[1].row_cells[0] == 0 && list[1].cells == 0);
     memset(products, 0, sizeof products);
-    value = icoac_priv_critic_value_dense(critic, v, factors, &products[0]);
+    value = icoac_priv_critic_value_dense(&cfg->critic, &grid, v, s, &products[0]);
     assert_true(isnan((double)value));
     assert_true(products[0].cell_begin <= products[0].cell_end);
-    assert_true(products[0].cell_end <= ICOAC_CRITIC_CELLS);
+    assert_true(products[0].cell_end <= products[0].stride);
     assert_true(products[1].cell_begin == 0 && products[1].cell_end == 0);
 }
 
 static void test_critic_scan_bounded_for_nan(void **unused)
 {
     icoac_config_t cfg = test_default_config();
-    icoac_real_t v[ICOAC_CRITIC_UNITS];
-    icoac_real_t factors[ICOAC_CRITIC_FACTORS];
-    const icoac_real_t s[ICOAC_N_INPUTS] = {ICOAC_R(0.3), ICOAC_R(-0.2), ICOAC_R(0.05), ICOAC_R(0.1)};
+    icoac_real_t v[ICOAC_PRIV_CRITIC_WEIGHTS];
+    icoac_real_t s[ICOAC_MAX_INPUTS] = {ICOAC_R(0.3), ICOAC_R(-0.2), ICOAC_R(0.05), ICOAC_R(0.1)};
+    icoac_real_t all_nan[ICOAC_MAX_INPUTS];
     int i;
     (void)unused;
-    for (i = 0; i < ICOAC_CRITIC_UNITS; ++i) {
+    cfg.mode = ICOAC_MODE_RL; /* the mode with a critic geometry */
+    for (i = 0; i < ICOAC_PRIV_CRITIC_WEIGHTS; ++i) {
         v[i] = (icoac_real_t)0.5;
     }
-    for (i = 0; i < ICOAC_CRITIC_FACTORS; ++i) {
-        factors[i] = (icoac_real_t)NAN;
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
+        all_nan[i] = (icoac_real_t)NAN;
     }
-    check_scan(&cfg.critic, v, factors, 0); /* sparse: no pair passes, nothing kept */
-    icoac_priv_critic_factors(&cfg.critic, s, factors);
-    for (i = ICOAC_CRITIC_N_X + ICOAC_CRITIC_N_X_DOT; i < ICOAC_CRITIC_FACTORS; ++i) {
-        factors[i] = (icoac_real_t)(i % 2 ? NAN : -NAN);
-    }
-    check_scan(&cfg.critic, v, factors, 1);
+    check_scan(&cfg, v, all_nan, 0); /* sparse: no row passes, nothing kept */
+    s[ICOAC_IDX_THETA] = (icoac_real_t)NAN;
+    s[ICOAC_IDX_THETA_DOT] = (icoac_real_t)-NAN;
+    check_scan(&cfg, v, s, 1);
     cfg.critic.threshold = 0; /* the smallest-normal floor */
-    check_scan(&cfg.critic, v, factors, 1);
+    check_scan(&cfg, v, s, 1);
 }
 
 /* Reproducer 1, second half: the configuration is now rejected, and an RL tick at s = 0 from
@@ -219,7 +221,7 @@ static void test_unclipped_huge_input(void **unused)
         assert_memory_equal(priv(&state)->w, priv(&twin)->w, sizeof priv(&state)->w);
         assert_memory_equal(priv(&state)->v, priv(&twin)->v, sizeof priv(&state)->v);
         assert_memory_equal(icoac_priv_cov_c(priv(&state)), icoac_priv_cov_c(priv(&twin)),
-                            sizeof(icoac_real_t) * ICOAC_N_INPUTS * ICOAC_N_INPUTS);
+                            sizeof(icoac_real_t) * ICOAC_CARTPOLE_INPUTS * ICOAC_CARTPOLE_INPUTS);
     }
 }
 
@@ -237,23 +239,23 @@ static void test_prior_bounds(void **unused)
     int k;
     int faults = 0;
     (void)unused;
-    assert_int_equal(icoac_prior_check(&prior), ICOAC_ERR_BAD_PRIOR);
+    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_BAD_PRIOR);
     prior = test_prior(0, 0, 0, 0, 1.0);
     prior.cov[1][1] = (icoac_real_t)1e-39; /* subnormal in float, tiny in double: below 1e-12 of the rest */
-    assert_int_equal(icoac_prior_check(&prior), REAL_IS_FLOAT ? ICOAC_ERR_BAD_PRIOR : ICOAC_OK);
+    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), REAL_IS_FLOAT ? ICOAC_ERR_BAD_PRIOR : ICOAC_OK);
     prior = test_prior(0, 0, 0, 0, 1.0);
     prior.cov[3][0] = (icoac_real_t)(REAL_IS_FLOAT ? -1e-39 : -1e-310);
-    assert_int_equal(icoac_prior_check(&prior), ICOAC_ERR_BAD_PRIOR);
+    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_BAD_PRIOR);
     prior.cov[0][3] = prior.cov[3][0]; /* symmetric now, but still subnormal */
-    assert_int_equal(icoac_prior_check(&prior), ICOAC_ERR_BAD_PRIOR);
+    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_BAD_PRIOR);
     prior = test_prior(ICOAC_PRIOR_MEAN_MAX, 0, 0, 0, 1.1 * (double)ICOAC_PRIOR_COV_MAX);
-    assert_int_equal(icoac_prior_check(&prior), ICOAC_ERR_BAD_PRIOR);
+    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_BAD_PRIOR);
 
     prior = test_prior(ICOAC_PRIOR_MEAN_MAX, 0.1, 0.5, 0.1, (double)ICOAC_PRIOR_COV_MAX);
     cfg.mode = ICOAC_MODE_RL;
     test_literal_reading(&cfg);
     cfg.actor.forgetting = ICOAC_FORGETTING_MIN;
-    assert_int_equal(icoac_prior_check(&prior), ICOAC_OK);
+    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), ICOAC_OK);
     assert_int_equal(icoac_init(&cfg, &state, &prior, 5u), ICOAC_OK);
     for (k = 0; k < (REAL_IS_FLOAT ? 200 : 1200); ++k) {
         faults += checked_step(&cfg, &state, &in) == ICOAC_ERR_NUMERIC;
@@ -327,7 +329,7 @@ static void test_contract_random_extremes(void **unused)
         for (k = 0; k < 300; ++k) {
             icoac_input_t in;
             int i;
-            for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+            for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
                 const int pick = (int)(test_rng_u64(&rng) % (uint64_t)(n_extremes + 4));
                 in.s[i] = (icoac_real_t)(pick < n_extremes ? extremes[pick] : test_uniform(&rng, -3, 3));
             }

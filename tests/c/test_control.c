@@ -42,7 +42,7 @@ static void test_control_learns_nothing(void **unused)
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
         icoac_priv_state_t *st = icoac_priv_state(&state);
-        icoac_real_t v0[ICOAC_CRITIC_UNITS];
+        icoac_real_t v0[ICOAC_CARTPOLE_CRITIC_UNITS];
         icoac_prior_t post;
         cfg.learn = 0;
         cfg.mode = (variant < 2 || variant >= 4) ? ICOAC_MODE_RL : ICOAC_MODE_ICO;

@@ -1,56 +1,116 @@
-/* NGnet critic (method.md, critic): separable evaluation against the direct 4-D formula, the activity
+/* NGnet critic (method.md, critic): separable evaluation against the direct n-D formula (long
+ * double) on the cart-pole's grid and on other task grids (6 inputs, 1, 3, 5), the activity
  * threshold and the kept-unit list, for both kernels (sparse: microcontrollers, dense: hosts);
  * the dense kernel against the sparse one; the TD(0) update through icoac_step in RL mode. */
 #include "test_common.h"
 
 #include "icoac_priv.h"
 
-#define K ICOAC_CRITIC_UNITS
+/* The critic grids under test: the cart-pole's, a double pendulum's (6 inputs), one input, a
+ * lopsided one whose rows are a single 16-unit input, and five 2-unit inputs. */
+typedef struct {
+    int n;
+    int sizes[6];
+    double ranges[6];
+} grid_t;
 
-static const double ranges[4] = {2.4, 3.5, 0.2094384, 2.0};
-static const int sizes[4] = {3, 3, 6, 3};
+static const grid_t grids[] = {
+    {4, {3, 3, 6, 3, 0, 0}, {2.4, 3.5, 0.2094384, 2.0, 0, 0}},
+    {6, {3, 3, 3, 2, 2, 2}, {2.4, 0.3, 0.35, 3.5, 2.0, 2.5}},
+    {1, {7, 0, 0, 0, 0, 0}, {1.5, 0, 0, 0, 0, 0}},
+    {3, {16, 13, 1, 0, 0, 0}, {1.0, 20.0, 0.5, 0, 0, 0}},
+    {5, {2, 2, 2, 2, 2, 0}, {1.0, 2.0, 3.0, 4.0, 5.0, 0}},
+};
+#define N_GRIDS ((int)(sizeof grids / sizeof grids[0]))
+#define CARTPOLE 0
 
-/* b_k(s) from the 4-D definition: a_k = exp(-1/2 sum_i ((s_i - c_ki)/sigma_i)^2), normalised.
- * Computed in log space (shifted by the largest exponent) in long double, so far-out states
- * do not turn into 0/0; the shift cancels in the ratio. */
-static void direct_b(const icoac_real_t s_in[4], double b[K])
+/* Room for any grid: the library's weight array. */
+#define KMAX ICOAC_PRIV_CRITIC_WEIGHTS
+#define K ICOAC_CARTPOLE_CRITIC_UNITS
+
+static int units_of(const grid_t *g)
 {
-    long double logs[K], top = -1e300L, total = 0;
-    int a, bb, c, d, k;
-    for (a = 0; a < sizes[0]; ++a) {
-        for (bb = 0; bb < sizes[1]; ++bb) {
-            for (c = 0; c < sizes[2]; ++c) {
-                for (d = 0; d < sizes[3]; ++d) {
-                    const int idx[4] = {a, bb, c, d};
-                    long double e = 0;
-                    int i;
-                    k = ((a * 3 + bb) * 6 + c) * 3 + d;
-                    for (i = 0; i < 4; ++i) {
-                        const long double sigma = (long double)ranges[i] / sizes[i];
-                        const long double centre = -(long double)ranges[i] + (2 * idx[i] + 1) * sigma;
-                        const long double u = ((long double)s_in[i] - centre) / sigma;
-                        e += u * u;
-                    }
-                    logs[k] = -0.5L * e;
-                    top = logs[k] > top ? logs[k] : top;
-                }
-            }
-        }
+    int k = 1, i;
+    for (i = 0; i < g->n; ++i) {
+        k *= g->sizes[i];
     }
-    for (k = 0; k < K; ++k) {
+    return k;
+}
+
+/* The configuration of a grid: RL mode, its inputs, ranges and counts. */
+static icoac_config_t grid_config(const grid_t *g)
+{
+    icoac_config_t cfg = test_default_config();
+    int i;
+    cfg.mode = ICOAC_MODE_RL;
+    cfg.task.n_inputs = g->n;
+    cfg.task.n_rules = 0;
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
+        cfg.policy.input_range[i] = (icoac_real_t)1.0;
+        cfg.critic.range[i] = i < g->n ? (icoac_real_t)g->ranges[i] : (icoac_real_t)1.0;
+        cfg.critic.units[i] = i < g->n ? g->sizes[i] : 1;
+    }
+    assert_int_equal(icoac_config_check(&cfg), ICOAC_OK);
+    return cfg;
+}
+
+static icoac_priv_grid_t grid_geometry(const icoac_config_t *cfg)
+{
+    icoac_priv_grid_t geometry;
+    icoac_priv_critic_grid(cfg, &geometry);
+    return geometry;
+}
+
+/* ((s_i - c_ij) / sigma_i)^2 of input i's unit j, less its smallest over j (a factor common to
+ * every unit, which the normalisation cancels: it keeps far-out inputs from swamping the others'
+ * digits in the sum). */
+static long double distance2(const grid_t *g, const icoac_real_t *s_in, int i, int j)
+{
+    const long double sigma = (long double)g->ranges[i] / g->sizes[i];
+    long double smallest = 1e300L, d = 0;
+    int jj;
+    for (jj = 0; jj < g->sizes[i]; ++jj) {
+        const long double centre = -(long double)g->ranges[i] + (2 * jj + 1) * sigma;
+        const long double u = ((long double)s_in[i] - centre) / sigma;
+        smallest = u * u < smallest ? u * u : smallest;
+        d = jj == j ? u * u : d;
+    }
+    return d - smallest;
+}
+
+/* b_k(s) from the n-D definition: a_k = exp(-1/2 sum_i ((s_i - c_ki)/sigma_i)^2), normalised,
+ * k row-major over the inputs. Computed in log space (shifted by the largest exponent) in long
+ * double, so far-out states do not turn into 0/0; the shifts cancel in the ratio. */
+static void direct_b(const grid_t *g, const icoac_real_t *s_in, double *b)
+{
+    static long double logs[1024];
+    long double top = -1e300L, total = 0;
+    const int units = units_of(g);
+    int k, i;
+    for (k = 0; k < units; ++k) {
+        long double e = 0;
+        int rest = k;
+        for (i = g->n - 1; i >= 0; --i) {
+            e += distance2(g, s_in, i, rest % g->sizes[i]);
+            rest /= g->sizes[i];
+        }
+        logs[k] = -0.5L * e;
+        top = logs[k] > top ? logs[k] : top;
+    }
+    for (k = 0; k < units; ++k) {
         total += expl(logs[k] - top);
     }
-    for (k = 0; k < K; ++k) {
+    for (k = 0; k < units; ++k) {
         b[k] = (double)(expl(logs[k] - top) / total);
     }
 }
 
 /* The same with the activity threshold (method.md, critic): b_k < threshold counts as 0. */
-static void direct_b_kept(const icoac_real_t s_in[4], double threshold, double b[K])
+static void direct_b_kept(const grid_t *g, const icoac_real_t *s_in, double threshold, double *b)
 {
     int k;
-    direct_b(s_in, b);
-    for (k = 0; k < K; ++k) {
+    direct_b(g, s_in, b);
+    for (k = 0; k < units_of(g); ++k) {
         b[k] = b[k] < threshold ? 0.0 : b[k];
     }
 }
@@ -64,11 +124,12 @@ static int near_threshold(double b, double threshold)
 /* The two critic kernels, whichever the build selects for icoac_step. */
 enum { SPARSE, DENSE, KERNELS };
 
-static icoac_real_t kernel_value(int kernel, const icoac_critic_config_t *critic, const icoac_real_t *v,
-                                 const icoac_real_t *factors, icoac_priv_critic_active_t *active)
+static icoac_real_t kernel_value(int kernel, const icoac_config_t *cfg, const icoac_real_t *v, const icoac_real_t *s,
+                                 icoac_priv_critic_active_t *active)
 {
-    return kernel == DENSE ? icoac_priv_critic_value_dense(critic, v, factors, &active->dense)
-                           : icoac_priv_critic_value_sparse(critic, v, factors, &active->sparse);
+    const icoac_priv_grid_t geometry = grid_geometry(cfg);
+    return kernel == DENSE ? icoac_priv_critic_value_dense(&cfg->critic, &geometry, v, s, &active->dense)
+                           : icoac_priv_critic_value_sparse(&cfg->critic, &geometry, v, s, &active->sparse);
 }
 
 static void kernel_update(int kernel, const icoac_critic_config_t *critic, icoac_real_t *v,
@@ -82,18 +143,16 @@ static void kernel_update(int kernel, const icoac_critic_config_t *critic, icoac
 }
 
 /* b_k(s) from a kernel: the value pass finds the kept units, and an update with step 1 on
- * v = 0 writes their b_k into v. */
-static void library_b(int kernel, const icoac_critic_config_t *critic, const icoac_real_t s[4], double b[K])
+ * v = 0 writes their b_k into v; the room past the grid's units stays 0. */
+static void library_b(int kernel, const icoac_config_t *cfg, const icoac_real_t *s, double *b)
 {
-    icoac_real_t factors[ICOAC_CRITIC_FACTORS];
-    icoac_real_t v[K];
+    icoac_real_t v[KMAX];
     icoac_priv_critic_active_t active;
     int k;
     memset(v, 0, sizeof v);
-    icoac_priv_critic_factors(critic, s, factors);
-    assert_true(kernel_value(kernel, critic, v, factors, &active) == 0);
-    kernel_update(kernel, critic, v, &active, (icoac_real_t)1.0);
-    for (k = 0; k < K; ++k) {
+    assert_true(kernel_value(kernel, cfg, v, s, &active) == 0);
+    kernel_update(kernel, &cfg->critic, v, &active, (icoac_real_t)1.0);
+    for (k = 0; k < KMAX; ++k) {
         b[k] = (double)v[k];
     }
 }
@@ -103,12 +162,13 @@ static double b_tol(void)
     return REAL_IS_FLOAT ? 2e-6 : 1e-12;
 }
 
-static void random_state(test_rng_t *rng, int far, icoac_real_t s[4])
+/* A state of a grid's inputs (0 past them): inside the grid, or far out. */
+static void random_state(const grid_t *g, test_rng_t *rng, int far, icoac_real_t s[ICOAC_MAX_INPUTS])
 {
     int i;
-    for (i = 0; i < 4; ++i) {
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
         const double scale = far ? (i == 2 ? 20.0 : 15.0) : 1.3;
-        s[i] = (icoac_real_t)test_uniform(rng, -scale * ranges[i], scale * ranges[i]);
+        s[i] = i < g->n ? (icoac_real_t)test_uniform(rng, -scale * g->ranges[i], scale * g->ranges[i]) : 0;
     }
 }
 
@@ -149,165 +209,190 @@ static void test_grid_centres(void **unused)
     }
 }
 
+/* Every kernel on every grid equals the n-D definition, with threshold 0 (every unit). */
 static void test_separable_equals_direct(void **unused)
 {
-    icoac_config_t cfg = test_default_config();
     test_rng_t rng = {0xC0FFEEu};
-    double bl[K], bd[K];
-    int n, k;
+    static double bl[KMAX], bd[1024];
+    int gi, n, k;
     (void)unused;
-    cfg.critic.threshold = 0; /* every unit */
-    for (n = 0; n < 2 * 400; ++n) {
-        const int kernel = n / 400;
-        icoac_real_t s[4];
-        double sum = 0;
-        random_state(&rng, n % 400 >= 200, s);
-        if (n % 400 == 0) {
-            s[0] = s[1] = s[2] = s[3] = 0; /* between centres in theta */
-        } else if (n % 400 == 1) {
-            s[0] = (icoac_real_t)1.6; /* on a centre in x */
-            s[1] = (icoac_real_t)-1e6;
-            s[2] = (icoac_real_t)100.0;
-            s[3] = (icoac_real_t)-1e4;
-        }
-        library_b(kernel, &cfg.critic, s, bl);
-        direct_b(s, bd);
-        for (k = 0; k < K; ++k) {
-            if (!(fabs(bl[k] - bd[k]) <= b_tol())) {
-                print_error("kernel %d state %d (%g, %g, %g, %g) unit %d: %.10g vs %.10g\n", kernel, n, (double)s[0],
-                            (double)s[1], (double)s[2], (double)s[3], k, bl[k], bd[k]);
-                fail();
+    for (gi = 0; gi < N_GRIDS; ++gi) {
+        const grid_t *g = &grids[gi];
+        icoac_config_t cfg = grid_config(g);
+        const int units = units_of(g);
+        cfg.critic.threshold = 0; /* every unit */
+        for (n = 0; n < 2 * 200; ++n) {
+            const int kernel = n / 200;
+            icoac_real_t s[ICOAC_MAX_INPUTS];
+            double sum = 0;
+            random_state(g, &rng, n % 200 >= 100, s);
+            if (n % 200 == 0) {
+                memset(s, 0, sizeof s); /* between or on centres */
+            } else if (n % 200 == 1) {
+                s[0] = (icoac_real_t)(g->ranges[0] * (1.0 - 1.0 / g->sizes[0])); /* on the last centre */
+                s[g->n - 1] = (icoac_real_t)-1e6;
             }
-            assert_true(bl[k] >= 0.0);
-            sum += bl[k];
+            library_b(kernel, &cfg, s, bl);
+            direct_b(g, s, bd);
+            for (k = 0; k < units; ++k) {
+                if (!(fabs(bl[k] - bd[k]) <= b_tol())) {
+                    print_error("grid %d kernel %d state %d unit %d: %.10g vs %.10g at (%.17g, %.17g, %.17g, %.17g)\n", gi, kernel, n, k,
+                                bl[k], bd[k], (double)s[0], (double)s[1], (double)s[2], (double)s[3]);
+                    fail();
+                }
+                assert_true(bl[k] >= 0.0);
+                sum += bl[k];
+            }
+            for (k = units; k < KMAX; ++k) {
+                assert_true(bl[k] == 0.0); /* nothing past the grid's units */
+            }
+            assert_close(sum, 1.0, REAL_IS_FLOAT ? 1e-5 : 1e-12);
         }
-        assert_close(sum, 1.0, REAL_IS_FLOAT ? 1e-5 : 1e-12);
     }
 }
 
-static void check_value(icoac_config_t cfg, unsigned seed, int kernel)
+static void check_value(const grid_t *g, icoac_real_t threshold, unsigned seed, int kernel)
 {
+    icoac_config_t cfg = grid_config(g);
     test_rng_t rng = {seed};
-    icoac_real_t v[K], factors[ICOAC_CRITIC_FACTORS], s[4];
+    const int units = units_of(g);
+    icoac_real_t v[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t active;
-    double bd[K];
+    static double bd[1024];
     int n, k;
-    for (n = 0; n < 200; ++n) {
+    cfg.critic.threshold = threshold;
+    for (n = 0; n < 100; ++n) {
         double expected = 0, slack = 0;
-        for (k = 0; k < K; ++k) {
-            v[k] = (icoac_real_t)test_uniform(&rng, -1, 1);
+        for (k = 0; k < KMAX; ++k) {
+            v[k] = k < units ? (icoac_real_t)test_uniform(&rng, -1, 1) : (icoac_real_t)NAN; /* past the grid: unread */
         }
-        random_state(&rng, n & 1, s);
-        icoac_priv_critic_factors(&cfg.critic, s, factors);
-        direct_b_kept(s, (double)cfg.critic.threshold, bd);
-        for (k = 0; k < K; ++k) {
+        random_state(g, &rng, n & 1, s);
+        direct_b_kept(g, s, (double)threshold, bd);
+        for (k = 0; k < units; ++k) {
             expected += (double)v[k] * bd[k];
-            slack += near_threshold(bd[k], (double)cfg.critic.threshold) ? fabs((double)v[k]) * bd[k] : 0;
+            slack += near_threshold(bd[k], (double)threshold) ? fabs((double)v[k]) * bd[k] : 0;
         }
-        assert_close(kernel_value(kernel, &cfg.critic, v, factors, &active), expected,
-                     slack + (REAL_IS_FLOAT ? 1e-5 : 1e-12));
+        assert_close(kernel_value(kernel, &cfg, v, s, &active), expected, slack + (REAL_IS_FLOAT ? 1e-5 : 1e-12));
     }
 }
 
 static void test_value_is_weighted_sum(void **unused)
 {
-    icoac_config_t cfg = test_default_config();
-    int kernel;
+    int gi, kernel;
     (void)unused;
-    for (kernel = SPARSE; kernel < KERNELS; ++kernel) {
-        cfg.critic.threshold = (icoac_real_t)0.001; /* the default */
-        check_value(cfg, 31u, kernel);
-        cfg.critic.threshold = 0;
-        check_value(cfg, 32u, kernel);
-        cfg.critic.threshold = (icoac_real_t)0.05;
-        check_value(cfg, 33u, kernel);
+    for (gi = 0; gi < N_GRIDS; ++gi) {
+        for (kernel = SPARSE; kernel < KERNELS; ++kernel) {
+            check_value(&grids[gi], (icoac_real_t)0.001, 31u, kernel); /* the default */
+            check_value(&grids[gi], 0, 32u, kernel);
+            check_value(&grids[gi], (icoac_real_t)0.05, 33u, kernel);
+        }
     }
 }
 
 static void test_threshold_drops_small_activations(void **unused)
 {
-    icoac_config_t cfg = test_default_config();
     test_rng_t rng = {8u};
-    double bl[K], bd[K];
-    int n, k, dropped = 0, kept = 0;
+    static double bl[KMAX], bd[1024];
+    int gi, n, k, dropped = 0, kept = 0;
     (void)unused;
-    assert_true(cfg.critic.threshold == (icoac_real_t)0.001); /* the authors' cut-off is the default */
-    for (n = 0; n < 2 * 200; ++n) {
-        icoac_real_t s[4];
-        random_state(&rng, n % 200 >= 150, s);
-        library_b(n / 200, &cfg.critic, s, bl);
-        direct_b(s, bd);
-        for (k = 0; k < K; ++k) {
-            if (near_threshold(bd[k], 0.001)) {
-                continue;
-            }
-            if (bd[k] < 0.001) {
-                assert_true(bl[k] == 0.0);
-                ++dropped;
-            } else {
-                assert_close(bl[k], bd[k], b_tol());
-                ++kept;
+    for (gi = 0; gi < N_GRIDS; ++gi) {
+        const grid_t *g = &grids[gi];
+        const icoac_config_t cfg = grid_config(g);
+        assert_true(cfg.critic.threshold == (icoac_real_t)0.001); /* the authors' cut-off is the default */
+        for (n = 0; n < 2 * 100; ++n) {
+            icoac_real_t s[ICOAC_MAX_INPUTS];
+            random_state(g, &rng, n % 100 >= 75, s);
+            library_b(n / 100, &cfg, s, bl);
+            direct_b(g, s, bd);
+            for (k = 0; k < units_of(g); ++k) {
+                if (near_threshold(bd[k], 0.001)) {
+                    continue;
+                }
+                if (bd[k] < 0.001) {
+                    assert_true(bl[k] == 0.0);
+                    ++dropped;
+                } else {
+                    assert_close(bl[k], bd[k], b_tol());
+                    ++kept;
+                }
             }
         }
     }
     assert_true(dropped > 0 && kept > 0);
 }
 
-/* The sparse kernel's kept-unit list: pairs in order with their leading cells, cells sorted by product with a
- * zero sentinel, and exactly the units with b_k >= threshold. */
+/* The sparse kernel's kept-unit list: rows in order with their leading cells, cells sorted by
+ * product with a zero sentinel, and exactly the units with b_k >= threshold. */
 static void test_kept_unit_list(void **unused)
 {
-    icoac_config_t cfg = test_default_config();
     test_rng_t rng = {12u};
-    icoac_real_t factors[ICOAC_CRITIC_FACTORS], v[K], s[4];
-    icoac_priv_critic_list_t active;
-    int n, i, p, total_kept = 0;
+    icoac_real_t v[KMAX], s[ICOAC_MAX_INPUTS];
+    icoac_priv_critic_active_t active;
+    static double bd[1024];
+    static int listed[1024];
+    int gi, n, i, r, total_kept = 0, total_units = 0, all_kept_grids = 0;
     (void)unused;
     memset(v, 0, sizeof v);
-    for (n = 0; n < 300; ++n) {
-        double bd[K];
-        int listed[K];
-        random_state(&rng, n % 3 == 2, s);
-        icoac_priv_critic_factors(&cfg.critic, s, factors);
-        (void)icoac_priv_critic_value_sparse(&cfg.critic, v, factors, &active);
-        direct_b(s, bd);
-        assert_true(active.cells <= ICOAC_CRITIC_CELLS);
-        assert_true(active.cell_product[active.cells] == 0);
-        for (i = 1; i < active.cells; ++i) {
-            assert_true(active.cell_product[i - 1] >= active.cell_product[i]);
-        }
-        for (i = 0; i < active.cells; ++i) {
-            assert_true(active.cell[i] < ICOAC_CRITIC_CELLS);
-        }
-        memset(listed, 0, sizeof listed);
-        for (p = 0; p < ICOAC_CRITIC_PAIRS; ++p) {
-            assert_true(active.pair_cells[p] <= active.cells);
-            for (i = 0; i < active.pair_cells[p]; ++i) {
-                const int k = p * ICOAC_CRITIC_CELLS + active.cell[i];
-                assert_true(listed[k] == 0);
-                listed[k] = 1;
+    for (gi = 0; gi < N_GRIDS; ++gi) {
+        const grid_t *g = &grids[gi];
+        icoac_config_t cfg = grid_config(g);
+        const icoac_priv_critic_list_t *list = &active.sparse;
+        const int units = units_of(g);
+        for (n = 0; n < 200; ++n) {
+            random_state(g, &rng, n % 3 == 2, s);
+            (void)kernel_value(SPARSE, &cfg, v, s, &active);
+            direct_b(g, s, bd);
+            assert_int_equal(list->rows * list->stride, units);
+            assert_true(list->stride <= ICOAC_CRITIC_BLOCK_MAX && list->rows <= ICOAC_CRITIC_BLOCK_MAX);
+            assert_true(list->cells <= list->stride);
+            assert_true(list->cell_product[list->cells] == 0);
+            for (i = 1; i < list->cells; ++i) {
+                assert_true(list->cell_product[i - 1] >= list->cell_product[i]);
             }
-        }
-        for (i = 0; i < K; ++i) {
-            if (!near_threshold(bd[i], 0.001)) {
-                assert_int_equal(listed[i], bd[i] >= 0.001);
+            for (i = 0; i < list->cells; ++i) {
+                assert_true(list->cell[i] < list->stride);
             }
-            total_kept += listed[i];
+            memset(listed, 0, sizeof listed);
+            for (r = 0; r < list->rows; ++r) {
+                assert_true(list->row_cells[r] <= list->cells);
+                for (i = 0; i < list->row_cells[r]; ++i) {
+                    const int k = r * list->stride + list->cell[i];
+                    assert_true(listed[k] == 0);
+                    listed[k] = 1;
+                }
+            }
+            for (i = 0; i < units; ++i) {
+                if (!near_threshold(bd[i], 0.001)) {
+                    assert_int_equal(listed[i], bd[i] >= 0.001);
+                }
+                total_kept += listed[i];
+            }
+            total_units += units;
+        }
+        /* threshold 0: a state at the grid's centre keeps every unit, where every b_k is well
+         * above the smallest normal number (the floor) */
+        cfg.critic.threshold = 0;
+        memset(s, 0, sizeof s);
+        (void)kernel_value(SPARSE, &cfg, v, s, &active);
+        direct_b(g, s, bd);
+        for (i = 0; i < units && bd[i] > 1e-30; ++i) {
+        }
+        if (i == units) {
+            assert_int_equal(list->cells, list->stride);
+            for (r = 0; r < list->rows; ++r) {
+                assert_int_equal(list->row_cells[r], list->stride);
+            }
+            ++all_kept_grids;
         }
     }
-    assert_true(total_kept > 0 && total_kept < 300 * K / 2); /* the threshold does prune */
-
-    /* threshold 0: a state inside the grid keeps all 162 units */
-    cfg.critic.threshold = 0;
-    s[0] = (icoac_real_t)0.3;
-    s[1] = (icoac_real_t)-0.2;
-    s[2] = (icoac_real_t)0.01;
-    s[3] = (icoac_real_t)0.1;
-    icoac_priv_critic_factors(&cfg.critic, s, factors);
-    (void)icoac_priv_critic_value_sparse(&cfg.critic, v, factors, &active);
-    assert_int_equal(active.cells, ICOAC_CRITIC_CELLS);
-    for (p = 0; p < ICOAC_CRITIC_PAIRS; ++p) {
-        assert_int_equal(active.pair_cells[p], ICOAC_CRITIC_CELLS);
+    assert_true(all_kept_grids >= 2); /* the cart-pole's and the double pendulum's at least */
+    assert_true(total_kept > 0 && total_kept < total_units / 2); /* the threshold does prune */
+    /* the cart-pole's blocks: (x, x_dot) rows by (theta, theta_dot) cells */
+    {
+        icoac_config_t cfg = grid_config(&grids[CARTPOLE]);
+        (void)kernel_value(SPARSE, &cfg, v, s, &active);
+        assert_int_equal(active.sparse.rows, ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT);
+        assert_int_equal(active.sparse.stride, ICOAC_CRITIC_N_THETA * ICOAC_CRITIC_N_THETA_DOT);
     }
 }
 
@@ -318,37 +403,40 @@ static void test_kept_unit_list(void **unused)
 static void test_dense_matches_sparse(void **unused)
 {
     const icoac_real_t thresholds[3] = {(icoac_real_t)0.0, (icoac_real_t)0.001, (icoac_real_t)0.05};
-    icoac_config_t cfg = test_default_config();
     test_rng_t rng = {0xD15Eu};
-    icoac_real_t v_sparse[K], v_dense[K], factors[ICOAC_CRITIC_FACTORS], s[4];
+    icoac_real_t v_sparse[KMAX], v_dense[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t sparse, dense;
+    static double bd[1024];
     double max_rel = 0;
-    int t, n, k;
+    int gi, t, n, k;
     (void)unused;
-    for (t = 0; t < 3; ++t) {
-        cfg.critic.threshold = thresholds[t];
-        for (k = 0; k < K; ++k) {
-            v_sparse[k] = v_dense[k] = (icoac_real_t)test_uniform(&rng, -2, 2);
-        }
-        for (n = 0; n < 3000; ++n) {
-            double bd[K], magnitude = 0;
-            icoac_real_t value_sparse, value_dense, step;
-            random_state(&rng, n % 10 == 9, s);
-            icoac_priv_critic_factors(&cfg.critic, s, factors);
-            value_sparse = kernel_value(SPARSE, &cfg.critic, v_sparse, factors, &sparse);
-            value_dense = kernel_value(DENSE, &cfg.critic, v_dense, factors, &dense);
-            direct_b(s, bd);
-            for (k = 0; k < K; ++k) {
-                magnitude += fabs((double)v_sparse[k]) * bd[k];
+    for (gi = 0; gi < N_GRIDS; ++gi) {
+        const grid_t *g = &grids[gi];
+        icoac_config_t cfg = grid_config(g);
+        for (t = 0; t < 3; ++t) {
+            cfg.critic.threshold = thresholds[t];
+            for (k = 0; k < KMAX; ++k) {
+                v_sparse[k] = v_dense[k] = (icoac_real_t)test_uniform(&rng, -2, 2);
             }
-            assert_close(value_dense, value_sparse, (REAL_IS_FLOAT ? 2e-6 : 1e-14) * magnitude + 1e-30);
-            if (magnitude > 0) {
-                max_rel = fmax(max_rel, fabs((double)value_dense - (double)value_sparse) / magnitude);
+            for (n = 0; n < 1000; ++n) {
+                double magnitude = 0;
+                icoac_real_t value_sparse, value_dense, step;
+                random_state(g, &rng, n % 10 == 9, s);
+                value_sparse = kernel_value(SPARSE, &cfg, v_sparse, s, &sparse);
+                value_dense = kernel_value(DENSE, &cfg, v_dense, s, &dense);
+                direct_b(g, s, bd);
+                for (k = 0; k < units_of(g); ++k) {
+                    magnitude += fabs((double)v_sparse[k]) * bd[k];
+                }
+                assert_close(value_dense, value_sparse, (REAL_IS_FLOAT ? 2e-6 : 1e-14) * magnitude + 1e-30);
+                if (magnitude > 0) {
+                    max_rel = fmax(max_rel, fabs((double)value_dense - (double)value_sparse) / magnitude);
+                }
+                step = (icoac_real_t)test_uniform(&rng, -0.05, 0.05);
+                kernel_update(SPARSE, &cfg.critic, v_sparse, &sparse, step);
+                kernel_update(DENSE, &cfg.critic, v_dense, &dense, step);
+                assert_memory_equal(v_dense, v_sparse, sizeof v_sparse);
             }
-            step = (icoac_real_t)test_uniform(&rng, -0.05, 0.05);
-            kernel_update(SPARSE, &cfg.critic, v_sparse, &sparse, step);
-            kernel_update(DENSE, &cfg.critic, v_dense, &dense, step);
-            assert_memory_equal(v_dense, v_sparse, sizeof v_sparse);
         }
     }
     assert_true(max_rel > 0); /* the orders do differ: the comparison is not vacuous */
@@ -371,6 +459,7 @@ static void test_td_update_through_step(void **unused)
     icoac_input_t sa = test_input(0.25, -0.3, 0.06, 0.1, 0);
     icoac_input_t sb = test_input(0.2, -0.35, 0.07, 0.15, 0);
     double b_t[K], b_a[K], b_b[K], v1[K];
+    const grid_t *g = &grids[CARTPOLE];
     double va = 0, vb = 0, delta;
     int k;
     (void)unused;
@@ -387,7 +476,7 @@ static void test_td_update_through_step(void **unused)
     step_ok(&cfg, &state, &fail_in, &out);
     assert_close(out.td_error, -1.0, 0.0);
     assert_true(out.force == 0);
-    direct_b_kept(st.s, 0.001, b_t);
+    direct_b_kept(g, st.s, 0.001, b_t);
     for (k = 0; k < K; ++k) {
         assert_close(priv->v[k], -0.6 * b_t[k], b_tol());
         v1[k] = (double)priv->v[k];
@@ -395,8 +484,8 @@ static void test_td_update_through_step(void **unused)
 
     /* a non-terminal transition s_a -> s_b: delta = gamma V(s_b) - V(s_a) */
     assert_int_equal(icoac_reset(&state), ICOAC_OK);
-    direct_b_kept(sa.s, 0.001, b_a);
-    direct_b_kept(sb.s, 0.001, b_b);
+    direct_b_kept(g, sa.s, 0.001, b_a);
+    direct_b_kept(g, sb.s, 0.001, b_b);
     for (k = 0; k < K; ++k) {
         va += v1[k] * b_a[k];
         vb += v1[k] * b_b[k];
@@ -432,7 +521,7 @@ static void test_td_clip(void **unused)
     step_ok(&cfg, &state, &st, &out);
     step_ok(&cfg, &state, &fail_in, &out);
     assert_close(out.td_error, -0.25, 0.0);
-    direct_b_kept(st.s, 0.001, b_t);
+    direct_b_kept(&grids[CARTPOLE], st.s, 0.001, b_t);
     for (k = 0; k < K; ++k) {
         assert_close(priv->v[k], -0.5 * 0.25 * b_t[k], b_tol());
     }

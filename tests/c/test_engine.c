@@ -124,9 +124,9 @@ static void test_numeric_fault_marks_cell_error(void **unused)
     for (k = 0; k < 2; ++k) {
         assert_int_equal(cells[k].outcome, ICOAC_SIM_ERROR);
         assert_int_equal(cells[k].status, ICOAC_ERR_NUMERIC);
-        for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
             assert_true(isfinite(cells[k].weights[i]));
-            for (j = 0; j < ICOAC_N_INPUTS; ++j) {
+            for (j = 0; j < ICOAC_CARTPOLE_INPUTS; ++j) {
                 assert_true(isfinite(cells[k].cov[i][j]));
             }
         }

@@ -199,8 +199,8 @@ static void test_zone_edges_are_strict(void **unused)
     for (e = 0; e < 4; ++e) {
         assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
         in = test_input(0, 0, 0, 0, 0);
-        in.s[0] = (icoac_real_t)edges[e][0] * cfg.policy.zone_x;
-        in.s[2] = (icoac_real_t)edges[e][1] * cfg.policy.zone_theta;
+        in.s[0] = (icoac_real_t)edges[e][0] * cfg.task.rule_threshold[3]; /* x above 2.35 m */
+        in.s[2] = (icoac_real_t)edges[e][1] * cfg.task.rule_threshold[0]; /* theta above 11.5 deg */
         assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
         assert_true(out.reflex == 0 && out.penalty == 0);
     }
@@ -215,9 +215,9 @@ static void test_feature_helpers(void **unused)
     int clip, i;
     (void)unused;
     for (r = 0; r < sizeof zone_rows / sizeof zone_rows[0]; ++r) {
-        const icoac_real_t s[ICOAC_N_INPUTS] = {(icoac_real_t)zone_rows[r].x, ICOAC_R(0.3),
-                                                (icoac_real_t)zone_rows[r].theta, ICOAC_R(-0.4)};
-        const icoac_priv_zone_t zone = icoac_priv_zone(&cfg.policy, s);
+        const icoac_real_t s[ICOAC_MAX_INPUTS] = {(icoac_real_t)zone_rows[r].x, ICOAC_R(0.3),
+                                                  (icoac_real_t)zone_rows[r].theta, ICOAC_R(-0.4)};
+        const icoac_priv_zone_t zone = icoac_priv_zone(&cfg.task, s);
         assert_true(zone.reflex == zone_rows[r].reflex && zone.penalty == zone_rows[r].penalty);
     }
     cfg.policy.reflex_force = (icoac_real_t)2.5;
@@ -230,11 +230,11 @@ static void test_feature_helpers(void **unused)
         cfg.policy.clip_inputs = clip;
         assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
         for (r = 0; r < sizeof scale_rows / sizeof scale_rows[0]; ++r) {
-            icoac_real_t s[ICOAC_N_INPUTS] = {ICOAC_R(0.0), ICOAC_R(0.0), ICOAC_R(0.0), ICOAC_R(0.0)};
-            icoac_real_t scaled[ICOAC_N_INPUTS];
+            icoac_real_t s[ICOAC_MAX_INPUTS] = {ICOAC_R(0.0)};
+            icoac_real_t scaled[ICOAC_MAX_INPUTS];
             s[scale_rows[r].component] = (icoac_real_t)scale_rows[r].value;
             icoac_priv_scale_inputs(&cfg.policy, icoac_priv_state_c(&state), s, scaled);
-            for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+            for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
                 const double expected = test_scale(i, (double)s[i], clip);
                 assert_close(scaled[i], expected, tol_of(expected));
             }

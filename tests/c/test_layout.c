@@ -85,11 +85,11 @@ static void test_constants_table(void **unused)
     }
     /* spot checks against the headers */
     assert_true(constant("ICOAC_ABI_VERSION") == ICOAC_ABI_VERSION);
-    assert_true(constant("ICOAC_ABI_VERSION") == 7);
+    assert_true(constant("ICOAC_ABI_VERSION") == 8);
     assert_true(constant("ICOAC_SIM_ABI_VERSION") == ICOAC_SIM_ABI_VERSION);
     assert_true(constant("ICOAC_SIM_ABI_VERSION") == 2);
-    assert_true(constant("ICOAC_N_INPUTS") == ICOAC_N_INPUTS);
-    assert_true(constant("ICOAC_CRITIC_UNITS") == ICOAC_CRITIC_UNITS);
+    assert_true(constant("ICOAC_CARTPOLE_INPUTS") == ICOAC_CARTPOLE_INPUTS);
+    assert_true(constant("ICOAC_CARTPOLE_CRITIC_UNITS") == ICOAC_CARTPOLE_CRITIC_UNITS);
     assert_true(constant("ICOAC_STATE_SIZE") == ICOAC_STATE_SIZE);
     assert_true(constant("ICOAC_STATE_SIZE") == (double)icoac_sizeof_state());
     assert_true(constant("ICOAC_INPUT_TERMINAL") == ICOAC_INPUT_TERMINAL);
@@ -206,7 +206,11 @@ static void test_fields_spot_checks(void **unused)
     SPOT(icoac_config_t, mode);
     SPOT(icoac_config_t, policy.input_range);
     SPOT(icoac_config_t, policy.gain);
-    SPOT(icoac_config_t, policy.zone_x);
+    SPOT(icoac_config_t, task.n_inputs);
+    SPOT(icoac_config_t, task.rule_threshold);
+    SPOT(icoac_config_t, task.rule_reflex);
+    SPOT(icoac_config_t, critic.units);
+    SPOT(icoac_input_t, reflex);
     SPOT(icoac_config_t, ico.rate);
     SPOT(icoac_config_t, ico.timing);
     SPOT(icoac_config_t, critic.range);
@@ -233,7 +237,9 @@ static void test_fields_spot_checks(void **unused)
     SPOT(icoac_sim_run_t, init_velocity_noise);
     SPOT(icoac_sim_cell_t, cov);
     /* the nested layout, as the table names it */
-    assert_int_equal(find_field("icoac_config_t", "critic.range")->size, ICOAC_N_INPUTS * sizeof(icoac_real_t));
+    assert_int_equal(find_field("icoac_config_t", "critic.range")->size, ICOAC_MAX_INPUTS * sizeof(icoac_real_t));
+    assert_int_equal(find_field("icoac_config_t", "task.rule_input")->size, ICOAC_MAX_RULES * sizeof(int32_t));
+    assert_int_equal(find_field("icoac_config_t", "task.n_inputs")->offset, offsetof(icoac_config_t, task));
     assert_int_equal(find_field("icoac_config_t", "mode")->offset, 0);
     assert_int_equal(find_field("icoac_config_t", "policy.input_range")->offset, offsetof(icoac_config_t, policy));
     assert_true(find_field("icoac_config_t", "ico.rate")->offset >= offsetof(icoac_config_t, ico));

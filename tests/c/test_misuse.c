@@ -8,7 +8,8 @@
 
 #include "icoac_priv.h"
 
-#define N ICOAC_N_INPUTS
+#define N ICOAC_CARTPOLE_INPUTS /* the cart-pole task's inputs */
+#define M ICOAC_MAX_INPUTS      /* the library's vectors: entries past N are 0 */
 
 static const icoac_priv_state_t *priv(const icoac_state_t *state)
 {
@@ -284,7 +285,7 @@ static void test_nonfinite_fields_and_recovery(void **unused)
         trial(state, &rng, 50);
     }
     /* corrupted learned values: the ticks fail, init restores */
-    for (k = 0; k < ICOAC_CRITIC_UNITS; ++k) {
+    for (k = 0; k < ICOAC_CARTPOLE_CRITIC_UNITS; ++k) {
         priv_mut(state)->v[k] = k % 2 ? (icoac_real_t)NAN : (icoac_real_t)INFINITY;
     }
     assert_int_equal(icoac_reset(state), ICOAC_OK);

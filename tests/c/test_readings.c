@@ -11,8 +11,9 @@
 
 #include "icoac_priv.h"
 
-#define N ICOAC_N_INPUTS
-#define K ICOAC_CRITIC_UNITS
+#define N ICOAC_CARTPOLE_INPUTS /* the cart-pole task's inputs */
+#define M ICOAC_MAX_INPUTS      /* the library's vectors: entries past N are 0 */
+#define K ICOAC_CARTPOLE_CRITIC_UNITS
 #define GAIN 10.0
 
 typedef struct {

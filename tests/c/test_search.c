@@ -17,7 +17,8 @@
 
 #include "icoac_priv.h"
 
-#define N ICOAC_N_INPUTS
+#define N ICOAC_CARTPOLE_INPUTS /* the cart-pole task's inputs */
+#define M ICOAC_MAX_INPUTS      /* the library's vectors: entries past N are 0 */
 #define KMAX ICOAC_SEARCH_BATCH_MAX
 #define GAIN 10.0
 
@@ -523,8 +524,8 @@ static void test_elite_choice(void **unused)
 static void assert_sigma_spd(const icoac_state_t *state, double margin, const char *what, int n)
 {
     const icoac_priv_state_t *st = priv(state);
-    const icoac_real_t(*cov)[N] = icoac_priv_cov_c(st);
-    icoac_real_t lower_r[N][N];
+    const icoac_real_t(*cov)[M] = icoac_priv_cov_c(st);
+    icoac_real_t lower_r[M][M] = {{0}};
     double m[N][N], l[N][N];
     int i, j, q;
     for (i = 0; i < N; ++i) {
@@ -537,7 +538,7 @@ static void assert_sigma_spd(const icoac_state_t *state, double margin, const ch
             }
         }
     }
-    if (!icoac_priv_cholesky4(cov, lower_r)) {
+    if (!icoac_priv_cholesky(cov, lower_r, ICOAC_CARTPOLE_INPUTS)) {
         print_error("%s %d: cov not positive definite\n", what, n);
         fail();
     }
@@ -726,12 +727,12 @@ static void test_rejected_prior_leaves_state(void **unused)
                 p.cov[i][j] = p.cov[j][i] = (icoac_real_t)sum;
             }
         }
-        if (icoac_prior_check(&p) != ICOAC_OK) {
+        if (icoac_prior_check(&p, ICOAC_CARTPOLE_INPUTS) != ICOAC_OK) {
             continue;
         }
         for (c = 0; c < sizeof scales / sizeof scales[0]; ++c) {
             icoac_config_t cfg = search_config(4, 0.5, 0.5, 0.1, scales[c]);
-            icoac_real_t scaled[N][N], lower[N][N];
+            icoac_real_t scaled[M][M] = {{0}}, lower[M][M] = {{0}};
             icoac_state_t state, sentinel;
             int mode;
             for (i = 0; i < N; ++i) {
@@ -739,7 +740,7 @@ static void test_rejected_prior_leaves_state(void **unused)
                     scaled[i][j] = p.cov[i][j] * cfg.search.cov_scale; /* Sigma0 as icoac_init forms it */
                 }
             }
-            if (icoac_priv_cholesky4(ICOAC_PRIV_CONST_MAT4(scaled), lower)) {
+            if (icoac_priv_cholesky(ICOAC_PRIV_CONST_MAT(scaled), lower, ICOAC_CARTPOLE_INPUTS)) {
                 continue;
             }
             ++found;
@@ -903,8 +904,8 @@ static void test_spd_over_many_updates(void **unused)
         int u, k, i, j;
         assert_int_equal(icoac_init(&cfg, &state, &p, 3u + c), ICOAC_OK);
         for (u = 0; u < sc->updates; ++u) {
-            const icoac_real_t(*cov)[N];
-            icoac_real_t lower[N][N];
+            const icoac_real_t(*cov)[M];
+            icoac_real_t lower[M][M] = {{0}};
             for (k = 0; k < sc->batch; ++k) {
                 icoac_input_t in;
                 icoac_output_t out;
@@ -934,7 +935,7 @@ static void test_spd_over_many_updates(void **unused)
                     }
                 }
             }
-            if (!icoac_priv_cholesky4(cov, lower)) {
+            if (!icoac_priv_cholesky(cov, lower, ICOAC_CARTPOLE_INPUTS)) {
                 print_error("case %u, update %d: cov not positive definite\n", (unsigned)c, u);
                 fail();
             }

@@ -6,23 +6,19 @@
  *   config  mode byte c. c odd: sizeof(icoac_config_t) raw bytes laid over
  *           icoac_config_default (fewer when the input ends; the nested layout of icoac.h,
  *           padding included). c even: the default with (c >> 1) % 8 mutations, each a field
- *           byte (% 38; indices in struct order, table in fuzz_input.c: 0 mode, 1 learn,
- *           2-5 policy.input_range, 6 policy.clip_inputs, 7 policy.gain, 8 policy.reflex_mode,
- *           9 policy.reflex_force, 10 policy.zone_theta, 11 policy.zone_x, 12 ico.rate,
- *           13 ico.timing, 14 critic.rate, 15 critic.discount, 16 critic.td_clip,
- *           17-20 critic.range, 21 critic.threshold, 22 critic.quirks, 23 actor.noise_std,
- *           24 actor.scale, 25 actor.forgetting, 26 actor.reflex, 27 actor.act_with_sample,
- *           28 actor.update, 29 actor.rate, 30 actor.likelihood_std, 31 actor.batch,
- *           32 actor.explore_ticks, 33 search.batch, 34 search.elite_fraction, 35 search.step,
- *           36 search.floor, 37 search.cov_scale) and a value.
- *   prior   byte p. p % 3: 0 NULL, 1 mean 0 and cov I, 2 that with (p / 3) % 8 mutations,
- *           each a field byte b ((b & 127) % 20: 0-3 mean[i], 4 + 4i + j cov[i][j];
+ *           byte (% 73; indices in struct order over every array element of the default maxima,
+ *           6 inputs and 6 rules: table in fuzz_input.c) and a value: random task descriptions
+ *           (input counts, rule tables, late-signal sources) and critic grids.
+ *   prior   byte p. p % 3: 0 NULL, 1 mean 0 and cov I (6 x 6), 2 that with (p / 3) % 8
+ *           mutations, each a field byte b ((b & 127) % 42: 0-5 mean[i], 6 + 6i + j cov[i][j];
  *           b & 128 also sets cov[j][i]) and a value.
  *   seed    8 bytes, little endian.
  *   ops     until the input ends, at most FZ_MAX_OPS ops and FZ_MAX_STEPS steps. Op byte o:
  *           o & 3: 0 or 1 step, 2 terminal step (ICOAC_INPUT_TERMINAL), 3 icoac_reset or retune.
  *           A step runs ((o >> 2) & 7) + 1 times; o & 0x20 keeps the previous s, else the
- *           4 values s[0..3] follow; bits 6 and 7 are ignored. o & 3 == 3: o & 0x40 clear:
+ *           n values s[0..n-1] follow (n = task.n_inputs; s[n..] is NaN, never read); o & 0x40
+ *           sets ICOAC_INPUT_LATE; o & 0x80: a value for in.reflex follows (else it is kept,
+ *           initially 0). o & 3 == 3: o & 0x40 clear:
  *           icoac_reset (bit 7 ignored); set: icoac_retune with a config section (as above)
  *           laid over the configuration in force (o & 0x80 clear) or over the default
  *           (o & 0x80 set: the config section exactly as at the start).
@@ -92,8 +88,8 @@
 
 #define FZ_MAX_OPS 128
 #define FZ_MAX_STEPS 512
-#define N ICOAC_N_INPUTS
-/* C will not pass T[4][4] as const T[4][4] implicitly. */
+#define N ICOAC_MAX_INPUTS /* the library's vectors; a task uses the first task.n_inputs */
+/* C will not pass T[N][N] as const T[N][N] implicitly. */
 #define CONST_MAT(m) ((const icoac_real_t(*)[N])(m))
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -105,7 +101,7 @@ typedef struct {
     icoac_real_t w[N];
     icoac_real_t weight_norm;
     icoac_real_t cov[N][N];
-    icoac_real_t v[ICOAC_CRITIC_UNITS];
+    icoac_real_t v[ICOAC_CARTPOLE_CRITIC_UNITS];
     icoac_real_t w_act[N];
     icoac_real_t batch_info[N][N];
     icoac_real_t batch_shift[N];
@@ -155,7 +151,15 @@ static int all_zero(const icoac_real_t *p, int n)
 
 static icoac_real_t trace4(const icoac_real_t m[N][N])
 {
-    return (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]); /* the library's order */
+    /* the library's order (entries past the task's inputs are 0) */
+    ICOAC_STATIC_ASSERT(N == 6, trace_of_the_default_maxima);
+    return ((m[0][0] + m[1][1]) + (m[2][2] + m[3][3])) + (m[4][4] + m[5][5]);
+}
+
+/* The task's inputs, bounded to the arrays as the library bounds them. */
+static int inputs_of(const icoac_config_t *cfg)
+{
+    return (uint32_t)cfg->task.n_inputs <= (uint32_t)N ? (int)cfg->task.n_inputs : N;
 }
 
 static icoac_counters_t counters_of(const icoac_state_t *state)
@@ -180,7 +184,7 @@ static const char *learned_nonfinite(const learned_t *l, int with_w_act)
             return "cov";
         }
     }
-    if (!fz_all_finite(l->v, ICOAC_CRITIC_UNITS)) {
+    if (!fz_all_finite(l->v, ICOAC_CARTPOLE_CRITIC_UNITS)) {
         return "v";
     }
     if (with_w_act && !fz_all_finite(l->w_act, N)) {
@@ -227,13 +231,14 @@ static const char *learned_changed(const learned_t *a, const learned_t *b, int w
     return 0;
 }
 
-/* cov[i][j] == cov[j][i] (exact; what icoac_prior_check asks of a prior). */
-static int cov_symmetric(const icoac_real_t cov[N][N])
+/* cov[i][j] == cov[j][i] over the leading n x n block (exact; what icoac_prior_check asks of a
+ * prior). */
+static int cov_symmetric(const icoac_real_t cov[N][N], int n)
 {
     int i;
     int j;
-    for (i = 0; i < N; ++i) {
-        for (j = i + 1; j < N; ++j) {
+    for (i = 0; i < n; ++i) {
+        for (j = i + 1; j < n; ++j) {
             if (cov[i][j] != cov[j][i]) {
                 return 0;
             }
@@ -270,17 +275,33 @@ static int is_flag(int32_t v)
 /* Necessary conditions from the documented ranges (icoac.h) of the groups a mode uses (ICO:
  * policy and ico; RL: policy, critic and actor; the others are ignored); the check may be
  * stricter. */
-static int policy_documented(const icoac_policy_config_t *p)
+static int task_documented(const icoac_task_config_t *t)
+{
+    int k;
+    if (t->n_inputs < 1 || t->n_inputs > N || t->n_rules < 0 || t->n_rules > ICOAC_MAX_RULES ||
+        (t->late_source != ICOAC_LATE_RULES && t->late_source != ICOAC_LATE_SENSOR)) {
+        return 0;
+    }
+    for (k = 0; t->late_source == ICOAC_LATE_RULES && k < t->n_rules; ++k) {
+        if (t->rule_input[k] < 0 || t->rule_input[k] >= t->n_inputs || !is_flag(t->rule_side[k]) ||
+            !isfinite(t->rule_threshold[k]) || !(fabs((double)t->rule_reflex[k]) <= 1.0)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+static int policy_documented(const icoac_policy_config_t *p, int n)
 {
     int i;
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < n; ++i) {
         if (!finite_positive(p->input_range[i])) {
             return 0;
         }
     }
     return is_flag(p->clip_inputs) && finite_non_negative(p->gain) &&
            (p->reflex_mode == ICOAC_REFLEX_UNIT || p->reflex_mode == ICOAC_REFLEX_GAIN) &&
-           finite_non_negative(p->reflex_force) && finite_positive(p->zone_theta) && finite_positive(p->zone_x);
+           finite_non_negative(p->reflex_force);
 }
 
 static int ico_documented(const icoac_ico_config_t *ico)
@@ -289,13 +310,18 @@ static int ico_documented(const icoac_ico_config_t *ico)
            (ico->timing == ICOAC_ICO_TIMING_CODE || ico->timing == ICOAC_ICO_TIMING_LITERAL);
 }
 
-static int critic_documented(const icoac_critic_config_t *c)
+static int critic_documented(const icoac_critic_config_t *c, int n)
 {
+    long units = 1;
     int i;
-    for (i = 0; i < N; ++i) {
-        if (!finite_positive(c->range[i])) {
+    for (i = 0; i < n; ++i) {
+        if (!finite_positive(c->range[i]) || c->units[i] < 1 || c->units[i] > ICOAC_CRITIC_UNITS_PER_INPUT_MAX) {
             return 0;
         }
+        units *= c->units[i];
+    }
+    if (units > ICOAC_MAX_CRITIC_UNITS) {
+        return 0;
     }
     return finite_non_negative(c->rate) && c->rate <= ICOAC_R(10.0) && finite_non_negative(c->discount) &&
            c->discount <= ICOAC_R(1.0) && finite_positive(c->td_clip) && finite_non_negative(c->threshold) &&
@@ -322,17 +348,18 @@ static int search_documented(const icoac_search_config_t *s)
 
 static int config_documented(const icoac_config_t *cfg)
 {
-    if (cfg->learn != 0 && cfg->learn != 1) {
+    const int n = cfg->task.n_inputs;
+    if ((cfg->learn != 0 && cfg->learn != 1) || !task_documented(&cfg->task) || !policy_documented(&cfg->policy, n)) {
         return 0;
     }
     if (cfg->mode == ICOAC_MODE_ICO) {
-        return policy_documented(&cfg->policy) && ico_documented(&cfg->ico);
+        return ico_documented(&cfg->ico);
     }
     if (cfg->mode == ICOAC_MODE_SEARCH) {
-        return policy_documented(&cfg->policy) && search_documented(&cfg->search);
+        return search_documented(&cfg->search);
     }
-    return cfg->mode == ICOAC_MODE_RL && policy_documented(&cfg->policy) && critic_documented(&cfg->critic) &&
-           actor_documented(&cfg->actor) && is_flag(cfg->critic.quirks);
+    return cfg->mode == ICOAC_MODE_RL && critic_documented(&cfg->critic, n) && actor_documented(&cfg->actor) &&
+           is_flag(cfg->critic.quirks);
 }
 
 /* The fields icoac_config_check_field may name, with their group's status and the mode that
@@ -346,16 +373,43 @@ typedef struct {
 static const named_field_t named_fields[] = {
     {"mode", ICOAC_ERR_BAD_MODE, -1},
     {"learn", ICOAC_ERR_BAD_MODE, -1},
+    {"task.n_inputs", ICOAC_ERR_BAD_TASK, -1},
+    {"task.late_source", ICOAC_ERR_BAD_TASK, -1},
+    {"task.n_rules", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_input[0]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_input[1]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_input[2]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_input[3]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_input[4]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_input[5]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_side[0]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_side[1]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_side[2]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_side[3]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_side[4]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_side[5]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.rule_threshold[0]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_threshold[1]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_threshold[2]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_threshold[3]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_threshold[4]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_threshold[5]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_reflex[0]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_reflex[1]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_reflex[2]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_reflex[3]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_reflex[4]", ICOAC_ERR_BAD_ZONE, -1},
+    {"task.rule_reflex[5]", ICOAC_ERR_BAD_ZONE, -1},
     {"policy.input_range[0]", ICOAC_ERR_BAD_SCALE, -1},
     {"policy.input_range[1]", ICOAC_ERR_BAD_SCALE, -1},
     {"policy.input_range[2]", ICOAC_ERR_BAD_SCALE, -1},
     {"policy.input_range[3]", ICOAC_ERR_BAD_SCALE, -1},
+    {"policy.input_range[4]", ICOAC_ERR_BAD_SCALE, -1},
+    {"policy.input_range[5]", ICOAC_ERR_BAD_SCALE, -1},
     {"policy.clip_inputs", ICOAC_ERR_BAD_MODE, -1},
     {"policy.gain", ICOAC_ERR_BAD_GAIN, -1},
     {"policy.reflex_mode", ICOAC_ERR_BAD_MODE, -1},
     {"policy.reflex_force", ICOAC_ERR_BAD_GAIN, -1},
-    {"policy.zone_theta", ICOAC_ERR_BAD_ZONE, -1},
-    {"policy.zone_x", ICOAC_ERR_BAD_ZONE, -1},
     {"ico.rate", ICOAC_ERR_BAD_ICO_RATE, ICOAC_MODE_ICO},
     {"ico.timing", ICOAC_ERR_BAD_MODE, ICOAC_MODE_ICO},
     {"critic.rate", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
@@ -365,6 +419,15 @@ static const named_field_t named_fields[] = {
     {"critic.range[1]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
     {"critic.range[2]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
     {"critic.range[3]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.range[4]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.range[5]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.units[0]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.units[1]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.units[2]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.units[3]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.units[4]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.units[5]", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
+    {"critic.units", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
     {"critic.threshold", ICOAC_ERR_BAD_CRITIC, ICOAC_MODE_RL},
     {"critic.quirks", ICOAC_ERR_BAD_MODE, ICOAC_MODE_RL},
     {"actor.noise_std", ICOAC_ERR_BAD_ACTOR, ICOAC_MODE_RL},
@@ -397,16 +460,16 @@ static int field_matches(const icoac_config_t *cfg, const char *field, int32_t s
     return 0;
 }
 
-/* Finite mean, finite exactly symmetric covariance with a positive diagonal. */
-static int prior_documented(const icoac_prior_t *prior)
+/* Finite mean, finite exactly symmetric covariance with a positive diagonal (the leading n). */
+static int prior_documented(const icoac_prior_t *prior, int n)
 {
     int i;
-    for (i = 0; i < N; ++i) {
-        if (!isfinite(prior->mean[i]) || !fz_all_finite(prior->cov[i], N) || !(prior->cov[i][i] > ICOAC_R(0.0))) {
+    for (i = 0; i < n; ++i) {
+        if (!isfinite(prior->mean[i]) || !fz_all_finite(prior->cov[i], n) || !(prior->cov[i][i] > ICOAC_R(0.0))) {
             return 0;
         }
     }
-    return cov_symmetric(prior->cov);
+    return cov_symmetric(prior->cov, n);
 }
 
 static int output_finite(const icoac_output_t *out)
@@ -492,7 +555,7 @@ static void check_search_step(const icoac_config_t *cfg, const learned_t *before
     }
     FZ_CHECK(after->search_count == 0, "op %d: the batch is full, but %d trials remain recorded", op,
              (int)after->search_count);
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < inputs_of(cfg); ++i) {
         FZ_CHECK(after->cov[i][i] >= after->search_floor[i], "op %d: cov[%d][%d] = %g below its floor %g", op, i, i,
                  (double)after->cov[i][i], (double)after->search_floor[i]);
         FZ_CHECK(after->search_lower[i][i] > ICOAC_R(0.0), "op %d: Cholesky factor with L[%d][%d] = %g", op, i, i,
@@ -538,8 +601,12 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
     status = (int32_t)icoac_step(state, in, &out);
     learned_take(state, &after);
     counted_after = counters_of(state);
-    for (i = 0; i < N; ++i) {
+    /* the task's inputs, and the sensor's reflex on a late tick: what the tick reads */
+    for (i = 0; i < inputs_of(cfg); ++i) {
         finite_in = finite_in && isfinite(in->s[i]);
+    }
+    if (cfg->task.late_source == ICOAC_LATE_SENSOR && (in->flags & ICOAC_INPUT_LATE) != 0u) {
+        finite_in = finite_in && isfinite(in->reflex);
     }
     FZ_CHECK(memcmp(&icoac_priv_state_c(state)->config, &icoac_priv_state_c(&state_before)->config,
                     sizeof(icoac_config_t)) == 0,
@@ -582,7 +649,12 @@ static void check_step(const icoac_config_t *cfg, icoac_state_t *state, const ic
         FZ_CHECK(field == 0, "op %d: ICOAC_OK left a non-finite learned %s (w = %g %g %g %g, |w| %g)", op,
                  field, (double)after.w[0], (double)after.w[1], (double)after.w[2], (double)after.w[3],
                  (double)after.weight_norm);
-        FZ_CHECK(cov_symmetric(CONST_MAT(after.cov)), "op %d: covariance not exactly symmetric", op);
+        FZ_CHECK(cov_symmetric(CONST_MAT(after.cov), N), "op %d: covariance not exactly symmetric", op);
+        FZ_CHECK(out.penalty == ICOAC_R(0.0) || out.penalty == ICOAC_R(-1.0), "op %d: penalty %g", op,
+                 (double)out.penalty);
+        FZ_CHECK(out.reflex >= ICOAC_R(-1.0) && out.reflex <= ICOAC_R(1.0) &&
+                     (out.penalty != ICOAC_R(0.0) || out.reflex == ICOAC_R(0.0)),
+                 "op %d: reflex %g with penalty %g", op, (double)out.reflex, (double)out.penalty);
         field = cfg->learn ? 0 : learned_changed(&before, &after, FZ_BATCH | FZ_RECORD);
         FZ_CHECK(field == 0, "op %d: learn = 0, but the tick changed the learned %s", op, field);
         FZ_CHECK(!terminal || (out.force == ICOAC_R(0.0) && out.noise == ICOAC_R(0.0)),
@@ -666,8 +738,10 @@ static int check_retune(const icoac_config_t *in_force, icoac_state_t *state, co
     if (config_status != ICOAC_OK) {
         FZ_CHECK(status == config_status, "op %d: icoac_retune returned %d, icoac_config_check %d", op, (int)status,
                  (int)config_status);
-    } else if (next->mode != in_force->mode) {
-        FZ_CHECK(status == ICOAC_ERR_RETUNE_MODE, "op %d: icoac_retune from mode %d to %d returned %d (%s)", op,
+    } else if (next->mode != in_force->mode || next->task.n_inputs != in_force->task.n_inputs ||
+               memcmp(next->critic.units, in_force->critic.units, sizeof next->critic.units) != 0) {
+        FZ_CHECK(status == ICOAC_ERR_RETUNE_MODE,
+                 "op %d: icoac_retune from mode %d to %d (or of the inputs or critic grid) returned %d (%s)", op,
                  (int)in_force->mode, (int)next->mode, (int)status, status_name(status));
     } else {
         FZ_CHECK(status == ICOAC_OK, "op %d: icoac_retune of a valid configuration returned %d (%s)", op, (int)status,
@@ -681,7 +755,7 @@ static int check_retune(const icoac_config_t *in_force, icoac_state_t *state, co
     FZ_CHECK(icoac_get_config(state, &got) == ICOAC_OK && fz_config_equal(&got, next),
              "op %d: icoac_get_config after icoac_retune is not the new configuration", op);
     for (i = 0; i < N; ++i) {
-        const icoac_real_t inv = ICOAC_R(1.0) / next->policy.input_range[i];
+        const icoac_real_t inv = i < next->task.n_inputs ? ICOAC_R(1.0) / next->policy.input_range[i] : ICOAC_R(0.0);
         FZ_CHECK(memcmp(&st->inv_range[i], &inv, sizeof inv) == 0, "op %d: icoac_retune: inv_range[%d] = %g, 1/%g", op,
                  i, (double)st->inv_range[i], (double)next->policy.input_range[i]);
         if (next->mode == ICOAC_MODE_SEARCH) {
@@ -696,6 +770,7 @@ static int check_retune(const icoac_config_t *in_force, icoac_state_t *state, co
     memcpy(&ex->config, &st->config, sizeof ex->config);
     memcpy(ex->inv_range, st->inv_range, sizeof ex->inv_range);
     memcpy(ex->search.floor, st->search.floor, sizeof ex->search.floor);
+    FZ_CHECK(memcmp(&ex->grid, &st->grid, sizeof ex->grid) == 0, "op %d: icoac_retune changed the critic geometry", op);
     FZ_CHECK(memcmp(&expect, state, sizeof expect) == 0,
              "op %d: icoac_retune changed more than the configuration and what it derives", op);
     return 1;
@@ -737,7 +812,7 @@ static void check_refusals(const icoac_config_t *cfg)
     status = (int32_t)icoac_step(0, &in, &out);
     FZ_CHECK(status == ICOAC_ERR_NULL && out.status == status && out.force == ICOAC_R(0.0),
              "icoac_step(NULL state): %d", (int)status);
-    FZ_CHECK(icoac_config_check(0) == ICOAC_ERR_NULL && icoac_prior_check(0) == ICOAC_ERR_NULL &&
+    FZ_CHECK(icoac_config_check(0) == ICOAC_ERR_NULL && icoac_prior_check(0, ICOAC_CARTPOLE_INPUTS) == ICOAC_ERR_NULL &&
                  icoac_init(cfg, 0, 0, 0u) == ICOAC_ERR_NULL,
              "NULL argument not refused with ICOAC_ERR_NULL");
 }
@@ -775,10 +850,12 @@ static int check_init(const icoac_config_t *cfg, icoac_state_t *state, const ico
     FZ_CHECK(config_status != ICOAC_OK || config_documented(cfg),
              "icoac_config_check accepted a configuration outside the documented ranges");
     if (prior != 0) {
-        prior_status = (int32_t)icoac_prior_check(prior);
-        FZ_CHECK(prior_status == ICOAC_OK || prior_status == ICOAC_ERR_BAD_PRIOR,
-                 "icoac_prior_check returned %d", (int)prior_status);
-        FZ_CHECK(prior_status != ICOAC_OK || prior_documented(prior),
+        prior_status = (int32_t)icoac_prior_check(prior, cfg->task.n_inputs);
+        /* a prior is checked over the task's inputs: ICOAC_ERR_BAD_TASK when their count is invalid */
+        FZ_CHECK(prior_status == ICOAC_OK || prior_status == ICOAC_ERR_BAD_PRIOR ||
+                     (prior_status == ICOAC_ERR_BAD_TASK && (cfg->task.n_inputs < 1 || cfg->task.n_inputs > N)),
+                 "icoac_prior_check returned %d (task.n_inputs %d)", (int)prior_status, (int)cfg->task.n_inputs);
+        FZ_CHECK(prior_status != ICOAC_OK || prior_documented(prior, cfg->task.n_inputs),
                  "icoac_prior_check accepted a non-finite or asymmetric prior");
     }
     /* a fill the rejected inits must leave as it is */
@@ -806,19 +883,24 @@ static int check_init(const icoac_config_t *cfg, icoac_state_t *state, const ico
     field = learned_nonfinite(&l, status == ICOAC_OK);
     FZ_CHECK(field == 0, "icoac_init (%s) left a non-finite learned %s (w = %g %g %g %g)", status_name(status),
              field, (double)l.w[0], (double)l.w[1], (double)l.w[2], (double)l.w[3]);
+    /* the prior's leading n x n block, 0 past it */
     for (i = 0; i < N; ++i) {
+        const int in_task = i < cfg->task.n_inputs;
         int j;
-        FZ_CHECK(l.w[i] == (prior != 0 ? prior->mean[i] : ICOAC_R(0.0)), "icoac_init: w[%d] is not the prior mean",
-                 i);
+        FZ_CHECK(l.w[i] == (prior != 0 && in_task ? prior->mean[i] : ICOAC_R(0.0)),
+                 "icoac_init: w[%d] is not the prior mean", i);
         for (j = 0; j < N; ++j) {
             icoac_real_t expect = prior != 0 ? prior->cov[i][j] : (i == j ? ICOAC_R(1.0) : ICOAC_R(0.0));
+            if (!in_task || j >= cfg->task.n_inputs) {
+                expect = ICOAC_R(0.0);
+            }
             if (cfg->mode == ICOAC_MODE_SEARCH) {
                 expect *= cfg->search.cov_scale; /* Sigma0 = c * the prior covariance */
             }
             FZ_CHECK(l.cov[i][j] == expect, "icoac_init: cov[%d][%d] = %g is not the prior's (%g)", i, j,
                      (double)l.cov[i][j], (double)expect);
         }
-        if (cfg->mode == ICOAC_MODE_SEARCH) {
+        if (cfg->mode == ICOAC_MODE_SEARCH && in_task) {
             FZ_CHECK(l.search_floor[i] == cfg->search.floor * l.cov[i][i] && l.search_lower[i][i] > ICOAC_R(0.0),
                      "icoac_init: search floor[%d] %g (expected %g), factor %g", i, (double)l.search_floor[i],
                      (double)(cfg->search.floor * l.cov[i][i]), (double)l.search_lower[i][i]);
@@ -887,11 +969,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             continue;
         }
         if ((op & 0x20u) == 0u) {
+            /* the task's n inputs; NaN past them, which the tick must not read */
             for (i = 0; i < N; ++i) {
-                in.s[i] = fz_real(&r);
+                in.s[i] = i < inputs_of(&cfg) ? fz_real(&r) : (icoac_real_t)NAN;
             }
         }
-        in.flags = (op & 3u) == 2u ? ICOAC_INPUT_TERMINAL : 0u;
+        if (op & 0x80u) {
+            in.reflex = fz_real(&r);
+        }
+        in.flags = ((op & 3u) == 2u ? ICOAC_INPUT_TERMINAL : 0u) | ((op & 0x40u) ? ICOAC_INPUT_LATE : 0u);
         for (repeat = ((op >> 2) & 7) + 1; repeat > 0 && steps < FZ_MAX_STEPS; --repeat, ++steps) {
             check_step(&cfg, &state, &in, ops);
         }

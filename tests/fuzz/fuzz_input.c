@@ -138,16 +138,18 @@ int64_t fz_i64(fz_reader_t *r)
     return k < 11 ? i64_table[k] : (int64_t)read_le(r, 8);
 }
 
-/* Config fields by index, in struct order (the order icoac_config_check walks them): the
- * member's offset and whether it is an int32 (switch or count) or a real. Indices:
- * 0 mode, 1 learn, 2-5 policy.input_range, 6 policy.clip_inputs, 7 policy.gain,
- * 8 policy.reflex_mode, 9 policy.reflex_force, 10 policy.zone_theta, 11 policy.zone_x,
- * 12 ico.rate, 13 ico.timing, 14 critic.rate, 15 critic.discount, 16 critic.td_clip,
- * 17-20 critic.range, 21 critic.threshold, 22 critic.quirks, 23 actor.noise_std,
- * 24 actor.scale, 25 actor.forgetting, 26 actor.reflex, 27 actor.act_with_sample,
- * 28 actor.update, 29 actor.rate, 30 actor.likelihood_std, 31 actor.batch,
- * 32 actor.explore_ticks, 33 search.batch, 34 search.elite_fraction, 35 search.step,
- * 36 search.floor, 37 search.cov_scale. */
+/* Config fields by index, in struct order (the order icoac_config_check walks them), every
+ * array element of the default maxima (6 inputs, 6 rules): the member's offset and whether it is
+ * an int32 (switch or count) or a real. Indices: 0 mode, 1 learn, 2 task.n_inputs,
+ * 3 task.late_source, 4 task.n_rules, 5-10 task.rule_input, 11-16 task.rule_side,
+ * 17-22 task.rule_threshold, 23-28 task.rule_reflex, 29-34 policy.input_range,
+ * 35 policy.clip_inputs, 36 policy.gain, 37 policy.reflex_mode, 38 policy.reflex_force,
+ * 39 ico.rate, 40 ico.timing, 41 critic.rate, 42 critic.discount, 43 critic.td_clip,
+ * 44-49 critic.range, 50-55 critic.units, 56 critic.threshold, 57 critic.quirks,
+ * 58 actor.noise_std, 59 actor.scale, 60 actor.forgetting, 61 actor.reflex,
+ * 62 actor.act_with_sample, 63 actor.update, 64 actor.rate, 65 actor.likelihood_std,
+ * 66 actor.batch, 67 actor.explore_ticks, 68 search.batch, 69 search.elite_fraction,
+ * 70 search.step, 71 search.floor, 72 search.cov_scale. */
 typedef struct {
     size_t offset;
     int is_int;
@@ -156,19 +158,48 @@ typedef struct {
 #define FZ_INT(member) {offsetof(icoac_config_t, member), 1}
 #define FZ_REAL(member) {offsetof(icoac_config_t, member), 0}
 
+ICOAC_STATIC_ASSERT(ICOAC_MAX_INPUTS == 6 && ICOAC_MAX_RULES == 6, fz_tables_of_the_default_maxima);
+
 static const config_field_t config_fields[] = {
     FZ_INT(mode),
     FZ_INT(learn),
+    FZ_INT(task.n_inputs),
+    FZ_INT(task.late_source),
+    FZ_INT(task.n_rules),
+    FZ_INT(task.rule_input[0]),
+    FZ_INT(task.rule_input[1]),
+    FZ_INT(task.rule_input[2]),
+    FZ_INT(task.rule_input[3]),
+    FZ_INT(task.rule_input[4]),
+    FZ_INT(task.rule_input[5]),
+    FZ_INT(task.rule_side[0]),
+    FZ_INT(task.rule_side[1]),
+    FZ_INT(task.rule_side[2]),
+    FZ_INT(task.rule_side[3]),
+    FZ_INT(task.rule_side[4]),
+    FZ_INT(task.rule_side[5]),
+    FZ_REAL(task.rule_threshold[0]),
+    FZ_REAL(task.rule_threshold[1]),
+    FZ_REAL(task.rule_threshold[2]),
+    FZ_REAL(task.rule_threshold[3]),
+    FZ_REAL(task.rule_threshold[4]),
+    FZ_REAL(task.rule_threshold[5]),
+    FZ_REAL(task.rule_reflex[0]),
+    FZ_REAL(task.rule_reflex[1]),
+    FZ_REAL(task.rule_reflex[2]),
+    FZ_REAL(task.rule_reflex[3]),
+    FZ_REAL(task.rule_reflex[4]),
+    FZ_REAL(task.rule_reflex[5]),
     FZ_REAL(policy.input_range[0]),
     FZ_REAL(policy.input_range[1]),
     FZ_REAL(policy.input_range[2]),
     FZ_REAL(policy.input_range[3]),
+    FZ_REAL(policy.input_range[4]),
+    FZ_REAL(policy.input_range[5]),
     FZ_INT(policy.clip_inputs),
     FZ_REAL(policy.gain),
     FZ_INT(policy.reflex_mode),
     FZ_REAL(policy.reflex_force),
-    FZ_REAL(policy.zone_theta),
-    FZ_REAL(policy.zone_x),
     FZ_REAL(ico.rate),
     FZ_INT(ico.timing),
     FZ_REAL(critic.rate),
@@ -178,6 +209,14 @@ static const config_field_t config_fields[] = {
     FZ_REAL(critic.range[1]),
     FZ_REAL(critic.range[2]),
     FZ_REAL(critic.range[3]),
+    FZ_REAL(critic.range[4]),
+    FZ_REAL(critic.range[5]),
+    FZ_INT(critic.units[0]),
+    FZ_INT(critic.units[1]),
+    FZ_INT(critic.units[2]),
+    FZ_INT(critic.units[3]),
+    FZ_INT(critic.units[4]),
+    FZ_INT(critic.units[5]),
     FZ_REAL(critic.threshold),
     FZ_INT(critic.quirks),
     FZ_REAL(actor.noise_std),
@@ -235,7 +274,7 @@ const icoac_prior_t *fz_prior(fz_reader_t *r, icoac_prior_t *prior)
         return 0;
     }
     memset(prior, 0, sizeof *prior);
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
         prior->cov[i][i] = ICOAC_R(1.0);
     }
     if (p % 3 == 1) {
@@ -245,11 +284,11 @@ const icoac_prior_t *fz_prior(fz_reader_t *r, icoac_prior_t *prior)
         const uint8_t b = fz_u8(r);
         const int field = (b & 0x7f) % FZ_PRIOR_FIELDS;
         const icoac_real_t v = fz_real(r);
-        if (field < ICOAC_N_INPUTS) {
+        if (field < ICOAC_MAX_INPUTS) {
             prior->mean[field] = v;
         } else {
-            const int row = (field - ICOAC_N_INPUTS) / ICOAC_N_INPUTS;
-            const int col = (field - ICOAC_N_INPUTS) % ICOAC_N_INPUTS;
+            const int row = (field - ICOAC_MAX_INPUTS) / ICOAC_MAX_INPUTS;
+            const int col = (field - ICOAC_MAX_INPUTS) % ICOAC_MAX_INPUTS;
             prior->cov[row][col] = v;
             if (b & 0x80) {
                 prior->cov[col][row] = v;

@@ -20,8 +20,8 @@ typedef struct {
 #define FZ_VALUE_RAW 4      /* 36..39: raw bits of the value, little endian */
 #define FZ_VALUE_KINDS (FZ_VALUE_TABLE + FZ_VALUE_BOUNDED + FZ_VALUE_RAW)
 
-#define FZ_CONFIG_FIELDS 38 /* config mutation field indices 0..37, struct order: fuzz_input.c */
-#define FZ_PRIOR_FIELDS 20  /* 0..3 mean, 4 + 4i + j cov[i][j] */
+#define FZ_CONFIG_FIELDS 73 /* config mutation field indices 0..72, struct order: fuzz_input.c */
+#define FZ_PRIOR_FIELDS 42  /* 0..5 mean, 6 + 6i + j cov[i][j] (ICOAC_MAX_INPUTS 6) */
 
 void fz_reader_init(fz_reader_t *r, const uint8_t *data, size_t size);
 int fz_done(const fz_reader_t *r);
@@ -44,8 +44,8 @@ void fz_config_over(fz_reader_t *r, icoac_config_t *cfg);
 /* Every field of a and b bitwise equal (NaN equals the same NaN; padding ignored). */
 int fz_config_equal(const icoac_config_t *a, const icoac_config_t *b);
 
-/* Prior section: a byte p; p % 3 == 0: NULL, 1: mean 0 and cov I, 2: that with (p / 3) % 8
- * mutations (field byte b: (b & 127) % 20, b & 128 also sets cov[j][i]; value). */
+/* Prior section: a byte p; p % 3 == 0: NULL, 1: mean 0 and cov I (6 x 6), 2: that with (p / 3) % 8
+ * mutations (field byte b: (b & 127) % 42, b & 128 also sets cov[j][i]; value). */
 const icoac_prior_t *fz_prior(fz_reader_t *r, icoac_prior_t *prior);
 
 #endif /* ICOAC_FUZZ_INPUT_H */

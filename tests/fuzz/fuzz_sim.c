@@ -53,7 +53,7 @@
 #define FZ_SIM_TICK_BUDGET 3600
 #define FZ_SIM_MAX_CELLS 4
 #define FZ_TRAJ_MAX_STEPS 64
-#define N ICOAC_N_INPUTS
+#define N ICOAC_CARTPOLE_INPUTS
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -166,6 +166,10 @@ static void decode_setup(fz_reader_t *r, setup_t *su)
     su->budget = FZ_SIM_TICK_BUDGET;
 
     status = (int32_t)icoac_config_check(&su->cfg);
+    /* the engine's plant is the cart-pole: a task of another input count is a bad argument */
+    if (status == ICOAC_OK && su->cfg.task.n_inputs != ICOAC_CARTPOLE_INPUTS) {
+        status = ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
     if (status != ICOAC_OK) {
         su->failing[su->n_failing++] = status;
     }
@@ -195,7 +199,7 @@ static void decode_setup(fz_reader_t *r, setup_t *su)
         su->failing[su->n_failing] = status;
         su->run_failing = 1;
     }
-    su->prior_status = su->prior != 0 ? (int32_t)icoac_prior_check(su->prior) : ICOAC_OK;
+    su->prior_status = su->prior != 0 ? (int32_t)icoac_prior_check(su->prior, ICOAC_CARTPOLE_INPUTS) : ICOAC_OK;
 }
 
 /* A call refused by the checks returns one of the failing checks' statuses. */

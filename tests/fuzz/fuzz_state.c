@@ -23,17 +23,18 @@
  *   B       byte f: f & 1 header word ICOAC_PRIV_STATE_ENDED, else ICOAC_PRIV_STATE_MAGIC. f & 2:
  *           sizeof(icoac_state_t) raw bytes over the whole state (fewer when the input ends: the
  *           rest stays as the warm-up left it); else (f >> 2) patches. Then the header word.
- *   patch   byte p % 39. 0-35 a named field of icoac_state.h (table state_fields below, in
+ *   patch   byte p % 46. 0-42 a named field of icoac_state.h (table state_fields below, in
  *           layout order; gen_corpus.py mirrors it), an element byte (% the field's element
  *           count), then the value: int32 / uint32 as an int32 switch, uint8
- *           a byte, uint64 8 bytes, real a real value (fuzz_controller.c). 36: the header word
- *           (a byte: odd ENDED, even MAGIC). 37: a config section over the configuration copy.
- *           38: raw bytes: offset (2 bytes, little endian, % sizeof(icoac_state_t)), length byte
+ *           a byte, uint64 8 bytes, real a real value (fuzz_controller.c). 43: the header word
+ *           (a byte: odd ENDED, even MAGIC). 44: a config section over the configuration copy.
+ *           45: raw bytes: offset (2 bytes, little endian, % sizeof(icoac_state_t)), length byte
  *           n, n bytes (clipped at the state's end); the header word is kept.
  *   ops     until the input ends, at most FZ_STATE_MAX_OPS ops and FZ_STATE_MAX_STEPS ticks.
  *           Op byte o, o % 8: 0 tick, 1 terminal tick (ICOAC_INPUT_TERMINAL), each run
- *           ((o >> 3) & 7) + 1 times, on the previous s when o & 0x40, else 4 real values
- *           follow; 2 icoac_reset; 3 icoac_retune with a config section laid over the state's
+ *           ((o >> 3) & 7) + 1 times, on the previous s when o & 0x40, else n real values
+ *           follow (n: the setup's task.n_inputs); o & 0x80: ICOAC_INPUT_LATE, and a real value
+ *           for in.reflex follows; 2 icoac_reset; 3 icoac_retune with a config section laid over the state's
  *           configuration (icoac_get_config; o & 0x08 set: over the setup configuration
  *           instead); 4 icoac_retune with the setup configuration (valid); 5 icoac_get_posterior,
  *           icoac_get_counters and icoac_get_config; 6 a config section over the configuration
@@ -88,7 +89,7 @@
 
 #define FZ_STATE_MAX_OPS 512
 #define FZ_STATE_MAX_STEPS 2048
-#define N ICOAC_N_INPUTS
+#define N ICOAC_MAX_INPUTS /* the library's vectors; a task uses the first task.n_inputs */
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -118,6 +119,9 @@ typedef struct {
 
 static const state_field_t state_fields[] = {
     FZ_FIELD("has_prev", has_prev, 4, 'i'),
+    FZ_FIELD("grid.n", grid.n, 1, 'b'),
+    FZ_FIELD("grid.split", grid.split, 1, 'b'),
+    FZ_FIELD("grid.units", grid.units, 1, 'b'),
     FZ_FIELD("inv_range", inv_range, R, 'r'),
     FZ_FIELD("w", w, R, 'r'),
     FZ_FIELD("weight_norm", weight_norm, R, 'r'),
@@ -135,14 +139,18 @@ static const state_field_t state_fields[] = {
     FZ_FIELD("rng.has_spare", rng.has_spare, 4, 'i'),
     FZ_FIELD("counters", counters, 4, 'u'),
     FZ_FIELD("cov_buffer", cov_buffer, R, 'r'),
-    FZ_ACTIVE("active.sparse.pair_product", sparse.pair_product, R, 'r'),
+    FZ_ACTIVE("active.sparse.row_product", sparse.row_product, R, 'r'),
     FZ_ACTIVE("active.sparse.cell_product", sparse.cell_product, R, 'r'),
-    FZ_ACTIVE("active.sparse.pair_cells", sparse.pair_cells, 1, 'b'),
+    FZ_ACTIVE("active.sparse.row_cells", sparse.row_cells, 1, 'b'),
     FZ_ACTIVE("active.sparse.cell", sparse.cell, 1, 'b'),
     FZ_ACTIVE("active.sparse.cells", sparse.cells, 1, 'b'),
+    FZ_ACTIVE("active.sparse.rows", sparse.rows, 1, 'b'),
+    FZ_ACTIVE("active.sparse.stride", sparse.stride, 1, 'b'),
     FZ_ACTIVE("active.dense.cell_product", dense.cell_product, R, 'r'),
     FZ_ACTIVE("active.dense.cell_begin", dense.cell_begin, 1, 'b'),
     FZ_ACTIVE("active.dense.cell_end", dense.cell_end, 1, 'b'),
+    FZ_ACTIVE("active.dense.rows", dense.rows, 1, 'b'),
+    FZ_ACTIVE("active.dense.stride", dense.stride, 1, 'b'),
     FZ_FIELD("v", v, R, 'r'),
     FZ_FIELD("batch.info", batch.info, R, 'r'),
     FZ_FIELD("batch.shift", batch.shift, R, 'r'),
@@ -160,7 +168,13 @@ static const state_field_t state_fields[] = {
 #define FZ_PATCH_CONFIG (FZ_STATE_FIELDS + 1)
 #define FZ_PATCH_RAW (FZ_STATE_FIELDS + 2)
 #define FZ_PATCH_KINDS (FZ_STATE_FIELDS + 3)
-ICOAC_STATIC_ASSERT(sizeof state_fields / sizeof state_fields[0] == 36, fz_state_field_count);
+ICOAC_STATIC_ASSERT(sizeof state_fields / sizeof state_fields[0] == 43, fz_state_field_count);
+
+/* The task's inputs as the library bounds the copy's n_inputs (whatever the copy holds). */
+static int inputs_of(const icoac_config_t *cfg)
+{
+    return (uint32_t)cfg->task.n_inputs <= (uint32_t)N ? (int)cfg->task.n_inputs : N;
+}
 
 /* ---- one input's objects: heap blocks of their exact size ---- */
 
@@ -339,7 +353,11 @@ static int32_t check_step(run_t *run)
     const icoac_priv_state_t *st = st_of(run);
     const icoac_priv_state_t *was = icoac_priv_state_c(&before);
     const int terminal = (run->in->flags & ICOAC_INPUT_TERMINAL) != 0u;
-    const int finite_in = fz_all_finite(run->in->s, N);
+    /* what the tick reads: the copy's n inputs, and a sensor's reflex on a late tick */
+    const icoac_config_t *copy = &st->config;
+    const int finite_in = fz_all_finite(run->in->s, inputs_of(copy)) &&
+                          (copy->task.late_source == ICOAC_LATE_RULES || (run->in->flags & ICOAC_INPUT_LATE) == 0u ||
+                           isfinite(run->in->reflex));
     int32_t status;
     int ended;
     memcpy(&before, run->state, sizeof before);
@@ -426,7 +444,7 @@ static const char *must_refuse(const icoac_priv_state_t *st)
         !fz_all_finite(&st->search.lower[0][0], N * N)) {
         return "search count or factor";
     }
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < inputs_of(&st->config); ++i) {
         if (!(st->search.prior_var[i] > ICOAC_R(0.0)) || !isfinite(st->search.prior_var[i])) {
             return "search prior variance";
         }
@@ -480,7 +498,8 @@ static int32_t check_reset(run_t *run)
                  memcmp(st->search.lower, was->search.lower, sizeof st->search.lower) == 0,
              "op %d: icoac_reset OK changed a learned value or the counters", run->op);
     for (i = 0; i < N; ++i) {
-        const icoac_real_t inv = ICOAC_R(1.0) / st->config.policy.input_range[i];
+        const icoac_real_t inv =
+            i < st->config.task.n_inputs ? ICOAC_R(1.0) / st->config.policy.input_range[i] : ICOAC_R(0.0);
         FZ_CHECK(memcmp(&st->inv_range[i], &inv, sizeof inv) == 0, "op %d: icoac_reset: inv_range[%d] = %g, 1/%g",
                  run->op, i, (double)st->inv_range[i], (double)st->config.policy.input_range[i]);
     }
@@ -502,8 +521,10 @@ static void check_retune(run_t *run, const icoac_config_t *next)
     if (config_status != ICOAC_OK) {
         FZ_CHECK(status == config_status, "op %d: icoac_retune returned %d, icoac_config_check %d", run->op,
                  (int)status, (int)config_status);
-    } else if (next->mode != was->config.mode) {
-        FZ_CHECK(status == ICOAC_ERR_RETUNE_MODE, "op %d: icoac_retune from mode %d to %d returned %d (%s)", run->op,
+    } else if (next->mode != was->config.mode || next->task.n_inputs != was->config.task.n_inputs ||
+               memcmp(next->critic.units, was->config.critic.units, sizeof next->critic.units) != 0) {
+        FZ_CHECK(status == ICOAC_ERR_RETUNE_MODE,
+                 "op %d: icoac_retune from mode %d to %d (or of the inputs or critic grid) returned %d (%s)", run->op,
                  (int)was->config.mode, (int)next->mode, (int)status, status_name(status));
     } else {
         FZ_CHECK(status == ICOAC_OK, "op %d: icoac_retune of a valid configuration of mode %d returned %d (%s)",
@@ -517,7 +538,7 @@ static void check_retune(run_t *run, const icoac_config_t *next)
     FZ_CHECK(icoac_get_config(run->state, run->got) == ICOAC_OK && fz_config_equal(run->got, next),
              "op %d: icoac_get_config after icoac_retune is not the new configuration", run->op);
     for (i = 0; i < N; ++i) {
-        const icoac_real_t inv = ICOAC_R(1.0) / next->policy.input_range[i];
+        const icoac_real_t inv = i < next->task.n_inputs ? ICOAC_R(1.0) / next->policy.input_range[i] : ICOAC_R(0.0);
         FZ_CHECK(same_real(st->inv_range[i], inv), "op %d: icoac_retune: inv_range[%d] = %g, 1/%g", run->op, i,
                  (double)st->inv_range[i], (double)next->policy.input_range[i]);
         if (next->mode == ICOAC_MODE_SEARCH) {
@@ -530,6 +551,7 @@ static void check_retune(run_t *run, const icoac_config_t *next)
     memcpy(&ex->config, &st->config, sizeof ex->config);
     memcpy(ex->inv_range, st->inv_range, sizeof ex->inv_range);
     memcpy(ex->search.floor, st->search.floor, sizeof ex->search.floor);
+    memcpy(&ex->grid, &st->grid, sizeof ex->grid); /* derived again from the same grid and mode */
     FZ_CHECK(memcmp(&expect, run->state, sizeof expect) == 0,
              "op %d: icoac_retune changed more than the configuration and what it derives", run->op);
 }
@@ -637,11 +659,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             case 1: {
                 int repeat;
                 if ((op & 0x40u) == 0u) {
-                    for (i = 0; i < N; ++i) {
+                    /* the setup task's n inputs (the rest keep their values) */
+                    for (i = 0; i < inputs_of(&run.setup); ++i) {
                         run.in->s[i] = fz_real(&r);
                     }
                 }
-                run.in->flags = (op % 8) == 1 ? ICOAC_INPUT_TERMINAL : 0u;
+                if (op & 0x80u) {
+                    run.in->reflex = fz_real(&r);
+                }
+                run.in->flags = ((op % 8) == 1 ? ICOAC_INPUT_TERMINAL : 0u) | ((op & 0x80u) ? ICOAC_INPUT_LATE : 0u);
                 for (repeat = ((op >> 3) & 7) + 1; repeat > 0 && steps < FZ_STATE_MAX_STEPS; --repeat, ++steps) {
                     (void)check_step(&run);
                 }

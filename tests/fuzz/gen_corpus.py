@@ -28,23 +28,27 @@ BOUNDED_SCALES = [1e-3, 1e-2, 0.1, 1.0, 3.0, 10.0, 100.0, 1e4]
 INT32_TABLE = [0, 1, 2, -1, 2**31 - 1, -2**31, 3]
 INT64_TABLE = [0, 1, 2, 3, -1, 300, 1000, 100000, 2**63 - 1, -2**63, 10]
 
-# icoac_config_t (icoac.h), one group per concern: (member, kind) with kind "i" an int32
-# (switch or count), "r" an icoac_real_t, "r4" an icoac_real_t[4], or a nested group.
+# icoac_config_t (icoac.h) with the default maxima (6 inputs, 6 rules), one group per concern:
+# (member, kind) with kind "i" an int32 (switch or count), "r" an icoac_real_t, "r6" / "i6" an
+# array of 6 of them, or a nested group.
+MAX_INPUTS = 6
 CONFIG_LAYOUT = [
     ("mode", "i"),
     ("learn", "i"),
-    ("policy", [("input_range", "r4"), ("clip_inputs", "i"), ("gain", "r"), ("reflex_mode", "i"),
-                ("reflex_force", "r"), ("zone_theta", "r"), ("zone_x", "r")]),
+    ("task", [("n_inputs", "i"), ("late_source", "i"), ("n_rules", "i"), ("rule_input", "i6"), ("rule_side", "i6"),
+              ("rule_threshold", "r6"), ("rule_reflex", "r6")]),
+    ("policy", [("input_range", "r6"), ("clip_inputs", "i"), ("gain", "r"), ("reflex_mode", "i"),
+                ("reflex_force", "r")]),
     ("ico", [("rate", "r"), ("timing", "i")]),
-    ("critic", [("rate", "r"), ("discount", "r"), ("td_clip", "r"), ("range", "r4"), ("threshold", "r"),
-                ("quirks", "i")]),
+    ("critic", [("rate", "r"), ("discount", "r"), ("td_clip", "r"), ("range", "r6"), ("units", "i6"),
+                ("threshold", "r"), ("quirks", "i")]),
     ("actor", [("noise_std", "r"), ("scale", "r"), ("forgetting", "r"), ("reflex", "i"),
                ("act_with_sample", "i"), ("update", "i"), ("rate", "r"), ("likelihood_std", "r"),
                ("batch", "i"), ("explore_ticks", "i")]),
     ("search", [("batch", "i"), ("elite_fraction", "r"), ("step", "r"), ("floor", "r"), ("cov_scale", "r")]),
 ]
 # sizeof(icoac_config_t) with float and with double reals (x86-64 and AArch64 alignment).
-CONFIG_SIZES = {"f": 152, "d": 280}
+CONFIG_SIZES = {"f": 292, "d": 480}
 
 
 def config_fields():
@@ -55,8 +59,8 @@ def config_fields():
         for name, kind in members:
             if isinstance(kind, list):
                 walk(kind, prefix + name + ".")
-            elif kind == "r4":
-                out.extend((f"{prefix}{name}[{i}]", False) for i in range(4))
+            elif kind in ("r6", "i6"):
+                out.extend((f"{prefix}{name}[{i}]", kind == "i6") for i in range(6))
             else:
                 out.append((prefix + name, kind == "i"))
 
@@ -67,17 +71,27 @@ def config_fields():
 # The mutation field indices of fuzz_input.c: struct order.
 CONFIG_FIELDS = [name for name, _ in config_fields()]
 CONFIG_INTS = {name for name, is_int in config_fields() if is_int}
-assert len(CONFIG_FIELDS) == 38
+assert len(CONFIG_FIELDS) == 73
+ZONE_THETA, ZONE_X = 0.20071286397934788, 2.35
+
+
+def array(name, values):
+    """{name[i]: values[i]} over the 6 entries (0 past the values)."""
+    return {f"{name}[{i}]": (values[i] if i < len(values) else 0) for i in range(MAX_INPUTS)}
+
+
 CONFIG_DEFAULT = {"mode": 0, "learn": 1,
-                  "policy.input_range[0]": 2.4, "policy.input_range[1]": 3.5,
-                  "policy.input_range[2]": 0.2094384, "policy.input_range[3]": 2.0,
+                  "task.n_inputs": 4, "task.late_source": 0, "task.n_rules": 4,
+                  **array("task.rule_input", [2, 0, 2, 0]), **array("task.rule_side", [1, 0, 0, 1]),
+                  **array("task.rule_threshold", [ZONE_THETA, -ZONE_X, -ZONE_THETA, ZONE_X]),
+                  **array("task.rule_reflex", [1.0, 1.0, -1.0, -1.0]),
+                  **array("policy.input_range", [2.4, 3.5, 0.2094384, 2.0]),
                   "policy.clip_inputs": 1, "policy.gain": 10.0, "policy.reflex_mode": 0,
-                  "policy.reflex_force": 1.0, "policy.zone_theta": 0.20071286397934788,
-                  "policy.zone_x": 2.35,
+                  "policy.reflex_force": 1.0,
                   "ico.rate": 1.0e-4, "ico.timing": 0,
                   "critic.rate": 0.6, "critic.discount": 0.95, "critic.td_clip": 1.0,
-                  "critic.range[0]": 2.4, "critic.range[1]": 3.5, "critic.range[2]": 0.2094384,
-                  "critic.range[3]": 2.0, "critic.threshold": 0.001, "critic.quirks": 0,
+                  **array("critic.range", [2.4, 3.5, 0.2094384, 2.0]), **array("critic.units", [3, 3, 6, 3]),
+                  "critic.threshold": 0.001, "critic.quirks": 0,
                   "actor.noise_std": 1.0, "actor.scale": 0.5, "actor.forgetting": 1.0,
                   "actor.reflex": 1, "actor.act_with_sample": 0, "actor.update": 2, "actor.rate": 0.01,
                   "actor.likelihood_std": 0.0, "actor.batch": 0, "actor.explore_ticks": 1000,
@@ -103,11 +117,11 @@ def config_offsets(fmt):
                 offset += size
                 align = max(align, sub_align)
                 continue
-            size, code = (4, "i") if kind == "i" else (real, fmt)
+            size, code = (4, "i") if kind in ("i", "i6") else (real, fmt)
             offset = -(-offset // size) * size
-            if kind == "r4":
-                fields.update({f"{name}[{i}]": (offset + i * size, code) for i in range(4)})
-                offset += 4 * size
+            if kind in ("r6", "i6"):
+                fields.update({f"{name}[{i}]": (offset + i * size, code) for i in range(6)})
+                offset += 6 * size
             else:
                 fields[name] = (offset, code)
                 offset += size
@@ -196,7 +210,7 @@ def prior(*mutations, fmt="f"):
     for m in mutations:
         field, v = m[0], m[1]
         mirror = len(m) > 2 and m[2]
-        index = int(field[4:]) if isinstance(field, str) else 4 + 4 * field[0] + field[1]
+        index = int(field[4:]) if isinstance(field, str) else MAX_INPUTS * (1 + field[0]) + field[1]
         out += bytes([index | (0x80 if mirror else 0)]) + real(v, fmt)
     return out
 
@@ -208,11 +222,14 @@ def seed(n):
     return struct.pack("<Q", n)
 
 
-def step(s=None, repeat=1, terminal=False):
-    """repeat (1..8) controller steps on s (4 values), or on the previous s when None."""
+def step(s=None, repeat=1, terminal=False, late=False, reflex=None):
+    """repeat (1..8) controller steps on s (the task's n values), or on the previous s when None;
+    late: ICOAC_INPUT_LATE; reflex: a value for in.reflex."""
     assert 1 <= repeat <= 8
-    op = (2 if terminal else 0) | ((repeat - 1) << 2) | (0x20 if s is None else 0)
-    return bytes([op]) + (b"".join(real(x) for x in s) if s is not None else b"")
+    op = ((2 if terminal else 0) | ((repeat - 1) << 2) | (0x20 if s is None else 0) | (0x40 if late else 0)
+          | (0x80 if reflex is not None else 0))
+    return (bytes([op]) + (b"".join(real(x) for x in s) if s is not None else b"")
+            + (real(reflex) if reflex is not None else b""))
 
 
 def steps(s, n, terminal=False):
@@ -390,6 +407,52 @@ def controller_seeds(fmt):
         "config-raw-retune": (config_raw(fmt, {**rl, "actor.noise_std": 0.5}) + NO_PRIOR + seed(50) + EXERCISE
                               + bytes([0x43]) + config_raw(fmt, {**rl, "actor.update": 1}) + EXERCISE),
     }
+    # Task descriptions (icoac.h, task): six inputs with a 3x3x3x2x2x2 critic and a rule on each
+    # position's two sides; one input; a sensor's late signal; random rule tables.
+    six = {"task.n_inputs": 6, "task.n_rules": 6, **array("task.rule_input", [0, 0, 1, 1, 2, 2]),
+           **array("task.rule_side", [1, 0, 1, 0, 1, 0]),
+           **array("task.rule_threshold", [2.35, -2.35, 0.3, -0.3, 0.3, -0.3]),
+           **array("task.rule_reflex", [-1.0, 1.0, 1.0, -1.0, 0.5, -0.5]),
+           **array("policy.input_range", [2.4, 0.35, 0.35, 3.5, 2.0, 2.0]),
+           **array("critic.range", [2.4, 0.35, 0.35, 3.5, 2.0, 2.0]), **array("critic.units", [3, 3, 3, 2, 2, 2])}
+    six_s = [(0.1 * k, 0.05 * k, -0.04 * k, 0.3, -0.2 * k, 0.1) for k in range(4)]
+    six_exercise = (b"".join(steps(x, 3) for x in six_s) + step((2.5, 0.4, 0.0, 1.0, 0.0, 0.0), terminal=True)
+                    + RESET + steps((-0.2, -0.31, 0.2, 0.0, 1.0, -1.0), 4) + step(("0", "nan", "0", "0", "0", "0")))
+    one = {"task.n_inputs": 1, "task.n_rules": 2, **array("task.rule_input", [0, 0]),
+           **array("task.rule_side", [1, 0]), **array("task.rule_threshold", [0.5, -0.5]),
+           **array("task.rule_reflex", [-1.0, 1.0]), **array("critic.units", [7])}
+    sensor_ops = (steps((0.1, 0.0, 0.01, 0.0), 3) + step((0.2, 0.0, 0.3, 0.0), late=True, reflex=1.0)
+                  + step(None, late=True, reflex=-0.25) + step(None, late=True, reflex=2.0) + step(None, late=False)
+                  + step(None, late=True, reflex="nan") + step(None, late=True, reflex="-inf")
+                  + step((0.2, 0.0, 0.3, 0.0), terminal=True, late=True, reflex=1.0) + RESET + EXERCISE)
+    for mode, name in ((0, "ico"), (1, "rl"), (2, "search")):
+        s[f"task-six-inputs-{name}"] = (config_raw(fmt, {**six, "mode": mode, "search.batch": 2}) + NO_PRIOR
+                                        + seed(60 + mode) + six_exercise * 2)
+        s[f"task-one-input-{name}"] = (config_raw(fmt, {**one, "mode": mode, "search.batch": 2}) + NO_PRIOR
+                                       + seed(63 + mode) + steps((0.1,), 3) + steps((0.6,), 2)
+                                       + step((-0.7,), terminal=True) + RESET + steps(("nan",), 1)
+                                       + steps((-0.2,), 4))
+        s[f"task-sensor-{name}"] = (config({"mode": mode, "task.late_source": 1, "search.batch": 2}) + NO_PRIOR
+                                    + seed(66 + mode) + sensor_ops)
+    rules = random.Random(20261202)
+    for k in range(6):
+        n_rules = rules.randrange(7)
+        table = {"task.n_rules": n_rules}
+        table.update(array("task.rule_input", [rules.randrange(4) for _ in range(6)]))
+        table.update(array("task.rule_side", [rules.randrange(2) for _ in range(6)]))
+        table.update(array("task.rule_threshold", [round(rules.uniform(-3, 3), 3) for _ in range(6)]))
+        table.update(array("task.rule_reflex", [rules.choice([-1.0, -0.5, 0.0, 0.5, 1.0]) for _ in range(6)]))
+        s[f"task-random-rules-{k}"] = (config_raw(fmt, {**table, "mode": k % 3, "search.batch": 2}) + NO_PRIOR
+                                       + seed(70 + k) + EXERCISE + EXERCISE)
+    s.update({
+        "task-bad-rule-input": config({"task.rule_input[2]": 4}) + NO_PRIOR + seed(80) + EXERCISE,
+        "task-bad-units": config({"mode": 1, "critic.units[0]": 16, "critic.units[1]": 16}) + NO_PRIOR + seed(81),
+        "task-retune-inputs-and-grid": (config({"mode": 1}) + NO_PRIOR + seed(82) + EXERCISE
+                                        + retune({"task.n_inputs": 3}) + retune({"critic.units[2]": 5})
+                                        + retune({"task.rule_threshold[0]": 0.1, "task.late_source": 1}) + EXERCISE),
+        "task-six-inputs-prior": (config_raw(fmt, {**six, "mode": 1}) + prior(("mean5", 2.0), ((5, 4), 0.3, True))
+                                  + seed(83) + six_exercise),
+    })
     for mode, name in ((0, "ico"), (1, "rl"), (2, "search")):
         # the same terminal tick again and again: one trial recorded, then refused until reset
         s[f"{name}-terminal-repeated"] = (config({"mode": mode, "search.batch": 2}) + NO_PRIOR + seed(51 + mode)
@@ -420,20 +483,21 @@ def controller_seeds(fmt):
 # The named fields of icoac_priv_state_t a patch sets (state_fields in fuzz_state.c, in its
 # order): (name, kind) with kind "i" int32, "u" uint32, "b" uint8, "q" uint64, "r" real.
 STATE_FIELDS = [
-    ("has_prev", "i"), ("inv_range", "r"), ("w", "r"), ("weight_norm", "r"), ("w_act", "r"), ("cov_slot", "i"),
+    ("has_prev", "i"), ("grid.n", "b"), ("grid.split", "b"), ("grid.units", "b"), ("inv_range", "r"), ("w", "r"), ("weight_norm", "r"), ("w_act", "r"), ("cov_slot", "i"),
     ("active_slot", "i"), ("x_prev", "r"), ("penalty_prev", "r"), ("value_prev", "r"), ("noise_prev", "r"),
     ("trial_ticks", "u"), ("rng.state", "q"), ("rng.increment", "q"), ("rng.spare_normal", "r"),
-    ("rng.has_spare", "i"), ("counters", "u"), ("cov_buffer", "r"), ("active.sparse.pair_product", "r"),
-    ("active.sparse.cell_product", "r"), ("active.sparse.pair_cells", "b"), ("active.sparse.cell", "b"),
-    ("active.sparse.cells", "b"), ("active.dense.cell_product", "r"), ("active.dense.cell_begin", "b"),
-    ("active.dense.cell_end", "b"), ("v", "r"), ("batch.info", "r"), ("batch.shift", "r"),
+    ("rng.has_spare", "i"), ("counters", "u"), ("cov_buffer", "r"), ("active.sparse.row_product", "r"),
+    ("active.sparse.cell_product", "r"), ("active.sparse.row_cells", "b"), ("active.sparse.cell", "b"),
+    ("active.sparse.cells", "b"), ("active.sparse.rows", "b"), ("active.sparse.stride", "b"),
+    ("active.dense.cell_product", "r"), ("active.dense.cell_begin", "b"), ("active.dense.cell_end", "b"),
+    ("active.dense.rows", "b"), ("active.dense.stride", "b"), ("v", "r"), ("batch.info", "r"), ("batch.shift", "r"),
     ("batch.staged_shift", "r"), ("search.w", "r"), ("search.ticks", "u"), ("search.lower", "r"),
     ("search.floor", "r"), ("search.prior_var", "r"), ("search.count", "i"),
 ]
 STATE_FIELD_NAMES = [name for name, _ in STATE_FIELDS]
 PATCH_HEADER, PATCH_CONFIG, PATCH_RAW = len(STATE_FIELDS), len(STATE_FIELDS) + 1, len(STATE_FIELDS) + 2
 # sizeof(icoac_state_t) with float and with double reals (ICOAC_STATE_SIZE).
-STATE_SIZES = {"f": 2048, "d": 4096}
+STATE_SIZES = {"f": 3328, "d": 6144}
 
 
 def patch(field, v, index=0, fmt="f"):
@@ -564,12 +628,23 @@ def state_seeds(fmt):
                                                     "search.batch": 0}, fmt=fmt, init_fields={"search.batch": 2})
                                      + trials(4, 3) + STATE_EXERCISE),
         "rl-actor-update-9": raw_config(1, {"actor.update": 9}, fmt=fmt) + ticks(ZERO, 3) + STATE_EXERCISE,
+        # the task in the copy: its input count, rules and critic geometry hold anything
+        "task-copy-corrupt": (raw_config(1, {"task.n_inputs": 200, "task.n_rules": -3, "task.rule_input[0]": 99,
+                                             "critic.units[1]": 40, "task.late_source": 5}, fmt=fmt)
+                              + ticks(ZERO, 4) + S_RESET + STATE_EXERCISE),
+        "task-grid-corrupt": (raw_state(1, [patch("grid.n", 255), patch("grid.split", 9), patch("grid.units", 200, 0),
+                                            patch("grid.units", 0, 3), patch("active.sparse.rows", 200, 0),
+                                            patch("active.sparse.stride", 200, 1), patch("active.dense.rows", 255, 0),
+                                            patch("active.dense.stride", 255, 1)], fmt=fmt) + ticks(ZERO, 4)
+                              + STATE_EXERCISE),
+        "task-sensor-copy": (raw_config(0, {"task.late_source": 1}, fmt=fmt) + ticks(ZERO, 2)
+                             + bytes([0x80]) + real(1.0) + bytes([0x80]) + real("nan") + STATE_EXERCISE),
         "rl-actor-update-9-batch": (raw_config(1, {"actor.update": 9}, fmt=fmt, init_fields={"actor.batch": 1})
                                     + ticks(ZERO, 3) + tick(FAIL, terminal=True) + STATE_EXERCISE),
         "rl-explore-negative": (raw_config(1, {"actor.explore_ticks": -1}, fmt=fmt) + ticks(ZERO, 4)
                                 + s_patch(patch("trial_ticks", 2**32 - 1)) + ticks(ZERO, 3) + STATE_EXERCISE),
         # the kept-unit lists of both critic kernels, and the slots, hold anything
-        "rl-kept-units-corrupt": (raw_state(1, [patch("active.sparse.pair_cells", 255, i) for i in range(18)]
+        "rl-kept-units-corrupt": (raw_state(1, [patch("active.sparse.row_cells", 255, i) for i in range(18)]
                                             + [patch("active.sparse.cell", 255, i) for i in range(0, 62, 5)]
                                             + [patch("active.sparse.cells", 255, 0), patch("active.sparse.cells", 255, 1),
                                                patch("active.dense.cell_begin", 0, 0), patch("active.dense.cell_end", 255, 0),
@@ -580,7 +655,7 @@ def state_seeds(fmt):
                                                   patch("active.dense.cell_end", 3, 0),
                                                   patch("active.dense.cell_begin", 17, 1),
                                                   patch("active.dense.cell_end", 18, 1)], fmt=fmt) + ticks(ZERO, 3)),
-        "rl-sparse-products-nan": (raw_state(1, [patch("active.sparse.pair_product", "nan", i) for i in range(18)]
+        "rl-sparse-products-nan": (raw_state(1, [patch("active.sparse.row_product", "nan", i) for i in range(18)]
                                              + [patch("active.sparse.cell_product", "inf", i) for i in range(0, 62, 7)],
                                              fmt=fmt) + ticks(ZERO, 3) + STATE_EXERCISE),
         "rl-learned-nonfinite": (raw_state(1, [patch("w", "nan", 1), patch("weight_norm", "inf"),
@@ -742,8 +817,11 @@ def sim_seeds():
         "repro-plant-dt-1e-310": plant(dt="1e-310") + run() + config() + NO_PRIOR + SIM_OPS,
         # Found by fuzzing the fixed engine: float subnormals in the configuration or prior are
         # checked as given, then flushed to 0 in the run (FTZ/DAZ), so the verdicts differ.
-        "repro-config-zone-theta-1e-39": (plant() + run() + config({"policy.zone_theta": "1e-39"}) + NO_PRIOR
+        "repro-config-zone-theta-1e-39": (plant() + run() + config({"task.rule_threshold[0]": "1e-39"}) + NO_PRIOR
                                           + SIM_OPS),
+        # the engine's plant is the cart-pole: a task of another size is refused
+        "task-six-inputs": (plant() + run() + config({"task.n_inputs": 6, "policy.input_range[4]": 1.0,
+                                                      "policy.input_range[5]": 1.0}) + NO_PRIOR + SIM_OPS),
         "repro-prior-cov-diag-1e-39": plant() + run() + config() + prior(((0, 0), "1e-39")) + SIM_OPS,
         "repro-prior-cov-asymmetric-1e-39": plant() + run() + config() + prior(((3, 0), "-1e-39")) + SIM_OPS,
     }

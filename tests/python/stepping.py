@@ -52,7 +52,8 @@ def tick(cfg, state, s, terminal=False, expect=B.OK):
 def posterior(state):
     """(mu_w, Sigma_w) as float64 arrays."""
     post = B.get_posterior(state)
-    return np.array(post.mean, dtype=float), np.array([list(r) for r in post.cov], dtype=float)
+    n = B.N_INPUTS  # the cart-pole task's weights: the leading entries
+    return np.array(post.mean[:n], dtype=float), np.array([list(r)[:n] for r in post.cov[:n]], dtype=float)
 
 
 def likelihood_var(cfg):
@@ -71,7 +72,7 @@ def stored(s):
 def scaled(cfg, s):
     """x~ = clip(s / input_range, -1, 1), in the real type like the library (s * (1 / range))."""
     c = cfg.controller.policy
-    inv = (REAL(1.0) / np.array(c.input_range, dtype=REAL)).astype(REAL)
+    inv = (REAL(1.0) / np.array(c.input_range[:B.N_INPUTS], dtype=REAL)).astype(REAL)
     x = (np.asarray(s, dtype=float).astype(REAL) * inv).astype(float)
     return np.clip(x, -1.0, 1.0) if c.clip_inputs else x
 

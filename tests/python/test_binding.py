@@ -58,7 +58,7 @@ def test_state_is_opaque_aligned_storage():
 
 
 def test_abi_versions():
-    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 7
+    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 8
     assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 2
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
@@ -86,20 +86,21 @@ def test_every_mirror_matches_the_c_field_table():
 
 class _WrongPolicy(ctypes.Structure):
     """icoac_policy_config_t with gain and clip_inputs swapped: same fields and size, wrong offsets."""
-    _fields_ = [("input_range", B.c_real * B.N_INPUTS), ("gain", B.c_real), ("clip_inputs", ctypes.c_int32),
-                ("reflex_mode", ctypes.c_int32), ("reflex_force", B.c_real), ("zone_theta", B.c_real),
-                ("zone_x", B.c_real)]
+    _fields_ = [("input_range", B.c_real * B.MAX_INPUTS), ("gain", B.c_real), ("clip_inputs", ctypes.c_int32),
+                ("reflex_mode", ctypes.c_int32), ("reflex_force", B.c_real)]
 
 
 class _WrongConfig(ctypes.Structure):
-    _fields_ = [("mode", ctypes.c_int32), ("learn", ctypes.c_int32), ("policy", _WrongPolicy), ("ico", B.IcoConfig),
+    _fields_ = [("mode", ctypes.c_int32), ("learn", ctypes.c_int32), ("task", B.TaskConfig), ("policy", _WrongPolicy),
+                ("ico", B.IcoConfig),
                 ("critic", B.CriticConfig), ("actor", B.ActorConfig), ("search", B.SearchConfig)]
 
 
 def test_field_check_catches_a_wrong_offset():
     assert ctypes.sizeof(_WrongConfig) == ctypes.sizeof(B.Config)
-    with pytest.raises(LibraryError, match=r"icoac_config_t\.policy\.clip_inputs: C offset 24 size 4, "
-                                           r"binding offset 28"):
+    offset = B.FIELDS["icoac_config_t"]["policy.clip_inputs"][0]
+    with pytest.raises(LibraryError, match=rf"icoac_config_t\.policy\.clip_inputs: C offset {offset} size 4, "
+                                           rf"binding offset {offset + 4}"):
         B.check_mirror("icoac_config_t", _WrongConfig, c_size=B.lib.icoac_sizeof_config())
     B.check_mirror("icoac_config_t", B.Config, c_size=B.lib.icoac_sizeof_config())
 
@@ -170,7 +171,10 @@ def test_counters_and_posterior_accessors():
     counters = B.get_counters(state)
     assert (counters.ticks, counters.nonfinite, counters.numeric_faults) == (3, 1, 0)
     post = B.get_posterior(state)
-    assert list(post.mean) == [0.0] * 4 and [list(r) for r in post.cov] == np.eye(4).tolist()
+    # the cart-pole task's 4 x 4 block (N(0, I) without a prior), 0 past it
+    eye = np.zeros((B.MAX_INPUTS, B.MAX_INPUTS))
+    eye[:4, :4] = np.eye(4)
+    assert list(post.mean) == [0.0] * B.MAX_INPUTS and [list(r) for r in post.cov] == eye.tolist()
 
 
 def test_cell_dtype_offsets():
@@ -184,16 +188,21 @@ def test_cell_dtype_offsets():
 def test_config_defaults_match_spec():
     d = build_config().to_dict()
     c, p, r = d["controller"], d["plant"], d["run"]
-    assert set(c) == {"mode", "learn", "policy", "ico", "critic", "actor", "search"}
+    assert set(c) == {"mode", "learn", "task", "policy", "ico", "critic", "actor", "search"}
     assert c["learn"] is True
     pol, ico, cri, act, sea = c["policy"], c["ico"], c["critic"], c["actor"], c["search"]
     assert c["mode"] == "ico" and pol["reflex_mode"] == "unit" and ico["timing"] == "code"
     assert pol["gain"] == 10.0
     assert pol["reflex_force"] == 1.0
     assert ico["rate"] == pytest.approx(1e-4)
-    assert pol["input_range"] == pytest.approx([2.4, 3.5, 0.2094384, 2.0])
-    assert pol["zone_theta"] == pytest.approx(math.radians(11.5), rel=1e-6)
-    assert pol["zone_x"] == pytest.approx(2.35)
+    assert pol["input_range"] == pytest.approx([2.4, 3.5, 0.2094384, 2.0] + [0.0] * (B.MAX_INPUTS - 4))
+    task = c["task"]  # the cart-pole task: Eq. (4)'s zone as four rules, the first match wins
+    assert task["n_inputs"] == 4 and task["late_source"] == "rules" and task["n_rules"] == 4
+    assert task["rule_input"][:4] == [2, 0, 2, 0] and task["rule_side"][:4] == ["above", "below", "below", "above"]
+    z, x = math.radians(11.5), 2.35
+    assert task["rule_threshold"][:4] == pytest.approx([z, -x, -z, x], rel=1e-6)
+    assert task["rule_reflex"][:4] == [1.0, 1.0, -1.0, -1.0]
+    assert c["critic"]["units"][:4] == [3, 3, 6, 3]
     assert cri["rate"] == pytest.approx(0.6)
     assert cri["discount"] == pytest.approx(0.95)
     assert act["noise_std"] == 3.0 and act["scale"] == 0.5 and act["forgetting"] == 1.0

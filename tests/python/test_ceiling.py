@@ -128,7 +128,7 @@ def test_lqr_starting_points_stabilise_the_linearised_plant():
     a, b = ceiling.linearise(cfg)
     starts = ceiling.lqr_starts(cfg)
     assert len(starts) == len(ceiling.LQR_FORCES)
-    ranges = np.array(list(cfg.controller.policy.input_range), dtype=float)
+    ranges = np.array(list(cfg.controller.policy.input_range)[:B.N_INPUTS], dtype=float)
     for _, w in starts:
         assert all(v > 0 for v in w)  # the sign pattern of a stabilising linear policy here
         k = -np.asarray(w) * cfg.controller.policy.gain / ranges

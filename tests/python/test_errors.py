@@ -11,7 +11,7 @@ from harness.config import build_config, make_prior
     ({"gain": -1.0}, "ico", B.ERR_BAD_GAIN, "rejected: policy.gain=-1.0"),
     ({"reflex_force": -2.0}, "ico", B.ERR_BAD_GAIN, "rejected: policy.reflex_force=-2.0"),
     ({"input_range": [2.4, 0.0, 0.2, 2.0]}, "ico", B.ERR_BAD_SCALE, "rejected: policy.input_range[1]=0.0"),
-    ({"zone_x": 0.0}, "ico", B.ERR_BAD_ZONE, "policy.zone_x"),
+    ({"task.rule_threshold": [2e6]}, "ico", B.ERR_BAD_ZONE, "rejected: task.rule_threshold[0]=2000000.0"),
     ({"ico_rate": -1e-4}, "ico", B.ERR_BAD_ICO_RATE, "rejected: ico.rate=-0.0001"),
     ({"discount": 1.5}, "rl", B.ERR_BAD_CRITIC, "rejected: critic.discount=1.5"),
     ({"critic.td_clip": 0.0}, "rl", B.ERR_BAD_CRITIC, "rejected: critic.td_clip=0.0"),

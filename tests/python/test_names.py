@@ -32,18 +32,31 @@ VALUES = {
 
 def test_alias_table_covers_the_abi3_names():
     old = json.loads((ABI3_ICO / "run.json").read_text())["config"]["controller"]
-    assert set(old) - {"mode"} == set(ALIASES) == set(VALUES)
-    # every ABI-3 field has its alias; "learn" (the no-learning control) and the learners' fields of
-    # ABI 6 (method.md, L2-L4, A10) came after ABI 3 and have canonical names only
+    assert set(old) - {"mode"} == set(ALIASES) | set(config.ZONE_ALIASES) == set(VALUES)
+    # every ABI-3 field has its alias (the zone's set the cart-pole task's rule thresholds);
+    # "learn" (the no-learning control), the learners' fields of ABI 6 (method.md, L2-L4, A10) and
+    # the task description of ABI 8 came after ABI 3 and have canonical names only
     after_abi3 = {"mode", "learn", "critic.quirks", "actor.update", "actor.rate", "actor.likelihood_std",
                   "actor.batch", "actor.explore_ticks", "search.batch", "search.elite_fraction", "search.step",
-                  "search.floor", "search.cov_scale"}
+                  "search.floor", "search.cov_scale", "task.n_inputs", "task.late_source", "task.n_rules",
+                  "task.rule_input", "task.rule_side", "task.rule_threshold", "task.rule_reflex", "critic.units"}
     assert set(ALIASES.values()) & after_abi3 == set()
     assert sorted(ALIASES.values()) == sorted(n for n in config.CONTROLLER_FIELDS if n not in after_abi3)
     for alias, name in ALIASES.items():
         assert canonical(alias) == canonical(name) == name
     for name in ALL_FIELDS:
         assert canonical(name) == name
+
+
+def test_zone_names_set_the_cartpole_rule_thresholds():
+    """zone_theta / zone_x (and policy.zone_*) of earlier versions: the preset's four thresholds."""
+    for name in ("zone_theta", "policy.zone_theta"):
+        t = list(build_config({name: 0.19, "zone_x": 2.2}).controller.task.rule_threshold)[:4]
+        assert t == pytest.approx([0.19, -2.2, -0.19, 2.2], rel=1e-6)
+    with pytest.raises(B.ConfigError, match="policy.zone_x") as info:
+        build_config({"zone_x": 0.0})
+    assert info.value.status == B.ERR_BAD_ZONE
+    assert "policy.zone_theta" not in build_config({"zone_theta": 0.19}).flat()  # recorded as the thresholds
 
 
 @pytest.mark.parametrize("alias", sorted(ALIASES))
@@ -59,7 +72,7 @@ def test_alias_and_canonical_give_identical_configs(alias):
 
 def test_all_aliases_at_once_and_a_field_given_twice():
     a = build_config(VALUES, condition="rl")
-    b = build_config({ALIASES[k]: v for k, v in VALUES.items()}, condition="rl")
+    b = build_config({{**ALIASES, **config.ZONE_ALIASES}[k]: v for k, v in VALUES.items()}, condition="rl")
     assert bytes(a.controller) == bytes(b.controller)
     for items in (["gain=3", "policy.gain=4"], ["policy.gain=4", "gain=3"], ["gain=3", "gain=3"]):
         with pytest.raises(UsageError, match=f"--set {items[0]} and --set {items[1]} both set policy.gain"):

@@ -90,10 +90,12 @@ def test_single_field_override(given_name, value, condition):
         assert kind(got) == kind(value) and math.isfinite(got)
 
 
-# switches, flags and counts: every integer field (explore_ticks and search.batch are plain int32 counts)
+# switches, flags and counts: every integer field (explore_ticks, search.batch and the task's sizes are
+# plain int32 counts; task.rule_side is an array of switches)
 INT_FIELDS = [n for n in ALL_FIELDS if n in ENUMS or n in BOOLS
-              or n in ("max_trials", "success_steps", "actor.explore_ticks", "search.batch")]
-assert len(INT_FIELDS) == 15
+              or n in ("max_trials", "success_steps", "actor.explore_ticks", "search.batch", "task.n_inputs",
+                       "task.n_rules")]
+assert len(INT_FIELDS) == 19
 assert {n for n in config.CONTROLLER_FIELDS if config._ctype(B.Config(), n) is ctypes.c_int32} <= set(INT_FIELDS)
 
 

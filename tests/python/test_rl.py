@@ -127,7 +127,7 @@ def test_rl_grid_deterministic_records_posterior(ico_dir, configuration):
     cfg = build_config(over, condition="ico-rl", prior=info.prior())
     assert cfg.controller.mode == B.MODE_RL
     assert cfg.controller.actor.update == B.ACTOR_UPDATES["posterior" if configuration == "literal" else "gradient"]
-    prior_cov = np.array([list(r) for r in info.prior().cov], dtype=float)  # in the real type
+    prior_cov = np.array([list(r)[:B.N_INPUTS] for r in info.prior().cov[:B.N_INPUTS]], dtype=float)  # in the real type
     a = grid.make_cells(5, [300, 611, 900])
     b = grid.make_cells(5, [300, 611, 900])
     grid.run_grid(cfg, a, threads=2, progress=False)
@@ -170,8 +170,8 @@ def test_control_learns_nothing_and_equals_zero_rates(ico_dir, condition, config
     cells = {name: grid.make_cells(5, [300, 611, 612, 900]) for name in ("control", "zero", "learning")}
     for name, cfg in (("control", control), ("zero", zero), ("learning", learning)):
         grid.run_grid(cfg, cells[name], threads=2, progress=False)
-    mean = np.array(prior.mean, dtype=float)
-    cov = np.array([list(r) for r in prior.cov], dtype=float)
+    mean = np.array(prior.mean[:B.N_INPUTS], dtype=float)
+    cov = np.array([list(r)[:B.N_INPUTS] for r in prior.cov[:B.N_INPUTS]], dtype=float)
     for w, c in zip(cells["control"]["weights"], cells["control"]["cov"]):
         assert np.array_equal(w, mean) and np.array_equal(c, cov)
     for f in ("outcome", "status", "trials", "total_steps", "last_trial_steps"):
@@ -209,7 +209,8 @@ def tick(cfg, state, s, terminal=False):
 
 def posterior(state):
     post = B.get_posterior(state)
-    return np.array(post.mean, dtype=float), np.array([list(r) for r in post.cov], dtype=float)
+    return (np.array(post.mean[:B.N_INPUTS], dtype=float),
+            np.array([list(r)[:B.N_INPUTS] for r in post.cov[:B.N_INPUTS]], dtype=float))
 
 
 MU = np.array([0.08, 0.05, 0.3, 0.09])
@@ -221,7 +222,7 @@ S_T1 = np.array([0.31, -0.38, 0.052, 0.58])
 
 def closed_form(cfg, mu, sigma, s_t, delta, eps):
     c = cfg.controller
-    rng = np.array(c.policy.input_range, dtype=float)
+    rng = np.array(c.policy.input_range[:B.N_INPUTS], dtype=float)
     h = c.policy.gain * np.clip(s_t / rng, -1.0, 1.0)
     y = h @ mu + c.actor.scale * delta * eps  # u_ob = mu_u + alpha * delta * eps
     # the likelihood std sigma_L (method.md, L2), not sigma_u; but sigma_u when likelihood_std is 0

@@ -26,7 +26,7 @@ TINY = {"max_trials": 12, "success_steps": 300}
 
 def probes(cfg):
     """The four probe states and their scaled value on the probed axis."""
-    ranges = np.array(cfg.controller.policy.input_range, dtype=float)
+    ranges = np.array(cfg.controller.policy.input_range[:B.N_INPUTS], dtype=float)
     states = [stored(0.5 * ranges[i] * np.eye(4)[i]) for i in range(4)]
     return states, np.array([scaled(cfg, s)[i] for i, s in enumerate(states)])
 
@@ -277,8 +277,8 @@ def test_no_learning_control_learns_nothing(condition):
     over = {**TINY, "search.cov_scale": 2.0, "search.batch": 2}
     control = build_config({**over, "learn": False}, condition=condition, prior=prior)
     learning = build_config(over, condition=condition, prior=prior)
-    mean = np.array(prior.mean, dtype=float)
-    sigma0 = initial_cov(control, [list(r) for r in prior.cov])
+    mean = np.array(prior.mean[:B.N_INPUTS], dtype=float)
+    sigma0 = initial_cov(control, [list(r)[:B.N_INPUTS] for r in prior.cov[:B.N_INPUTS]])
     cells = {}
     for name, cfg in (("control", control), ("learning", learning)):
         cells[name] = grid.make_cells(9, [0, 300, 611, 900, 1224])
@@ -291,7 +291,7 @@ def test_no_learning_control_learns_nothing(condition):
     assert len(learned) and not np.array_equal(learned["weights"][0], mean)
     # tick by tick, through the batch's terminal ticks
     rng = np.random.default_rng(2)
-    state = controller(control, mean, [list(r) for r in prior.cov], seed=4)
+    state = controller(control, mean, [list(r)[:B.N_INPUTS] for r in prior.cov[:B.N_INPUTS]], seed=4)
     start = posterior(state)
     draws = set()
     for k in range(10):

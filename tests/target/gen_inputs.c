@@ -36,7 +36,7 @@ static int emit(const char *name, const char *upper, int32_t mode, uint64_t seed
     icoac_sim_plant_t plant;
     icoac_input_t in;
     icoac_output_t out;
-    double s[ICOAC_N_INPUTS];
+    double s[ICOAC_CARTPOLE_INPUTS];
     unsigned flags = 2u; /* reset before the first tick */
     int i, k;
     int trials = 0;
@@ -58,7 +58,7 @@ static int emit(const char *name, const char *upper, int32_t mode, uint64_t seed
         if ((flags & 2u) != 0u) {
             icoac_reset(&st);
         }
-        for (k = 0; k < ICOAC_N_INPUTS; ++k) {
+        for (k = 0; k < ICOAC_CARTPOLE_INPUTS; ++k) {
             in.s[k] = (float)s[k];
         }
         in.flags = (flags & 1u) ? ICOAC_INPUT_TERMINAL : 0u;

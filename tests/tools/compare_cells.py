@@ -1,7 +1,8 @@
 """Bit-for-bit comparison of grid cells against committed reference cells.
 
 Runs a spread subset of the paper grid's cells (CELLS, failing and successful ones) for every
-learning condition and its no-learning control, with small caps, through the harness and the
+learning condition and its no-learning control, and a few variants (VARIANTS: the literal
+reading, batch updates, the dense threshold 0, ...), with small caps, through the harness and the
 library it loads, and compares every result field of every cell (outcome, status, trials, steps,
 elapsed time, final weights and covariance) bit for bit with the reference.
 
@@ -30,6 +31,17 @@ CELLS = sorted(set(range(0, 1225, 41)) | set(range(596, 630, 4)))
 SEED = 3
 CAPS = {"max_trials": 100, "success_steps": 5000}
 ICO_CAPS = {"max_trials": 3000, "success_steps": 5000}
+# Further readings and switches, each on a condition: name -> (condition, overrides).
+VARIANTS = {
+    "ico-rl literal": ("ico-rl", {"actor.update": "posterior", "actor.noise_std": 1, "actor.scale": 0.5,
+                                  "actor.likelihood_std": 0, "actor.batch": 0, "actor.explore_ticks": 0,
+                                  "critic.quirks": 0}),
+    "ico-rl batch sample": ("ico-rl", {"actor.batch": 1, "actor.act_with_sample": 1, "actor.update": "mean",
+                                       "actor.likelihood_std": 0.1}),
+    "ico-rl quirks dense": ("ico-rl", {"critic.quirks": 1, "critic.threshold": 0.0}),
+    "ico literal timing": ("ico", {"ico.timing": "literal", "policy.reflex_mode": "gain"}),
+    "search small batch": ("ico-search", {"search.batch": 3, "search.elite_fraction": 0.5}),
+}
 RESULT_FIELDS = ("outcome", "status", "trials", "total_steps", "last_trial_steps", "elapsed_time", "weights",
                  "cov")
 CART_POLE_INPUTS = 4
@@ -38,11 +50,12 @@ CART_POLE_INPUTS = 4
 # (results/ico-seed0: seed 0, 1e5 trials, at ad0bc3e), stored in the reference by --generate.
 
 
-def _run_condition(condition: str, ico_prior) -> np.ndarray:
+def _run_condition(name: str, ico_prior) -> np.ndarray:
     from harness import _binding as B
     from harness import grid
     from harness import prior as P
     from harness.config import CONDITION_OVERRIDES, build_config, make_prior
+    condition, extra = VARIANTS.get(name, (name, {}))
     caps = ICO_CAPS if condition == "ico" else CAPS
     info = None
     base = {"ico-rl-control": "ico-rl", "ico-mean-rl-control": "ico-mean-rl", "rl-ico-cov-control": "rl-ico-cov",
@@ -57,7 +70,7 @@ def _run_condition(condition: str, ico_prior) -> np.ndarray:
         mean[:CART_POLE_INPUTS] = info.mean[:CART_POLE_INPUTS]
         cov[:CART_POLE_INPUTS, :CART_POLE_INPUTS] = info.cov[:CART_POLE_INPUTS, :CART_POLE_INPUTS]
         prior = make_prior(mean, cov)
-    cfg = build_config({**CONDITION_OVERRIDES[condition], **caps}, prior=prior)
+    cfg = build_config({**CONDITION_OVERRIDES[condition], **extra, **caps}, prior=prior)
     cells = grid.make_cells(SEED, CELLS)
     grid.run_grid(cfg, cells, threads=2, progress=False)
     out = np.zeros(cells.size, dtype=[(f, np.float64 if f in ("elapsed_time",) else np.int64)
@@ -88,34 +101,33 @@ def _commit() -> str:
         return "unknown"
 
 
-def generate(ico_prior_from: Path) -> None:
+def generate(ico_prior_from: Path, reference: Path = REFERENCE) -> None:
     from harness import options
     from harness import prior as P
     ico = P.from_results(ico_prior_from)
     arrays = {"ico_prior_mean": ico.mean[:CART_POLE_INPUTS],
               "ico_prior_cov": ico.cov[:CART_POLE_INPUTS, :CART_POLE_INPUTS]}
-    for condition in options.CONDITIONS:
-        arrays[condition] = _run_condition(condition, ico)
+    for name in (*options.CONDITIONS, *VARIANTS):
+        arrays[name] = _run_condition(name, ico)
     meta = {"commit": _commit(), "cells": CELLS, "seed": SEED, "caps": CAPS, "ico_caps": ICO_CAPS,
             "command": f"python -m tests.tools.compare_cells --generate --ico-prior-from {ico_prior_from}"}
     arrays["meta"] = np.array(json.dumps(meta))
-    np.savez_compressed(REFERENCE, **arrays)
-    print(f"wrote {REFERENCE} ({meta['commit']})")
+    np.savez_compressed(reference, **arrays)
+    print(f"wrote {reference} ({meta['commit']})")
 
 
-def load_conditions() -> list[str]:
+def load_conditions(reference: Path = REFERENCE) -> list[str]:
     """The conditions of the reference."""
-    return [name for name in np.load(REFERENCE).files if name not in ("meta", "ico_prior_mean", "ico_prior_cov")]
+    return [name for name in np.load(reference).files if name not in ("meta", "ico_prior_mean", "ico_prior_cov")]
 
 
-def compare(conditions=None) -> dict[str, dict[str, int]]:
+def compare(conditions=None, reference: Path = REFERENCE) -> dict[str, dict[str, int]]:
     """{condition: {"cells": compared, "identical": bit-identical cells, "outcome_or_trials": cells
     whose outcome or trial count differs}}."""
-    from harness import options
-    data = np.load(REFERENCE)
+    data = np.load(reference)
     ico = _ico_prior_from_reference(data)
     report = {}
-    for condition in conditions or options.CONDITIONS:
+    for condition in conditions or load_conditions(reference):
         ref = data[condition]
         new = _run_condition(condition, ico)
         same = np.ones(ref.size, dtype=bool)
@@ -136,15 +148,16 @@ def main(argv=None) -> int:
     parser.add_argument("--ico-prior-from", type=Path, default=ROOT / "results" / "ico-seed0",
                         help="ICO results directory of the prior (--generate only)")
     parser.add_argument("--condition", action="append", help="compare only these conditions")
+    parser.add_argument("--reference", type=Path, default=REFERENCE, help="reference file (default: the committed one)")
     args = parser.parse_args(argv)
     if args.generate:
-        generate(args.ico_prior_from)
+        generate(args.ico_prior_from, args.reference)
         return 0
-    report = compare(args.condition)
-    meta = json.loads(str(np.load(REFERENCE)["meta"]))
+    report = compare(args.condition, args.reference)
+    meta = json.loads(str(np.load(args.reference)["meta"]))
     print(f"reference: commit {meta['commit']}, {len(meta['cells'])} cells, seed {meta['seed']}")
     for condition, row in report.items():
-        print(f"{condition:22s} {row['identical']:3d} / {row['cells']} bit-identical, "
+        print(f"{condition:24s} {row['identical']:3d} / {row['cells']} bit-identical, "
               f"{row['outcome_or_trials']} differ in outcome or trials ({row['successes']} reference successes)")
     return 0 if all(r["identical"] == r["cells"] for r in report.values()) else 1
 

@@ -32,7 +32,32 @@ typedef enum {
     ICOAC_ACTOR_GRADIENT = 2   /* Gaussian-policy gradient step beta * delta * eps * h / sigma_u^2 */
 } icoac_actor_update_t;
 
-/* How the reflex U in {-1, 0, +1} enters the force (method.md, A2). */
+/* Task description (method.md, the task): what the controller needs to know about a plant.
+ * - inputs: n observations s_0 .. s_{n-1} per tick (task.n_inputs), each scaled to x~_i =
+ *   s_i / policy.input_range[i] (clipped to [-1, 1] with policy.clip_inputs); the feature is
+ *   z = w^T x~ over the n inputs, the prior and the learned weights are n-vectors.
+ * - late signal: the penalty r in {-1, 0} that ICO learns from and the reflex U that acts with
+ *   it. With ICOAC_LATE_RULES, a table of task.n_rules rules on the raw inputs, checked in order,
+ *   the first match wins: rule k matches when s[rule_input[k]] is above (ICOAC_RULE_ABOVE: >)
+ *   or below (ICOAC_RULE_BELOW: <) rule_threshold[k], and gives r = -1, U = rule_reflex[k]; no
+ *   match gives r = 0, U = 0. With ICOAC_LATE_SENSOR the plant measures it: a tick whose input
+ *   has ICOAC_INPUT_LATE set has r = -1 and U = in.reflex, any other tick r = 0, U = 0 (a bump
+ *   switch, a limit switch).
+ * - critic (RL mode): critic.units[i] normalized Gaussian units along input i over
+ *   [-critic.range[i], critic.range[i]], the grid being their product (method.md, critic).
+ * The inputs a task does not use (index n and up) are never read. icoac_task_cartpole gives the
+ * cart-pole task, which icoac_config_default installs. */
+typedef enum {
+    ICOAC_LATE_RULES = 0, /* the rule table on the inputs */
+    ICOAC_LATE_SENSOR = 1 /* the input's ICOAC_INPUT_LATE flag and reflex */
+} icoac_late_source_t;
+
+typedef enum {
+    ICOAC_RULE_BELOW = 0, /* matches when s[input] < threshold */
+    ICOAC_RULE_ABOVE = 1  /* matches when s[input] > threshold */
+} icoac_rule_side_t;
+
+/* How the reflex U (in [-1, 1]; the cart-pole's -1, 0, +1) enters the force (method.md, A2). */
 typedef enum {
     ICOAC_REFLEX_UNIT = 0,  /* F = G*z + U*reflex_force (literal Eq. 5, 1 N) */
     ICOAC_REFLEX_GAIN = 1   /* F = G*(z + U) (authors' code, 10 N) */
@@ -52,9 +77,7 @@ typedef enum {
 #define ICOAC_RANGE_MAX ICOAC_R(1.0e6)
 #define ICOAC_GAIN_MAX ICOAC_R(1.0e4)         /* policy.gain (N per unit feature), >= 0 */
 #define ICOAC_FORCE_MAX ICOAC_R(1.0e4)        /* policy.reflex_force (N), >= 0 */
-#define ICOAC_ZONE_MIN ICOAC_R(1.0e-6)        /* policy.zone_theta (rad), policy.zone_x (m) */
-#define ICOAC_ZONE_THETA_MAX ICOAC_R(3.14159265358979)
-#define ICOAC_ZONE_X_MAX ICOAC_R(1.0e6)
+#define ICOAC_RULE_THRESHOLD_MAX ICOAC_R(1.0e6) /* |task.rule_threshold| (the input's unit) */
 #define ICOAC_ICO_RATE_MAX ICOAC_R(1.0)       /* ico.rate, >= 0 */
 #define ICOAC_CRITIC_RATE_MAX ICOAC_R(10.0)   /* critic.rate, >= 0 */
 #define ICOAC_TD_CLIP_MIN ICOAC_R(1.0e-6)     /* critic.td_clip */
@@ -71,18 +94,29 @@ typedef enum {
 #define ICOAC_SEARCH_COV_SCALE_MAX ICOAC_R(1.0e3) /* search.cov_scale, >= 1 */
 
 /* Configuration, one group per concern; a mode validates and uses only its groups (ICO:
- * policy, ico; RL: policy, critic, actor; search: policy, search). Integer switches are int32_t so the layout is the
- * same on every ABI. Ranges: the ICOAC_*_MIN / _MAX bounds above (search: its own group). */
+ * task, policy, ico; RL: task, policy, critic, actor; search: task, policy, search). Integer switches are int32_t
+ * so the layout is the same on every ABI. Ranges: the ICOAC_*_MIN / _MAX bounds above (search: its own
+ * group). Arrays have room for ICOAC_MAX_INPUTS inputs or ICOAC_MAX_RULES rules; only the first
+ * task.n_inputs or task.n_rules entries are checked and used. */
+
+/* Task: the plant's inputs and late signal (above). Defaults: the cart-pole (icoac_task_cartpole). */
+typedef struct {
+    int32_t n_inputs;                             /* n, [1, ICOAC_MAX_INPUTS]. 4 */
+    int32_t late_source;                          /* icoac_late_source_t. rules */
+    int32_t n_rules;                              /* rules in the table, [0, ICOAC_MAX_RULES]. 4 */
+    int32_t rule_input[ICOAC_MAX_RULES];          /* input index, [0, n) */
+    int32_t rule_side[ICOAC_MAX_RULES];           /* icoac_rule_side_t */
+    icoac_real_t rule_threshold[ICOAC_MAX_RULES]; /* in the input's unit, |.| <= 1e6 */
+    icoac_real_t rule_reflex[ICOAC_MAX_RULES];    /* U of a match, [-1, 1] */
+} icoac_task_config_t;
 
 /* Policy: how the state becomes the feature z = w^T x~ and the force (every mode). */
 typedef struct {
-    icoac_real_t input_range[ICOAC_N_INPUTS]; /* (m, m/s, rad, rad/s) maps to +-1; [1e-6, 1e6]. 2.4, 3.5, 0.2094384, 2.0 */
+    icoac_real_t input_range[ICOAC_MAX_INPUTS]; /* s_i maps to +-1 at this value; [1e-6, 1e6]. 2.4, 3.5, 0.2094384, 2.0 */
     int32_t clip_inputs;                      /* 1: clip scaled inputs to [-1, 1]; 0: no clip */
     icoac_real_t gain;                        /* G (N per unit feature), [0, 1e4]. 10 */
     int32_t reflex_mode;                      /* icoac_reflex_mode_t */
     icoac_real_t reflex_force;                /* N per unit U in ICOAC_REFLEX_UNIT, [0, 1e4]. 1 */
-    icoac_real_t zone_theta;                  /* reflex/penalty angle (rad), [1e-6, pi]. 11.5 deg = 0.20071286 */
-    icoac_real_t zone_x;                      /* reflex/penalty cart position (m), [1e-6, 1e6]. 2.35 */
 } icoac_policy_config_t;
 
 /* ICO rule (ICOAC_MODE_ICO). */
@@ -91,12 +125,17 @@ typedef struct {
     int32_t timing;    /* icoac_ico_timing_t */
 } icoac_ico_config_t;
 
-/* Normalized-Gaussian critic (ICOAC_MODE_RL). */
+/* Normalized-Gaussian critic (ICOAC_MODE_RL). Unit k of the grid is row-major over the inputs
+ * (input n-1 fastest). The library evaluates it as rows x cells: the cells are the units of the
+ * last inputs, from the first input m at which their product is <= 31, the rows the units of
+ * inputs 0 .. m-1; the rows must be <= 31 too (ICOAC_CRITIC_BLOCK_MAX; the cart-pole: 9 x 18). */
 typedef struct {
     icoac_real_t rate;                  /* eta_c, [0, 10]. 0.6 */
     icoac_real_t discount;              /* gamma per tick, [0, 1]. 0.95 */
     icoac_real_t td_clip;               /* |delta| limit, [1e-6, 1e3]. 1 */
-    icoac_real_t range[ICOAC_N_INPUTS]; /* grid half-widths (SI), [1e-6, 1e6]. 2.4, 3.5, 0.2094, 2.0 */
+    icoac_real_t range[ICOAC_MAX_INPUTS]; /* grid half-widths (input units), [1e-6, 1e6]. 2.4, 3.5, 0.2094, 2.0 */
+    int32_t units[ICOAC_MAX_INPUTS];      /* units along each input, [1, 16]; their product <= ICOAC_MAX_CRITIC_UNITS
+                                             and splits into blocks (below). 3, 3, 6, 3 */
     icoac_real_t threshold;             /* drop normalized activations below this, [0, 1). 0.001 (code); 0 = dense */
     int32_t quirks;                     /* 1: the authors' code (A10): TD update on b(s_t+1), V_old = 0 at a
                                            reset; 0: TD(0) on b(s_t), V(s_0) (default) */
@@ -135,6 +174,7 @@ typedef struct {
     int32_t learn;                /* 1: learn (default); 0: every update off (w, Sigma_w, v fixed): the
                                      no-learning control of a condition, or a fixed-w evaluation.
                                      Acting, exploration noise and its random stream are unchanged */
+    icoac_task_config_t task;
     icoac_policy_config_t policy;
     icoac_ico_config_t ico;
     icoac_critic_config_t critic;
@@ -142,26 +182,34 @@ typedef struct {
     icoac_search_config_t search;
 } icoac_config_t;
 
-/* Gaussian prior / posterior of the feature weights, (w_x, w_xdot, w_theta, w_thetadot).
- * A prior must have |mean_i| <= ICOAC_PRIOR_MEAN_MAX, |cov_ij| <= ICOAC_PRIOR_COV_MAX, no
- * subnormal entry, and an exactly symmetric positive definite covariance. */
+/* Gaussian prior / posterior of the feature weights w_0 .. w_{n-1} (the cart-pole: w_x, w_xdot,
+ * w_theta, w_thetadot). Only the leading n entries of mean and the leading n x n block of cov
+ * are read (n = task.n_inputs); icoac_get_posterior writes 0 to the others. A prior must have
+ * |mean_i| <= ICOAC_PRIOR_MEAN_MAX, |cov_ij| <= ICOAC_PRIOR_COV_MAX, no subnormal entry, and an
+ * exactly symmetric positive definite covariance. */
 #define ICOAC_PRIOR_MEAN_MAX ICOAC_R(1.0e6)
 #define ICOAC_PRIOR_COV_MAX ICOAC_R(1.0e12)
 typedef struct {
-    icoac_real_t mean[ICOAC_N_INPUTS];
-    icoac_real_t cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS];
+    icoac_real_t mean[ICOAC_MAX_INPUTS];
+    icoac_real_t cov[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS];
 } icoac_prior_t;
 
 /* Controller state: caller-owned storage of ICOAC_STATE_SIZE bytes, 8-byte aligned (it may be
  * a static, a stack or a struct member; no heap). Its layout is private and may change
  * between releases: read it through icoac_get_posterior, icoac_get_counters and
- * icoac_get_config. It holds a copy of the configuration in force. The size has room for
- * later learners. */
-#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
-#define ICOAC_STATE_SIZE 4096
-#else
-#define ICOAC_STATE_SIZE 2048
-#endif
+ * icoac_get_config. It holds a copy of the configuration in force. Its size follows the build
+ * maxima (an upper bound of the layout, checked at compile time to within 128 bytes, rounded up
+ * to 64): reals for the configuration copy, the weight vectors, four n x n matrices (two
+ * Sigma_w, the batch's information, the search's factor), the search's recorded trials
+ * (ICOAC_SEARCH_BATCH_MAX n-vectors), the critic weights (ICOAC_MAX_CRITIC_UNITS plus 31) and
+ * two kept-unit lists (64 reals each). Default maxima: 3,328 bytes with float, 6,144 with
+ * double; cart-pole maxima (4 inputs, 4 rules, 162 units): 2,560 / 4,608. */
+#define ICOAC_STATE_REALS                                                                                \
+    (4 * ICOAC_MAX_INPUTS * ICOAC_MAX_INPUTS + 26 * ICOAC_MAX_INPUTS + 2 * ICOAC_MAX_RULES + ICOAC_MAX_CRITIC_UNITS + \
+     179)
+#define ICOAC_STATE_WORDS (2 * ICOAC_MAX_RULES + ICOAC_MAX_INPUTS + 48)
+#define ICOAC_STATE_SIZE                                                                                  \
+    (((int)sizeof(icoac_real_t) * ICOAC_STATE_REALS + 4 * ICOAC_STATE_WORDS + ICOAC_MAX_INPUTS + 216 + 63) / 64 * 64)
 typedef struct {
     uint64_t opaque[ICOAC_STATE_SIZE / 8];
 } icoac_state_t;
@@ -176,18 +224,21 @@ typedef struct {
 /* Flags of icoac_input_t. */
 #define ICOAC_INPUT_TERMINAL 1u /* s is a failure state: learn from it, output no action; ends a trial
                                    (batch updates and the search's trial record happen here) */
+#define ICOAC_INPUT_LATE 2u     /* task.late_source ICOAC_LATE_SENSOR: the late signal is on (r = -1, U = reflex) */
 
-/* One tick's observation, SI units, theta > 0 leans toward +x. */
+/* One tick's observation: the task's n inputs (the cart-pole: x m, x_dot m/s, theta rad,
+ * theta_dot rad/s, theta > 0 leaning toward +x); entries n and up are not read. */
 typedef struct {
-    icoac_real_t s[ICOAC_N_INPUTS]; /* (x m, x_dot m/s, theta rad, theta_dot rad/s) */
-    uint32_t flags;                 /* ICOAC_INPUT_* */
+    icoac_real_t s[ICOAC_MAX_INPUTS];
+    uint32_t flags;      /* ICOAC_INPUT_* */
+    icoac_real_t reflex; /* U in [-1, 1] of a tick with ICOAC_INPUT_LATE (sensor late signal); else not read */
 } icoac_input_t;
 
 /* One tick's action and diagnostics. */
 typedef struct {
     icoac_real_t force;       /* F (N), to apply until the next tick; 0 on error or terminal */
     icoac_real_t z;           /* feature w^T x~ */
-    icoac_real_t reflex;      /* U in {-1, 0, 1} */
+    icoac_real_t reflex;      /* U in [-1, 1] (the cart-pole: -1, 0, 1) */
     icoac_real_t penalty;     /* r in {-1, 0} */
     icoac_real_t q;           /* ICO learning signal in {0, 1} */
     icoac_real_t weight_norm; /* |w| after this tick */
@@ -201,6 +252,10 @@ typedef struct {
 /* Defaults of every group, ICO mode: the paper's values, and the learner sweeps' choices for the
  * actor and the search (docs/method.md lists each with its source). */
 void icoac_config_default(icoac_config_t *cfg);
+/* The cart-pole task: its four inputs, its rule table (theta > 11.5 deg or x < -2.35 m: U = +1;
+ * theta < -11.5 deg or x > 2.35 m: U = -1; the first match wins) and its input ranges and
+ * critic grid in policy and critic. The task group of icoac_config_default. */
+void icoac_task_cartpole(icoac_config_t *cfg);
 void icoac_policy_config_default(icoac_policy_config_t *policy);
 void icoac_ico_config_default(icoac_ico_config_t *ico);
 void icoac_critic_config_default(icoac_critic_config_t *critic);
@@ -213,8 +268,9 @@ void icoac_search_config_default(icoac_search_config_t *search);
 icoac_status_t icoac_config_check(const icoac_config_t *cfg);
 icoac_status_t icoac_config_check_field(const icoac_config_t *cfg, const char **field);
 
-/* Validate a prior (the bounds at icoac_prior_t). */
-icoac_status_t icoac_prior_check(const icoac_prior_t *prior);
+/* Validate a prior's leading n_inputs entries (the bounds at icoac_prior_t); n_inputs out of
+ * [1, ICOAC_MAX_INPUTS]: ICOAC_ERR_BAD_TASK. */
+icoac_status_t icoac_prior_check(const icoac_prior_t *prior, int32_t n_inputs);
 
 /* Check cfg and prior, then clear state and keep a copy of cfg in it (the caller's cfg is not
  * read again). prior NULL: mean 0, covariance I. In ICO mode the prior mean is the initial w.
@@ -228,8 +284,9 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state,
  * and, in search mode, the floors search.floor * search.cov_scale * prior variance, to which
  * Sigma_w's diagonal is raised (the initial Sigma0 = cov_scale * prior covariance is icoac_init's
  * alone; a new search.batch takes effect when the batch in progress is closed, at the first
- * terminal tick with at least batch - 1 trials recorded). The mode cannot change
- * (ICOAC_ERR_RETUNE_MODE: icoac_init with icoac_get_posterior's result as the prior). On any
+ * terminal tick with at least batch - 1 trials recorded). The mode, task.n_inputs and
+ * critic.units cannot change (ICOAC_ERR_RETUNE_MODE: icoac_init with icoac_get_posterior's
+ * result as the prior); the rest of the task (its rules, its late-signal source) can. On any
  * error the state is unchanged. */
 icoac_status_t icoac_retune(icoac_state_t *state, const icoac_config_t *cfg);
 

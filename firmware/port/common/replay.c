@@ -105,12 +105,12 @@ static void print_posterior(const icoac_state_t *state)
     char line[128];
     int i, j;
     (void)icoac_get_posterior(state, &post);
-    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+    for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
         char *p = line;
         *p++ = 'P';
         *p++ = ' ';
         p = replay_fmt_real(p, post.mean[i]);
-        for (j = i; j < ICOAC_N_INPUTS; ++j) {
+        for (j = i; j < ICOAC_CARTPOLE_INPUTS; ++j) {
             *p++ = ' ';
             p = replay_fmt_real(p, post.cov[i][j]);
         }

@@ -14,7 +14,7 @@
 #define REPLAY_FLAG_RESET 2u    /* call icoac_reset before this tick (new trial) */
 
 typedef struct {
-    float s[ICOAC_N_INPUTS]; /* observation as the host controller saw it */
+    float s[ICOAC_CARTPOLE_INPUTS]; /* observation as the host controller saw it */
     uint8_t flags;           /* REPLAY_FLAG_* */
 } replay_tick_t;
 

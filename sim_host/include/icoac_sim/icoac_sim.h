@@ -82,8 +82,8 @@ typedef struct {
     int64_t total_steps;        /* steps over all trials */
     int64_t last_trial_steps;   /* length of the final trial */
     double elapsed_time;        /* s: dt * total_steps */
-    double weights[ICOAC_N_INPUTS];              /* final w (ICO) or mu_w (RL) */
-    double cov[ICOAC_N_INPUTS][ICOAC_N_INPUTS];  /* final Sigma_w (RL) */
+    double weights[ICOAC_CARTPOLE_INPUTS];              /* final w (ICO) or mu_w (RL) */
+    double cov[ICOAC_CARTPOLE_INPUTS][ICOAC_CARTPOLE_INPUTS];  /* final Sigma_w (RL) */
 } icoac_sim_cell_t;
 
 /* Indices of the progress array given to icoac_sim_run_grid. */
@@ -112,10 +112,10 @@ void icoac_sim_run_default(icoac_sim_run_t *run);
 int32_t icoac_sim_run_check(const icoac_sim_run_t *run);
 
 /* Advance state (x, x_dot, theta, theta_dot) by one dt under force (N). */
-int32_t icoac_sim_plant_step(const icoac_sim_plant_t *plant, double state[ICOAC_N_INPUTS], double force);
+int32_t icoac_sim_plant_step(const icoac_sim_plant_t *plant, double state[ICOAC_CARTPOLE_INPUTS], double force);
 
 /* 1 when state is outside the strict limits (or not finite), else 0. */
-int32_t icoac_sim_failed(const icoac_sim_plant_t *plant, const double state[ICOAC_N_INPUTS]);
+int32_t icoac_sim_failed(const icoac_sim_plant_t *plant, const double state[ICOAC_CARTPOLE_INPUTS]);
 
 /* Fill the paper's grid, row-major over theta (row i: theta0 = (-12 + i) deg) then x
  * (column j: x0 = -2.4 + 0.1 j m); cell seeds derive from seed; outcomes set PENDING. */
