@@ -180,7 +180,7 @@ uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step
         if ((seq[i].flags & REPLAY_FLAG_RESET) != 0u) {
             (void)icoac_reset(&ctrl->state);
         }
-        memcpy(in.s, seq[i].s, sizeof in.s);
+        memcpy(in.s, seq[i].s, sizeof seq[i].s); /* the recorded cart-pole inputs; in.s has room for more */
         in.flags = terminal ? ICOAC_INPUT_TERMINAL : 0u;
         (void)step(&ctrl->state, &in, &out);
         if (verbose) {
