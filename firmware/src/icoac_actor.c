@@ -33,32 +33,34 @@ void icoac_priv_actor_sample(icoac_priv_state_t *st)
 
 /* Posterior reading: Sigma' = A Sigma A^T + sigma_L^2 k k^T with A = I - k h^T (Joseph form),
  * evaluated as A Sigma = Sigma - k (Sigma h)^T and (A Sigma) A^T = A Sigma - (A Sigma h) k^T;
- * the upper triangle is mirrored, so Sigma stays exactly symmetric. */
+ * the upper triangle is mirrored, so Sigma stays exactly symmetric. A Sigma is formed one row at
+ * a time (row i of the result needs row i of A Sigma only), so the frame holds vectors, no
+ * matrix; with forgetting, Sigma / lambda_f is formed entry by entry where it is read. cov must
+ * not be the prior it is computed from (the tick stages into the spare buffer). */
 static inline void posterior_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
                                   const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
                                   icoac_real_t cov[N][N])
 {
     const icoac_real_t noise_var = likelihood_var(actor);
     const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
+    const int forget = actor->forgetting < ICOAC_R(1.0);
+    const icoac_real_t inflate = forget ? ICOAC_R(1.0) / actor->forgetting : ICOAC_R(1.0);
+    icoac_real_t row[N];
     icoac_real_t cov_h[N];
     icoac_real_t gain[N];
-    icoac_real_t a_cov[N][N];
-    icoac_real_t a_cov_h[N];
     icoac_real_t inv_innovation_var;
     int i;
     int j;
 
-    if (actor->forgetting < ICOAC_R(1.0)) {
-        const icoac_real_t inflate = ICOAC_R(1.0) / actor->forgetting;
-        for (i = 0; i < N; ++i) {
-            for (j = 0; j < N; ++j) {
-                cov[i][j] = prior[i][j] * inflate;
-            }
-        }
-        prior = ICOAC_PRIV_CONST_MAT(cov);
-    }
     for (i = 0; i < N; ++i) {
-        cov_h[i] = icoac_priv_dot(prior[i], h);
+        if (forget) {
+            for (j = 0; j < N; ++j) {
+                row[j] = prior[i][j] * inflate;
+            }
+            cov_h[i] = icoac_priv_dot(row, h);
+        } else {
+            cov_h[i] = icoac_priv_dot(prior[i], h);
+        }
     }
     inv_innovation_var = ICOAC_R(1.0) / (icoac_priv_dot(h, cov_h) + noise_var);
     for (i = 0; i < N; ++i) {
@@ -66,17 +68,13 @@ static inline void posterior_step(const icoac_actor_config_t *actor, const icoac
         w[i] = st->w[i] + gain[i] * innovation;
     }
     for (i = 0; i < N; ++i) {
+        icoac_real_t a_cov_h;
         for (j = 0; j < N; ++j) {
-            a_cov[i][j] = prior[i][j] - gain[i] * cov_h[j];
+            row[j] = (forget ? prior[i][j] * inflate : prior[i][j]) - gain[i] * cov_h[j];
         }
-    }
-    for (i = 0; i < N; ++i) {
-        a_cov_h[i] = icoac_priv_dot(a_cov[i], h);
-    }
-    /* written last: cov may be the prior it was computed from */
-    for (i = 0; i < N; ++i) {
+        a_cov_h = icoac_priv_dot(row, h);
         for (j = i; j < N; ++j) {
-            const icoac_real_t value = a_cov[i][j] - a_cov_h[i] * gain[j] + noise_var * gain[i] * gain[j];
+            const icoac_real_t value = row[j] - a_cov_h * gain[j] + noise_var * gain[i] * gain[j];
             cov[i][j] = value;
             cov[j][i] = value;
         }
@@ -87,7 +85,12 @@ void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_p
                                 const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
                                 icoac_real_t cov[N][N])
 {
-    posterior_step(actor, st, h, innovation, w, cov);
+    icoac_real_t staged[N][N];
+    int i;
+    posterior_step(actor, st, h, innovation, w, staged);
+    for (i = 0; i < N; ++i) {
+        icoac_priv_copy(cov[i], staged[i]);
+    }
 }
 
 /* Mean reading: mu += Sigma0 h innovation / (h^T Sigma0 h + sigma_L^2), Sigma_w unchanged. */

@@ -195,26 +195,15 @@ static int clamp_int(int32_t x, int lo, int hi)
  * failure nothing is recorded and 0 is returned). The batch closes when at least batch - 1
  * trials are recorded (more after a retune to a smaller batch). Count and batch are clamped to
  * the arrays, whatever the state holds. */
-ICOAC_PRIV_NOINLINE static int end_trial(const icoac_config_t *cfg, icoac_priv_state_t *st)
+ICOAC_PRIV_NOINLINE static int close_batch(const icoac_config_t *cfg, icoac_priv_state_t *st, int batch, int count)
 {
     icoac_priv_search_t *recorded = &st->search;
-    const int batch = clamp_int(cfg->search.batch, 1, ICOAC_SEARCH_BATCH_MAX);
-    const int count = clamp_int(recorded->count, 0, ICOAC_SEARCH_BATCH_MAX - 1);
     closing_batch_t b;
     icoac_real_t w[N];
     icoac_real_t lower[N][N];
     icoac_real_t (*cov)[N] = icoac_priv_cov_spare(st);
     int i;
     int j;
-    if (!cfg->learn) {
-        return 1;
-    }
-    if (count + 1 < batch) {
-        icoac_priv_copy(recorded->w[count], st->w_act);
-        recorded->ticks[count] = st->trial_ticks;
-        recorded->count = count + 1;
-        return 1;
-    }
     b.recorded = recorded;
     b.count = count;
     b.last_w = st->w_act;
@@ -233,6 +222,24 @@ ICOAC_PRIV_NOINLINE static int end_trial(const icoac_config_t *cfg, icoac_priv_s
     st->weight_norm = ICOAC_PRIV_SQRT(icoac_priv_dot(w, w));
     recorded->count = 0;
     return 1;
+}
+
+/* The batch's update is kept out of line: a trial that only records pays no frame for it. */
+static int end_trial(const icoac_config_t *cfg, icoac_priv_state_t *st)
+{
+    icoac_priv_search_t *recorded = &st->search;
+    const int batch = clamp_int(cfg->search.batch, 1, ICOAC_SEARCH_BATCH_MAX);
+    const int count = clamp_int(recorded->count, 0, ICOAC_SEARCH_BATCH_MAX - 1);
+    if (!cfg->learn) {
+        return 1;
+    }
+    if (count + 1 < batch) {
+        icoac_priv_copy(recorded->w[count], st->w_act);
+        recorded->ticks[count] = st->trial_ticks;
+        recorded->count = count + 1;
+        return 1;
+    }
+    return close_batch(cfg, st, batch, count);
 }
 
 /* Writes every output field but reflex, penalty, weight_norm and status. */
