@@ -40,88 +40,63 @@ int icoac_priv_critic_split(const int32_t *units, int n)
 
 void icoac_priv_critic_grid(const icoac_config_t *cfg, icoac_priv_grid_t *grid)
 {
+    static const int32_t cartpole_units[ICOAC_CARTPOLE_INPUTS] = ICOAC_PRIV_CARTPOLE_UNITS;
     const int n = icoac_priv_inputs(cfg);
     const int split = icoac_priv_critic_split(cfg->critic.units, n) - 1;
+    int cartpole_grid = n == ICOAC_CARTPOLE_INPUTS;
     int i;
     memset(grid, 0, sizeof *grid);
+    if (n == ICOAC_CARTPOLE_INPUTS && cfg->task.late_source == ICOAC_LATE_RULES &&
+        cfg->task.n_rules == ICOAC_CARTPOLE_RULES) {
+        grid->shape |= ICOAC_PRIV_SHAPE_CARTPOLE_TASK;
+    }
     if (cfg->mode != ICOAC_MODE_RL) {
         return; /* no critic: its group is not checked, nothing derived from it */
     }
     grid->n = (uint8_t)n;
     grid->split = (uint8_t)(split > 0 ? split : 0);
+    for (i = 0; cartpole_grid && i < ICOAC_CARTPOLE_INPUTS; ++i) {
+        cartpole_grid = cfg->critic.units[i] == cartpole_units[i];
+    }
+    if (cartpole_grid) {
+        grid->shape |= ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC;
+    }
+}
+
+int icoac_priv_critic_shape(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                            icoac_priv_shape_t *shape)
+{
+    const int n = grid->n <= ICOAC_MAX_INPUTS ? (int)grid->n : ICOAC_MAX_INPUTS;
+    const int split = grid->split;
+    int rows = 1;
+    int cells = 1;
+    int i;
+    if (split >= n) {
+        return 0;
+    }
     for (i = 0; i < n; ++i) {
-        grid->units[i] = (uint8_t)cfg->critic.units[i];
+        const int32_t count = critic->units[i];
+        if (count < 1 || count > ICOAC_CRITIC_UNITS_PER_INPUT_MAX) {
+            return 0;
+        }
+        shape->units[i] = (int)count;
+        if (i < split) {
+            rows *= (int)count;
+        } else {
+            cells *= (int)count;
+        }
+        if (rows > ICOAC_CRITIC_BLOCK_MAX || cells > ICOAC_CRITIC_BLOCK_MAX) {
+            return 0;
+        }
     }
-}
-
-/* Normalized 1-D Gaussian factors of one input. With centres c_j = -R + (2j+1)R/n and
- * width sigma = R/n, (s - c_j)/sigma = d_j = o - 2j with o = s*n/R + n - 1. Relative to the
- * nearest centre j* (distance d), a_{j*+1}/a_{j*} = exp(2d - 2) =: up, a_{j*-1}/a_{j*} =
- * exp(-2d - 2) = e^-4 / up, and each further step out multiplies the ratio by e^-4: one
- * exponential per dimension instead of n. a_{j*} = 1, so far-away states never give 0/0. */
-static inline void factors_of(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
-{
-    const icoac_real_t exp_minus_4 = ICOAC_R(0.018315638888734180294);
-    const icoac_real_t offset = value * ((icoac_real_t)n / range) + (icoac_real_t)(n - 1);
-    icoac_real_t up = ICOAC_R(0.0);
-    icoac_real_t down = ICOAC_R(0.0);
-    icoac_real_t ratio;
-    icoac_real_t distance;
-    icoac_real_t total = ICOAC_R(0.0);
-    icoac_real_t inv_total;
-    int nearest;
-    int j;
-    if (!(offset > ICOAC_R(0.0))) {
-        nearest = 0;
-    } else if (offset >= (icoac_real_t)(2 * (n - 1))) {
-        nearest = n - 1;
-    } else {
-        nearest = (int)(offset * ICOAC_R(0.5) + ICOAC_R(0.5));
+    if (rows * cells > ICOAC_MAX_CRITIC_UNITS) {
+        return 0;
     }
-    distance = offset - (icoac_real_t)(2 * nearest);
-    if (nearest < n - 1) {
-        up = icoac_priv_exp(ICOAC_R(2.0) * distance - ICOAC_R(2.0));
-    }
-    if (nearest > 0) {
-        /* inside the grid |distance| <= 1, so up >= e^-4 and down = e^-4 / up <= 1 */
-        down = nearest < n - 1 ? exp_minus_4 / up : icoac_priv_exp(ICOAC_R(-2.0) * distance - ICOAC_R(2.0));
-    }
-    /* Both chains run over the whole array and select, so no branch depends on nearest. */
-    for (j = 0; j < n; ++j) {
-        g[j] = ICOAC_R(1.0);
-    }
-    ratio = up;
-    for (j = 1; j < n; ++j) {
-        const int above = j > nearest;
-        const icoac_real_t next = g[j - 1] * ratio;
-        g[j] = above ? next : g[j];
-        ratio = above ? ratio * exp_minus_4 : ratio;
-    }
-    ratio = down;
-    for (j = n - 2; j >= 0; --j) {
-        const int below = j < nearest;
-        const icoac_real_t next = g[j + 1] * ratio;
-        g[j] = below ? next : g[j];
-        ratio = below ? ratio * exp_minus_4 : ratio;
-    }
-    for (j = 0; j < n; ++j) {
-        total += g[j];
-    }
-    inv_total = ICOAC_R(1.0) / total;
-    for (j = 0; j < n; ++j) {
-        g[j] *= inv_total;
-    }
-}
-
-/* The common counts get loops of a constant length (unrolled), the others the general ones. */
-void icoac_priv_critic_factors(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
-{
-    switch (n) {
-    case 2: factors_of(value, range, 2, g); break;
-    case 3: factors_of(value, range, 3, g); break;
-    case 6: factors_of(value, range, 6, g); break;
-    default: factors_of(value, range, n, g); break;
-    }
+    shape->n = n;
+    shape->split = split;
+    shape->rows = rows;
+    shape->cells = cells;
+    return 1;
 }
 
 /* With threshold 0 the floor is the smallest normal number: b_k below it is 0 under
@@ -150,129 +125,191 @@ static inline void kept_range(const icoac_real_t *g, int n, icoac_real_t thresho
     *end = j;
 }
 
-/* A unit count from the state's geometry, bounded to the factor array. */
-static inline int bounded_units(uint8_t units)
+/* The sparse kernel (see the file's head) for the grid of n inputs with these units, split and
+ * rows x stride: fills the list and returns V(s). The caller has checked the shape (rows and
+ * stride <= ICOAC_CRITIC_BLOCK_MAX, rows * stride <= ICOAC_MAX_CRITIC_UNITS), so every product,
+ * the sentinel and every weight read stay inside their arrays. */
+static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, const icoac_real_t *v,
+                                        const icoac_real_t s[ICOAC_MAX_INPUTS], icoac_priv_critic_list_t *list,
+                                        int n, const int *units, int split, int rows, int stride)
 {
-    return units <= ICOAC_CRITIC_UNITS_PER_INPUT_MAX ? (int)units : ICOAC_CRITIC_UNITS_PER_INPUT_MAX;
-}
-
-/* The kept cells' products and indices, sorted by product (largest first, ties in cell order),
- * then a 0 sentinel; the list's stride and rows; the row products in row_product. */
-static int sorted_cells(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
-                        const icoac_real_t s[ICOAC_MAX_INPUTS], icoac_real_t threshold,
-                        icoac_priv_critic_list_t *list)
-{
+    const icoac_real_t threshold = icoac_priv_critic_floor(critic);
     icoac_real_t g[ICOAC_CRITIC_UNITS_PER_INPUT_MAX];
-    const int n = grid->n <= ICOAC_MAX_INPUTS ? (int)grid->n : ICOAC_MAX_INPUTS;
-    const int split = grid->split < n ? (int)grid->split : n;
-    int rows = 1;
-    int stride = 1;
+    icoac_real_t *const row_product = list->product;
+    icoac_real_t *const cell_product = list->product + rows;
+    uint8_t *const row_cells = list->index;
+    uint8_t *const cell_index = list->index + rows;
+    icoac_real_t value = ICOAC_R(0.0);
     int entries = 1;
     int cells = 0;
+    int prefix_first;
     int i;
     int k;
-    list->row_product[0] = ICOAC_R(1.0);
-    for (i = 0; i < split; ++i) {
-        const int count = bounded_units(grid->units[i]);
-        icoac_priv_critic_factors(s[i], critic->range[i], count, g);
-        rows = icoac_priv_critic_expand(list->row_product, 0, g, count, 0, count, rows);
+    int r;
+    row_product[0] = ICOAC_R(1.0);
+    for (i = 0; i < ICOAC_MAX_INPUTS && i < split; ++i) {
+        icoac_priv_factors(s[i], critic->range[i], units[i], g);
+        entries = icoac_priv_critic_expand_all(row_product, g, units[i], entries);
     }
-    list->cell_product[0] = ICOAC_R(1.0);
-    list->cell[0] = 0u;
-    for (i = split; i < n; ++i) {
-        const int count = bounded_units(grid->units[i]);
+    /* The cell inputs but the last: the products and indices of their kept units, expanded at
+     * the end of the cells' room (stride + 1 slots), since their count is at most
+     * stride / units[n - 1]. */
+    prefix_first = stride + 1 - stride / units[n - 1];
+    cell_product[prefix_first] = ICOAC_R(1.0);
+    cell_index[prefix_first] = 0u;
+    entries = 1;
+    for (i = 0; i < ICOAC_MAX_INPUTS && i < n - 1; ++i) {
         int begin;
         int end;
-        icoac_priv_critic_factors(s[i], critic->range[i], count, g);
-        kept_range(g, count, threshold, &begin, &end);
-        entries = icoac_priv_critic_expand(list->cell_product, list->cell, g, count, begin, end, entries);
-        stride *= count;
-    }
-    /* a geometry the configuration check would refuse (a corrupted state) keeps no unit */
-    if (stride > ICOAC_PRIV_CELL_MASK || rows * stride > ICOAC_MAX_CRITIC_UNITS) {
-        rows = 0;
-        entries = 0;
-    }
-    for (k = 0; k < entries; ++k) {
-        const icoac_real_t product = list->cell_product[k];
-        const uint8_t cell = list->cell[k];
-        int j = cells;
-        if (!icoac_priv_nonneg_at_least(product, threshold)) {
+        if (i < split) {
             continue;
         }
-        while (j > 0 && !icoac_priv_nonneg_at_least(list->cell_product[j - 1], product)) {
-            list->cell_product[j] = list->cell_product[j - 1];
-            list->cell[j] = list->cell[j - 1];
-            --j;
-        }
-        list->cell_product[j] = product;
-        list->cell[j] = cell;
-        ++cells;
+        icoac_priv_factors(s[i], critic->range[i], units[i], g);
+        kept_range(g, units[i], threshold, &begin, &end);
+        entries = icoac_priv_critic_expand(cell_product + prefix_first, cell_index + prefix_first, g, units[i], begin,
+                                           end, entries);
     }
-    /* sentinel: at most 31 cells are listed; with a row product in [threshold, 1] it ends every
+    /* The last input's kept units times each of them: the kept cells, sorted by product (largest
+     * first, ties in cell order) into the front of the room. After e entries at most e * units
+     * cells are listed, below the entries still to read. */
+    {
+        const int count = units[n - 1];
+        int begin;
+        int end;
+        int e;
+        icoac_priv_factors(s[n - 1], critic->range[n - 1], count, g);
+        kept_range(g, count, threshold, &begin, &end);
+        for (e = 0; e < entries; ++e) {
+            const icoac_real_t p = cell_product[prefix_first + e];
+            const int base = cell_index[prefix_first + e] * count;
+            for (k = begin; k < end; ++k) {
+                const icoac_real_t product = p * g[k];
+                int j = cells;
+                if (!icoac_priv_nonneg_at_least(product, threshold)) {
+                    continue;
+                }
+                while (j > 0 && !icoac_priv_nonneg_at_least(cell_product[j - 1], product)) {
+                    cell_product[j] = cell_product[j - 1];
+                    cell_index[j] = cell_index[j - 1];
+                    --j;
+                }
+                cell_product[j] = product;
+                cell_index[j] = (uint8_t)(base + k);
+                ++cells;
+            }
+        }
+    }
+    /* sentinel: cells <= stride, so it fits; with a row product in [threshold, 1] it ends every
      * scan of the list (threshold >= the smallest normal) */
-    list->cell_product[cells] = ICOAC_R(0.0);
+    cell_product[cells] = ICOAC_R(0.0);
+    for (r = 0; r < rows; ++r) {
+        const icoac_real_t product_r = row_product[r];
+        const icoac_real_t *u = v + r * stride;
+        const icoac_real_t *product = cell_product;
+        const uint8_t *cell = cell_index;
+        icoac_real_t unit_b;
+        row_cells[r] = 0u;
+        /* threshold <= product_r <= 1 as bit patterns: false for NaN, Inf and negative
+         * values, so product_r * 0 = 0 and the sentinel ends the scan below */
+        if (!icoac_priv_nonneg_at_least(product_r, threshold) ||
+            !icoac_priv_nonneg_at_least(ICOAC_R(1.0), product_r)) {
+            continue;
+        }
+        unit_b = product_r * *product;
+        while (icoac_priv_nonneg_at_least(unit_b, threshold)) {
+            value += u[*cell++] * unit_b;
+            unit_b = product_r * *++product;
+        }
+        row_cells[r] = (uint8_t)(cell - cell_index);
+    }
+    list->cells = (uint8_t)cells;
     list->rows = (uint8_t)rows;
     list->stride = (uint8_t)stride;
-    return cells;
+    return value;
+}
+
+/* v_k += step * b_k over the units of a list of rows x stride (checked by the caller against
+ * the weights). The list lives in the state between ticks, so its counts and cell indices are
+ * checked here (nothing is updated past a bad one); a list the value pass wrote passes. */
+static inline void sparse_update(icoac_real_t *v, const icoac_priv_critic_list_t *list, icoac_real_t step, int rows,
+                                 int stride)
+{
+    const icoac_real_t *const cell_product = list->product + rows;
+    const uint8_t *const cell_index = list->index + rows;
+    const int cells = list->cells;
+    int r;
+    int i;
+    if (cells > stride) {
+        return;
+    }
+    for (i = 0; i < cells; ++i) {
+        if (cell_index[i] >= stride) {
+            return;
+        }
+    }
+    for (r = 0; r < rows; ++r) {
+        const int kept = list->index[r];
+        const icoac_real_t row_step = step * list->product[r];
+        const uint8_t *cell = cell_index;
+        const uint8_t *const end = cell + kept;
+        const icoac_real_t *product = cell_product;
+        icoac_real_t *u = v + r * stride;
+        if (kept > cells) {
+            return;
+        }
+        ICOAC_PRIV_OPAQUE(u);
+        while (cell != end) {
+            u[*cell++] += row_step * *product++;
+        }
+    }
+}
+
+/* The general instances: the shape of the state's configuration, checked. */
+ICOAC_PRIV_NOINLINE static icoac_real_t value_general(const icoac_critic_config_t *critic,
+                                                      const icoac_priv_grid_t *grid, const icoac_real_t *v,
+                                                      const icoac_real_t s[ICOAC_MAX_INPUTS],
+                                                      icoac_priv_critic_list_t *list)
+{
+    icoac_priv_shape_t shape;
+    if (!icoac_priv_critic_shape(critic, grid, &shape) || shape.n > ICOAC_MAX_INPUTS || shape.split >= shape.n) {
+        /* a geometry the configuration check would refuse (a corrupted state) keeps no unit */
+        list->product[0] = ICOAC_R(0.0);
+        list->cells = 0u;
+        list->rows = 0u;
+        list->stride = 0u;
+        return ICOAC_R(0.0);
+    }
+    return sparse_value(critic, v, s, list, shape.n, shape.units, shape.split, shape.rows, shape.cells);
 }
 
 icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
                                             const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
                                             icoac_priv_critic_list_t *list)
 {
-    const icoac_real_t threshold = icoac_priv_critic_floor(critic);
-    const int cells = sorted_cells(critic, grid, s, threshold, list);
-    const int rows = list->rows;
-    const int stride = list->stride;
-    icoac_real_t value = ICOAC_R(0.0);
-    int r;
-    for (r = 0; r < rows; ++r) {
-        const icoac_real_t row_product = list->row_product[r];
-        const icoac_real_t *u = v + r * stride;
-        const icoac_real_t *product = list->cell_product;
-        const uint8_t *cell = list->cell;
-        icoac_real_t unit_b;
-        list->row_cells[r] = 0u;
-        /* threshold <= row_product <= 1 as bit patterns: false for NaN, Inf and negative
-         * values, so row_product * 0 = 0 and the sentinel ends the scan below */
-        if (!icoac_priv_nonneg_at_least(row_product, threshold) ||
-            !icoac_priv_nonneg_at_least(ICOAC_R(1.0), row_product)) {
-            continue;
-        }
-        unit_b = row_product * *product;
-        while (icoac_priv_nonneg_at_least(unit_b, threshold)) {
-            value += u[*cell++] * unit_b;
-            unit_b = row_product * *++product;
-        }
-        list->row_cells[r] = (uint8_t)(cell - list->cell);
+    static const int cartpole_units[ICOAC_CARTPOLE_INPUTS] = ICOAC_PRIV_CARTPOLE_UNITS;
+    if ((grid->shape & ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) != 0u) {
+        return sparse_value(critic, v, s, list, ICOAC_CARTPOLE_INPUTS, cartpole_units, 2, ICOAC_PRIV_CARTPOLE_ROWS,
+                            ICOAC_PRIV_CARTPOLE_CELLS);
     }
-    list->cells = (uint8_t)cells;
-    return value;
+    return value_general(critic, grid, v, s, list);
 }
 
-/* v_k += step * b_k over the units listed by icoac_priv_critic_value_sparse. The list lives in
- * the state between ticks, so what it holds is bounded here: rows and stride must describe a
- * grid of at most ICOAC_MAX_CRITIC_UNITS units (else nothing is updated), and a count or a cell
- * index is masked (the list's arrays and the weights have room for a masked value:
- * icoac_state.h). A list the value pass wrote passes unchanged. */
 void icoac_priv_critic_update_sparse(icoac_real_t *v, const icoac_priv_critic_list_t *list, icoac_real_t step)
 {
     const int rows = list->rows;
     const int stride = list->stride;
-    int r;
-    if (rows > ICOAC_PRIV_BLOCK || stride > ICOAC_PRIV_CELL_MASK || rows * stride > ICOAC_MAX_CRITIC_UNITS) {
+    if (rows > ICOAC_CRITIC_BLOCK_MAX || stride > ICOAC_CRITIC_BLOCK_MAX || rows * stride > ICOAC_MAX_CRITIC_UNITS) {
         return;
     }
-    for (r = 0; r < rows; ++r) {
-        const icoac_real_t row_step = step * list->row_product[r];
-        const uint8_t *cell = list->cell;
-        const uint8_t *const end = cell + (list->row_cells[r] & ICOAC_PRIV_CELL_MASK);
-        const icoac_real_t *product = list->cell_product;
-        icoac_real_t *u = v + r * stride;
-        ICOAC_PRIV_OPAQUE(u);
-        while (cell != end) {
-            u[*cell++ & ICOAC_PRIV_CELL_MASK] += row_step * *product++;
-        }
+    sparse_update(v, list, step, rows, stride);
+}
+
+void icoac_priv_critic_update_sparse_shaped(const icoac_priv_grid_t *grid, icoac_real_t *v,
+                                            const icoac_priv_critic_list_t *list, icoac_real_t step)
+{
+    if ((grid->shape & ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) != 0u) {
+        sparse_update(v, list, step, ICOAC_PRIV_CARTPOLE_ROWS, ICOAC_PRIV_CARTPOLE_CELLS);
+        return;
     }
+    icoac_priv_critic_update_sparse(v, list, step);
 }

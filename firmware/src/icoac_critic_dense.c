@@ -34,33 +34,36 @@ static inline icoac_real_t select_kept(icoac_real_t b, icoac_real_t threshold, i
     return kept;
 }
 
-icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
-                                           const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
-                                           icoac_priv_critic_products_t *products)
+/* The dense kernel for the grid of n inputs with these units, split and rows x stride (checked
+ * by the caller: rows and stride <= ICOAC_CRITIC_BLOCK_MAX, rows * stride <=
+ * ICOAC_MAX_CRITIC_UNITS). */
+static inline icoac_real_t dense_value(const icoac_critic_config_t *critic, const icoac_real_t *v,
+                                       const icoac_real_t s[ICOAC_MAX_INPUTS], icoac_priv_critic_products_t *products,
+                                       int n, const int *units, int split, int rows, int stride)
 {
     const icoac_real_t threshold = icoac_priv_critic_floor(critic);
-    const int n = grid->n <= ICOAC_MAX_INPUTS ? (int)grid->n : ICOAC_MAX_INPUTS;
-    const int split = grid->split < n ? (int)grid->split : n;
     icoac_real_t g[ICOAC_CRITIC_UNITS_PER_INPUT_MAX];
-    icoac_real_t cell_sum[ICOAC_PRIV_BLOCK];
+    icoac_real_t cell_sum[ICOAC_CRITIC_BLOCK_MAX];
+    icoac_real_t *const row_product = products->product;
+    icoac_real_t *const cell_product = products->product + rows;
     icoac_real_t value = ICOAC_R(0.0);
-    int rows = 1;
-    int cells = 1;
+    int entries = 1;
     int begin = 0;
     int end = 0;
     int i, c, r, j;
-    products->row_product[0] = ICOAC_R(1.0);
-    for (i = 0; i < split; ++i) {
-        const int count = grid->units[i] <= ICOAC_CRITIC_UNITS_PER_INPUT_MAX ? (int)grid->units[i]
-                                                                            : ICOAC_CRITIC_UNITS_PER_INPUT_MAX;
-        icoac_priv_critic_factors(s[i], critic->range[i], count, g);
-        rows = icoac_priv_critic_expand(products->row_product, 0, g, count, 0, count, rows);
+    row_product[0] = ICOAC_R(1.0);
+    for (i = 0; i < ICOAC_MAX_INPUTS && i < split; ++i) {
+        icoac_priv_factors(s[i], critic->range[i], units[i], g);
+        entries = icoac_priv_critic_expand_all(row_product, g, units[i], entries);
     }
-    products->cell_product[0] = ICOAC_R(1.0);
-    for (i = split; i < n; ++i) {
-        const int count = grid->units[i] <= ICOAC_CRITIC_UNITS_PER_INPUT_MAX ? (int)grid->units[i]
-                                                                            : ICOAC_CRITIC_UNITS_PER_INPUT_MAX;
-        icoac_priv_critic_factors(s[i], critic->range[i], count, g);
+    cell_product[0] = ICOAC_R(1.0);
+    entries = 1;
+    for (i = 0; i < ICOAC_MAX_INPUTS && i < n; ++i) {
+        const int count = units[i];
+        if (i < split) {
+            continue;
+        }
+        icoac_priv_factors(s[i], critic->range[i], count, g);
         if (i == split) {
             /* Only units of the first cell input with g >= the threshold can be kept (every factor
              * is <= 1); g is unimodal, so they are one run [begin, end) of it. */
@@ -74,25 +77,20 @@ icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic, 
             begin *= count;
             end *= count;
         }
-        cells = icoac_priv_critic_expand(products->cell_product, 0, g, count, 0, count, cells);
-    }
-    /* a geometry the configuration check would refuse (a corrupted state) keeps no unit */
-    if (cells == 0 || rows * cells > ICOAC_MAX_CRITIC_UNITS) {
-        rows = 0;
-        end = 0;
+        entries = icoac_priv_critic_expand_all(cell_product, g, count, entries);
     }
     products->rows = (uint8_t)rows;
-    products->stride = (uint8_t)cells;
+    products->stride = (uint8_t)stride;
     products->cell_begin = (uint8_t)begin;
     products->cell_end = (uint8_t)end;
     for (j = begin; j < end; ++j) {
         cell_sum[j] = ICOAC_R(0.0);
     }
     for (r = 0; r < rows; ++r) {
-        const icoac_real_t row_product = products->row_product[r];
-        const icoac_real_t *u = v + r * cells;
+        const icoac_real_t product_r = row_product[r];
+        const icoac_real_t *u = v + r * stride;
         for (j = begin; j < end; ++j) {
-            const icoac_real_t unit_b = row_product * products->cell_product[j];
+            const icoac_real_t unit_b = product_r * cell_product[j];
             cell_sum[j] += select_kept(unit_b, threshold, u[j] * unit_b, ICOAC_R(0.0));
         }
     }
@@ -102,28 +100,70 @@ icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic, 
     return value;
 }
 
-void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, icoac_real_t *v,
-                                    const icoac_priv_critic_products_t *products, icoac_real_t step)
+/* The update over rows x stride (checked by the caller against the weights); the cell range
+ * lives in the state between ticks, so it is bounded to the stride here. */
+static inline void dense_update(const icoac_critic_config_t *critic, icoac_real_t *v,
+                                const icoac_priv_critic_products_t *products, icoac_real_t step, int rows, int stride)
 {
     const icoac_real_t threshold = icoac_priv_critic_floor(critic);
-    /* the products live in the state between ticks: bounded, whatever they hold */
-    const int rows = products->rows;
-    const int stride = products->stride;
+    const icoac_real_t *const cell_product = products->product + rows;
     const int begin = products->cell_begin;
     const int end = products->cell_end < stride ? (int)products->cell_end : stride;
     int r, j;
-    if (rows > ICOAC_PRIV_BLOCK || stride > ICOAC_PRIV_BLOCK || rows * stride > ICOAC_MAX_CRITIC_UNITS) {
-        return;
-    }
     for (r = 0; r < rows; ++r) {
-        const icoac_real_t row_product = products->row_product[r];
-        const icoac_real_t row_step = step * row_product;
+        const icoac_real_t product_r = products->product[r];
+        const icoac_real_t row_step = step * product_r;
         icoac_real_t *u = v + r * stride;
         for (j = begin; j < end; ++j) {
-            const icoac_real_t cell_product = products->cell_product[j];
             const icoac_real_t unit = u[j];
-            const icoac_real_t updated = unit + row_step * cell_product;
-            u[j] = select_kept(row_product * cell_product, threshold, updated, unit);
+            const icoac_real_t updated = unit + row_step * cell_product[j];
+            u[j] = select_kept(product_r * cell_product[j], threshold, updated, unit);
         }
     }
+}
+
+ICOAC_PRIV_NOINLINE static icoac_real_t value_general(const icoac_critic_config_t *critic,
+                                                      const icoac_priv_grid_t *grid, const icoac_real_t *v,
+                                                      const icoac_real_t s[ICOAC_MAX_INPUTS],
+                                                      icoac_priv_critic_products_t *products)
+{
+    icoac_priv_shape_t shape;
+    if (!icoac_priv_critic_shape(critic, grid, &shape) || shape.n > ICOAC_MAX_INPUTS || shape.split >= shape.n) {
+        /* a geometry the configuration check would refuse (a corrupted state) keeps no unit */
+        products->rows = 0u;
+        products->stride = 0u;
+        products->cell_begin = 0u;
+        products->cell_end = 0u;
+        return ICOAC_R(0.0);
+    }
+    return dense_value(critic, v, s, products, shape.n, shape.units, shape.split, shape.rows, shape.cells);
+}
+
+icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                                           const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
+                                           icoac_priv_critic_products_t *products)
+{
+    static const int cartpole_units[ICOAC_CARTPOLE_INPUTS] = ICOAC_PRIV_CARTPOLE_UNITS;
+    if ((grid->shape & ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) != 0u) {
+        return dense_value(critic, v, s, products, ICOAC_CARTPOLE_INPUTS, cartpole_units, 2,
+                           ICOAC_PRIV_CARTPOLE_ROWS, ICOAC_PRIV_CARTPOLE_CELLS);
+    }
+    return value_general(critic, grid, v, s, products);
+}
+
+void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                                    icoac_real_t *v, const icoac_priv_critic_products_t *products,
+                                    icoac_real_t step)
+{
+    /* the products live in the state between ticks: bounded, whatever they hold */
+    const int rows = products->rows;
+    const int stride = products->stride;
+    if ((grid->shape & ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) != 0u) {
+        dense_update(critic, v, products, step, ICOAC_PRIV_CARTPOLE_ROWS, ICOAC_PRIV_CARTPOLE_CELLS);
+        return;
+    }
+    if (rows > ICOAC_CRITIC_BLOCK_MAX || stride > ICOAC_CRITIC_BLOCK_MAX || rows * stride > ICOAC_MAX_CRITIC_UNITS) {
+        return;
+    }
+    dense_update(critic, v, products, step, rows, stride);
 }

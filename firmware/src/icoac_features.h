@@ -27,24 +27,24 @@ static inline void icoac_priv_task_inputs(int n, const icoac_real_t s[ICOAC_MAX_
     }
 }
 
-/* x~_i = clip(s_i / range_i), with 1 / range_i precomputed by icoac_init (0 past n). */
-static inline void icoac_priv_scale_inputs(const icoac_policy_config_t *policy, const icoac_priv_state_t *st,
+/* x~_i = clip(s_i / range_i) for i < n, with 1 / range_i precomputed by icoac_init; 0 past n. */
+static inline void icoac_priv_scale_inputs(const icoac_policy_config_t *policy, const icoac_priv_state_t *st, int n,
                                            const icoac_real_t s[ICOAC_MAX_INPUTS],
                                            icoac_real_t scaled[ICOAC_MAX_INPUTS])
 {
     int i;
     for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
         const icoac_real_t a = s[i] * st->inv_range[i];
-        scaled[i] = policy->clip_inputs ? icoac_priv_clip_unit(a) : a;
+        scaled[i] = i < n ? (policy->clip_inputs ? icoac_priv_clip_unit(a) : a) : ICOAC_R(0.0);
     }
 }
 
-/* The late signal of the rule table (icoac.h, task): the first matching rule gives r = -1 and
- * its reflex; none gives 0, 0. The table's size and input indices are bounded to the arrays. */
-static inline icoac_priv_zone_t icoac_priv_zone(const icoac_task_config_t *task,
+/* The late signal of the rule table (icoac.h, task): the first matching rule of the first
+ * `rules` (<= ICOAC_MAX_RULES) gives r = -1 and its reflex; none gives 0, 0. The input indices
+ * are bounded to the arrays. */
+static inline icoac_priv_zone_t icoac_priv_zone(const icoac_task_config_t *task, int rules,
                                                 const icoac_real_t s[ICOAC_MAX_INPUTS])
 {
-    const int rules = (uint32_t)task->n_rules <= (uint32_t)ICOAC_MAX_RULES ? (int)task->n_rules : ICOAC_MAX_RULES;
     icoac_priv_zone_t zone;
     int k;
     zone.reflex = ICOAC_R(0.0);
@@ -60,6 +60,12 @@ static inline icoac_priv_zone_t icoac_priv_zone(const icoac_task_config_t *task,
         }
     }
     return zone;
+}
+
+/* The table's size, bounded to the arrays whatever the state's copy holds. */
+static inline int icoac_priv_rules(const icoac_task_config_t *task)
+{
+    return (uint32_t)task->n_rules <= (uint32_t)ICOAC_MAX_RULES ? (int)task->n_rules : ICOAC_MAX_RULES;
 }
 
 /* Force of the reflex U (method.md, A2). */

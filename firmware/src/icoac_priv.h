@@ -265,9 +265,14 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
  * The update adds the same step to the same units in both; V differs by the rounding of the
  * sum's order. ICOAC_CRITIC_DENSE=1 (the host build's default, CMake ICOAC_CRITIC_KERNEL)
  * selects the dense kernel in icoac_priv_critic_value / _update; both are always built.
- * v has ICOAC_PRIV_CRITIC_WEIGHTS entries (the state's). */
+ * Each kernel is one static inline function of the grid's shape (inputs, units per input, the
+ * rows / cells split), instantiated twice: with the cart-pole's shape as compile-time constants
+ * (unrolled like hard-wired code), and with the shape of the state's configuration, checked
+ * against the arrays first; the state's shape tag (ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) selects one
+ * per call. v has ICOAC_PRIV_CRITIC_WEIGHTS entries (the state's). */
 
-/* Derive the geometry of a checked configuration (icoac_config_check accepted it). */
+/* Derive the geometry and the shape tags of a checked configuration (icoac_config_check
+ * accepted it). */
 void icoac_priv_critic_grid(const icoac_config_t *cfg, icoac_priv_grid_t *grid);
 /* The rows x cells split of a grid of n inputs with these unit counts: the first input m from
  * which the counts multiply to at most ICOAC_CRITIC_BLOCK_MAX cells; 0 when the rows do not fit
@@ -275,20 +280,101 @@ void icoac_priv_critic_grid(const icoac_config_t *cfg, icoac_priv_grid_t *grid);
 int icoac_priv_critic_split(const int32_t *units, int n);
 /* b_k below this floor counts as 0: the threshold, or with threshold 0 the smallest normal number. */
 icoac_real_t icoac_priv_critic_floor(const icoac_critic_config_t *critic);
-/* The normalized 1-D factors g_0 .. g_{count-1} of one input (count in [1, 16]). */
-void icoac_priv_critic_factors(icoac_real_t value, icoac_real_t range, int count, icoac_real_t *g);
-/* The products of the factors of inputs [first, last) over their index ranges [begin_i, end_i),
- * row-major (input last-1 fastest), left to right; index = the units' row-major index within
- * those inputs. Returns the number of products, 0 when it would exceed ICOAC_PRIV_BLOCK. */
-static inline int icoac_priv_critic_expand(icoac_real_t product[ICOAC_PRIV_BLOCK], uint8_t *index, const icoac_real_t *g,
-                             int count, int begin, int end, int entries)
+/* The normalized 1-D Gaussian factors g_0 .. g_{n-1} of one input (n in [1, 16]). With centres c_j = -R + (2j+1)R/n and
+ * width sigma = R/n, (s - c_j)/sigma = d_j = o - 2j with o = s*n/R + n - 1. Relative to the
+ * nearest centre j* (distance d), a_{j*+1}/a_{j*} = exp(2d - 2) =: up, a_{j*-1}/a_{j*} =
+ * exp(-2d - 2) = e^-4 / up, and each further step out multiplies the ratio by e^-4: one
+ * exponential per dimension instead of n. a_{j*} = 1, so far-away states never give 0/0. */
+static inline void icoac_priv_factors_of(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
+{
+    const icoac_real_t exp_minus_4 = ICOAC_R(0.018315638888734180294);
+    const icoac_real_t offset = value * ((icoac_real_t)n / range) + (icoac_real_t)(n - 1);
+    icoac_real_t up = ICOAC_R(0.0);
+    icoac_real_t down = ICOAC_R(0.0);
+    icoac_real_t ratio;
+    icoac_real_t distance;
+    icoac_real_t total = ICOAC_R(0.0);
+    icoac_real_t inv_total;
+    int nearest;
+    int j;
+    if (!(offset > ICOAC_R(0.0))) {
+        nearest = 0;
+    } else if (offset >= (icoac_real_t)(2 * (n - 1))) {
+        nearest = n - 1;
+    } else {
+        nearest = (int)(offset * ICOAC_R(0.5) + ICOAC_R(0.5));
+    }
+    distance = offset - (icoac_real_t)(2 * nearest);
+    if (nearest < n - 1) {
+        up = icoac_priv_exp(ICOAC_R(2.0) * distance - ICOAC_R(2.0));
+    }
+    if (nearest > 0) {
+        /* inside the grid |distance| <= 1, so up >= e^-4 and down = e^-4 / up <= 1 */
+        down = nearest < n - 1 ? exp_minus_4 / up : icoac_priv_exp(ICOAC_R(-2.0) * distance - ICOAC_R(2.0));
+    }
+    /* Both chains run over the whole array and select, so no branch depends on nearest. */
+    for (j = 0; j < n; ++j) {
+        g[j] = ICOAC_R(1.0);
+    }
+    ratio = up;
+    for (j = 1; j < n; ++j) {
+        const int above = j > nearest;
+        const icoac_real_t next = g[j - 1] * ratio;
+        g[j] = above ? next : g[j];
+        ratio = above ? ratio * exp_minus_4 : ratio;
+    }
+    ratio = down;
+    for (j = n - 2; j >= 0; --j) {
+        const int below = j < nearest;
+        const icoac_real_t next = g[j + 1] * ratio;
+        g[j] = below ? next : g[j];
+        ratio = below ? ratio * exp_minus_4 : ratio;
+    }
+    for (j = 0; j < n; ++j) {
+        total += g[j];
+    }
+    inv_total = ICOAC_R(1.0) / total;
+    for (j = 0; j < n; ++j) {
+        g[j] *= inv_total;
+    }
+}
+
+/* The grid of the state's configuration (the general instances): n, split, the units of each
+ * input and rows x cells, with n <= ICOAC_MAX_INPUTS, every count in [1, 16], rows and cells <=
+ * ICOAC_CRITIC_BLOCK_MAX and rows * cells <= ICOAC_MAX_CRITIC_UNITS; 0 (no unit kept) when the
+ * state's copy does not describe such a grid (a corrupted state). */
+typedef struct {
+    int n;
+    int split;
+    int rows;
+    int cells;
+    int units[ICOAC_MAX_INPUTS];
+} icoac_priv_shape_t;
+int icoac_priv_critic_shape(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                            icoac_priv_shape_t *shape);
+/* The cart-pole's units per input (the compile-time shape of the cart-pole instances). */
+#define ICOAC_PRIV_CARTPOLE_UNITS {ICOAC_CRITIC_N_X, ICOAC_CRITIC_N_X_DOT, ICOAC_CRITIC_N_THETA, ICOAC_CRITIC_N_THETA_DOT}
+/* The same, with loops of a constant length (unrolled) for the common counts: the kernels' input
+ * loops do not unroll, so the count is a constant only inside such a case. */
+static inline void icoac_priv_factors(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
+{
+    switch (n) {
+    case 2: icoac_priv_factors_of(value, range, 2, g); break;
+    case 3: icoac_priv_factors_of(value, range, 3, g); break;
+    case 6: icoac_priv_factors_of(value, range, 6, g); break;
+    default: icoac_priv_factors_of(value, range, n, g); break;
+    }
+}
+/* The products of the factors g of one input over its index range [begin, end) with each of the
+ * entries products so far, in place, row-major (this input fastest), left to right; index (or
+ * NULL) = the units' row-major index within the inputs so far. Returns the new number of
+ * products; the caller bounds it (entries * (end - begin) <= the array's room). */
+static inline int icoac_priv_critic_expand_of(icoac_real_t *product, uint8_t *index, const icoac_real_t *g,
+                                              int count, int begin, int end, int entries)
 {
     const int width = end > begin ? end - begin : 0;
     int e;
     int j;
-    if (entries * width > ICOAC_PRIV_CELL_MASK) {
-        return 0;
-    }
     /* from the back, so that each entry is read before its slots are written */
     for (e = entries - 1; e >= 0; --e) {
         const icoac_real_t p = product[e];
@@ -305,15 +391,40 @@ static inline int icoac_priv_critic_expand(icoac_real_t product[ICOAC_PRIV_BLOCK
     }
     return entries * width;
 }
+/* The same, with the common counts as constants (see icoac_priv_factors). */
+static inline int icoac_priv_critic_expand(icoac_real_t *product, uint8_t *index, const icoac_real_t *g, int count,
+                                           int begin, int end, int entries)
+{
+    switch (count) {
+    case 3: return icoac_priv_critic_expand_of(product, index, g, 3, begin, end, entries);
+    case 6: return icoac_priv_critic_expand_of(product, index, g, 6, begin, end, entries);
+    default: return icoac_priv_critic_expand_of(product, index, g, count, begin, end, entries);
+    }
+}
+/* Every unit of an input: its whole index range, no index. */
+static inline int icoac_priv_critic_expand_all(icoac_real_t *product, const icoac_real_t *g, int count, int entries)
+{
+    switch (count) {
+    case 3: return icoac_priv_critic_expand_of(product, 0, g, 3, 0, 3, entries);
+    case 6: return icoac_priv_critic_expand_of(product, 0, g, 6, 0, 6, entries);
+    default: return icoac_priv_critic_expand_of(product, 0, g, count, 0, count, entries);
+    }
+}
 icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
                                             const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
                                             icoac_priv_critic_list_t *list);
+/* The update of a list of the general instance: its rows and stride are checked against the
+ * weights, its counts and cell indices against the list (nothing is updated when they do not
+ * describe a list the value pass could write). */
 void icoac_priv_critic_update_sparse(icoac_real_t *v, const icoac_priv_critic_list_t *list, icoac_real_t step);
+void icoac_priv_critic_update_sparse_shaped(const icoac_priv_grid_t *grid, icoac_real_t *v,
+                                            const icoac_priv_critic_list_t *list, icoac_real_t step);
 icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
                                            const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
                                            icoac_priv_critic_products_t *products);
-void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, icoac_real_t *v,
-                                    const icoac_priv_critic_products_t *products, icoac_real_t step);
+void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                                    icoac_real_t *v, const icoac_priv_critic_products_t *products,
+                                    icoac_real_t step);
 
 /* No unit kept: the empty eligibility of a trial's start. */
 static inline void icoac_priv_critic_clear(icoac_priv_critic_active_t *active)
@@ -322,7 +433,8 @@ static inline void icoac_priv_critic_clear(icoac_priv_critic_active_t *active)
     active->dense.cell_begin = 0u;
     active->dense.cell_end = 0u;
 #else
-    memset(active->sparse.row_cells, 0, sizeof active->sparse.row_cells);
+    memset(active->sparse.index, 0, sizeof active->sparse.index);
+    active->sparse.cells = 0u;
 #endif
 }
 
@@ -337,14 +449,15 @@ static inline icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *
 #endif
 }
 
-static inline void icoac_priv_critic_update(const icoac_critic_config_t *critic, icoac_real_t *v,
-                                            const icoac_priv_critic_active_t *active, icoac_real_t step)
+static inline void icoac_priv_critic_update(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
+                                            icoac_real_t *v, const icoac_priv_critic_active_t *active,
+                                            icoac_real_t step)
 {
 #if defined(ICOAC_CRITIC_DENSE) && ICOAC_CRITIC_DENSE
-    icoac_priv_critic_update_dense(critic, v, &active->dense, step);
+    icoac_priv_critic_update_dense(critic, grid, v, &active->dense, step);
 #else
     (void)critic;
-    icoac_priv_critic_update_sparse(v, &active->sparse, step);
+    icoac_priv_critic_update_sparse_shaped(grid, v, &active->sparse, step);
 #endif
 }
 

@@ -19,43 +19,59 @@
 #define ICOAC_PRIV_STATE_ENDED 0x1C0AC07Eu
 
 /* Critic blocks (icoac.h, critic): unit k = row * cells + cell with rows, cells <=
- * ICOAC_CRITIC_BLOCK_MAX. The kernels' arrays have ICOAC_PRIV_BLOCK slots, so a count or index
- * masked with ICOAC_PRIV_CELL_MASK stays inside them whatever the state holds, and the critic
- * weights have room for the last row's masked index. */
+ * ICOAC_CRITIC_BLOCK_MAX and rows * cells <= ICOAC_MAX_CRITIC_UNITS, so rows + cells <=
+ * ICOAC_CRITIC_BLOCK_MAX + ICOAC_MAX_CRITIC_UNITS / ICOAC_CRITIC_BLOCK_MAX (the sum of two factors of
+ * a bounded product is largest at the extremes). A kept-unit list holds the rows' products, then
+ * the cells' and a 0 after them, in one array of ICOAC_PRIV_LIST slots; the kernels check a
+ * geometry against these bounds before they use it, whatever the state holds. */
 #define ICOAC_PRIV_CELL_MASK 31
-#define ICOAC_PRIV_BLOCK (ICOAC_PRIV_CELL_MASK + 1)
-#define ICOAC_PRIV_CRITIC_WEIGHTS (ICOAC_MAX_CRITIC_UNITS + ICOAC_PRIV_CELL_MASK)
+#define ICOAC_PRIV_LIST ICOAC_STATE_LIST
+ICOAC_STATIC_ASSERT(ICOAC_STATE_LIST == (ICOAC_CRITIC_BLOCK_MAX + ICOAC_MAX_CRITIC_UNITS / ICOAC_CRITIC_BLOCK_MAX + 1 <
+                                                 2 * ICOAC_CRITIC_BLOCK_MAX + 1
+                                             ? ICOAC_CRITIC_BLOCK_MAX + ICOAC_MAX_CRITIC_UNITS / ICOAC_CRITIC_BLOCK_MAX + 1
+                                             : 2 * ICOAC_CRITIC_BLOCK_MAX + 1),
+                    list_room_as_bounded);
+#define ICOAC_PRIV_CRITIC_WEIGHTS ICOAC_MAX_CRITIC_UNITS
 ICOAC_STATIC_ASSERT(ICOAC_CRITIC_BLOCK_MAX <= ICOAC_PRIV_CELL_MASK, block_fits_its_mask);
 ICOAC_STATIC_ASSERT(ICOAC_CRITIC_UNITS_PER_INPUT_MAX <= ICOAC_CRITIC_BLOCK_MAX, an_input_fits_a_block);
 
-/* The critic's geometry, derived from the configuration by icoac_init / icoac_retune /
- * icoac_reset: inputs [0, split) index the rows, [split, n) the cells. */
+/* Shape tags of the configuration in force (icoac_priv_grid_t.shape), derived by icoac_init /
+ * icoac_retune / icoac_reset: the tick runs the kernels instantiated for the cart-pole's shape
+ * when a bit is set, the general ones otherwise. The cart-pole instances use their compile-time
+ * shape, inside every array whatever the state holds, so a corrupted tag stays memory-safe. */
+#define ICOAC_PRIV_SHAPE_CARTPOLE_TASK 1u   /* 4 inputs, the rule table with 4 rules */
+#define ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC 2u /* RL with 4 inputs and the 3 x 3 x 6 x 3 grid (rows 9, cells 18) */
+#define ICOAC_PRIV_CARTPOLE_ROWS (ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT)
+#define ICOAC_PRIV_CARTPOLE_CELLS (ICOAC_CRITIC_N_THETA * ICOAC_CRITIC_N_THETA_DOT)
+ICOAC_STATIC_ASSERT(ICOAC_PRIV_CARTPOLE_ROWS + ICOAC_PRIV_CARTPOLE_CELLS < ICOAC_PRIV_LIST, cartpole_list_fits);
+
+/* The critic's geometry, derived from the configuration: inputs [0, split) index the rows,
+ * [split, n) the cells. units is not kept: critic.units of the configuration copy holds it. */
 typedef struct {
-    uint8_t n;                       /* task.n_inputs */
-    uint8_t split;                   /* first cell input, < n */
-    uint8_t units[ICOAC_MAX_INPUTS]; /* critic.units */
+    uint8_t n;     /* task.n_inputs */
+    uint8_t split; /* first cell input, < n */
+    uint8_t shape; /* ICOAC_PRIV_SHAPE_* bits */
+    uint8_t unused;
 } icoac_priv_grid_t;
 
 /* Critic units kept (b_k >= critic.threshold) at one state: the eligibility of the next TD
  * update, in the layout of the critic kernel that found them (icoac_priv.h).
- * Sparse kernel: row r keeps the units of the first row_cells[r] cells of the list, in the
- * listed order (0: none). */
+ * Sparse kernel: product[0, rows) are the rows' products, product[rows, rows + cells) the kept
+ * cells' products, largest first, then a 0; index[r] (r < rows) is the number of leading cells
+ * of the list that row r keeps (0: none), index[rows + i] the listed cell's index. */
 typedef struct {
-    icoac_real_t row_product[ICOAC_PRIV_BLOCK];  /* product of a row's factors */
-    icoac_real_t cell_product[ICOAC_PRIV_BLOCK]; /* product of a cell's factors, largest first; then 0 */
-    uint8_t row_cells[ICOAC_PRIV_BLOCK];         /* leading cells kept by each row */
-    uint8_t cell[ICOAC_PRIV_BLOCK];              /* the cell's index */
-    uint8_t cells;                               /* cells listed */
-    uint8_t rows;                                /* rows of the grid */
-    uint8_t stride;                              /* cells of the grid: a row's units */
+    icoac_real_t product[ICOAC_PRIV_LIST];
+    uint8_t index[ICOAC_PRIV_LIST];
+    uint8_t cells;  /* cells listed */
+    uint8_t rows;   /* rows of the grid */
+    uint8_t stride; /* cells of the grid: a row's units */
 } icoac_priv_critic_list_t;
 
-/* Dense kernel: the products of every row and every cell; unit row * stride + cell is kept when
- * row_product[row] * cell_product[cell] reaches the threshold. Only cells in
+/* Dense kernel: product[0, rows) the rows' products, product[rows, rows + stride) every cell's;
+ * unit row * stride + cell is kept when their product reaches the threshold. Only cells in
  * [cell_begin, cell_end) can be (the others have a product below it). */
 typedef struct {
-    icoac_real_t row_product[ICOAC_PRIV_BLOCK];
-    icoac_real_t cell_product[ICOAC_PRIV_BLOCK];
+    icoac_real_t product[ICOAC_PRIV_LIST];
     uint8_t cell_begin;
     uint8_t cell_end; /* <= cell_begin: no unit kept */
     uint8_t rows;
@@ -108,8 +124,7 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
     icoac_counters_t counters;
     icoac_real_t cov_buffer[2][ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS]; /* Sigma_w, and the spare the RL tick stages into */
     icoac_priv_critic_active_t active[2];             /* kept critic units of s_t and of s */
-    icoac_real_t v[ICOAC_PRIV_CRITIC_WEIGHTS];        /* critic weights: the grid's units, then room
-                                                         for a masked index (never read) */
+    icoac_real_t v[ICOAC_PRIV_CRITIC_WEIGHTS];        /* critic weights: the grid's units */
     icoac_priv_actor_batch_t batch;                   /* RL, actor.batch: this trial's sums */
     icoac_priv_search_t search;                       /* search mode */
 } icoac_priv_state_t;

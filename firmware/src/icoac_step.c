@@ -53,38 +53,31 @@ ICOAC_PRIV_NOINLINE static icoac_status_t not_in_trial(icoac_priv_state_t *st, i
     return ICOAC_ERR_NOT_INITIALISED;
 }
 
-icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
+/* A tick on an initialised state in a trial, for a task of n inputs whose late signal is the
+ * first `rules` rules of its table (sensor: 0, the input's flag instead). One implementation,
+ * instantiated for the cart-pole's task (compile-time n and rules: unrolled) and for the
+ * configuration's (bounded to the arrays); the state's shape tag selects one. */
+static inline icoac_status_t tick(icoac_priv_state_t *st, const icoac_input_t *in, icoac_output_t *out, int n,
+                                  int rules, int sensor)
 {
     static const icoac_real_t zeros[ICOAC_MAX_INPUTS] = {ICOAC_R(0.0)};
-    icoac_priv_state_t *st = icoac_priv_state(state);
-    const icoac_config_t *cfg;
+    const icoac_config_t *cfg = &st->config;
     icoac_real_t inputs[ICOAC_MAX_INPUTS];
     icoac_real_t scaled[ICOAC_MAX_INPUTS];
     icoac_priv_zone_t zone;
     int terminal;
     int ok;
-    if (state == 0 || in == 0 || out == 0) {
-        if (out != 0) {
-            clear_output(out);
-            out->status = ICOAC_ERR_NULL;
-        }
-        return ICOAC_ERR_NULL;
-    }
-    if (st->magic != ICOAC_PRIV_STATE_MAGIC) {
-        return not_in_trial(st, out);
-    }
-    cfg = &st->config;
     st->counters.ticks++;
-    icoac_priv_task_inputs(icoac_priv_inputs(cfg), in->s, inputs);
+    icoac_priv_task_inputs(n, in->s, inputs);
     /* s_i * 0 is 0 for finite s_i and NaN for NaN or Inf: one test for all n. */
     if (!(icoac_priv_dot(inputs, zeros) == ICOAC_R(0.0))) {
         st->counters.nonfinite++;
         return rejected(st, out, ICOAC_ERR_NONFINITE_INPUT);
     }
     terminal = (in->flags & ICOAC_INPUT_TERMINAL) != 0u;
-    icoac_priv_scale_inputs(&cfg->policy, st, inputs, scaled);
-    if (cfg->task.late_source == ICOAC_LATE_RULES) {
-        zone = icoac_priv_zone(&cfg->task, inputs);
+    icoac_priv_scale_inputs(&cfg->policy, st, n, inputs, scaled);
+    if (!sensor) {
+        zone = icoac_priv_zone(&cfg->task, rules, inputs);
     } else {
         zone = sensor_zone(in);
         if (!icoac_priv_finite(zone.reflex)) {
@@ -116,4 +109,32 @@ icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_o
     out->weight_norm = st->weight_norm;
     out->status = ICOAC_OK;
     return ICOAC_OK;
+}
+
+/* The general instance: the configuration's task. */
+ICOAC_PRIV_NOINLINE static icoac_status_t tick_general(icoac_priv_state_t *st, const icoac_input_t *in,
+                                                       icoac_output_t *out)
+{
+    const icoac_task_config_t *task = &st->config.task;
+    const int sensor = task->late_source != ICOAC_LATE_RULES;
+    return tick(st, in, out, icoac_priv_inputs(&st->config), sensor ? 0 : icoac_priv_rules(task), sensor);
+}
+
+icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
+{
+    icoac_priv_state_t *st = icoac_priv_state(state);
+    if (state == 0 || in == 0 || out == 0) {
+        if (out != 0) {
+            clear_output(out);
+            out->status = ICOAC_ERR_NULL;
+        }
+        return ICOAC_ERR_NULL;
+    }
+    if (st->magic != ICOAC_PRIV_STATE_MAGIC) {
+        return not_in_trial(st, out);
+    }
+    if ((st->grid.shape & ICOAC_PRIV_SHAPE_CARTPOLE_TASK) != 0u) {
+        return tick(st, in, out, ICOAC_CARTPOLE_INPUTS, ICOAC_CARTPOLE_RULES, 0);
+    }
+    return tick_general(st, in, out);
 }

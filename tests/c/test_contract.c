@@ -132,12 +132,12 @@ static void check_scan(const icoac_config_t *cfg, const icoac_real_t *v, const i
     assert_true(isnan((double)value) || value == ICOAC_R(0.0)); /* as the dense kernel's, below */
     assert_true(list[0].cells <= list[0].stride && list[0].stride <= ICOAC_CRITIC_BLOCK_MAX);
     for (i = 0; i < list[0].rows; ++i) {
-        assert_true(list[0].row_cells[i] <= list[0].cells);
+        assert_true(list[0].index[i] <= list[0].cells);
     }
     for (i = 0; i < list[0].cells; ++i) {
-        assert_true(list[0].cell[i] < list[0].stride);
+        assert_true(list[0].index[list[0].rows + i] < list[0].stride);
     }
-    assert_true(list[1].row_cells[0] == 0 && list[1].cells == 0);
+    assert_true(list[1].index[0] == 0 && list[1].cells == 0);
     memset(products, 0, sizeof products);
     value = icoac_priv_critic_value_dense(&cfg->critic, &grid, v, s, &products[0]);
     /* factors computed from NaN are NaN of either sign (IEEE 754 leaves it open): a positive one

@@ -132,13 +132,16 @@ static icoac_real_t kernel_value(int kernel, const icoac_config_t *cfg, const ic
                            : icoac_priv_critic_value_sparse(&cfg->critic, &geometry, v, s, &active->sparse);
 }
 
-static void kernel_update(int kernel, const icoac_critic_config_t *critic, icoac_real_t *v,
+/* Through the state's shape tag, as the tick does (the cart-pole's grid takes the cart-pole
+ * instance, the others the general one). */
+static void kernel_update(int kernel, const icoac_config_t *cfg, icoac_real_t *v,
                           const icoac_priv_critic_active_t *active, icoac_real_t step)
 {
+    const icoac_priv_grid_t geometry = grid_geometry(cfg);
     if (kernel == DENSE) {
-        icoac_priv_critic_update_dense(critic, v, &active->dense, step);
+        icoac_priv_critic_update_dense(&cfg->critic, &geometry, v, &active->dense, step);
     } else {
-        icoac_priv_critic_update_sparse(v, &active->sparse, step);
+        icoac_priv_critic_update_sparse_shaped(&geometry, v, &active->sparse, step);
     }
 }
 
@@ -151,7 +154,7 @@ static void library_b(int kernel, const icoac_config_t *cfg, const icoac_real_t 
     int k;
     memset(v, 0, sizeof v);
     assert_true(kernel_value(kernel, cfg, v, s, &active) == 0);
-    kernel_update(kernel, &cfg->critic, v, &active, (icoac_real_t)1.0);
+    kernel_update(kernel, cfg, v, &active, (icoac_real_t)1.0);
     for (k = 0; k < KMAX; ++k) {
         b[k] = (double)v[k];
     }
@@ -345,18 +348,19 @@ static void test_kept_unit_list(void **unused)
             assert_int_equal(list->rows * list->stride, units);
             assert_true(list->stride <= ICOAC_CRITIC_BLOCK_MAX && list->rows <= ICOAC_CRITIC_BLOCK_MAX);
             assert_true(list->cells <= list->stride);
-            assert_true(list->cell_product[list->cells] == 0);
+            assert_true(list->rows + list->cells < ICOAC_PRIV_LIST);
+            assert_true(list->product[list->rows + list->cells] == 0);
             for (i = 1; i < list->cells; ++i) {
-                assert_true(list->cell_product[i - 1] >= list->cell_product[i]);
+                assert_true(list->product[list->rows + i - 1] >= list->product[list->rows + i]);
             }
             for (i = 0; i < list->cells; ++i) {
-                assert_true(list->cell[i] < list->stride);
+                assert_true(list->index[list->rows + i] < list->stride);
             }
             memset(listed, 0, sizeof listed);
             for (r = 0; r < list->rows; ++r) {
-                assert_true(list->row_cells[r] <= list->cells);
-                for (i = 0; i < list->row_cells[r]; ++i) {
-                    const int k = r * list->stride + list->cell[i];
+                assert_true(list->index[r] <= list->cells);
+                for (i = 0; i < list->index[r]; ++i) {
+                    const int k = r * list->stride + list->index[list->rows + i];
                     assert_true(listed[k] == 0);
                     listed[k] = 1;
                 }
@@ -380,7 +384,7 @@ static void test_kept_unit_list(void **unused)
         if (i == units) {
             assert_int_equal(list->cells, list->stride);
             for (r = 0; r < list->rows; ++r) {
-                assert_int_equal(list->row_cells[r], list->stride);
+                assert_int_equal(list->index[r], list->stride);
             }
             ++all_kept_grids;
         }
@@ -433,8 +437,8 @@ static void test_dense_matches_sparse(void **unused)
                     max_rel = fmax(max_rel, fabs((double)value_dense - (double)value_sparse) / magnitude);
                 }
                 step = (icoac_real_t)test_uniform(&rng, -0.05, 0.05);
-                kernel_update(SPARSE, &cfg.critic, v_sparse, &sparse, step);
-                kernel_update(DENSE, &cfg.critic, v_dense, &dense, step);
+                kernel_update(SPARSE, &cfg, v_sparse, &sparse, step);
+                kernel_update(DENSE, &cfg, v_dense, &dense, step);
                 assert_memory_equal(v_dense, v_sparse, sizeof v_sparse);
             }
         }

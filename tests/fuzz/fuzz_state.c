@@ -121,7 +121,7 @@ static const state_field_t state_fields[] = {
     FZ_FIELD("has_prev", has_prev, 4, 'i'),
     FZ_FIELD("grid.n", grid.n, 1, 'b'),
     FZ_FIELD("grid.split", grid.split, 1, 'b'),
-    FZ_FIELD("grid.units", grid.units, 1, 'b'),
+    FZ_FIELD("grid.shape", grid.shape, 1, 'b'),
     FZ_FIELD("inv_range", inv_range, R, 'r'),
     FZ_FIELD("w", w, R, 'r'),
     FZ_FIELD("weight_norm", weight_norm, R, 'r'),
@@ -139,14 +139,12 @@ static const state_field_t state_fields[] = {
     FZ_FIELD("rng.has_spare", rng.has_spare, 4, 'i'),
     FZ_FIELD("counters", counters, 4, 'u'),
     FZ_FIELD("cov_buffer", cov_buffer, R, 'r'),
-    FZ_ACTIVE("active.sparse.row_product", sparse.row_product, R, 'r'),
-    FZ_ACTIVE("active.sparse.cell_product", sparse.cell_product, R, 'r'),
-    FZ_ACTIVE("active.sparse.row_cells", sparse.row_cells, 1, 'b'),
-    FZ_ACTIVE("active.sparse.cell", sparse.cell, 1, 'b'),
+    FZ_ACTIVE("active.sparse.product", sparse.product, R, 'r'),
+    FZ_ACTIVE("active.sparse.index", sparse.index, 1, 'b'),
     FZ_ACTIVE("active.sparse.cells", sparse.cells, 1, 'b'),
     FZ_ACTIVE("active.sparse.rows", sparse.rows, 1, 'b'),
     FZ_ACTIVE("active.sparse.stride", sparse.stride, 1, 'b'),
-    FZ_ACTIVE("active.dense.cell_product", dense.cell_product, R, 'r'),
+    FZ_ACTIVE("active.dense.product", dense.product, R, 'r'),
     FZ_ACTIVE("active.dense.cell_begin", dense.cell_begin, 1, 'b'),
     FZ_ACTIVE("active.dense.cell_end", dense.cell_end, 1, 'b'),
     FZ_ACTIVE("active.dense.rows", dense.rows, 1, 'b'),
@@ -168,7 +166,7 @@ static const state_field_t state_fields[] = {
 #define FZ_PATCH_CONFIG (FZ_STATE_FIELDS + 1)
 #define FZ_PATCH_RAW (FZ_STATE_FIELDS + 2)
 #define FZ_PATCH_KINDS (FZ_STATE_FIELDS + 3)
-ICOAC_STATIC_ASSERT(sizeof state_fields / sizeof state_fields[0] == 43, fz_state_field_count);
+ICOAC_STATIC_ASSERT(sizeof state_fields / sizeof state_fields[0] == 41, fz_state_field_count);
 
 /* The task's inputs as the library bounds the copy's n_inputs (whatever the copy holds). */
 static int inputs_of(const icoac_config_t *cfg)

@@ -483,13 +483,13 @@ def controller_seeds(fmt):
 # The named fields of icoac_priv_state_t a patch sets (state_fields in fuzz_state.c, in its
 # order): (name, kind) with kind "i" int32, "u" uint32, "b" uint8, "q" uint64, "r" real.
 STATE_FIELDS = [
-    ("has_prev", "i"), ("grid.n", "b"), ("grid.split", "b"), ("grid.units", "b"), ("inv_range", "r"), ("w", "r"), ("weight_norm", "r"), ("w_act", "r"), ("cov_slot", "i"),
+    ("has_prev", "i"), ("grid.n", "b"), ("grid.split", "b"), ("grid.shape", "b"), ("inv_range", "r"), ("w", "r"), ("weight_norm", "r"), ("w_act", "r"), ("cov_slot", "i"),
     ("active_slot", "i"), ("x_prev", "r"), ("penalty_prev", "r"), ("value_prev", "r"), ("noise_prev", "r"),
     ("trial_ticks", "u"), ("rng.state", "q"), ("rng.increment", "q"), ("rng.spare_normal", "r"),
-    ("rng.has_spare", "i"), ("counters", "u"), ("cov_buffer", "r"), ("active.sparse.row_product", "r"),
-    ("active.sparse.cell_product", "r"), ("active.sparse.row_cells", "b"), ("active.sparse.cell", "b"),
+    ("rng.has_spare", "i"), ("counters", "u"), ("cov_buffer", "r"), ("active.sparse.product", "r"),
+    ("active.sparse.index", "b"),
     ("active.sparse.cells", "b"), ("active.sparse.rows", "b"), ("active.sparse.stride", "b"),
-    ("active.dense.cell_product", "r"), ("active.dense.cell_begin", "b"), ("active.dense.cell_end", "b"),
+    ("active.dense.product", "r"), ("active.dense.cell_begin", "b"), ("active.dense.cell_end", "b"),
     ("active.dense.rows", "b"), ("active.dense.stride", "b"), ("v", "r"), ("batch.info", "r"), ("batch.shift", "r"),
     ("batch.staged_shift", "r"), ("search.w", "r"), ("search.ticks", "u"), ("search.lower", "r"),
     ("search.floor", "r"), ("search.prior_var", "r"), ("search.count", "i"),
@@ -497,7 +497,7 @@ STATE_FIELDS = [
 STATE_FIELD_NAMES = [name for name, _ in STATE_FIELDS]
 PATCH_HEADER, PATCH_CONFIG, PATCH_RAW = len(STATE_FIELDS), len(STATE_FIELDS) + 1, len(STATE_FIELDS) + 2
 # sizeof(icoac_state_t) with float and with double reals (ICOAC_STATE_SIZE).
-STATE_SIZES = {"f": 3328, "d": 6144}
+STATE_SIZES = {"f": 2880, "d": 5440}
 
 
 def patch(field, v, index=0, fmt="f"):
@@ -632,11 +632,13 @@ def state_seeds(fmt):
         "task-copy-corrupt": (raw_config(1, {"task.n_inputs": 200, "task.n_rules": -3, "task.rule_input[0]": 99,
                                              "critic.units[1]": 40, "task.late_source": 5}, fmt=fmt)
                               + ticks(ZERO, 4) + S_RESET + STATE_EXERCISE),
-        "task-grid-corrupt": (raw_state(1, [patch("grid.n", 255), patch("grid.split", 9), patch("grid.units", 200, 0),
-                                            patch("grid.units", 0, 3), patch("active.sparse.rows", 200, 0),
+        "task-grid-corrupt": (raw_state(1, [patch("grid.n", 255), patch("grid.split", 9), patch("grid.shape", 255, 0), patch("active.sparse.rows", 200, 0),
                                             patch("active.sparse.stride", 200, 1), patch("active.dense.rows", 255, 0),
                                             patch("active.dense.stride", 255, 1)], fmt=fmt) + ticks(ZERO, 4)
                               + STATE_EXERCISE),
+        # the shape tag cleared: the general kernels on the cart-pole's configuration
+        "task-shape-general": (raw_state(1, [patch("grid.shape", 0, 0)], fmt=fmt) + ticks(ZERO, 4)
+                               + STATE_EXERCISE),
         "task-sensor-copy": (raw_config(0, {"task.late_source": 1}, fmt=fmt) + ticks(ZERO, 2)
                              + bytes([0x80]) + real(1.0) + bytes([0x80]) + real("nan") + STATE_EXERCISE),
         "rl-actor-update-9-batch": (raw_config(1, {"actor.update": 9}, fmt=fmt, init_fields={"actor.batch": 1})
@@ -644,8 +646,8 @@ def state_seeds(fmt):
         "rl-explore-negative": (raw_config(1, {"actor.explore_ticks": -1}, fmt=fmt) + ticks(ZERO, 4)
                                 + s_patch(patch("trial_ticks", 2**32 - 1)) + ticks(ZERO, 3) + STATE_EXERCISE),
         # the kept-unit lists of both critic kernels, and the slots, hold anything
-        "rl-kept-units-corrupt": (raw_state(1, [patch("active.sparse.row_cells", 255, i) for i in range(18)]
-                                            + [patch("active.sparse.cell", 255, i) for i in range(0, 62, 5)]
+        "rl-kept-units-corrupt": (raw_state(1, [patch("active.sparse.index", 255, i) for i in range(18)]
+                                            + [patch("active.sparse.index", 255, i) for i in range(9, 74, 5)]
                                             + [patch("active.sparse.cells", 255, 0), patch("active.sparse.cells", 255, 1),
                                                patch("active.dense.cell_begin", 0, 0), patch("active.dense.cell_end", 255, 0),
                                                patch("active.dense.cell_begin", 0, 1), patch("active.dense.cell_end", 255, 1)],
@@ -655,8 +657,8 @@ def state_seeds(fmt):
                                                   patch("active.dense.cell_end", 3, 0),
                                                   patch("active.dense.cell_begin", 17, 1),
                                                   patch("active.dense.cell_end", 18, 1)], fmt=fmt) + ticks(ZERO, 3)),
-        "rl-sparse-products-nan": (raw_state(1, [patch("active.sparse.row_product", "nan", i) for i in range(18)]
-                                             + [patch("active.sparse.cell_product", "inf", i) for i in range(0, 62, 7)],
+        "rl-sparse-products-nan": (raw_state(1, [patch("active.sparse.product", "nan", i) for i in range(9)]
+                                             + [patch("active.sparse.product", "inf", i) for i in range(9, 74, 7)],
                                              fmt=fmt) + ticks(ZERO, 3) + STATE_EXERCISE),
         "rl-learned-nonfinite": (raw_state(1, [patch("w", "nan", 1), patch("weight_norm", "inf"),
                                                patch("cov_buffer", "nan", 5), patch("v", "nan", 80),

@@ -201,15 +201,18 @@ typedef struct {
  * maxima (an upper bound of the layout, checked at compile time to within 128 bytes, rounded up
  * to 64): reals for the configuration copy, the weight vectors, four n x n matrices (two
  * Sigma_w, the batch's information, the search's factor), the search's recorded trials
- * (ICOAC_SEARCH_BATCH_MAX n-vectors), the critic weights (ICOAC_MAX_CRITIC_UNITS plus 31) and
- * two kept-unit lists (64 reals each). Default maxima: 3,328 bytes with float, 6,144 with
- * double; cart-pole maxima (4 inputs, 4 rules, 162 units): 2,560 / 4,608. */
+ * (ICOAC_SEARCH_BATCH_MAX n-vectors), the critic weights (ICOAC_MAX_CRITIC_UNITS) and two
+ * kept-unit lists (ICOAC_STATE_LIST reals and bytes each: a critic block's rows and cells).
+ * Default maxima: 2,880 bytes with float, 5,440 with double; cart-pole maxima (4 inputs, 4 rules,
+ * 162 units): 2,112 / 3,840. */
+#define ICOAC_STATE_LIST_BOUND (32 + ICOAC_MAX_CRITIC_UNITS / 31)
+#define ICOAC_STATE_LIST (ICOAC_STATE_LIST_BOUND < 63 ? ICOAC_STATE_LIST_BOUND : 63)
 #define ICOAC_STATE_REALS                                                                                \
     (4 * ICOAC_MAX_INPUTS * ICOAC_MAX_INPUTS + 26 * ICOAC_MAX_INPUTS + 2 * ICOAC_MAX_RULES + ICOAC_MAX_CRITIC_UNITS + \
-     179)
-#define ICOAC_STATE_WORDS (2 * ICOAC_MAX_RULES + ICOAC_MAX_INPUTS + 48)
+     2 * ICOAC_STATE_LIST + 32)
+#define ICOAC_STATE_WORDS (2 * ICOAC_MAX_RULES + ICOAC_MAX_INPUTS + 41)
 #define ICOAC_STATE_SIZE                                                                                  \
-    (((int)sizeof(icoac_real_t) * ICOAC_STATE_REALS + 4 * ICOAC_STATE_WORDS + ICOAC_MAX_INPUTS + 216 + 63) / 64 * 64)
+    (((int)sizeof(icoac_real_t) * ICOAC_STATE_REALS + 4 * ICOAC_STATE_WORDS + 2 * ICOAC_STATE_LIST + 63) / 64 * 64)
 typedef struct {
     uint64_t opaque[ICOAC_STATE_SIZE / 8];
 } icoac_state_t;
