@@ -17,14 +17,15 @@ static inline icoac_real_t icoac_priv_clip_unit(icoac_real_t a)
     return a > ICOAC_R(1.0) ? ICOAC_R(1.0) : (a < ICOAC_R(-1.0) ? ICOAC_R(-1.0) : a);
 }
 
-/* The task's inputs: s_i for i < n, 0 past n (never read there). */
-static inline void icoac_priv_task_inputs(int n, const icoac_real_t s[ICOAC_MAX_INPUTS],
-                                          icoac_real_t inputs[ICOAC_MAX_INPUTS])
+/* The task's n inputs finite (entries n and up are not read). */
+static inline int icoac_priv_inputs_finite(int n, const icoac_real_t s[ICOAC_MAX_INPUTS])
 {
+    int finite = 1;
     int i;
-    for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
-        inputs[i] = i < n ? s[i] : ICOAC_R(0.0);
+    for (i = 0; i < ICOAC_MAX_INPUTS && i < n; ++i) {
+        finite &= icoac_priv_finite(s[i]);
     }
+    return finite;
 }
 
 /* x~_i = clip(s_i / range_i) for i < n, with 1 / range_i precomputed by icoac_init; 0 past n. */
@@ -34,15 +35,19 @@ static inline void icoac_priv_scale_inputs(const icoac_policy_config_t *policy, 
 {
     int i;
     for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
-        const icoac_real_t a = s[i] * st->inv_range[i];
-        scaled[i] = i < n ? (policy->clip_inputs ? icoac_priv_clip_unit(a) : a) : ICOAC_R(0.0);
+        if (i < n) {
+            const icoac_real_t a = s[i] * st->inv_range[i];
+            scaled[i] = policy->clip_inputs ? icoac_priv_clip_unit(a) : a;
+        } else {
+            scaled[i] = ICOAC_R(0.0);
+        }
     }
 }
 
 /* The late signal of the rule table (icoac.h, task): the first matching rule of the first
  * `rules` (<= ICOAC_MAX_RULES) gives r = -1 and its reflex; none gives 0, 0. The input indices
- * are bounded to the arrays. */
-static inline icoac_priv_zone_t icoac_priv_zone(const icoac_task_config_t *task, int rules,
+ * are bounded to the task's n inputs (1 <= n <= ICOAC_MAX_INPUTS): entries n and up are not read. */
+static inline icoac_priv_zone_t icoac_priv_zone(const icoac_task_config_t *task, int rules, int n,
                                                 const icoac_real_t s[ICOAC_MAX_INPUTS])
 {
     icoac_priv_zone_t zone;
@@ -51,7 +56,7 @@ static inline icoac_priv_zone_t icoac_priv_zone(const icoac_task_config_t *task,
     zone.penalty = ICOAC_R(0.0);
     for (k = 0; k < rules; ++k) {
         const uint32_t input = (uint32_t)task->rule_input[k];
-        const icoac_real_t value = s[input < (uint32_t)ICOAC_MAX_INPUTS ? input : 0u];
+        const icoac_real_t value = s[input < (uint32_t)n ? input : 0u];
         const icoac_real_t threshold = task->rule_threshold[k];
         if (task->rule_side[k] == ICOAC_RULE_ABOVE ? value > threshold : value < threshold) {
             zone.reflex = task->rule_reflex[k];

@@ -130,12 +130,11 @@ static int well_conditioned(const icoac_real_t cov[N][N], icoac_real_t lower[N][
     return 1;
 }
 
-/* The update after a full batch, staged into w, cov and lower: mu' = (1-a) mu + a mean_elite;
+/* The update after a full batch, staged into w and cov: mu' = (1-a) mu + a mean_elite;
  * Sigma' = (1-a) Sigma + a Cov_elite about mu' (upper triangle mirrored), then
- * Sigma'_ii >= floor_i. Returns 0 when a value is not finite or Sigma' not positive definite. */
-static int search_update(const icoac_search_config_t *search, const icoac_priv_state_t *st,
-                         const closing_batch_t *b, int n_elite, icoac_real_t w[N], icoac_real_t cov[N][N],
-                         icoac_real_t lower[N][N])
+ * Sigma'_ii >= floor_i. Returns 0 when a value is not finite. */
+static int search_update(const icoac_search_config_t *search, const icoac_priv_state_t *st, const closing_batch_t *b,
+                         int n_elite, icoac_real_t w[N], icoac_real_t cov[N][N])
 {
     const icoac_real_t (*sigma)[N] = icoac_priv_cov_c(st);
     const icoac_real_t a = search->step;
@@ -171,6 +170,14 @@ static int search_update(const icoac_search_config_t *search, const icoac_priv_s
     if (!icoac_priv_all_finite(w, N) || !icoac_priv_all_finite(&cov[0][0], N * N)) {
         return 0;
     }
+    return 1;
+}
+
+/* Sigma' (staged in cov) factored, L L^T = Sigma', with every pivot a fair fraction of its
+ * variance (else with the floors added to the diagonal); 0 when it is not positive definite. */
+static int factor_update(const icoac_priv_state_t *st, icoac_real_t cov[N][N], icoac_real_t lower[N][N])
+{
+    int i;
     if (!well_conditioned(ICOAC_PRIV_CONST_MAT(cov), lower, icoac_priv_inputs(&st->config))) {
         /* A rank-deficient elite (n_e <= n) with a step near 1 leaves Sigma' singular or nearly
          * so, which a diagonal floor need not repair: add the floor to the diagonal instead, a
@@ -191,25 +198,30 @@ static int clamp_int(int32_t x, int lo, int hi)
     return x < lo ? lo : (x > hi ? hi : (int)x);
 }
 
-/* A terminal tick ends the trial: record (w_act, length); a full batch updates (staged: on a
- * failure nothing is recorded and 0 is returned). The batch closes when at least batch - 1
- * trials are recorded (more after a retune to a smaller batch). Count and batch are clamped to
- * the arrays, whatever the state holds. */
-ICOAC_PRIV_NOINLINE static int close_batch(const icoac_config_t *cfg, icoac_priv_state_t *st, int batch, int count)
+/* The closing batch's mean and Sigma' staged (into batch.staged_shift and the spare buffer). */
+ICOAC_PRIV_NOINLINE static int stage_batch(const icoac_config_t *cfg, icoac_priv_state_t *st, int batch, int count)
 {
-    icoac_priv_search_t *recorded = &st->search;
     closing_batch_t b;
-    icoac_real_t w[N];
-    icoac_real_t lower[N][N];
-    icoac_real_t (*cov)[N] = icoac_priv_cov_spare(st);
-    int i;
-    int j;
-    b.recorded = recorded;
+    b.recorded = &st->search;
     b.count = count;
     b.last_w = st->w_act;
     b.last_ticks = st->trial_ticks;
     b.size = count + 1;
-    if (!search_update(&cfg->search, st, &b, elite_size(&cfg->search, batch), w, cov, lower)) {
+    return search_update(&cfg->search, st, &b, elite_size(&cfg->search, batch), st->batch.staged_shift,
+                         icoac_priv_cov_spare(st));
+}
+
+/* The staged mean (batch.staged_shift, a tick's scratch, unused by the search otherwise) and
+ * Sigma' (the spare buffer) factored and committed, or nothing when Sigma' is not positive
+ * definite. */
+ICOAC_PRIV_NOINLINE static int commit_batch(icoac_priv_state_t *st)
+{
+    icoac_priv_search_t *recorded = &st->search;
+    const icoac_real_t *w = st->batch.staged_shift;
+    icoac_real_t lower[N][N];
+    int i;
+    int j;
+    if (!factor_update(st, icoac_priv_cov_spare(st), lower)) {
         return 0;
     }
     icoac_priv_copy(st->w, w);
@@ -224,7 +236,11 @@ ICOAC_PRIV_NOINLINE static int close_batch(const icoac_config_t *cfg, icoac_priv
     return 1;
 }
 
-/* The batch's update is kept out of line: a trial that only records pays no frame for it. */
+/* A terminal tick ends the trial: record (w_act, length); a full batch updates (staged: on a
+ * failure nothing is recorded and 0 is returned). The batch closes when at least batch - 1
+ * trials are recorded (more after a retune to a smaller batch). Count and batch are clamped to
+ * the arrays, whatever the state holds. The update's two stages are kept out of line, one after
+ * the other: a trial that only records pays no frame for them, and their frames do not add up. */
 static int end_trial(const icoac_config_t *cfg, icoac_priv_state_t *st)
 {
     icoac_priv_search_t *recorded = &st->search;
@@ -239,7 +255,7 @@ static int end_trial(const icoac_config_t *cfg, icoac_priv_state_t *st)
         recorded->count = count + 1;
         return 1;
     }
-    return close_batch(cfg, st, batch, count);
+    return stage_batch(cfg, st, batch, count) && commit_batch(st);
 }
 
 /* Writes every output field but reflex, penalty, weight_norm and status. */

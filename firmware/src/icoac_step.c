@@ -60,24 +60,21 @@ ICOAC_PRIV_NOINLINE static icoac_status_t not_in_trial(icoac_priv_state_t *st, i
 static inline icoac_status_t tick(icoac_priv_state_t *st, const icoac_input_t *in, icoac_output_t *out, int n,
                                   int rules, int sensor)
 {
-    static const icoac_real_t zeros[ICOAC_MAX_INPUTS] = {ICOAC_R(0.0)};
     const icoac_config_t *cfg = &st->config;
-    icoac_real_t inputs[ICOAC_MAX_INPUTS];
+    const icoac_real_t *const inputs = in->s; /* entries n and up are not read */
     icoac_real_t scaled[ICOAC_MAX_INPUTS];
     icoac_priv_zone_t zone;
     int terminal;
     int ok;
     st->counters.ticks++;
-    icoac_priv_task_inputs(n, in->s, inputs);
-    /* s_i * 0 is 0 for finite s_i and NaN for NaN or Inf: one test for all n. */
-    if (!(icoac_priv_dot(inputs, zeros) == ICOAC_R(0.0))) {
+    if (!icoac_priv_inputs_finite(n, inputs)) {
         st->counters.nonfinite++;
         return rejected(st, out, ICOAC_ERR_NONFINITE_INPUT);
     }
     terminal = (in->flags & ICOAC_INPUT_TERMINAL) != 0u;
     icoac_priv_scale_inputs(&cfg->policy, st, n, inputs, scaled);
     if (!sensor) {
-        zone = icoac_priv_zone(&cfg->task, rules, inputs);
+        zone = icoac_priv_zone(&cfg->task, rules, n, inputs);
     } else {
         zone = sensor_zone(in);
         if (!icoac_priv_finite(zone.reflex)) {

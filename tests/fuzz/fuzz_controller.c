@@ -775,7 +775,7 @@ static int check_retune(const icoac_config_t *in_force, icoac_state_t *state, co
              "op %d: icoac_retune changed the critic geometry", op);
     /* the task's shape tag follows the rules and the late-signal source, which a retune may change */
     FZ_CHECK(((st->grid.shape & ICOAC_PRIV_SHAPE_CARTPOLE_TASK) != 0u) ==
-                 (icoac_priv_inputs(next) == ICOAC_CARTPOLE_INPUTS && next->task.late_source == ICOAC_LATE_RULES &&
+                 (next->task.n_inputs == ICOAC_CARTPOLE_INPUTS && next->task.late_source == ICOAC_LATE_RULES &&
                   next->task.n_rules == ICOAC_CARTPOLE_RULES),
              "op %d: icoac_retune: task shape tag %u", op, (unsigned)st->grid.shape);
     ex->grid.shape = st->grid.shape;
