@@ -39,7 +39,7 @@ void icoac_priv_actor_sample(icoac_priv_state_t *st)
  * not be the prior it is computed from (the tick stages into the spare buffer). */
 static inline void posterior_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
                                   const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
-                                  icoac_real_t cov[N][N])
+                                  icoac_real_t cov[N][N], int n)
 {
     const icoac_real_t noise_var = likelihood_var(actor);
     const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
@@ -52,28 +52,32 @@ static inline void posterior_step(const icoac_actor_config_t *actor, const icoac
     int i;
     int j;
 
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < n; ++i) {
         if (forget) {
-            for (j = 0; j < N; ++j) {
+            for (j = 0; j < n; ++j) {
                 row[j] = prior[i][j] * inflate;
             }
-            cov_h[i] = icoac_priv_dot(row, h);
+            cov_h[i] = icoac_priv_dot_n(row, h, n);
         } else {
-            cov_h[i] = icoac_priv_dot(prior[i], h);
+            cov_h[i] = icoac_priv_dot_n(prior[i], h, n);
         }
     }
-    inv_innovation_var = ICOAC_R(1.0) / (icoac_priv_dot(h, cov_h) + noise_var);
+    inv_innovation_var = ICOAC_R(1.0) / (icoac_priv_dot_n(h, cov_h, n) + noise_var);
     for (i = 0; i < N; ++i) {
-        gain[i] = cov_h[i] * inv_innovation_var;
-        w[i] = st->w[i] + gain[i] * innovation;
+        if (i < n) {
+            gain[i] = cov_h[i] * inv_innovation_var;
+            w[i] = st->w[i] + gain[i] * innovation;
+        } else {
+            w[i] = st->w[i];
+        }
     }
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < n; ++i) {
         icoac_real_t a_cov_h;
-        for (j = 0; j < N; ++j) {
+        for (j = 0; j < n; ++j) {
             row[j] = (forget ? prior[i][j] * inflate : prior[i][j]) - gain[i] * cov_h[j];
         }
-        a_cov_h = icoac_priv_dot(row, h);
-        for (j = i; j < N; ++j) {
+        a_cov_h = icoac_priv_dot_n(row, h, n);
+        for (j = i; j < n; ++j) {
             const icoac_real_t value = row[j] - a_cov_h * gain[j] + noise_var * gain[i] * gain[j];
             cov[i][j] = value;
             cov[j][i] = value;
@@ -87,7 +91,7 @@ void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_p
 {
     icoac_real_t staged[N][N];
     int i;
-    posterior_step(actor, st, h, innovation, w, staged);
+    posterior_step(actor, st, h, innovation, w, staged, N);
     for (i = 0; i < N; ++i) {
         icoac_priv_copy(cov[i], staged[i]);
     }
@@ -240,7 +244,11 @@ int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t 
         return 0;
     }
     case ICOAC_ACTOR_POSTERIOR:
-        posterior_step(actor, st, h, innovation, w, cov);
+        if ((st->grid.shape & ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) != 0u) {
+            posterior_step(actor, st, h, innovation, w, cov, ICOAC_CARTPOLE_INPUTS);
+        } else {
+            posterior_step(actor, st, h, innovation, w, cov, N);
+        }
         return 1;
     default:
         return -2;

@@ -46,10 +46,6 @@ void icoac_priv_critic_grid(const icoac_config_t *cfg, icoac_priv_grid_t *grid)
     int cartpole_grid = n == ICOAC_CARTPOLE_INPUTS;
     int i;
     memset(grid, 0, sizeof *grid);
-    if (n == ICOAC_CARTPOLE_INPUTS && cfg->task.late_source == ICOAC_LATE_RULES &&
-        cfg->task.n_rules == ICOAC_CARTPOLE_RULES) {
-        grid->shape |= ICOAC_PRIV_SHAPE_CARTPOLE_TASK;
-    }
     if (cfg->mode != ICOAC_MODE_RL) {
         return; /* no critic: its group is not checked, nothing derived from it */
     }
@@ -131,8 +127,11 @@ static inline void kept_range(const icoac_real_t *g, int n, icoac_real_t thresho
  * the sentinel and every weight read stay inside their arrays. */
 static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, const icoac_real_t *v,
                                         const icoac_real_t s[ICOAC_MAX_INPUTS], icoac_priv_critic_list_t *list,
-                                        int n, const int *units, int split, int rows, int stride)
+                                        int n_inputs, const int *units, int first_cell, int rows, int stride)
 {
+    /* the callers' bounds, restated for the compiler: 1 <= n <= ICOAC_MAX_INPUTS, split < n */
+    const int n = n_inputs < ICOAC_MAX_INPUTS ? n_inputs : ICOAC_MAX_INPUTS;
+    const int split = first_cell < n - 1 ? first_cell : n - 1;
     const icoac_real_t threshold = icoac_priv_critic_floor(critic);
     icoac_real_t g[ICOAC_CRITIC_UNITS_PER_INPUT_MAX];
     icoac_real_t *const row_product = list->product;
@@ -147,7 +146,8 @@ static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, con
     int k;
     int r;
     row_product[0] = ICOAC_R(1.0);
-    for (i = 0; i < ICOAC_MAX_INPUTS && i < split; ++i) {
+    ICOAC_PRIV_UNROLL
+    for (i = 0; i < split; ++i) {
         icoac_priv_factors(s[i], critic->range[i], units[i], g);
         entries = icoac_priv_critic_expand_all(row_product, g, units[i], entries);
     }
@@ -158,12 +158,10 @@ static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, con
     cell_product[prefix_first] = ICOAC_R(1.0);
     cell_index[prefix_first] = 0u;
     entries = 1;
-    for (i = 0; i < ICOAC_MAX_INPUTS && i < n - 1; ++i) {
+    ICOAC_PRIV_UNROLL
+    for (i = split; i < n - 1; ++i) {
         int begin;
         int end;
-        if (i < split) {
-            continue;
-        }
         icoac_priv_factors(s[i], critic->range[i], units[i], g);
         kept_range(g, units[i], threshold, &begin, &end);
         entries = icoac_priv_critic_expand(cell_product + prefix_first, cell_index + prefix_first, g, units[i], begin,

@@ -39,8 +39,11 @@ static inline icoac_real_t select_kept(icoac_real_t b, icoac_real_t threshold, i
  * ICOAC_MAX_CRITIC_UNITS). */
 static inline icoac_real_t dense_value(const icoac_critic_config_t *critic, const icoac_real_t *v,
                                        const icoac_real_t s[ICOAC_MAX_INPUTS], icoac_priv_critic_products_t *products,
-                                       int n, const int *units, int split, int rows, int stride)
+                                       int n_inputs, const int *units, int first_cell, int rows, int stride)
 {
+    /* the callers' bounds, restated for the compiler: 1 <= n <= ICOAC_MAX_INPUTS, split < n */
+    const int n = n_inputs < ICOAC_MAX_INPUTS ? n_inputs : ICOAC_MAX_INPUTS;
+    const int split = first_cell < n - 1 ? first_cell : n - 1;
     const icoac_real_t threshold = icoac_priv_critic_floor(critic);
     icoac_real_t g[ICOAC_CRITIC_UNITS_PER_INPUT_MAX];
     icoac_real_t cell_sum[ICOAC_CRITIC_BLOCK_MAX];
@@ -52,17 +55,16 @@ static inline icoac_real_t dense_value(const icoac_critic_config_t *critic, cons
     int end = 0;
     int i, c, r, j;
     row_product[0] = ICOAC_R(1.0);
-    for (i = 0; i < ICOAC_MAX_INPUTS && i < split; ++i) {
+    ICOAC_PRIV_UNROLL
+    for (i = 0; i < split; ++i) {
         icoac_priv_factors(s[i], critic->range[i], units[i], g);
         entries = icoac_priv_critic_expand_all(row_product, g, units[i], entries);
     }
     cell_product[0] = ICOAC_R(1.0);
     entries = 1;
-    for (i = 0; i < ICOAC_MAX_INPUTS && i < n; ++i) {
+    ICOAC_PRIV_UNROLL
+    for (i = split; i < n; ++i) {
         const int count = units[i];
-        if (i < split) {
-            continue;
-        }
         icoac_priv_factors(s[i], critic->range[i], count, g);
         if (i == split) {
             /* Only units of the first cell input with g >= the threshold can be kept (every factor

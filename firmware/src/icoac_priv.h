@@ -30,6 +30,14 @@
 #define ICOAC_PRIV_OPAQUE(p) ((void)0)
 #endif
 
+/* Unroll the next loop completely when its trip count is a compile-time constant: the input
+ * loops of the kernels' cart-pole instances (GCC 8 and later; elsewhere nothing). */
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 8
+#define ICOAC_PRIV_UNROLL _Pragma("GCC unroll 16")
+#else
+#define ICOAC_PRIV_UNROLL
+#endif
+
 /* Kept out of line: a per-trial path whose frame should not add to the per-tick one. */
 #if defined(__GNUC__)
 #define ICOAC_PRIV_NOINLINE __attribute__((__noinline__))
@@ -206,6 +214,21 @@ static inline icoac_real_t icoac_priv_dot(const icoac_real_t a[ICOAC_MAX_INPUTS]
     }
     if ((ICOAC_MAX_INPUTS & 1) != 0) {
         sum += a[ICOAC_MAX_INPUTS - 1] * b[ICOAC_MAX_INPUTS - 1];
+    }
+    return sum;
+}
+
+/* The same order over the first n entries (4 <= n <= ICOAC_MAX_INPUTS): the dot product of the
+ * instances with a compile-time n; with n = ICOAC_MAX_INPUTS it is icoac_priv_dot. */
+static inline icoac_real_t icoac_priv_dot_n(const icoac_real_t *a, const icoac_real_t *b, int n)
+{
+    icoac_real_t sum = (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
+    int i;
+    for (i = 4; i + 1 < n && i + 1 < ICOAC_MAX_INPUTS; i += 2) {
+        sum += a[i] * b[i] + a[i + 1] * b[i + 1];
+    }
+    if ((n & 1) != 0 && n <= ICOAC_MAX_INPUTS) {
+        sum += a[n - 1] * b[n - 1];
     }
     return sum;
 }

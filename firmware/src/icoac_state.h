@@ -35,11 +35,12 @@ ICOAC_STATIC_ASSERT(ICOAC_STATE_LIST == (ICOAC_CRITIC_BLOCK_MAX + ICOAC_MAX_CRIT
 ICOAC_STATIC_ASSERT(ICOAC_CRITIC_BLOCK_MAX <= ICOAC_PRIV_CELL_MASK, block_fits_its_mask);
 ICOAC_STATIC_ASSERT(ICOAC_CRITIC_UNITS_PER_INPUT_MAX <= ICOAC_CRITIC_BLOCK_MAX, an_input_fits_a_block);
 
-/* Shape tags of the configuration in force (icoac_priv_grid_t.shape), derived by icoac_init /
- * icoac_retune / icoac_reset: the tick runs the kernels instantiated for the cart-pole's shape
- * when a bit is set, the general ones otherwise. The cart-pole instances use their compile-time
- * shape, inside every array whatever the state holds, so a corrupted tag stays memory-safe. */
-#define ICOAC_PRIV_SHAPE_CARTPOLE_TASK 1u   /* 4 inputs, the rule table with 4 rules */
+/* Shape tag of the configuration in force (icoac_priv_grid_t.shape), derived by icoac_init /
+ * icoac_retune / icoac_reset: the RL tick runs the critic kernels and the posterior step
+ * instantiated for the cart-pole's shape when it is set, the general ones otherwise. The
+ * cart-pole instances use their compile-time shape, inside every array whatever the state
+ * holds, so a corrupted tag stays memory-safe. (The tick's features test the task's three words
+ * in the configuration copy instead: icoac_step.c.) */
 #define ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC 2u /* RL with 4 inputs and the 3 x 3 x 6 x 3 grid (rows 9, cells 18) */
 #define ICOAC_PRIV_CARTPOLE_ROWS (ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT)
 #define ICOAC_PRIV_CARTPOLE_CELLS (ICOAC_CRITIC_N_THETA * ICOAC_CRITIC_N_THETA_DOT)
@@ -50,7 +51,7 @@ ICOAC_STATIC_ASSERT(ICOAC_PRIV_CARTPOLE_ROWS + ICOAC_PRIV_CARTPOLE_CELLS < ICOAC
 typedef struct {
     uint8_t n;     /* task.n_inputs */
     uint8_t split; /* first cell input, < n */
-    uint8_t shape; /* ICOAC_PRIV_SHAPE_* bits */
+    uint8_t shape; /* ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC or 0 */
     uint8_t unused;
 } icoac_priv_grid_t;
 

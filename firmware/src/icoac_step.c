@@ -56,7 +56,7 @@ ICOAC_PRIV_NOINLINE static icoac_status_t not_in_trial(icoac_priv_state_t *st, i
 /* A tick on an initialised state in a trial, for a task of n inputs whose late signal is the
  * first `rules` rules of its table (sensor: 0, the input's flag instead). One implementation,
  * instantiated for the cart-pole's task (compile-time n and rules: unrolled) and for the
- * configuration's (bounded to the arrays); the state's shape tag selects one. */
+ * configuration's (bounded to the arrays); icoac_step selects one per tick. */
 static inline icoac_status_t tick(icoac_priv_state_t *st, const icoac_input_t *in, icoac_output_t *out, int n,
                                   int rules, int sensor)
 {
@@ -130,7 +130,10 @@ icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_o
     if (st->magic != ICOAC_PRIV_STATE_MAGIC) {
         return not_in_trial(st, out);
     }
-    if ((st->grid.shape & ICOAC_PRIV_SHAPE_CARTPOLE_TASK) != 0u) {
+    /* the cart-pole's task: tested on the configuration copy itself (three words), so the
+     * instance reads exactly the inputs and rules the copy names, whatever else the state holds */
+    if (st->config.task.n_inputs == ICOAC_CARTPOLE_INPUTS && st->config.task.late_source == ICOAC_LATE_RULES &&
+        st->config.task.n_rules == ICOAC_CARTPOLE_RULES) {
         return tick(st, in, out, ICOAC_CARTPOLE_INPUTS, ICOAC_CARTPOLE_RULES, 0);
     }
     return tick_general(st, in, out);
