@@ -74,7 +74,7 @@ static inline void posterior_step(const icoac_actor_config_t *actor, const icoac
     for (i = 0; i < n; ++i) {
         icoac_real_t a_cov_h;
         for (j = 0; j < n; ++j) {
-            row[j] = (forget ? prior[i][j] * inflate : prior[i][j]) - gain[i] * cov_h[j];
+            row[j] = prior[i][j] * inflate - gain[i] * cov_h[j]; /* inflate 1 without forgetting: exact */
         }
         a_cov_h = icoac_priv_dot_n(row, h, n);
         for (j = i; j < n; ++j) {
