@@ -2,8 +2,9 @@
  * critic), evaluated separably: a_k = prod_i f_i(k_i) and sum_k a_k = prod_i sum_j f_i(j), so the
  * normalized activation is b_k = prod_i g_i(k_i) with per-input normalized factors g.
  * Units with b_k below critic->threshold count as 0 (method.md, A10). This file: the grid's
- * geometry, the factors and the sparse kernel (the dense one is icoac_critic_dense.c); its value
- * pass lists the units it kept, and the TD update of the next tick walks that list.
+ * geometry and the sparse kernel (the factors are icoac_priv.h's, the dense kernel is
+ * icoac_critic_dense.c); its value pass lists the units it kept, and the TD update of the next
+ * tick walks that list.
  * Layout: k = row * cells + cell, row-major over the row inputs [0, split) and the cell inputs
  * [split, n) (the cart-pole: rows over (x, x_dot), cells over (theta, theta_dot)); b_k is
  * evaluated as (row product) * (cell product), each a left-to-right product of its factors.
@@ -93,18 +94,6 @@ int icoac_priv_critic_shape(const icoac_critic_config_t *critic, const icoac_pri
     shape->rows = rows;
     shape->cells = cells;
     return 1;
-}
-
-/* With threshold 0 the floor is the smallest normal number: b_k below it is 0 under
- * flush-to-zero and adds nothing to V either way. */
-icoac_real_t icoac_priv_critic_floor(const icoac_critic_config_t *critic)
-{
-#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
-    const icoac_real_t smallest_normal = DBL_MIN;
-#else
-    const icoac_real_t smallest_normal = FLT_MIN;
-#endif
-    return critic->threshold > smallest_normal ? critic->threshold : smallest_normal;
 }
 
 /* First and one-past-last index of the factors >= threshold (factors are unimodal). */

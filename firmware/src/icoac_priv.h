@@ -3,6 +3,7 @@
 #ifndef ICOAC_PRIV_H
 #define ICOAC_PRIV_H
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -301,8 +302,17 @@ void icoac_priv_critic_grid(const icoac_config_t *cfg, icoac_priv_grid_t *grid);
  * which the counts multiply to at most ICOAC_CRITIC_BLOCK_MAX cells; 0 when the rows do not fit
  * that bound (or a count is not in [1, ICOAC_CRITIC_UNITS_PER_INPUT_MAX]), else m + 1. */
 int icoac_priv_critic_split(const int32_t *units, int n);
-/* b_k below this floor counts as 0: the threshold, or with threshold 0 the smallest normal number. */
-icoac_real_t icoac_priv_critic_floor(const icoac_critic_config_t *critic);
+/* b_k below this floor counts as 0: the threshold, or with threshold 0 the smallest normal number
+ * (b_k below it is 0 under flush-to-zero and adds nothing to V either way). */
+static inline icoac_real_t icoac_priv_critic_floor(const icoac_critic_config_t *critic)
+{
+#if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
+    const icoac_real_t smallest_normal = DBL_MIN;
+#else
+    const icoac_real_t smallest_normal = FLT_MIN;
+#endif
+    return critic->threshold > smallest_normal ? critic->threshold : smallest_normal;
+}
 /* The normalized 1-D Gaussian factors g_0 .. g_{n-1} of one input (n in [1, 16]). With centres c_j = -R + (2j+1)R/n and
  * width sigma = R/n, (s - c_j)/sigma = d_j = o - 2j with o = s*n/R + n - 1. Relative to the
  * nearest centre j* (distance d), a_{j*+1}/a_{j*} = exp(2d - 2) =: up, a_{j*-1}/a_{j*} =
