@@ -386,7 +386,8 @@ typedef struct {
 int icoac_priv_critic_shape(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
                             icoac_priv_shape_t *shape);
 /* The cart-pole's units per input (the compile-time shape of the cart-pole instances). */
-#define ICOAC_PRIV_CARTPOLE_UNITS {ICOAC_CRITIC_N_X, ICOAC_CRITIC_N_X_DOT, ICOAC_CRITIC_N_THETA, ICOAC_CRITIC_N_THETA_DOT}
+#define ICOAC_PRIV_CARTPOLE_UNITS \
+    {ICOAC_CRITIC_N_X, ICOAC_CRITIC_N_X_DOT, ICOAC_CRITIC_N_THETA, ICOAC_CRITIC_N_THETA_DOT}
 /* The same, with loops of a constant length (unrolled) for the common counts: the kernels' input
  * loops do not unroll, so the count is a constant only inside such a case. */
 #if defined(__GNUC__) && defined(ICOAC_CRITIC_DENSE) && ICOAC_CRITIC_DENSE

@@ -95,8 +95,8 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     }
     /* commit */
     if (update) {
-        icoac_priv_critic_update(&cfg->critic, &st->grid, st->v, &st->active[cfg->critic.quirks ? slot_prev ^ 1 : slot_prev],
-                                 cfg->critic.rate * delta);
+        icoac_priv_critic_update(&cfg->critic, &st->grid, st->v,
+                                 &st->active[cfg->critic.quirks ? slot_prev ^ 1 : slot_prev], cfg->critic.rate * delta);
         icoac_priv_copy(st->w, w);
         st->cov_slot = (st->cov_slot & 1) ^ cov_changed;
         st->weight_norm = norm;

@@ -26,10 +26,10 @@
  * geometry against these bounds before they use it, whatever the state holds. */
 #define ICOAC_PRIV_CELL_MASK 31
 #define ICOAC_PRIV_LIST ICOAC_STATE_LIST
-ICOAC_STATIC_ASSERT(ICOAC_STATE_LIST == (ICOAC_CRITIC_BLOCK_MAX + ICOAC_MAX_CRITIC_UNITS / ICOAC_CRITIC_BLOCK_MAX + 1 <
-                                                 2 * ICOAC_CRITIC_BLOCK_MAX + 1
-                                             ? ICOAC_CRITIC_BLOCK_MAX + ICOAC_MAX_CRITIC_UNITS / ICOAC_CRITIC_BLOCK_MAX + 1
-                                             : 2 * ICOAC_CRITIC_BLOCK_MAX + 1),
+#define ICOAC_PRIV_LIST_BOUND (ICOAC_CRITIC_BLOCK_MAX + ICOAC_MAX_CRITIC_UNITS / ICOAC_CRITIC_BLOCK_MAX + 1)
+#define ICOAC_PRIV_LIST_MAX (2 * ICOAC_CRITIC_BLOCK_MAX + 1)
+ICOAC_STATIC_ASSERT(ICOAC_STATE_LIST ==
+                        (ICOAC_PRIV_LIST_BOUND < ICOAC_PRIV_LIST_MAX ? ICOAC_PRIV_LIST_BOUND : ICOAC_PRIV_LIST_MAX),
                     list_room_as_bounded);
 #define ICOAC_PRIV_CRITIC_WEIGHTS ICOAC_MAX_CRITIC_UNITS
 ICOAC_STATIC_ASSERT(ICOAC_CRITIC_BLOCK_MAX <= ICOAC_PRIV_CELL_MASK, block_fits_its_mask);

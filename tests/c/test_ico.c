@@ -217,7 +217,8 @@ static void test_feature_helpers(void **unused)
     for (r = 0; r < sizeof zone_rows / sizeof zone_rows[0]; ++r) {
         const icoac_real_t s[ICOAC_MAX_INPUTS] = {(icoac_real_t)zone_rows[r].x, ICOAC_R(0.3),
                                                   (icoac_real_t)zone_rows[r].theta, ICOAC_R(-0.4)};
-        const icoac_priv_zone_t zone = icoac_priv_zone(&cfg.task, icoac_priv_rules(&cfg.task), ICOAC_CARTPOLE_INPUTS, s);
+        const icoac_priv_zone_t zone =
+            icoac_priv_zone(&cfg.task, icoac_priv_rules(&cfg.task), ICOAC_CARTPOLE_INPUTS, s);
         assert_true(zone.reflex == zone_rows[r].reflex && zone.penalty == zone_rows[r].penalty);
     }
     cfg.policy.reflex_force = (icoac_real_t)2.5;
