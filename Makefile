@@ -117,13 +117,19 @@ sweeps: build venv
 	cp $(SWEEP_OUT)/summary.md docs/sweeps.md
 
 # RL alone's own sweep (N(0, sigma_w^2 I), nothing from ICO; the ICO grid only names the
-# ICO-failed cells): stage 1, readings x sigma_w; stage 2 around its choice (RL_ALONE_BASE).
+# ICO-failed cells): stage 1, readings x sigma_w; stage 2 one at a time around its choice
+# (RL_ALONE_BASE), the schedule grid, the noise grid at the schedule's choice (RL_ALONE_SCHEDULE);
+# then 5-seed grids of every cell for the best 3 settings (--confirm).
 RL_ALONE_OUT ?= results/sweeps-rl-alone
 RL_ALONE_BASE ?= --base actor.update=gradient --base actor.rate=0.03
+RL_ALONE_SCHEDULE ?= --base actor.update=gradient --base actor.explore_ticks=1000 --base actor.batch=0
 RL_ALONE_SWEEP = $(VPY) -m harness.tools.learner_sweeps --prior-from $(SWEEP_ICO) --out $(RL_ALONE_OUT)
 sweeps-rl-alone: build venv
 	$(RL_ALONE_SWEEP) --stage rl-alone
-	$(RL_ALONE_SWEEP) --stage rl-alone-2 $(RL_ALONE_BASE)
+	$(RL_ALONE_SWEEP) --stage rl-alone-2 --only rl-alone-stage2 $(RL_ALONE_BASE)
+	$(RL_ALONE_SWEEP) --stage rl-alone-2 --only rl-alone-schedule-grid --base actor.update=gradient
+	$(RL_ALONE_SWEEP) --stage rl-alone-2 --only rl-alone-noise-grid $(RL_ALONE_SCHEDULE)
+	$(RL_ALONE_SWEEP) --confirm
 	$(RL_ALONE_SWEEP) --report
 	cp $(RL_ALONE_OUT)/summary.md docs/sweeps-rl-alone.md
 

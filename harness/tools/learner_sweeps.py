@@ -21,7 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import results, store
+from .. import geometry, results, store
+from ..config import NAMED_CONFIGURATIONS
 from ..sweep import SweepOptions, run_sweep
 
 SEEDS = 2
@@ -89,10 +90,12 @@ RL_ALONE_2 = (
     ("rl-alone-stage2", "rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
                                "actor.noise_std=1,0.5,2,3,5", "actor.scale=0.5,0.1,0.25,2", "prior_std=1,0.3,3"],
      True),
-    ("rl-alone-noise-grid", "rl", ["actor.explore_ticks=1000", "actor.noise_std=2,3,5,8", "actor.scale=0.1,0.25,0.5"],
-     False),
-    ("rl-alone-schedule-grid", "rl", ["actor.noise_std=3", "actor.explore_ticks=100,300,1000",
-                                      "prior_std=0.3,1,3"], False),
+    # The grids vary what the gradient reading uses (beta, sigma_u, the schedule, the batch);
+    # alpha and sigma_w play no part in it (the spread cells of stage 2: identical rows).
+    ("rl-alone-schedule-grid", "rl", ["actor.explore_ticks=300,1000,3000", "actor.batch=0,1",
+                                      "actor.rate=0.01,0.03,0.1"], False),
+    # sigma_u x beta at the schedule grid's choice (--base)
+    ("rl-alone-noise-grid", "rl", ["actor.noise_std=0.5,1,2,3", "actor.rate=0.01,0.03,0.1"], False),
 )
 
 
@@ -156,6 +159,78 @@ def report(out: Path) -> str:
     return "\n".join(lines)
 
 
+# RL alone's confirmation: the best few distinct settings of its sweeps, on every cell of the grid
+# with 5 seeds, ranked by the same criterion (its ICO-failed cells are those of --prior-from).
+CONFIRM_SEEDS = 5
+CONFIRM_FEW = 3
+ALL_CELLS = f"0-{geometry.CELLS - 1}"
+ONE_POINT = 0.01
+
+
+def _effective(items: list[str]) -> dict[str, str]:
+    """NAME=VALUE items applied in order (a later item overrides an earlier one)."""
+    return dict(item.split("=", 1) for item in items)
+
+
+def ranked_rows(out: Path, prefix: str) -> list[dict]:
+    """Every learning row of the sweeps OUT/PREFIX-*-ico-failed (no-learning controls and
+    confirmations left out), each with its full setting (the sweep's fixed items, then the row's)
+    and its spread row, best first by the criterion: the highest ICO-failed success; rows within
+    one point of the best are ordered by spread success, then by fewer median trials. Rows with
+    identical results on both selections (parameters the reading does not use) count once."""
+    rows, seen = [], set()
+    for path in sorted(out.glob(f"{prefix}-*-ico-failed/sweep.csv")):
+        name = path.parent.name[: -len("-ico-failed")]
+        meta = json.loads((path.parent / "sweep.json").read_text())
+        if meta["condition"].endswith("-control") or "-confirm" in name:
+            continue
+        spread_path = out / f"{name}-spread" / "sweep.csv"
+        spread = {}
+        if spread_path.is_file():
+            with open(spread_path, newline="") as fh:
+                spread = {r["key"]: r for r in csv.DictReader(fh)}
+        with open(path, newline="") as fh:
+            for r in csv.DictReader(fh):
+                s = spread.get(r["key"], {})
+                setting = _effective(meta["set"] + [f"{a}={b}" for a, b in json.loads(r["key"]).items()])
+                row = {"sweep": name, "setting": setting, "ico_failed": float(r["success_rate_mean"]),
+                       "ico_failed_sd": float(r["success_rate_sd"]),
+                       "spread": float(s["success_rate_mean"]) if s else float("nan"),
+                       "median_trials": float(r["median_trials"]) if r["median_trials"] else float("inf")}
+                signature = (r["success_rate_mean"], r["success_rate_sd"], r["median_trials"],
+                             s.get("success_rate_mean"), s.get("median_trials"))
+                if signature not in seen:
+                    seen.add(signature)
+                    rows.append(row)
+    rows.sort(key=lambda r: -r["ico_failed"])
+    if rows:
+        best = rows[0]["ico_failed"]
+        near = [r for r in rows if r["ico_failed"] >= best - ONE_POINT]
+        near.sort(key=lambda r: (-r["spread"], r["median_trials"]))
+        rows = near + rows[len(near):]
+    return rows
+
+
+def literal_items(setting: dict[str, str]) -> list[str]:
+    """The items of a full setting that differ from the literal configuration."""
+    base = _effective(list(NAMED_CONFIGURATIONS["literal"]))
+    return [f"{k}={v}" for k, v in setting.items() if base.get(k) != v]
+
+
+def confirm(args, prefix: str = "rl-alone") -> int:
+    """5-seed grids (every cell) of the best few settings of the sweeps OUT/PREFIX-*."""
+    for i, row in enumerate(ranked_rows(args.out, prefix)[:CONFIRM_FEW], 1):
+        items = literal_items(row["setting"])
+        print(f"[learner_sweeps] {prefix}-confirm-{i}: {', '.join(items)}", file=sys.stderr, flush=True)
+        code = run_sweep(SweepOptions(prior_from=args.prior_from, out=args.out / f"{prefix}-confirm-{i}",
+                                      params=items, condition="rl", seeds=CONFIRM_SEEDS, cells=ALL_CELLS,
+                                      max_trials=MAX_TRIALS, configuration="literal", sets=[],
+                                      one_at_a_time=False, threads=args.threads, quiet=True))
+        if code:
+            return code
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m harness.tools.learner_sweeps", description=__doc__.split("\n")[0])
     ap.add_argument("--prior-from", required=True, type=Path, help="ICO results directory (one seed)")
@@ -168,12 +243,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", action="append", default=[], help="run only the sweeps of these names")
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--report", action="store_true", help="only write OUT/summary.md from the finished sweeps")
+    ap.add_argument("--confirm", action="store_true",
+                    help=f"RL alone: {CONFIRM_SEEDS}-seed grids of every cell for the best {CONFIRM_FEW} settings "
+                         "of OUT's rl-alone sweeps")
     args = ap.parse_args(argv)
     if args.report:
         path = args.out / "summary.md"
         store.write_text(path, report(args.out))
         print(path)
         return 0
+    if args.confirm:
+        return confirm(args)
     selections = {"spread": dict(subset=SPREAD_CELLS), "ico-failed": dict(cells=ico_failed_cells(args.prior_from))}
     plan = PLANS[args.stage]
     for name, condition, params, one_at_a_time in plan:
