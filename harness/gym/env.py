@@ -19,15 +19,12 @@ from .plants import PLANTS, PlantSpec
 
 
 def parse_force(action: Any, limit: float) -> float:
-    """One finite force from an action (a number or an array of one number), clipped to
-    [-limit, limit]; ValueError for anything else."""
-    try:
-        values = np.asarray(action, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        values = None
-    if values is None or values.size != 1 or not math.isfinite(values[0]):
+    """One finite force from an action (a real number, or an array of one), clipped to
+    [-limit, limit]; ValueError for anything else (strings and booleans included)."""
+    values = np.asarray(action)
+    if values.dtype.kind not in "iuf" or values.size != 1 or not math.isfinite(values.reshape(-1)[0]):
         raise ValueError(f"action must be one finite force (N), got {action!r:.60}")
-    return float(min(max(values[0], -limit), limit))
+    return float(min(max(float(values.reshape(-1)[0]), -limit), limit))
 
 
 class IcoacPlantEnv(gymnasium.Env):
@@ -48,7 +45,8 @@ class IcoacPlantEnv(gymnasium.Env):
         self.render_mode = None
         self.parameters = self.plant.configure(parameters)
         limit = self.plant.action_limit if force_limit is None else force_limit
-        if isinstance(limit, bool) or not isinstance(limit, (int, float)) or not 0 < limit <= self.plant.action_limit:
+        if isinstance(limit, bool) or not isinstance(limit, (int, float, np.integer, np.floating)) \
+                or not 0 < limit <= self.plant.action_limit:
             raise ValueError(f"force_limit must be a number in (0, {self.plant.action_limit:g}] N, "
                              f"got {force_limit!r:.40}")
         self.force_limit = float(limit)

@@ -7,6 +7,7 @@ cart-pole is here; another plant is another PlantSpec built on its own C functio
 from __future__ import annotations
 
 import ctypes
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
@@ -19,10 +20,12 @@ from ..config import PLANT_FIELDS, RunConfig, build_config
 
 @dataclass(frozen=True)
 class Variable:
-    """One component of a plant's state or action."""
+    """One component of a plant's state or action; ``limit``: the parameter bounding it (the
+    failure test: |value| > that parameter), if any."""
     name: str
     unit: str
     meaning: str
+    limit: str | None = None
 
 
 @dataclass(frozen=True)
@@ -75,18 +78,13 @@ def cart_pole_failed(cfg: RunConfig, state: np.ndarray) -> bool:
     return bool(B.lib.icoac_sim_failed(ctypes.byref(cfg.plant), state))
 
 
-class _Grid:
-    """The paper grid of one seed (icoac_sim_paper_grid), the last one kept."""
-    seed: int | None = None
-    cells: np.ndarray | None = None
-
-    @classmethod
-    def get(cls, seed: int) -> np.ndarray:
-        if cls.seed != seed:
-            cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
-            B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, seed), "paper grid")
-            cls.seed, cls.cells = seed, cells
-        return cls.cells
+@functools.lru_cache(maxsize=1)
+def paper_grid(seed: int) -> np.ndarray:
+    """The paper grid's cells for a seed (icoac_sim_paper_grid), read-only; the last one is kept."""
+    cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
+    B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, seed), "paper grid")
+    cells.flags.writeable = False
+    return cells
 
 
 def _index(options: Mapping[str, Any], name: str, limit: int, rng: np.random.Generator) -> int:
@@ -136,15 +134,15 @@ def cart_pole_start(cfg: RunConfig, rng: np.random.Generator, options: Mapping[s
         return state, {}
     cell = _index(options, "cell", B.GRID_CELLS, rng)
     grid_seed = _index(options, "grid_seed", UINT64_LIMIT, rng)
-    row = _Grid.get(grid_seed)[cell]
+    row = paper_grid(grid_seed)[cell]
     state = engine_start(cfg, row["x0"], row["theta0"], int(row["seed"]))
     return state, {"cell": cell, "grid_seed": grid_seed, "cell_seed": int(row["seed"])}
 
 
 CART_POLE = PlantSpec(
     name="CartPole",
-    state=(Variable("x", "m", "cart position"), Variable("x_dot", "m/s", "cart velocity"),
-           Variable("theta", "rad", "pole angle, > 0 leaning toward +x"),
+    state=(Variable("x", "m", "cart position", "x_limit"), Variable("x_dot", "m/s", "cart velocity"),
+           Variable("theta", "rad", "pole angle, > 0 leaning toward +x", "theta_limit"),
            Variable("theta_dot", "rad/s", "pole angular velocity")),
     action=Variable("force", "N", "horizontal force on the cart, held for one period"),
     action_limit=float(B.constant("ICOAC_FORCE_MAX")),

@@ -22,12 +22,13 @@ from ..config import RunConfig, build_config
 
 @dataclass
 class Episode:
-    """One episode: steps taken, summed reward, how it ended; with ``trace``, the observations
-    (steps + 1, the start included) and the forces (steps)."""
+    """One episode: steps taken, summed reward, how it ended, the info of its reset; with
+    ``trace``, the observations (steps + 1, the start included) and the forces (steps)."""
     steps: int
     total_reward: float
     terminated: bool
     truncated: bool
+    reset_info: dict = field(default_factory=dict, repr=False)
     observations: np.ndarray | None = field(default=None, repr=False)
     forces: np.ndarray | None = field(default=None, repr=False)
 
@@ -70,13 +71,11 @@ class IcoacPolicy:
         B.check_status(B.lib.icoac_reset(ctypes.byref(self._state)), "icoac_reset")
 
     def _tick(self, observation: Any, flags: int) -> float:
-        try:
-            s = np.asarray(observation, dtype=np.float64)
-        except (TypeError, ValueError):
-            s = None
-        if s is None or s.shape != (B.N_INPUTS,):
+        s = np.asarray(observation)
+        if s.dtype.kind not in "iuf" or s.shape != (B.N_INPUTS,):
             raise ValueError(f"observation must be {B.N_INPUTS} numbers (x, x_dot, theta, theta_dot), "
                              f"got {observation!r:.80}")
+        s = s.astype(np.float64)
         with np.errstate(over="ignore"):  # beyond the real type: inf, which icoac_step rejects
             real = s.astype(B.real_dtype)
         for i in range(B.N_INPUTS):
@@ -113,7 +112,7 @@ class IcoacPolicy:
         """One episode of env (reset with seed and options) under this controller, learning as
         the configuration says."""
         check_layout(env)
-        obs, _ = env.reset(seed=seed, options=options)
+        obs, reset_info = env.reset(seed=seed, options=options)
         self.reset()
         dtype = env.action_space.dtype
         observations, forces = [np.asarray(obs, dtype=np.float64)], []
@@ -128,5 +127,5 @@ class IcoacPolicy:
                 forces.append(force)
         if terminated:
             self.learn_from_failure(obs)
-        return Episode(steps, total, bool(terminated), bool(truncated),
+        return Episode(steps, total, bool(terminated), bool(truncated), reset_info,
                        np.array(observations) if trace else None, np.array(forces) if trace else None)

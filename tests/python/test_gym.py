@@ -1,7 +1,11 @@
 """The Gymnasium side (harness.gym): the registered cart-pole env against the engine it must
 reproduce, the controller as a policy, Gymnasium's own CartPole-v1 under a continuous force."""
 import ctypes
+import re
+import subprocess
+import sys
 import warnings
+from pathlib import Path
 
 import gymnasium
 import numpy as np
@@ -16,6 +20,7 @@ from harness.config import build_config
 from harness.grid import run_cell, trajectory
 from harness.options import TYPICAL_ICO_WEIGHTS
 
+REPO = Path(__file__).resolve().parents[2]
 ENV_ID = "icoac/CartPole-v0"
 CENTRE, CORNER = 612, 0          # paper-grid cells: theta0 = 0, x0 = 0; theta0 = -12 deg, x0 = -2.4 m
 # check_env's advice that this env does not follow, on purpose: the action is a force in N, and
@@ -133,7 +138,7 @@ def test_bad_actions_and_order():
     with pytest.raises(ResetNeeded):
         env.step([0.0])
     env.reset(options={"cell": CORNER, "grid_seed": 0})
-    for bad in ([np.nan], [np.inf], [1.0, 2.0], "left", None):
+    for bad in ([np.nan], [np.inf], [1.0, 2.0], "left", "1.5", True, None, []):
         with pytest.raises(ValueError, match="one finite force"):
             env.step(bad)
     _, _, _, _, info = env.step([1e6])
@@ -152,7 +157,7 @@ def test_policy_rejects_bad_observations():
         with pytest.raises(B.IcoacError, match="non-finite observation") as err:
             policy.act(bad)
         assert err.value.status == B.ERR_NONFINITE_INPUT
-    for bad in ([0.0, 0.0, 0.0], "xyz", None):
+    for bad in ([0.0, 0.0, 0.0], "xyz", None, ["0", "0", "0", "0"], [True] * 4):
         with pytest.raises(ValueError, match="observation must be 4 numbers"):
             policy.act(bad)
     assert np.isfinite(policy.act([0.0, 0.0, 0.01, 0.0]))
@@ -204,3 +209,12 @@ def test_policy_learns_on_gymnasium_cartpole():
     for condition in ("rl", "search"):  # the other modes run there too
         other = hg.IcoacPolicy(condition=condition, seed=2)
         assert all(other.run_episode(env, seed=k).steps > 0 for k in range(3))
+
+
+def test_readme_example_prints_what_the_readme_shows():
+    text = (REPO / "README.md").read_text()
+    section = text[text.index("## Gymnasium"):]
+    code, shown = re.findall(r"```[a-z]*\n(.*?)```", section, re.S)[:2]
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout == shown
