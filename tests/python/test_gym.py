@@ -49,26 +49,24 @@ def test_registered_and_passes_check_env():
     assert gymnasium.make("harness.gym:" + ENV_ID).spec.id == ENV_ID
 
 
-@pytest.mark.parametrize("w, cell", [(TYPICAL_ICO_WEIGHTS, CENTRE), (TYPICAL_ICO_WEIGHTS, 100), ((0, 0, 0, 0), CENTRE),
-                                     (TYPICAL_ICO_WEIGHTS, CORNER)])
-def test_fixed_w_episode_equals_the_engine_trajectory(w, cell):
+# (w, cell, steps the engine's trial lasts): it balances for the whole 1500 steps, or falls
+@pytest.mark.parametrize("w, cell, lasts", [(TYPICAL_ICO_WEIGHTS, CENTRE, 1500), (TYPICAL_ICO_WEIGHTS, 100, 36),
+                                            ((0, 0, 0, 0), CENTRE, 295), (TYPICAL_ICO_WEIGHTS, CORNER, 2)])
+def test_fixed_w_episode_equals_the_engine_trajectory(w, cell, lasts):
     """Same start (the engine's draw for the cell), same forces, same states, bit for bit."""
     steps, grid_seed = 1500, 7
     cfg = fixed_config(w)
-    env = make(steps)
     policy = hg.IcoacPolicy(cfg)
-    episode = policy.run_episode(env, options={"cell": cell, "grid_seed": grid_seed}, trace=True)
-    _, info = env.reset(options={"cell": cell, "grid_seed": grid_seed})
+    episode = policy.run_episode(make(steps), options={"cell": cell, "grid_seed": grid_seed}, trace=True)
     cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
     B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, grid_seed))
-    assert info["cell_seed"] == cells[cell]["seed"]
+    assert episode.reset_info == {"cell": cell, "grid_seed": grid_seed, "cell_seed": int(cells[cell]["seed"])}
     engine = trajectory(cfg, cells[cell]["x0"], cells[cell]["theta0"], duration=steps * cfg.plant.dt,
-                        seed=info["cell_seed"])
-    assert episode.steps == engine.n_steps
+                        seed=int(cells[cell]["seed"]))
+    assert episode.steps == engine.n_steps == lasts
     assert np.array_equal(episode.forces, engine.forces)
     assert np.array_equal(episode.observations, engine.states)
-    assert episode.terminated == (engine.n_steps < steps)
-    assert episode.truncated == (not episode.terminated)
+    assert episode.terminated == (lasts < steps) and episode.truncated == (lasts == steps)
     assert np.array_equal(policy.weights, np.asarray(w, dtype=B.real_dtype))  # learn = 0: w kept
 
 
