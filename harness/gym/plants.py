@@ -136,7 +136,8 @@ def cart_pole_start(cfg: RunConfig, rng: np.random.Generator, options: Mapping[s
     grid_seed = _index(options, "grid_seed", UINT64_LIMIT, rng)
     row = paper_grid(grid_seed)[cell]
     state = engine_start(cfg, row["x0"], row["theta0"], int(row["seed"]))
-    return state, {"cell": cell, "grid_seed": grid_seed, "cell_seed": int(row["seed"])}
+    # seeds as numpy uint64: a vector env gathers info values into arrays of their type
+    return state, {"cell": cell, "grid_seed": np.uint64(grid_seed), "cell_seed": np.uint64(row["seed"])}
 
 
 CART_POLE = PlantSpec(

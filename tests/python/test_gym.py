@@ -49,6 +49,15 @@ def test_registered_and_passes_check_env():
     assert gymnasium.make("harness.gym:" + ENV_ID).spec.id == ENV_ID
 
 
+def test_vector_env():
+    envs = gymnasium.make_vec(ENV_ID, num_envs=2, vectorization_mode="sync", max_episode_steps=20)
+    obs, info = envs.reset(seed=1)
+    assert obs.shape == (2, 4) and info["cell_seed"].dtype == np.uint64  # seeds beyond int64 kept
+    for _ in range(30):
+        obs, reward, terminated, truncated, info = envs.step(np.zeros((2, 1)))
+    assert obs.shape == (2, 4) and np.all(np.isfinite(obs))
+
+
 # (w, cell, steps the engine's trial lasts): it balances for the whole 1500 steps, or falls
 @pytest.mark.parametrize("w, cell, lasts", [(TYPICAL_ICO_WEIGHTS, CENTRE, 1500), (TYPICAL_ICO_WEIGHTS, 100, 36),
                                             ((0, 0, 0, 0), CENTRE, 295), (TYPICAL_ICO_WEIGHTS, CORNER, 2)])
