@@ -7,5 +7,7 @@ prior < figures, conditions < bench, sweep < cli (arguments and reports only; im
 __main__ alone). The Dask backend: _worker (what a worker runs;
 errors and options at import, the binding only inside a task) < cluster (the client side, after
 grid; imported by bench and sweep, and by conditions inside a function).
+Gymnasium: gym (the simulator's plants as envs, the controller as a policy; after config) is
+imported by no other module.
 """
 __version__ = "0.1.0"

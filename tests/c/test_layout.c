@@ -93,6 +93,7 @@ static void test_constants_table(void **unused)
     assert_true(constant("ICOAC_STATE_SIZE") == ICOAC_STATE_SIZE);
     assert_true(constant("ICOAC_STATE_SIZE") == (double)icoac_sizeof_state());
     assert_true(constant("ICOAC_INPUT_TERMINAL") == ICOAC_INPUT_TERMINAL);
+    assert_true(constant("ICOAC_FORCE_MAX") == (double)ICOAC_FORCE_MAX);
     assert_true(constant("ICOAC_MODE_ICO") == ICOAC_MODE_ICO);
     assert_true(constant("ICOAC_MODE_RL") == ICOAC_MODE_RL);
     assert_true(constant("ICOAC_MODE_SEARCH") == ICOAC_MODE_SEARCH);
