@@ -80,8 +80,8 @@ _LEARNER_OVERRIDES: dict[str, dict[str, Any]] = {
     # mean 0 with the ICO covariance (method.md, A16): the reading the learner sweeps chose for it
     "rl-ico-cov": {"mode": "rl", "actor.update": "mean", "actor.likelihood_std": 0.1, "actor.noise_std": 5,
                    "actor.scale": 0.1, "actor.explore_ticks": 1000},
-    # RL alone, N(0, sigma_w^2 I): the reading of its own sweep (docs/sweeps.md)
-    "rl": {"mode": "rl", "actor.update": "mean", "actor.likelihood_std": 0.1, "actor.noise_std": 5,
+    # RL alone, N(0, sigma_w^2 I) with sigma_w = 1: the reading its own sweep chose (docs/sweeps-rl-alone.md)
+    "rl": {"mode": "rl", "actor.update": "mean", "actor.likelihood_std": 0.1, "actor.noise_std": 12,
            "actor.scale": 0.1, "actor.explore_ticks": 1000},
     "ico-search": {"mode": "search"},  # prior from an ICO grid, Sigma0 = search.cov_scale * its covariance
     "search": {"mode": "search", "search.cov_scale": 4},  # prior N(0, I) (method.md, L4); Sigma0 = 4 I by the sweeps

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import hashlib
 import json
 import sys
 from pathlib import Path
@@ -77,7 +78,9 @@ STAGE_2 = (
 # ICO-failed cells, ties (within one point) broken by the spread cells, then by fewer median
 # trials. Stage 1 varies the reading with its rate and the prior's sigma_w; stage 2 (``--base``
 # the stage-1 choice) the exploration schedule, the batch, the critic quirks, sigma_u, alpha and
-# sigma_w around it, then grids. At least the settings ICO->RL was given (63 rows).
+# sigma_w one at a time, then grids over what the chosen reading uses, and the mean reading at
+# the schedule stage 1 left out; --confirm runs the best 3 on every cell with 5 seeds. More
+# settings than ICO->RL was given (63 rows).
 RL_ALONE_1 = (
     ("rl-alone-control", "rl-control", ["actor.update=posterior"], False),
     ("rl-alone-posterior", "rl", ["actor.update=posterior", "actor.likelihood_std=1,10", "prior_std=0.1,1,10"],
@@ -96,6 +99,13 @@ RL_ALONE_2 = (
                                       "actor.rate=0.01,0.03,0.1"], False),
     # sigma_u x beta at the schedule grid's choice (--base)
     ("rl-alone-noise-grid", "rl", ["actor.noise_std=0.5,1,2,3", "actor.rate=0.01,0.03,0.1"], False),
+    # The mean reading at the schedule its stage 1 never tried (exploring until tick 1000, alpha =
+    # 0.1): sigma_u x sigma_w, which it uses as the preconditioner of every step.
+    ("rl-alone-mean-grid", "rl", ["actor.update=mean", "actor.likelihood_std=0.1", "actor.explore_ticks=1000",
+                                  "actor.scale=0.1", "actor.noise_std=3,5,8", "prior_std=0.3,1,3"], False),
+    # past the mean grid's edge (its best sigma_u, 8 N, was the largest tried)
+    ("rl-alone-mean-edge", "rl", ["actor.update=mean", "actor.likelihood_std=0.1", "actor.explore_ticks=1000",
+                                  "actor.scale=0.1", "actor.noise_std=12,16", "prior_std=1"], False),
 )
 
 
@@ -156,7 +166,34 @@ def report(out: Path) -> str:
                          (r or {}).get("median_trials") or "n/a"]
             lines.append(f"| {setting} | " + " | ".join(cols) + " |")
         lines.append("")
-    return "\n".join(lines)
+    return "\n".join(lines + rl_alone_report(out))
+
+
+def rl_alone_report(out: Path, prefix: str = "rl-alone", top: int = 10) -> list[str]:
+    """RL alone's ranking by the criterion and its 5-seed confirmations (every cell)."""
+    rows = ranked_rows(out, prefix)
+    if not rows:
+        return []
+    lines = [f"## RL alone: the best {top} distinct settings by the criterion", "",
+             "Highest success on the ICO-failed cells; rows within one point of the best ordered by the spread "
+             "cells, then by fewer median trials (2 seeds, cap 1000).", "",
+             "| rank | sweep | setting (beside the literal configuration) | ICO-failed % (± sd) | spread % | "
+             "median trials |", "|---|---|---|---|---|---|"]
+    for i, r in enumerate(rows[:top], 1):
+        lines.append(f"| {i} | {r['sweep']} | {', '.join(literal_items(r['setting']))} | "
+                     f"{100 * r['ico_failed']:.1f} ± {100 * r['ico_failed_sd']:.1f} | {100 * r['spread']:.1f} | "
+                     f"{r['median_trials']:g} |")
+    confirmed = sorted(out.glob(f"{prefix}-confirm-*/sweep.csv"))
+    if confirmed:
+        lines += ["", f"## RL alone: {CONFIRM_SEEDS}-seed grids of every cell (`--confirm`)", "",
+                  "| setting | success, all cells % (± sd) | ICO-failed cells % | median trials |", "|---|---|---|---|"]
+        for path in confirmed:
+            with open(path, newline="") as fh:
+                for r in csv.DictReader(fh):
+                    setting = ", ".join(f"{a}={b}" for a, b in json.loads(r["key"]).items())
+                    lines.append(f"| {setting} | {_pct(r, 'success_rate_mean')} ± {_pct(r, 'success_rate_sd')} | "
+                                 f"{_pct(r, 'success_rate_ico_failed')} | {r['median_trials'] or 'n/a'} |")
+    return lines + [""]
 
 
 # RL alone's confirmation: the best few distinct settings of its sweeps, on every cell of the grid
@@ -217,12 +254,18 @@ def literal_items(setting: dict[str, str]) -> list[str]:
     return [f"{k}={v}" for k, v in setting.items() if base.get(k) != v]
 
 
+def confirm_name(prefix: str, items: list[str]) -> str:
+    """Directory of a setting's confirmation, named by the setting (a later ranking keeps it)."""
+    return f"{prefix}-confirm-" + hashlib.sha1(",".join(items).encode()).hexdigest()[:8]
+
+
 def confirm(args, prefix: str = "rl-alone") -> int:
     """5-seed grids (every cell) of the best few settings of the sweeps OUT/PREFIX-*."""
-    for i, row in enumerate(ranked_rows(args.out, prefix)[:CONFIRM_FEW], 1):
+    for row in ranked_rows(args.out, prefix)[:CONFIRM_FEW]:
         items = literal_items(row["setting"])
-        print(f"[learner_sweeps] {prefix}-confirm-{i}: {', '.join(items)}", file=sys.stderr, flush=True)
-        code = run_sweep(SweepOptions(prior_from=args.prior_from, out=args.out / f"{prefix}-confirm-{i}",
+        name = confirm_name(prefix, items)
+        print(f"[learner_sweeps] {name}: {', '.join(items)}", file=sys.stderr, flush=True)
+        code = run_sweep(SweepOptions(prior_from=args.prior_from, out=args.out / name,
                                       params=items, condition="rl", seeds=CONFIRM_SEEDS, cells=ALL_CELLS,
                                       max_trials=MAX_TRIALS, configuration="literal", sets=[],
                                       one_at_a_time=False, threads=args.threads, quiet=True))
