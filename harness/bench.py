@@ -19,9 +19,10 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from . import ceiling as C
 from . import figures, geometry, grid, metrics, results, store, tables
 from . import prior as P
+from .ceiling.records import bench_ceiling, load_ceiling, reference_lines
+from .ceiling.weights import format_w
 from .conditions import run_condition
 from .config import build_config, command_overrides, named_sets
 from .errors import ResultsError
@@ -160,7 +161,7 @@ def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
         cap = "one trial per cell" if p == "first" else f"retries up to {s.get('max_trials', st['max_trials']):g} trials"
         parts.append(f"{cap}: {percent(s['success_rate'])} of {s['n_cells']} cells, "
                      f"{percent(s['success_rate_interior'])} of {s['n_interior']} interior")
-    lines = ["", f"Linear-policy ceiling (method.md, L5; no learning, the best single w = {C.format_w(best['w'])} "
+    lines = ["", f"Linear-policy ceiling (method.md, L5; no learning, the best single w = {format_w(best['w'])} "
              f"of `python -m harness ceiling`, seed {st['seed']}, horizon {st['success_steps']:g} steps): "
              + "; ".join(parts) + "."]
     b = record.get("first_step_bound") or {}
@@ -247,7 +248,7 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
                                           [agg[c]["success_rate"] for c in conds],
                                           [agg[c]["success_rate_interior"] for c in conds],
                                           [(PAPER.get(c) or {}).get("success_rate") for c in conds],
-                                          ceiling=C.reference_lines(ceiling)))
+                                          ceiling=reference_lines(ceiling)))
         written.append(figures.plot_fig3b(figdir / "fig3b_elapsed_time.png", [REGISTRY[c].label for c in conds],
                                           [agg[c]["mean_elapsed_time_success"] for c in conds]))
         curved = [c for c in conds if agg[c].get("success_within")]
@@ -387,7 +388,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
         """The ceiling shown (--ceiling, else OUT/ceiling/ceiling.json if present); a damaged default
         file is reported and skipped rather than failing the bench at its end."""
         try:
-            return C.bench_ceiling(out, opt.ceiling)
+            return bench_ceiling(out, opt.ceiling)
         except ResultsError as exc:
             if opt.ceiling is not None:
                 raise
@@ -439,7 +440,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
     for condition in CONDITIONS:  # every override valid before the first grid runs
         build_config(overrides(condition), condition=condition)
     if opt.ceiling is not None:
-        C.load_ceiling(opt.ceiling)
+        load_ceiling(opt.ceiling)
 
     out_stages = [grid_stage("ico", s) for s in seeds]
     out_stages += [prior_stage(s) for s in seeds]

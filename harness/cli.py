@@ -3,7 +3,8 @@
 This module only parses arguments and reports; the work is done by harness.conditions (one
 condition's grid and prior), harness.bench (the benchmark stages), harness.sweep,
 harness.ceiling and harness.figures. Nothing imports this module. The parser is built without loading the shared
-library (names and limits come from harness.options), so `--help` works without it.
+library (names and limits come from harness.options, the conditions from harness.registry), so `--help`
+works without it.
 
 Options have one meaning in every command: ``--seed S`` is the first (for `grid` the only) seed
 and ``--seeds N`` the number of seeds, S .. S+N-1; ``--set NAME=VALUE`` takes canonical names
@@ -400,7 +401,7 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_ceiling(args) -> int:
-    from . import ceiling
+    from .ceiling import command as ceiling
 
     opt = ceiling.CeilingOptions(
         out=Path(args.out), prior_from=Path(args.prior_from) if args.prior_from else None, w=args.w,
