@@ -374,10 +374,10 @@ def stages(opt: BenchOptions) -> list[Stage]:
     def prior_stage(seed: int):
         def run(ctx):
             info = P.from_results(seed_dir(out, "ico", seed), opt.frame, opt.ridge)
-            for cond in REGISTRY.values():  # a control shares its condition's prior
+            for cond in REGISTRY.values():
                 if cond.prior is not None and cond.learns:
                     ctx[("prior", cond.name, seed)] = P.condition_prior(cond.name, info, opt.prior_std)
-            for cond in REGISTRY.values():
+            for cond in REGISTRY.values():  # a control shares its condition's prior
                 if not cond.learns:
                     ctx[("prior", cond.name, seed)] = ctx[("prior", cond.base, seed)]
             progress(f"  prior seed {seed}: {info.n_cells} cells, mean "
