@@ -1,6 +1,6 @@
 """Python harness of the icoac controller: ctypes binding of libicoac_sim, grid runs, results, figures.
 
-Layers (no import cycle; `python -m harness.tools.imports` prints the graph): errors, options,
+Layers (no import cycle; `python -m harness.tools.imports` prints the graph): errors, options, registry,
 literals (no dependencies) < _binding (the C library, its constants and checked struct mirrors)
 < geometry, config < metrics, grid < results < store (every write into an output directory),
 prior < figures, conditions < bench, sweep < cli (arguments and reports only; imported by

@@ -19,14 +19,16 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from . import ceiling as C
 from . import figures, geometry, grid, metrics, results, store, tables
 from . import prior as P
+from .ceiling.records import bench_ceiling, load_ceiling, reference_lines
+from .ceiling.weights import format_w
 from .conditions import run_condition
 from .config import build_config, command_overrides, named_sets
 from .errors import ResultsError
 from .metrics import percent
-from .options import CONDITION_LABELS as LABELS, CONDITIONS, CONTROL_OF, PRIOR_RULES, PROFILE_NAMES
+from .options import PROFILE_NAMES
+from .registry import CONDITIONS, PRIOR_CONDITIONS, REGISTRY
 
 # Paper (Fig. 1b, 2b, 3a): ~68 % ICO, ~84 % ICO->RL; RL alone only "smaller" and "very slow" (Fig. 3 bars).
 PAPER = {
@@ -35,7 +37,7 @@ PAPER = {
     "rl": {"success_rate": None, "note": "Fig. 3: smaller domain than ICO, very slow; no number in the text"},
 }
 # The learners after ICO and its prior, in stage order.
-LEARNERS = tuple(c for c in CONDITIONS if c != "ico")
+LEARNERS = PRIOR_CONDITIONS
 
 # Spread subset for smoke tests: rows (theta0 + 12 deg) x columns ((x0 + 2.4) / 0.1); includes
 # Fig. 1g's start (row 8, column 19) and enough central cells for a prior.
@@ -159,7 +161,7 @@ def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
         cap = "one trial per cell" if p == "first" else f"retries up to {s.get('max_trials', st['max_trials']):g} trials"
         parts.append(f"{cap}: {percent(s['success_rate'])} of {s['n_cells']} cells, "
                      f"{percent(s['success_rate_interior'])} of {s['n_interior']} interior")
-    lines = ["", f"Linear-policy ceiling (method.md, L5; no learning, the best single w = {C.format_w(best['w'])} "
+    lines = ["", f"Linear-policy ceiling (method.md, L5; no learning, the best single w = {format_w(best['w'])} "
              f"of `python -m harness ceiling`, seed {st['seed']}, horizon {st['success_steps']:g} steps): "
              + "; ".join(parts) + "."]
     b = record.get("first_step_bound") or {}
@@ -180,7 +182,7 @@ def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None =
         e = agg[cond]
         paper = e["paper"] or {}
         ptxt = (f"{percent(paper['success_rate'], 0)}; " if paper.get("success_rate") else "") + paper.get("note", "")
-        lines.append(f"| {LABELS[cond]} | {len(e['seeds'])} | {e['max_trials']:g} / {e['success_steps']:g} | "
+        lines.append(f"| {REGISTRY[cond].label} | {len(e['seeds'])} | {e['max_trials']:g} / {e['success_steps']:g} | "
                      f"{_fmt(e['success_rate'], True)} of {e['n_cells']} | "
                      f"{_fmt(e['success_rate_interior'], True)} of {e['n_interior']} | "
                      f"{_fmt(e['median_trials_to_success'])} | {_fmt(e['mean_elapsed_time_success'])} | {ptxt} |")
@@ -191,8 +193,8 @@ def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None =
                   "| condition | control | points of success (all) | cells gained | cells lost |",
                   "|---|---|---|---|---|"]
         for cond, g in gains:
-            control = next(k for k, v in CONTROL_OF.items() if v == cond)
-            lines.append(f"| {LABELS[cond]} | {LABELS[control]} | {_fmt(g['points'])} | "
+            control = REGISTRY[REGISTRY[cond].control]
+            lines.append(f"| {REGISTRY[cond].label} | {control.label} | {_fmt(g['points'])} | "
                          f"{_fmt(g['cells_gained'])} | {_fmt(g['cells_lost'])} |")
     if "ico-rl" in agg and agg["ico-rl"].get("ico_phase_simulated_time", {}).get("mean") is not None:
         lines += ["", "ICO->RL counts RL-phase trials only (A17); the ICO phase that produced each prior took "
@@ -242,19 +244,19 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
                                                 label="ICO->RL", outline=outline, frame=frame))
     conds = [c for c in CONDITIONS if c in agg]
     if conds:
-        written.append(figures.plot_fig3a(figdir / "fig3a_success_rate.png", [LABELS[c] for c in conds],
+        written.append(figures.plot_fig3a(figdir / "fig3a_success_rate.png", [REGISTRY[c].label for c in conds],
                                           [agg[c]["success_rate"] for c in conds],
                                           [agg[c]["success_rate_interior"] for c in conds],
                                           [(PAPER.get(c) or {}).get("success_rate") for c in conds],
-                                          ceiling=C.reference_lines(ceiling)))
-        written.append(figures.plot_fig3b(figdir / "fig3b_elapsed_time.png", [LABELS[c] for c in conds],
+                                          ceiling=reference_lines(ceiling)))
+        written.append(figures.plot_fig3b(figdir / "fig3b_elapsed_time.png", [REGISTRY[c].label for c in conds],
                                           [agg[c]["mean_elapsed_time_success"] for c in conds]))
         curved = [c for c in conds if agg[c].get("success_within")]
         if curved:
-            bases = [c for c in CONDITIONS if c not in CONTROL_OF]
-            curves = [{"label": LABELS[c], "mean": agg[c]["success_within"]["all"]["mean"],
-                       "sd": agg[c]["success_within"]["all"]["sd"], "control": c in CONTROL_OF,
-                       "color": bases.index(CONTROL_OF.get(c, c))} for c in curved]
+            bases = [c.name for c in REGISTRY.values() if c.learns]
+            curves = [{"label": REGISTRY[c].label, "mean": agg[c]["success_within"]["all"]["mean"],
+                       "sd": agg[c]["success_within"]["all"]["sd"], "control": not REGISTRY[c].learns,
+                       "color": bases.index(REGISTRY[c].base)} for c in curved]
             retries = ((ceiling or {}).get("best", {}).get("protocols", {}) or {}).get("retries") or {}
             line = None
             if retries.get("success_within"):
@@ -372,10 +374,12 @@ def stages(opt: BenchOptions) -> list[Stage]:
     def prior_stage(seed: int):
         def run(ctx):
             info = P.from_results(seed_dir(out, "ico", seed), opt.frame, opt.ridge)
-            for condition in PRIOR_RULES:
-                ctx[("prior", condition, seed)] = P.condition_prior(condition, info, opt.prior_std)
-            for control, condition in CONTROL_OF.items():
-                ctx[("prior", control, seed)] = ctx[("prior", condition, seed)]
+            for cond in REGISTRY.values():
+                if cond.prior is not None and cond.learns:
+                    ctx[("prior", cond.name, seed)] = P.condition_prior(cond.name, info, opt.prior_std)
+            for cond in REGISTRY.values():  # a control shares its condition's prior
+                if not cond.learns:
+                    ctx[("prior", cond.name, seed)] = ctx[("prior", cond.base, seed)]
             progress(f"  prior seed {seed}: {info.n_cells} cells, mean "
                      + ", ".join(f"{v:.4g}" for v in info.mean))
         return Stage(f"prior seed-{seed}", run)
@@ -384,7 +388,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
         """The ceiling shown (--ceiling, else OUT/ceiling/ceiling.json if present); a damaged default
         file is reported and skipped rather than failing the bench at its end."""
         try:
-            return C.bench_ceiling(out, opt.ceiling)
+            return bench_ceiling(out, opt.ceiling)
         except ResultsError as exc:
             if opt.ceiling is not None:
                 raise
@@ -404,8 +408,9 @@ def stages(opt: BenchOptions) -> list[Stage]:
     def summary_stage(ctx):
         recs = {c: [ctx[(c, s)][1] for s in seeds if (c, s) in ctx] for c in CONDITIONS}
         agg = aggregate(recs)
-        for control, condition in CONTROL_OF.items():
-            if condition in agg and control in agg:
+        for cond in REGISTRY.values():
+            condition, control = cond.name, cond.control
+            if control is not None and condition in agg and control in agg:
                 agg[condition]["gain_over_control"] = gain_over_control(
                     {s: ctx[(condition, s)][0] for s in seeds if (condition, s) in ctx},
                     {s: ctx[(control, s)][0] for s in seeds if (control, s) in ctx})
@@ -435,7 +440,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
     for condition in CONDITIONS:  # every override valid before the first grid runs
         build_config(overrides(condition), condition=condition)
     if opt.ceiling is not None:
-        C.load_ceiling(opt.ceiling)
+        load_ceiling(opt.ceiling)
 
     out_stages = [grid_stage("ico", s) for s in seeds]
     out_stages += [prior_stage(s) for s in seeds]

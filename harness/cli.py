@@ -3,7 +3,8 @@
 This module only parses arguments and reports; the work is done by harness.conditions (one
 condition's grid and prior), harness.bench (the benchmark stages), harness.sweep,
 harness.ceiling and harness.figures. Nothing imports this module. The parser is built without loading the shared
-library (names and limits come from harness.options), so `--help` works without it.
+library (names and limits come from harness.options, the conditions from harness.registry), so `--help`
+works without it.
 
 Options have one meaning in every command: ``--seed S`` is the first (for `grid` the only) seed
 and ``--seeds N`` the number of seeds, S .. S+N-1; ``--set NAME=VALUE`` takes canonical names
@@ -18,6 +19,7 @@ from pathlib import Path
 
 from . import literals
 from . import options as O
+from . import registry as R
 from .errors import HarnessError, UsageError
 
 PROG = "icoac-harness"
@@ -165,7 +167,7 @@ def build_parser() -> argparse.ArgumentParser:
                f"{every:g} s + 0.2 s before the kill. Cells in progress (at most one per thread) "
                "are lost too and rerun by --resume, which finishes the grid with bitwise the same cells. "
                "Ctrl-C (SIGINT) saves every finished cell and exits with status 130.")
-    g.add_argument("--condition", choices=O.CONDITIONS, default=None,
+    g.add_argument("--condition", choices=R.CONDITIONS, default=None,
                    help="learning condition (default ico); rl and ico-rl run the actor-critic")
     g.add_argument("--prior-from", default=None, metavar="ICO_DIR",
                    help="ICO results directory the rl / ico-rl prior is computed from")
@@ -241,7 +243,7 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2,...",
                    help="values of one parameter (repeatable; names as for --set); prior_frame=central,all "
                         "and prior_ridge allowed")
-    w.add_argument("--condition", choices=O.RL_CONDITIONS + O.SEARCH_CONDITIONS, default=O.RL_CONDITIONS[0])
+    w.add_argument("--condition", choices=R.PRIOR_CONDITIONS, default=R.PRIOR_CONDITIONS[0])
     sel = w.add_mutually_exclusive_group()
     sel.add_argument("--cells", default=None, help="cell indices, e.g. 0,5,600-610")
     sel.add_argument("--subset", type=_subset, default=None, help="N evenly spread cells, at most the grid's cell count")
@@ -342,7 +344,7 @@ def cmd_grid(args) -> int:
 
     explicit = any(v is not None for v in (args.condition, args.seed, args.max_trials, args.success_steps,
                                             args.cells, args.prior_from)) or bool(_overrides(args))
-    condition = args.condition or O.CONDITIONS[0]
+    condition = args.condition or R.CONDITIONS[0]
     info = None
     if explicit or not args.resume:
         info = conditions.condition_prior(condition, args.prior_from, _frame(args), args.prior_ridge, args.prior_std)
@@ -399,7 +401,7 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_ceiling(args) -> int:
-    from . import ceiling
+    from .ceiling import command as ceiling
 
     opt = ceiling.CeilingOptions(
         out=Path(args.out), prior_from=Path(args.prior_from) if args.prior_from else None, w=args.w,

@@ -17,7 +17,8 @@ from . import grid, results, store
 from . import prior as P
 from .config import RunConfig, build_config
 from .errors import UsageError
-from .options import CONDITIONS, CONTROL_OF, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, PRIOR_RULES
+from .options import DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY
+from .registry import CONDITIONS, REGISTRY
 
 
 def check_condition(condition: Any) -> str:
@@ -27,12 +28,12 @@ def check_condition(condition: Any) -> str:
 
 
 def condition_prior(condition: str, prior_from, frame, ridge: float, std: float = P.DEFAULT_STD) -> P.PriorInfo | None:
-    """PriorInfo of a condition (None for ico) by its rule (options.PRIOR_RULES); a no-learning
+    """PriorInfo of a condition (None for ico) by its rule (harness.registry); a no-learning
     control has the prior of its condition. --prior-from is required exactly when the rule takes
     the mean or the covariance from ICO: a condition that takes nothing from ICO refuses it."""
-    condition = CONTROL_OF.get(check_condition(condition), condition)
-    rule = PRIOR_RULES.get(condition)
-    if rule is None or "ico" not in rule:
+    cond = REGISTRY[check_condition(condition)]
+    condition, rule = cond.base, cond.prior
+    if rule is None or not rule.takes_ico:
         if prior_from is not None:
             raise UsageError(f"condition {condition} takes nothing from ICO; drop --prior-from")
         return None if rule is None else P.condition_prior(condition, None, std)

@@ -22,6 +22,7 @@ import numpy as np
 
 from . import _binding as B
 from . import literals, options
+from .registry import CONDITIONS, REGISTRY
 from ._binding import ConfigError
 from .errors import UsageError
 
@@ -71,25 +72,9 @@ ENUMS: dict[str, dict[str, int]] = {
 BOOLS = ("learn", "policy.clip_inputs", "critic.quirks", "actor.reflex", "actor.act_with_sample", "actor.batch")
 _BOOL_NAMES = {"true": 1, "false": 0, "on": 1, "off": 0, "yes": 1, "no": 0, "1": 1, "0": 0}
 
-# Overrides of each learning condition on top of the defaults; a no-learning control has its
-# condition's overrides plus learn = 0.
-_LEARNER_OVERRIDES: dict[str, dict[str, Any]] = {
-    "ico": {"mode": "ico"},
-    "ico-rl": {"mode": "rl"},   # prior from an ICO grid (method.md, priors); the C defaults' reading
-    "ico-mean-rl": {"mode": "rl"},  # the ICO mean with sigma_w^2 I: ICO->RL's reading
-    # mean 0 with the ICO covariance (method.md, A16): the reading the learner sweeps chose for it
-    "rl-ico-cov": {"mode": "rl", "actor.update": "mean", "actor.likelihood_std": 0.1, "actor.noise_std": 5,
-                   "actor.scale": 0.1, "actor.explore_ticks": 1000},
-    # RL alone, N(0, sigma_w^2 I) with sigma_w = 1: the reading its own sweep chose (docs/sweeps-rl-alone.md)
-    "rl": {"mode": "rl", "actor.update": "mean", "actor.likelihood_std": 0.1, "actor.noise_std": 12,
-           "actor.scale": 0.1, "actor.explore_ticks": 1000},
-    "ico-search": {"mode": "search"},  # prior from an ICO grid, Sigma0 = search.cov_scale * its covariance
-    "search": {"mode": "search", "search.cov_scale": 4},  # prior N(0, I) (method.md, L4); Sigma0 = 4 I by the sweeps
-}
-CONDITION_OVERRIDES: dict[str, dict[str, Any]] = {
-    c: {**_LEARNER_OVERRIDES[options.CONTROL_OF[c]], "learn": 0} if c in options.CONTROL_OF else _LEARNER_OVERRIDES[c]
-    for c in options.CONDITIONS}
-assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS)
+# Every field each condition sets over the C defaults (harness.registry defines them).
+CONDITION_OVERRIDES: dict[str, dict[str, Any]] = {c.name: c.config_overrides() for c in REGISTRY.values()}
+assert {c.mode for c in REGISTRY.values()} <= set(B.MODES), B.MODES
 
 
 # Named configurations: --set items applied before the command's own --set. "literal" restores the
@@ -552,7 +537,7 @@ def build_config(overrides: Mapping[str, Any] | None = None, condition: str | No
     if condition is not None:
         if not isinstance(condition, str) or condition not in CONDITION_OVERRIDES:
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
-                              f"unknown condition {_short(condition)}; valid: {', '.join(options.CONDITIONS)}")
+                              f"unknown condition {_short(condition)}; valid: {', '.join(CONDITIONS)}")
         items += CONDITION_OVERRIDES[condition].items()
     items += (overrides or {}).items()
     for name, value in items:

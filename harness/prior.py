@@ -3,7 +3,8 @@
 ICO->RL: mean and 4x4 sample covariance (ddof 1) of the final ICO weights of the ICO-successful cells
 inside a frame (default |x0| <= 1.2 m, |theta0| <= 6 deg; or every successful cell), plus ridge * I.
 The other actor-critic priors take the ICO mean, the ICO covariance, both or neither
-(options.PRIOR_RULES; method.md, A16 and L6); the search's is N(0, I) or the ICO prior.
+(each condition's rule: harness.registry; method.md, A16 and L6); the search's is N(0, I) or the
+ICO prior.
 """
 from __future__ import annotations
 
@@ -18,8 +19,9 @@ from . import _binding as B
 from . import metrics, results
 from .config import make_prior
 from .errors import PriorError
-from .options import FRAME_NAMES, PRIOR_FRAME as DEFAULT_FRAME, PRIOR_RIDGE as DEFAULT_RIDGE, PRIOR_RULES
+from .options import FRAME_NAMES, PRIOR_FRAME as DEFAULT_FRAME, PRIOR_RIDGE as DEFAULT_RIDGE
 from .options import PRIOR_STD as DEFAULT_STD
+from .registry import COV_RULES, MEAN_RULES, REGISTRY
 
 _TOL = 1e-9
 
@@ -109,20 +111,28 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | None = DEFAULT_FRAME
     return PriorInfo(mean=mean, cov=cov, frame=frame, n_cells=n, ridge=float(ridge))
 
 
+# The words of a prior rule (harness.registry) -> the mean (from the ICO prior) and covariance (from
+# the ICO prior and sigma_w).
+_MEANS = {"ico": lambda ico: ico.mean.copy(), "zero": lambda ico: np.zeros(B.N_INPUTS)}
+_COVS = {"ico": lambda ico, std: ico.cov.copy(), "isotropic": lambda ico, std: std ** 2 * np.eye(B.N_INPUTS),
+         "identity": lambda ico, std: np.eye(B.N_INPUTS)}
+assert tuple(_MEANS) == MEAN_RULES and tuple(_COVS) == COV_RULES
+
+
 def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_STD) -> PriorInfo:
-    """The prior of a condition by its rule (options.PRIOR_RULES): the mean and the covariance each
+    """The prior of a condition by its rule (harness.registry): the mean and the covariance each
     from the ICO prior ``ico`` or not ("zero" mean, "isotropic" std^2 I, "identity" I). Provenance is
     recorded only for what came from ICO: a prior that takes nothing from it carries no source."""
-    mean_rule, cov_rule = PRIOR_RULES[condition]
-    from_ico = mean_rule == "ico" or cov_rule == "ico"
+    rule = REGISTRY[condition].prior
+    if rule is None:
+        raise PriorError(f"condition {condition} has no prior")
+    mean_rule, cov_rule = rule
+    from_ico = rule.takes_ico
     if from_ico and ico is None:
         raise PriorError(f"condition {condition} needs an ICO prior (--prior-from ICO_RESULTS_DIR)")
     if cov_rule == "isotropic" and not (math.isfinite(std) and std > 0):
         raise PriorError(f"--prior-std must be a finite number > 0, got {std!r}")
-    n = B.N_INPUTS
-    mean = ico.mean.copy() if mean_rule == "ico" else np.zeros(n)
-    cov = {"ico": lambda: ico.cov.copy(), "isotropic": lambda: std ** 2 * np.eye(n),
-           "identity": lambda: np.eye(n)}[cov_rule]()
+    mean, cov = _MEANS[mean_rule](ico), _COVS[cov_rule](ico, std)
     extra = {"mean_from": mean_rule, "cov_from": cov_rule}
     if cov_rule == "isotropic":
         extra["prior_std"] = float(std)

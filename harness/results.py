@@ -18,7 +18,8 @@ from . import geometry, metrics
 from .config import RunConfig, config_from_dict
 from .errors import ResultsError
 from .grid import make_cells, parse_cell_indices
-from .options import CONDITIONS, SEED_LIMIT
+from .options import SEED_LIMIT
+from .registry import CONDITIONS
 
 CELLS_FILE = "cells.npz"
 RUN_FILE = "run.json"

@@ -26,7 +26,8 @@ from ._binding import ConfigError
 from .config import build_config, canonical, command_overrides, given_twice, named_sets, parse_sets, parse_value
 from .errors import SweepError, UsageError
 from .metrics import percent
-from .options import CONTROL_OF, FRAME_NAMES, PRIOR_RULES, PRIOR_STD, SWEEP_MAX_TRIALS
+from .options import FRAME_NAMES, PRIOR_STD, SWEEP_MAX_TRIALS
+from .registry import REGISTRY
 
 PRIOR_PARAMS = ("prior_frame", "prior_ridge", "prior_std")
 DEFAULT_CELLS = list(range(0, geometry.CELLS, 25))  # 49 cells spread over the grid
@@ -236,10 +237,10 @@ def run_sweep(opt: SweepOptions) -> int:
 
     def prior_for(setting):
         """The condition's prior; the ICO grid of --prior-from reaches it only when its rule takes
-        the mean or the covariance from ICO (options.PRIOR_RULES)."""
-        condition = CONTROL_OF.get(opt.condition, opt.condition)
+        the mean or the covariance from ICO (its rule: harness.registry)."""
+        condition = REGISTRY[opt.condition].base
         std = float(setting.get("prior_std", opt.prior_std))
-        if "ico" not in PRIOR_RULES[condition]:
+        if not REGISTRY[condition].prior.takes_ico:
             return P.condition_prior(condition, None, std)
         frame = P.parse_frame(str(setting.get("prior_frame", FRAME_NAMES[0])))
         ridge = float(setting.get("prior_ridge", P.DEFAULT_RIDGE))

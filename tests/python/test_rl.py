@@ -12,9 +12,9 @@ import pytest
 
 from harness import _binding as B
 from harness import grid, results
-from harness import options
 from harness import prior as P
 from harness.config import build_config, make_prior, named_sets, parse_sets
+from harness.registry import CONDITIONS, REGISTRY
 
 REPO = Path(__file__).resolve().parents[2]
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -157,12 +157,12 @@ def test_control_learns_nothing_and_equals_zero_rates(ico_dir, condition, config
     those of its condition with the learning rates at 0: the critic rate and the actor's, the
     rate beta of the gradient reading (ICO->RL's default), the scale alpha of the mean (RL
     alone's default) and posterior (literal) ones."""
-    info = P.condition_prior(options.CONTROL_OF[condition], P.from_results(ico_dir))
+    info = P.condition_prior(REGISTRY[condition].control_of, P.from_results(ico_dir))
     prior = info.prior()
     named = LITERAL if configuration == "literal" else {}
     control = build_config({**TINY_RL, **named}, condition=condition, prior=prior)
     assert control.controller.learn == 0 and control.controller.mode == B.MODE_RL
-    base = options.CONTROL_OF[condition]
+    base = REGISTRY[condition].control_of
     reading = build_config({**TINY_RL, **named}, condition=base).flat()["actor.update"]
     actor_rate = "actor.rate" if reading == "gradient" else "actor.scale"  # beta, or alpha of u_ob
     zero = build_config({**TINY_RL, **named, "critic.rate": 0, actor_rate: 0}, condition=base, prior=prior)
@@ -372,7 +372,7 @@ def test_bench_quick_writes_comparison(tmp_path):
     conds = ("ico", "ico-rl", "ico-rl-control", "ico-mean-rl", "ico-mean-rl-control", "rl-ico-cov",
              "rl-ico-cov-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
              "search-control")
-    assert options.CONDITIONS == conds
+    assert CONDITIONS == conds
     for cond in conds:
         for seed in (0, 1):
             assert results.exists(out / cond / f"seed-{seed}")
@@ -380,9 +380,8 @@ def test_bench_quick_writes_comparison(tmp_path):
     assert set(summary) == set(conds) and summary["ico"]["paper"]["success_rate"] == 0.68
     text = (out / "summary.md").read_text()
     assert "ICO->RL" in text
-    for control, cond in options.CONTROL_OF.items():
-        labels = options.CONDITION_LABELS
-        assert f"| {labels[cond]} | {labels[control]} |" in text
+    for cond, control in ((c.name, c.control) for c in REGISTRY.values() if c.control):
+        assert f"| {REGISTRY[cond].label} | {REGISTRY[control].label} |" in text
         # the gain over the control, recomputed from the cells
         gain = summary[cond]["gain_over_control"]
         for i, seed in enumerate((0, 1)):
@@ -420,7 +419,7 @@ def test_bench_quick_writes_comparison(tmp_path):
         record = json.loads((out / cond / "seed-0" / "run.json").read_text())
         controller = record["config"]["controller"]
         assert controller["mode"] == "search" and controller["search"]["cov_scale"] == scale
-        assert controller["learn"] is (cond not in options.CONTROL_OF)
+        assert controller["learn"] is REGISTRY[cond].learns
         identity = record["prior_info"]["cov"] == np.eye(4).tolist()
         assert identity is cond.startswith("search"), cond
     icorl = json.loads((out / "ico-rl" / "seed-0" / "run.json").read_text())
