@@ -5,11 +5,9 @@
 
 #include "icoac_sim/icoac_sim.h"
 
-typedef void (*sim_derivatives_t)(const double *p, const double *s, double u, double *ds);
-
 /* Advance the n values of s by one dt: explicit Euler (every right-hand side from the old state,
  * Sutton's order) or classical RK4. */
-static inline void sim_integrate(sim_derivatives_t derivatives, int n, const double *p, double dt,
+static inline void sim_integrate(icoac_sim_derivatives_fn derivatives, int n, const double *p, double dt,
                                  int32_t integrator, double *s, double u)
 {
     double k1[ICOAC_SIM_MAX_STATE], k2[ICOAC_SIM_MAX_STATE], k3[ICOAC_SIM_MAX_STATE];

@@ -167,7 +167,7 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t 
  * conditions. The cart-pole above is the registry's first plant, ICOAC_SIM_CART_POLE; its
  * icoac_sim_plant_t maps onto a model with icoac_sim_model_from_plant. */
 #define ICOAC_SIM_MAX_STATE 6   /* state components of any plant */
-#define ICOAC_SIM_MAX_PARAMS 12 /* parameters of any plant */
+#define ICOAC_SIM_MAX_PARAMS 16 /* parameters of any plant */
 #define ICOAC_SIM_CART_POLE 0   /* registry index of the cart-pole */
 
 /* A named, unit-carrying quantity: a state component or the plant's input. */

@@ -1,9 +1,10 @@
 /* Furuta (rotary inverted) pendulum driven by a DC motor, with the parameters of the Quanser
  * QUBE-Servo 2 (QUBE-Servo 2 User Manual, system parameters table: motor and rotary pendulum
  * module; the module's masses and lengths are also listed in the QUBE-Servo 3 User Manual,
- * Table 2.2). Equations: Lagrange's equations of the two rigid bodies, derived in docs/plants.md
- * (the same model as Cazzolato & Prime, "On the dynamics of the Furuta pendulum", J. Control
- * Sci. Eng. 2011, with thin-rod links).
+ * Table 2.2). Equations: Lagrange's equations of the two links, derived in docs/plants.md (the
+ * model of Acosta, "Furuta's pendulum: a conservative nonlinear model for theory and practise",
+ * Math. Probl. Eng. 2010, article 742894, and of Cazzolato & Prime, "On the dynamics of the Furuta
+ * pendulum", J. Control Sci. Eng. 2011, here with thin-rod links).
  *
  * State (theta, theta_dot, alpha, alpha_dot): arm angle about the motor axis, pendulum angle
  * from upright (positive when the pendulum leans the way the arm's tip moves for theta_dot > 0).
@@ -94,8 +95,8 @@ static const icoac_sim_param_t params[N_PARAMS] = {
 const icoac_sim_plant_desc_t sim_furuta = {
     "furuta",
     "Furuta pendulum (Quanser QUBE-Servo 2), motor voltage on the arm",
-    "Quanser QUBE-Servo 2 User Manual (system parameters); Cazzolato & Prime, J. Control Sci. "
-    "Eng. 2011, article 528341",
+    "Quanser QUBE-Servo 2 User Manual (system parameters); Acosta, Math. Probl. Eng. 2010, "
+    "article 742894; Cazzolato & Prime, J. Control Sci. Eng. 2011",
     {"voltage", "V"},
     4,
     N_PARAMS,
