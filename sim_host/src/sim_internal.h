@@ -6,14 +6,22 @@
 
 #include "icoac_sim/icoac_sim.h"
 
+/* Time step of every default plant and model (s). */
+#define SIM_DT_DEFAULT 0.01
+
 /* Failure test of the plant (method.md) with strict limits; written so that NaN counts as failure.
  * Non-finite velocities fail too (icoac_sim_failed contract: "or not finite"); otherwise the
  * next tick hands them to the controller, which rejects the observation and the cell ends
  * as ICOAC_SIM_ERROR instead of a failed trial. */
+static inline int32_t sim_cart_pole_failed(double x_limit, double theta_limit, const double s[4])
+{
+    return !(s[0] >= -x_limit && s[0] <= x_limit && s[2] >= -theta_limit && s[2] <= theta_limit &&
+             isfinite(s[1]) && isfinite(s[3]));
+}
+
 static inline int32_t sim_failed(const icoac_sim_plant_t *plant, const double s[ICOAC_N_INPUTS])
 {
-    return !(s[0] >= -plant->x_limit && s[0] <= plant->x_limit && s[2] >= -plant->theta_limit &&
-             s[2] <= plant->theta_limit && isfinite(s[1]) && isfinite(s[3]));
+    return sim_cart_pole_failed(plant->x_limit, plant->theta_limit, s);
 }
 
 /* Check the controller configuration, plant and (if not NULL) run parameters (params.c). */
@@ -22,6 +30,13 @@ int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
 
 /* Initial velocity noise a: 0, or in [ICOAC_SIM_NOISE_MIN, ICOAC_SIM_NOISE_MAX] (params.c). */
 int sim_velocity_noise_valid(double a);
+
+/* Uniform in (-a, a) from the plant's own generator, in double. */
+static inline double sim_uniform_symmetric(icoac_rng_t *rng, double a)
+{
+    const double u = (double)icoac_rng_next_u32(rng) * (1.0 / 4294967296.0);
+    return a * (2.0 * u - 1.0);
+}
 
 /* Start state of a trial from cell (x0, theta0) with velocities U(-noise, noise) (trial.c). */
 void sim_start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t *rng, double s[ICOAC_N_INPUTS]);

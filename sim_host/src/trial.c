@@ -19,19 +19,12 @@
 #define SIM_REAL_MAX ((double)FLT_MAX)
 #endif
 
-/* Uniform in (-a, a) from the plant's own generator, in double. */
-static double uniform_symmetric(icoac_rng_t *rng, double a)
-{
-    const double u = (double)icoac_rng_next_u32(rng) * (1.0 / 4294967296.0);
-    return a * (2.0 * u - 1.0);
-}
-
 void sim_start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t *rng, double s[4])
 {
     s[0] = cell->x0;
-    s[1] = uniform_symmetric(rng, noise);
+    s[1] = sim_uniform_symmetric(rng, noise);
     s[2] = cell->theta0;
-    s[3] = uniform_symmetric(rng, noise);
+    s[3] = sim_uniform_symmetric(rng, noise);
 }
 
 /* The plant state as the controller's reals. A value outside the real type's range would be
