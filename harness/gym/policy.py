@@ -46,7 +46,7 @@ def check_layout(env: gymnasium.Env) -> None:
 
 class IcoacPolicy:
     """A controller state initialised from ``config`` (a RunConfig: its controller and prior; e.g.
-    harness.ceiling.fixed_config(w) for a fixed w) or else from ``condition``, ``overrides`` and
+    harness.ceiling.fixed.fixed_config(w) for a fixed w) or else from ``condition``, ``overrides`` and
     ``prior`` as harness.config.build_config takes them. ``seed`` seeds the exploration noise
     (icoac_init)."""
 

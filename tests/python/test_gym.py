@@ -15,7 +15,7 @@ from gymnasium.utils.env_checker import check_env
 
 import harness.gym as hg
 from harness import _binding as B
-from harness.ceiling import fixed_config
+from harness.ceiling.fixed import fixed_config
 from harness.config import build_config
 from harness.grid import run_cell, trajectory
 from harness.options import TYPICAL_ICO_WEIGHTS
