@@ -2,8 +2,9 @@
 
 One env step is one control period: the input (a force, or the Furuta's voltage) is held for the
 plant's dt (0.01 s by default, the controller's 100 Hz tick) and the state advanced by the C step
-function, for the cart-pole exactly what the engine does per tick. Termination is the plant's failure test; truncation is the TimeLimit of the
-registration (max_episode_steps). The reward is 1 per step, the failing one included.
+function, for the cart-pole exactly what the engine does per tick. Termination is the plant's
+failure test; truncation is the TimeLimit of the registration (max_episode_steps). The reward is
+1 per step, the failing one included.
 """
 from __future__ import annotations
 

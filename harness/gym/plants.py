@@ -138,7 +138,8 @@ def _grid_start(options: Mapping[str, Any], names: tuple[str, ...], n_cells: int
     grid_seed = _index(options, "grid_seed", UINT64_LIMIT, rng)
     row = grid(grid_seed)[cell:cell + 1]
     # seeds as numpy uint64: a vector env gathers info values into arrays of their type
-    return start_of(row), {"cell": cell, "grid_seed": np.uint64(grid_seed), "cell_seed": np.uint64(row[0]["seed"])}
+    return start_of(row), {"cell": cell, "grid_seed": np.uint64(grid_seed),
+                           "cell_seed": np.uint64(row[0]["seed"])}
 
 
 def cart_pole_start(cfg: RunConfig, rng: np.random.Generator, options: Mapping[str, Any]) -> tuple[np.ndarray, dict]:
@@ -243,8 +244,8 @@ def registry_spec(registry_name: str) -> PlantSpec:
 
     def start(parameters: ModelParameters, rng: np.random.Generator,
               options: Mapping[str, Any]) -> tuple[np.ndarray, dict]:
-        return _grid_start(options, tuple(name for name, _ in info["state"]), cells, rng, lambda seed: plant_grid(index, seed),
-                           lambda cell: model_start(parameters, cell)[:n].copy())
+        return _grid_start(options, tuple(name for name, _ in info["state"]), cells, rng,
+                           lambda seed: plant_grid(index, seed), lambda cell: model_start(parameters, cell)[:n].copy())
 
     return PlantSpec(
         name=gym_name(info["name"]),
