@@ -429,6 +429,12 @@ class PlantDesc(ctypes.Structure):
     ]
 
 
+class Rng(ctypes.Structure):
+    """icoac_rng_t: a PCG32 generator's state (seeded by icoac_rng_seed)."""
+    _fields_ = [("state", ctypes.c_uint64), ("increment", ctypes.c_uint64), ("spare_normal", c_real),
+                ("has_spare", ctypes.c_int32)]
+
+
 class Model(ctypes.Structure):
     """icoac_sim_model_t: a registry plant's parameter block with dt and the integrator."""
     _fields_ = [("plant", ctypes.c_int32), ("integrator", ctypes.c_int32), ("dt", ctypes.c_double),
@@ -467,6 +473,7 @@ MIRRORS: dict[str, tuple[Mirror, str | None]] = {
     "icoac_sim_sweep_t": (Sweep, None),
     "icoac_sim_plant_desc_t": (PlantDesc, None),
     "icoac_sim_model_t": (Model, None),
+    "icoac_rng_t": (Rng, None),
 }
 
 
@@ -612,6 +619,8 @@ _PROTOTYPES = {
     "icoac_sim_model_failed": ([_P(Model), _state_r, _P(ctypes.c_int32)], ctypes.c_int32),
     "icoac_sim_model_energy": ([_P(Model), _state_r, _P(ctypes.c_double)], ctypes.c_int32),
     "icoac_sim_plant_grid": ([ctypes.c_int32, _cells_p, ctypes.c_int64, ctypes.c_uint64], ctypes.c_int32),
+    "icoac_rng_seed": ([_P(Rng), ctypes.c_uint64, ctypes.c_uint64], None),
+    "icoac_sim_model_start": ([_P(Model), ndpointer(CELL_DTYPE, shape=(1,), flags="C_CONTIGUOUS"), ctypes.c_double, _P(Rng), _state_w], ctypes.c_int32),
 }
 for _name, (_args, _res) in _PROTOTYPES.items():
     _fn = getattr(lib, _name)

@@ -1,7 +1,8 @@
 """Gymnasium for icoac: the simulator's plants as registered envs, an icoac controller as a policy
 on any env with the cart-pole's observation layout, and a continuous-force Gymnasium CartPole-v1.
 
-Importing this package registers ``icoac/CartPole-v0`` (one id per plant of harness.gym.plants);
+Importing this package registers ``icoac/CartPole-v0``, ``icoac/Furuta-v0`` and
+``icoac/DoubleCartPole-v0`` (one id per plant of harness.gym.plants);
 ``gymnasium.make("harness.gym:icoac/CartPole-v0")`` imports it on the way. Modules: plants (what
 each plant is), env (IcoacPlantEnv), policy (IcoacPolicy), cartpole_v1 (ContinuousCartPole).
 docs/gymnasium.md describes them.

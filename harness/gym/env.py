@@ -1,9 +1,10 @@
 """IcoacPlantEnv: a plant of harness.gym.plants as a gymnasium.Env, stepped by the C simulator.
 
-One env step is one control period: the force is held for the plant's dt (0.01 s by default,
-the controller's 100 Hz tick) and the state advanced by the C step function, exactly what the
-engine does per tick. Termination is the plant's failure test; truncation is the TimeLimit of the
-registration (max_episode_steps). The reward is 1 per step, the failing one included.
+One env step is one control period: the input (a force, or the Furuta's voltage) is held for the
+plant's dt (0.01 s by default, the controller's 100 Hz tick) and the state advanced by the C step
+function, for the cart-pole exactly what the engine does per tick. Termination is the plant's
+failure test; truncation is the TimeLimit of the registration (max_episode_steps). The reward is
+1 per step, the failing one included.
 """
 from __future__ import annotations
 
@@ -29,9 +30,8 @@ def parse_force(action: Any, limit: float) -> float:
 
 class IcoacPlantEnv(gymnasium.Env):
     """A plant as an env. ``plant``: a name in harness.gym.plants.PLANTS; ``force_limit``: the
-    action bound (N, default the plant's); every other keyword is a plant parameter (the
-    cart-pole's: gravity, cart_mass, pole_mass, half_length, dt, x_limit, theta_limit,
-    integrator, init_velocity_noise), checked by C. No rendering."""
+    action bound (in the plant's input unit, default the plant's); every other keyword is a plant
+    parameter (its PlantSpec.parameter_names), checked by C. No rendering."""
 
     metadata = {"render_modes": []}
 

@@ -1,8 +1,9 @@
 """The plants the Gymnasium envs serve, each described once: its state (names, units), its action,
 its parameters and the C functions that step it, test failure and draw start states.
 
-A plant is a PlantSpec in PLANTS; harness.gym registers ``icoac/<name>-v0`` for each. Only the
-cart-pole is here; another plant is another PlantSpec built on its own C functions.
+A plant is a PlantSpec in PLANTS; harness.gym registers ``icoac/<name>-v0`` for each. The
+cart-pole is stepped by its own C functions (bit for bit the engine's trial loop); every other
+plant of the C registry (docs/plants.md) by the model API, described from its C descriptor.
 """
 from __future__ import annotations
 
@@ -50,7 +51,7 @@ class PlantSpec:
 
 # -- the cart-pole: icoac_sim_plant_t, icoac_sim_plant_step, icoac_sim_failed, the paper grid ----------
 CART_POLE_PARAMETERS = PLANT_FIELDS + ("init_velocity_noise",)
-CART_POLE_OPTIONS = ("state", "cell", "grid_seed")
+RESET_OPTIONS = ("state", "cell", "grid_seed")
 UINT64_LIMIT = 2 ** 64
 
 
@@ -113,14 +114,15 @@ def engine_start(cfg: RunConfig, x0: float, theta0: float, cell_seed: int) -> np
     return states[:B.N_INPUTS].copy()
 
 
-def cart_pole_start(cfg: RunConfig, rng: np.random.Generator, options: Mapping[str, Any]) -> tuple[np.ndarray, dict]:
-    """Options: ``state`` (x, x_dot, theta, theta_dot), any finite state; or ``cell`` (index in the
-    paper grid, row-major over theta0 then x0) and ``grid_seed`` (the seed of the grid's cell
-    seeds): the start of that cell's first engine trial. Each of cell and grid_seed not given is
-    drawn from rng."""
-    unknown = sorted(set(options) - set(CART_POLE_OPTIONS))
+def _grid_start(options: Mapping[str, Any], names: tuple[str, ...], n_cells: int, rng: np.random.Generator,
+                grid: Callable[[int], np.ndarray],
+                start_of: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, dict]:
+    """Options: ``state`` (one finite value per name), any state; or ``cell`` (index in the plant's
+    grid, row-major) and ``grid_seed`` (the seed of the grid's cell seeds): start_of(that cell, as
+    an array of one). Each of cell and grid_seed not given is drawn from rng."""
+    unknown = sorted(set(options) - set(RESET_OPTIONS))
     if unknown:
-        raise ValueError(f"unknown reset option {unknown[0]!r}; valid: {', '.join(CART_POLE_OPTIONS)}")
+        raise ValueError(f"unknown reset option {unknown[0]!r}; valid: {', '.join(RESET_OPTIONS)}")
     if "state" in options:
         if len(options) > 1:
             raise ValueError("reset option 'state' excludes 'cell' and 'grid_seed'")
@@ -128,16 +130,22 @@ def cart_pole_start(cfg: RunConfig, rng: np.random.Generator, options: Mapping[s
             state = np.array(options["state"], dtype=np.float64)
         except (TypeError, ValueError):
             state = None
-        if state is None or state.shape != (B.N_INPUTS,) or not np.all(np.isfinite(state)):
-            raise ValueError(f"reset option 'state' must be {B.N_INPUTS} finite numbers "
-                             f"(x, x_dot, theta, theta_dot), got {options['state']!r:.60}")
+        if state is None or state.shape != (len(names),) or not np.all(np.isfinite(state)):
+            raise ValueError(f"reset option 'state' must be {len(names)} finite numbers "
+                             f"({', '.join(names)}), got {options['state']!r:.60}")
         return state, {}
-    cell = _index(options, "cell", B.GRID_CELLS, rng)
+    cell = _index(options, "cell", n_cells, rng)
     grid_seed = _index(options, "grid_seed", UINT64_LIMIT, rng)
-    row = paper_grid(grid_seed)[cell]
-    state = engine_start(cfg, row["x0"], row["theta0"], int(row["seed"]))
+    row = grid(grid_seed)[cell:cell + 1]
     # seeds as numpy uint64: a vector env gathers info values into arrays of their type
-    return state, {"cell": cell, "grid_seed": np.uint64(grid_seed), "cell_seed": np.uint64(row["seed"])}
+    return start_of(row), {"cell": cell, "grid_seed": np.uint64(grid_seed),
+                           "cell_seed": np.uint64(row[0]["seed"])}
+
+
+def cart_pole_start(cfg: RunConfig, rng: np.random.Generator, options: Mapping[str, Any]) -> tuple[np.ndarray, dict]:
+    """The options of _grid_start on the paper grid; a cell starts where its first engine trial does."""
+    return _grid_start(options, tuple(v.name for v in CART_POLE.state), B.GRID_CELLS, rng, paper_grid,
+                       lambda row: engine_start(cfg, row[0]["x0"], row[0]["theta0"], int(row[0]["seed"])))
 
 
 CART_POLE = PlantSpec(
@@ -148,7 +156,7 @@ CART_POLE = PlantSpec(
     action=Variable("force", "N", "horizontal force on the cart, held for one period"),
     action_limit=float(B.constant("ICOAC_FORCE_MAX")),
     parameter_names=CART_POLE_PARAMETERS,
-    reset_options=CART_POLE_OPTIONS,
+    reset_options=RESET_OPTIONS,
     max_episode_steps=int(_run_default().success_steps),
     configure=cart_pole_configure,
     step=cart_pole_step,
@@ -157,7 +165,104 @@ CART_POLE = PlantSpec(
     period=lambda cfg: float(cfg.plant.dt),
 )
 
-PLANTS: dict[str, PlantSpec] = {spec.name: spec for spec in (CART_POLE,)}
+# -- any other registry plant: icoac_sim_model_t, icoac_sim_model_step / _failed / _start, its grid --
+MODEL_OPTIONS = ("dt", "integrator", "init_velocity_noise")
+# Every plant of the C registry but the cart-pole (which has its own spec above).
+REGISTRY_PLANTS = tuple(B.plant_info(i)["name"] for i in range(int(B.lib.icoac_sim_plant_count()))
+                        if i != B.constant("ICOAC_SIM_CART_POLE"))
+
+
+@dataclass(frozen=True)
+class ModelParameters:
+    """A registry plant's checked model (parameters, dt, integrator) and its start-velocity noise."""
+    model: B.Model
+    init_velocity_noise: float
+
+
+def gym_name(registry_name: str) -> str:
+    """The env name of a C registry plant: "double_cart_pole" -> "DoubleCartPole"."""
+    return "".join(word.capitalize() for word in registry_name.split("_"))
+
+
+@functools.lru_cache(maxsize=4)
+def plant_grid(index: int, seed: int) -> np.ndarray:
+    """A registry plant's grid cells for a seed (icoac_sim_plant_grid), read-only."""
+    info = B.plant_info(index)
+    cells = np.zeros(info["rows"]["count"] * info["cols"]["count"], dtype=B.CELL_DTYPE)
+    B.check_status(B.lib.icoac_sim_plant_grid(index, cells, cells.size, seed), "plant grid")
+    cells.flags.writeable = False
+    return cells
+
+
+def model_start(parameters: ModelParameters, cell: np.ndarray) -> np.ndarray:
+    """The start state (all MAX_STATE values) of a trial from a grid cell (an array of one), its
+    drawn components from the generator the engine seeds for that cell."""
+    rng = B.Rng()
+    B.lib.icoac_rng_seed(ctypes.byref(rng), int(cell[0]["seed"]), int(B.constant("ICOAC_SIM_START_STREAM")))
+    state = np.zeros(B.MAX_STATE)
+    B.check_status(B.lib.icoac_sim_model_start(ctypes.byref(parameters.model), cell,
+                                               parameters.init_velocity_noise, ctypes.byref(rng), state),
+                   "start state")
+    return state
+
+
+def registry_spec(registry_name: str) -> PlantSpec:
+    """The PlantSpec of a C registry plant: state, action and parameter names and units from its
+    descriptor; stepped, tested and started by icoac_sim_model_step / _failed / _start."""
+    info = B.plant_info(registry_name)
+    index, n = info["index"], len(info["state"])
+    names = tuple(p["name"] for p in info["params"]) + MODEL_OPTIONS
+    cells = info["rows"]["count"] * info["cols"]["count"]
+
+    def configure(parameters: Mapping[str, Any]) -> ModelParameters:
+        unknown = sorted(set(parameters) - set(names))
+        if unknown:
+            raise ValueError(f"unknown {registry_name} parameter {unknown[0]!r}; valid: {', '.join(names)}")
+        given = dict(parameters)
+        if isinstance(given.get("integrator"), str) and given["integrator"] not in B.INTEGRATORS:
+            raise ValueError(f"integrator must be one of {', '.join(B.INTEGRATORS)}, got {given['integrator']!r:.40}")
+        noise = float(given.pop("init_velocity_noise", _run_default().init_velocity_noise))
+        result = ModelParameters(B.model_default(index, **given), noise)
+        model_start(result, plant_grid(index, 0)[:1])  # C checks the noise
+        return result
+
+    def to_model(state: np.ndarray) -> np.ndarray:
+        full = np.zeros(B.MAX_STATE)
+        full[:n] = state
+        return full
+
+    def step(parameters: ModelParameters, state: np.ndarray, u: float) -> None:
+        full = to_model(state)
+        B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(parameters.model), full, u), "plant step")
+        state[:] = full[:n]
+
+    def failed(parameters: ModelParameters, state: np.ndarray) -> bool:
+        flag = ctypes.c_int32(0)
+        B.check_status(B.lib.icoac_sim_model_failed(ctypes.byref(parameters.model), to_model(state),
+                                                    ctypes.byref(flag)), "failure test")
+        return bool(flag.value)
+
+    def start(parameters: ModelParameters, rng: np.random.Generator,
+              options: Mapping[str, Any]) -> tuple[np.ndarray, dict]:
+        return _grid_start(options, tuple(name for name, _ in info["state"]), cells, rng,
+                           lambda seed: plant_grid(index, seed), lambda cell: model_start(parameters, cell)[:n].copy())
+
+    return PlantSpec(
+        name=gym_name(info["name"]),
+        state=tuple(Variable(name, unit, f"state component {i} of {info['title']}")
+                    for i, (name, unit) in enumerate(info["state"])),
+        action=Variable(*info["input"], "plant input, held for one period"),
+        action_limit=float(B.constant("ICOAC_FORCE_MAX")),  # the controller's output bound
+        parameter_names=names,
+        reset_options=RESET_OPTIONS,
+        max_episode_steps=int(_run_default().success_steps),
+        configure=configure, step=step, failed=failed, start=start,
+        period=lambda parameters: float(parameters.model.dt),
+    )
+
+
+PLANTS: dict[str, PlantSpec] = {spec.name: spec for spec in
+                                (CART_POLE, *(registry_spec(name) for name in REGISTRY_PLANTS))}
 assert all(math.isfinite(spec.action_limit) and spec.action_limit > 0 for spec in PLANTS.values())
 
 

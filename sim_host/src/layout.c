@@ -79,6 +79,7 @@ static const icoac_sim_constant_t constants[] = {
     CONSTANT(ICOAC_SIM_MAX_STATE),
     CONSTANT(ICOAC_SIM_MAX_PARAMS),
     CONSTANT(ICOAC_SIM_CART_POLE),
+    CONSTANT(ICOAC_SIM_START_STREAM),
 };
 
 #define FIELD(type, member) {#type, #member, (uint32_t)offsetof(type, member), (uint32_t)sizeof(((type *)0)->member)}
@@ -157,6 +158,10 @@ static const icoac_sim_field_t fields[] = {
     FIELD(icoac_sim_cell_t, elapsed_time),
     FIELD(icoac_sim_cell_t, weights),
     FIELD(icoac_sim_cell_t, cov),
+    FIELD(icoac_rng_t, state),
+    FIELD(icoac_rng_t, increment),
+    FIELD(icoac_rng_t, spare_normal),
+    FIELD(icoac_rng_t, has_spare),
     FIELD(icoac_sim_axis_t, name),
     FIELD(icoac_sim_axis_t, unit),
     FIELD(icoac_sim_param_t, name),

@@ -34,7 +34,7 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t 
     memset(&cell, 0, sizeof cell);
     cell.x0 = x0;
     cell.theta0 = theta0;
-    icoac_rng_seed(&rng, seed, 2u);
+    icoac_rng_seed(&rng, seed, ICOAC_SIM_START_STREAM);
     sim_start_trial(&cell, init_velocity_noise, &rng, s);
     memcpy(states, s, sizeof s);
     *n_steps = 0;

@@ -122,7 +122,7 @@ static int end_trial(const sim_job_t *job, sim_lane_t *lane, int balanced)
 int32_t sim_lane_init(const sim_job_t *job, sim_lane_t *lane, icoac_sim_cell_t *cell)
 {
     const int32_t status = (int32_t)icoac_init(job->cfg, &lane->ctrl, job->prior, icoac_mix_seed(cell->seed, 1u));
-    icoac_rng_seed(&lane->rng, cell->seed, 2u);
+    icoac_rng_seed(&lane->rng, cell->seed, ICOAC_SIM_START_STREAM);
     lane->cell = cell;
     lane->trials = 0;
     lane->total = 0;

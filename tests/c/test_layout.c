@@ -20,7 +20,7 @@ static const type_size_t types[] = {
     {"icoac_sim_run_t", sizeof(icoac_sim_run_t)},     {"icoac_sim_cell_t", sizeof(icoac_sim_cell_t)},
     {"icoac_sim_axis_t", sizeof(icoac_sim_axis_t)},   {"icoac_sim_param_t", sizeof(icoac_sim_param_t)},
     {"icoac_sim_sweep_t", sizeof(icoac_sim_sweep_t)}, {"icoac_sim_plant_desc_t", sizeof(icoac_sim_plant_desc_t)},
-    {"icoac_sim_model_t", sizeof(icoac_sim_model_t)},
+    {"icoac_sim_model_t", sizeof(icoac_sim_model_t)},       {"icoac_rng_t", sizeof(icoac_rng_t)},
 };
 
 #define N_TYPES (sizeof types / sizeof types[0])
@@ -124,6 +124,7 @@ static void test_constants_table(void **unused)
     assert_true(constant("ICOAC_SIM_MAX_STATE") == ICOAC_SIM_MAX_STATE);
     assert_true(constant("ICOAC_SIM_MAX_PARAMS") == ICOAC_SIM_MAX_PARAMS);
     assert_true(constant("ICOAC_SIM_CART_POLE") == ICOAC_SIM_CART_POLE);
+    assert_true(constant("ICOAC_SIM_START_STREAM") == ICOAC_SIM_START_STREAM);
     assert_true(constant("ICOAC_SIM_ERR_NONFINITE") == ICOAC_SIM_ERR_NONFINITE);
 }
 

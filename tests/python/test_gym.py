@@ -225,3 +225,103 @@ def test_readme_example_prints_what_the_readme_shows():
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, run.stderr
     assert run.stdout == shown
+
+
+# -- the registry plants served through the model API ----------------------------------------------------
+NEW_PLANTS = {"icoac/Furuta-v0": "furuta", "icoac/DoubleCartPole-v0": "double_cart_pole"}
+
+
+def c_model_start(model, plant, cell, grid_seed, noise):
+    """The start of a grid cell straight from C: the plant's grid, the engine's start generator."""
+    info = B.plant_info(plant)
+    cells = np.zeros(info["rows"]["count"] * info["cols"]["count"], dtype=B.CELL_DTYPE)
+    B.check_status(B.lib.icoac_sim_plant_grid(info["index"], cells, cells.size, grid_seed))
+    rng = B.Rng()
+    B.lib.icoac_rng_seed(ctypes.byref(rng), int(cells[cell]["seed"]), B.constant("ICOAC_SIM_START_STREAM"))
+    s = np.zeros(B.MAX_STATE)
+    B.check_status(B.lib.icoac_sim_model_start(ctypes.byref(model), cells[cell:cell + 1], noise,
+                                               ctypes.byref(rng), s))
+    return s, cells[cell]
+
+
+@pytest.mark.parametrize("env_id, plant", NEW_PLANTS.items())
+def test_registry_plant_spaces_from_the_descriptor_and_check_env(env_id, plant):
+    info = B.plant_info(plant)
+    env = gymnasium.make(env_id)
+    spec = env.unwrapped.plant
+    assert env.spec.max_episode_steps == build_config().run.success_steps
+    assert env.observation_space.shape == (len(info["state"]),) and env.action_space.shape == (1,)
+    assert [(v.name, v.unit) for v in spec.state] == info["state"]
+    assert (spec.action.name, spec.action.unit) == info["input"]
+    assert set(spec.parameter_names) >= {p["name"] for p in info["params"]}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check_env(env.unwrapped)
+    assert [str(w.message) for w in caught if not any(k in str(w.message) for k in KNOWN_WARNINGS)] == []
+
+
+@pytest.mark.parametrize("env_id, plant", NEW_PLANTS.items())
+def test_zero_action_episode_equals_the_c_model(env_id, plant):
+    """From a tilted grid cell, an episode under zero input = icoac_sim_model_step from the same
+    start, bit for bit, and it terminates where icoac_sim_model_failed first says so."""
+    cell, grid_seed = 100, 7  # row 2: the pendulum 10 deg from upright
+    env = gymnasium.make(env_id)
+    obs, info = env.reset(options={"cell": cell, "grid_seed": grid_seed})
+    model = B.model_default(plant)
+    s, row = c_model_start(model, plant, cell, grid_seed, build_config().run.init_velocity_noise)
+    n = len(B.plant_info(plant)["state"])
+    assert info == {"cell": cell, "grid_seed": grid_seed, "cell_seed": int(row["seed"])}
+    assert np.array_equal(obs, s[:n]) and np.any(s[:n] != 0)
+    failed = ctypes.c_int32(0)
+    for k in range(1, 2000):
+        obs, reward, terminated, truncated, _ = env.step(np.zeros(1))
+        B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(model), s, 0.0))
+        B.check_status(B.lib.icoac_sim_model_failed(ctypes.byref(model), s, ctypes.byref(failed)))
+        assert np.array_equal(obs, s[:n]), k
+        assert terminated == bool(failed.value) and not truncated and reward == 1.0
+        if terminated:
+            break
+    assert terminated and k > 1  # it falls, not at once
+    with pytest.raises(ResetNeeded):
+        env.step(np.zeros(1))
+    # truncation: the step limit, from the upright rest state
+    short = gymnasium.make(env_id, max_episode_steps=5)
+    short.reset(options={"state": np.zeros(n)})
+    outcomes = [short.step(np.zeros(1))[2:4] for _ in range(5)]
+    assert outcomes == [(False, False)] * 4 + [(False, True)]
+
+
+@pytest.mark.parametrize("env_id, plant", NEW_PLANTS.items())
+def test_registry_plant_parameters_and_bad_input(env_id, plant):
+    info = B.plant_info(plant)
+    first = info["params"][0]["name"]
+    env = gymnasium.make(env_id, dt=0.02, integrator="rk4", init_velocity_noise=0.0,
+                         **{first: 2 * info["params"][0]["value"]})
+    model = env.unwrapped.parameters.model
+    assert (model.dt, model.integrator, model.param[0]) == (0.02, B.INTEGRATORS["rk4"], 2 * info["params"][0]["value"])
+    n = len(info["state"])
+    obs, _ = env.reset(options={"cell": 0})
+    assert np.all(obs[[i for i in range(n) if info["drawn"][i]]] == 0)  # no noise
+    s = np.zeros(B.MAX_STATE)
+    s[:n] = obs
+    obs, *_ = env.step([0.5])
+    B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(model), s, 0.5))
+    assert np.array_equal(obs, s[:n])
+    env.reset(options={"state": np.zeros(n)})
+    for bad in ([np.nan], [np.inf], [1.0, 2.0], "1.5", True):
+        with pytest.raises(ValueError, match="one finite"):
+            env.step(bad)
+    with pytest.raises(B.ConfigError):
+        gymnasium.make(env_id, **{first: -1.0})
+    with pytest.raises(B.ConfigError):
+        gymnasium.make(env_id, init_velocity_noise=-1.0)
+    with pytest.raises(ValueError, match=f"unknown {plant} parameter 'pole_mas'"):
+        gymnasium.make(env_id, pole_mas=1.0)
+    for bad in ({"state": np.zeros(n + 1)}, {"state": [np.nan] * n}, {"cell": 10 ** 6}, {"theta0": 0}):
+        with pytest.raises(ValueError, match="reset option"):
+            env.reset(options=bad)
+
+
+def test_policy_refuses_the_six_state_env():
+    with pytest.raises(ValueError, match="observation must be a Box of 4"):
+        hg.IcoacPolicy().run_episode(gymnasium.make("icoac/DoubleCartPole-v0"))

@@ -269,7 +269,9 @@ int32_t icoac_sim_model_energy(const icoac_sim_model_t *model, const double stat
  * column value; seeds and outcomes as icoac_sim_paper_grid (the cart-pole's is that grid). */
 int32_t icoac_sim_plant_grid(int32_t index, icoac_sim_cell_t *cells, int64_t n_cells, uint64_t seed);
 /* Start state of a trial from cell: start[], the swept components from the cell, the drawn ones
- * U(-noise, noise) from rng (for the cart-pole, the trial loop's start). */
+ * U(-noise, noise) from rng (for the cart-pole, the trial loop's start). The engine seeds that rng
+ * with icoac_rng_seed(&rng, cell seed, ICOAC_SIM_START_STREAM). */
+#define ICOAC_SIM_START_STREAM 2u
 int32_t icoac_sim_model_start(const icoac_sim_model_t *model, const icoac_sim_cell_t *cell, double noise,
                               icoac_rng_t *rng, double state[ICOAC_SIM_MAX_STATE]);
 
