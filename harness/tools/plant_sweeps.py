@@ -1,0 +1,191 @@
+"""The sweep that chose a plant's task settings (harness.plants), as one command:
+
+    python -m harness.tools.plant_sweeps --plant furuta --out results/sweeps-furuta
+
+The task settings are what the controller needs to know of a plant beyond the cart-pole's
+defaults: the input scaling (arm angle, arm velocity and pendulum velocity ranges; the pendulum
+angle is scaled to its failure limit), the reflex zone's angle, ICO's rate and the policy gain.
+The criterion, fixed before the runs: ICO's success rate (all cells, mean over seeds); settings
+within one point of the best are ordered by fewer median trials to success.
+
+Stage 1 draws SAMPLES settings from SPACE (a seeded generator, so the same settings every time)
+and runs ICO on the 36 spread cells of the quick profile, seed 0. Stage 2 runs the best
+STAGE_2_TOP of stage 1 on 49 cells evenly over the grid, seeds 0 and 1; stage 3 varies one
+parameter at a time over its values around stage 2's best, on the same cells and seeds. The
+choice is the best of stages 2 and 3. Every stage resumes (finished settings are skipped);
+--report writes summary.md (docs/sweeps-<plant>.md).
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .. import grid, store
+from ..bench import QUICK_CELLS
+from ..config import build_config
+from ..plants import ZONE_FRACTION
+
+SAMPLES = 80
+STAGE_2_TOP = 5
+MAX_TRIALS = 20000
+SUCCESS_STEPS = 2000
+SPREAD_CELLS = list(range(0, 1225, 25))
+SPACE = (  # name, values (the pendulum angle range is its failure limit)
+    ("arm_range", (0.5, 1.0, 1.5708, 3.0)),
+    ("arm_velocity_range", (1.0, 2.3, 6.4, 15.0, 40.0)),
+    ("pendulum_velocity_range", (0.3, 0.6, 1.0, 2.0, 5.6)),
+    ("zone_deg", (11.5, 10.0, 8.0, 6.0)),
+    ("ico.rate", (1e-4, 1e-3, 1e-2)),
+    ("policy.gain", (1.0, 3.0, 10.0)),
+)
+FIELDS = ["key", "seed", "cells", "success_rate", "median_trials", "wall_time"]
+
+
+def samples(seed: int = 1) -> list[dict]:
+    """The stage-1 settings, drawn in a fixed order from a seeded generator."""
+    rng = np.random.default_rng(seed)
+    return [{name: float(rng.choice(values)) for name, values in SPACE} for _ in range(SAMPLES)]
+
+
+def key(setting: dict) -> str:
+    return ",".join(f"{name}={setting[name]:g}" for name, _ in SPACE)
+
+
+def overrides(plant: str, setting: dict) -> dict:
+    """The controller settings of a sample (the critic grid spans the input ranges)."""
+    from .. import _binding as B
+    limit = {p["name"]: p["value"] for p in B.plant_info(plant)["params"]}["pendulum_limit"]
+    ranges = [setting["arm_range"], setting["arm_velocity_range"], limit, setting["pendulum_velocity_range"]]
+    return {"policy.input_range": ranges, "critic.range": ranges,
+            "policy.zone_x": ZONE_FRACTION[0] * setting["arm_range"],
+            "policy.zone_theta": math.radians(setting["zone_deg"]),
+            "ico.rate": setting["ico.rate"], "policy.gain": setting["policy.gain"],
+            "max_trials": MAX_TRIALS, "success_steps": SUCCESS_STEPS}
+
+
+def run_one(plant: str, setting: dict, seed: int, cells: list[int]) -> dict:
+    cfg = build_config(overrides(plant, setting), plant=plant)
+    arr = grid.make_cells(seed, cells, plant=plant)
+    t0 = time.monotonic()
+    run = grid.run_grid(cfg, arr, progress=False)
+    if run.cancelled:
+        raise KeyboardInterrupt
+    ok = arr["outcome"] == 1
+    return {"key": key(setting), "seed": seed, "cells": len(cells), "success_rate": float(ok.mean()),
+            "median_trials": float(np.median(arr["trials"][ok])) if ok.any() else "",
+            "wall_time": round(time.monotonic() - t0, 2)}
+
+
+def read_rows(path: Path) -> list[dict]:
+    if not path.is_file():
+        return []
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def run_stage(plant: str, path: Path, settings: list[dict], seeds: list[int], cells: list[int]) -> list[dict]:
+    rows = read_rows(path)
+    done = {(r["key"], int(r["seed"])) for r in rows}
+    for i, setting in enumerate(settings, 1):
+        for seed in seeds:
+            if (key(setting), seed) in done:
+                continue
+            rows.append(run_one(plant, setting, seed, cells))
+            with open(path.with_suffix(".tmp"), "w", newline="") as f:
+                w = csv.DictWriter(f, fieldnames=FIELDS)
+                w.writeheader()
+                w.writerows(rows)
+            path.with_suffix(".tmp").replace(path)
+            r = rows[-1]
+            print(f"[{i}/{len(settings)}] seed {seed}: {r['key']}: success {r['success_rate']:.3f}", file=sys.stderr)
+    return rows
+
+
+def ranked(rows: list[dict]) -> list[dict]:
+    """Settings by the criterion: mean success over seeds; within one point of the best, fewer
+    median trials first (no success: last)."""
+    by_key: dict[str, list[dict]] = {}
+    for r in rows:
+        by_key.setdefault(r["key"], []).append(r)
+    out = []
+    for k, rs in by_key.items():
+        med = [float(r["median_trials"]) for r in rs if r["median_trials"] not in ("", None)]
+        out.append({"key": k, "seeds": len(rs), "success_rate": float(np.mean([float(r["success_rate"]) for r in rs])),
+                    "median_trials": float(np.median(med)) if med else math.inf})
+    out.sort(key=lambda r: -r["success_rate"])
+    if out:
+        best = out[0]["success_rate"]
+        top = sorted([r for r in out if r["success_rate"] >= best - 0.01], key=lambda r: r["median_trials"])
+        out = top + [r for r in out if r["success_rate"] < best - 0.01]
+    return out
+
+
+def one_at_a_time(out: Path) -> list[dict]:
+    """Stage 3's settings: stage 2's best with one parameter changed to each of its other values."""
+    best = setting_of(ranked(read_rows(out / "stage2.csv"))[0]["key"])
+    return [{**best, name: float(v)} for name, values in SPACE for v in values if float(v) != best[name]]
+
+
+def setting_of(k: str) -> dict:
+    return {name: float(value) for name, value in (item.split("=") for item in k.split(","))}
+
+
+def _trials(median: float) -> str:
+    return "-" if math.isinf(median) else f"{median:g}"
+
+
+def report(plant: str, out: Path) -> Path:
+    s1, s2, s3 = (ranked(read_rows(out / f"stage{i}.csv")) for i in (1, 2, 3))
+    final = ranked(read_rows(out / "stage2.csv") + read_rows(out / "stage3.csv"))
+    lines = [f"# The {plant}'s task settings: sweep", "",
+             f"Written by `python -m harness.tools.plant_sweeps --plant {plant} --out {out} --report`.", "",
+             "Criterion, fixed before the runs: ICO's success rate (all cells, mean over seeds); settings within "
+             "one point of the best are ordered by fewer median trials to success.", "",
+             f"Space: {', '.join(f'{n} in {list(v)}' for n, v in SPACE)}; the pendulum angle is scaled to its "
+             "failure limit and the critic grid spans the same ranges. Stage 1: "
+             f"{SAMPLES} settings drawn from it (seeded), ICO on the quick profile's {len(QUICK_CELLS)} spread cells, "
+             f"seed 0, cap {MAX_TRIALS} trials, success {SUCCESS_STEPS} steps. Stage 2: the best {STAGE_2_TOP} "
+             f"on {len(SPREAD_CELLS)} cells evenly over the grid, seeds 0 and 1, same caps. Stage 3: one "
+             "parameter at a time over its values around stage 2's best, same cells, seeds and caps. The choice "
+             "is the best of stages 2 and 3 by the criterion.", ""]
+    for title, rows in (("Stages 2 and 3, ranked together", final), ("Stage 3", s3), ("Stage 2", s2),
+                        ("Stage 1", s1)):
+        lines += [f"## {title}", "", "| rank | setting | seeds | success | median trials |", "|---|---|---|---|---|"]
+        lines += [f"| {i} | {r['key']} | {r['seeds']} | {100 * r['success_rate']:.1f} % | "
+                  f"{_trials(r['median_trials'])} |" for i, r in enumerate(rows, 1)]
+        lines.append("")
+    if final:
+        lines += ["## Choice", "", f"`{final[0]['key']}` (harness/plants.py)."]
+    path = out / "summary.md"
+    store.write_text(path, "\n".join(lines) + "\n")
+    return path
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m harness.tools.plant_sweeps", description=__doc__.split("\n")[0])
+    p.add_argument("--plant", required=True)
+    p.add_argument("--out", required=True, type=Path)
+    p.add_argument("--stage", choices=("1", "2", "3", "all"), default="all")
+    p.add_argument("--report", action="store_true", help="only write summary.md")
+    args = p.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    if not args.report:
+        if args.stage in ("1", "all"):
+            run_stage(args.plant, args.out / "stage1.csv", samples(), [0], list(QUICK_CELLS))
+        if args.stage in ("2", "all"):
+            top = [setting_of(r["key"]) for r in ranked(read_rows(args.out / "stage1.csv"))[:STAGE_2_TOP]]
+            run_stage(args.plant, args.out / "stage2.csv", top, [0, 1], SPREAD_CELLS)
+        if args.stage in ("3", "all"):
+            run_stage(args.plant, args.out / "stage3.csv", one_at_a_time(args.out), [0, 1], SPREAD_CELLS)
+    print(report(args.plant, args.out))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
