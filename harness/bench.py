@@ -114,7 +114,7 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, A
                                  "n_interior": recs[0]["summary"]["n_interior"],
                                  "max_trials": recs[0]["config"]["run"]["max_trials"],
                                  "success_steps": recs[0]["config"]["run"]["success_steps"],
-                                 "paper": PAPER.get(cond)}
+                                 "paper": PAPER.get(cond) if results.record_plant(recs[0]) == CART_POLE else None}
         for key, _ in STATS:
             values = [r["summary"].get(key) for r in recs]
             mean, sd, n = _mean_sd(values)

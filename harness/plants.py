@@ -8,6 +8,7 @@ reads 4 inputs) is listed with why it cannot run; config.check_model refuses it 
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -23,32 +24,31 @@ class PlantSpec:
     why: str = ""  # where the settings come from
 
 
-def _furuta_ranges() -> list[float]:
-    """Arm angle and pendulum angle scaled to +-1 at the plant's limits; the velocity ranges chosen
-    by the Furuta sweep (docs/plants.md)."""
-    params = {p["name"]: p["value"] for p in B.plant_info("furuta")["params"]}
-    return [params["arm_limit"], FURUTA_VELOCITY_RANGES[0], params["pendulum_limit"], FURUTA_VELOCITY_RANGES[1]]
+# The cart-pole's reflex zone along its position, 2.35 of 2.4 m, as a fraction of the input range.
+ZONE_FRACTION = 2.35 / 2.4
 
 
-# The Furuta's arm and pendulum velocity ranges (rad/s), from its sweep (docs/plants.md).
-FURUTA_VELOCITY_RANGES = (6.4, 5.6)
-# The cart-pole's reflex zone, 2.35 of 2.4 m and 11.5 of 12 deg, as fractions of the limits.
-ZONE_FRACTION = (2.35 / 2.4, 11.5 / 12.0)
+def task_overrides(plant: str, setting: dict[str, float]) -> dict[str, Any]:
+    """The controller settings of a task setting (the plant sweep's space, harness.tools.plant_sweeps):
+    input ranges (arm angle, arm velocity, pendulum angle = its failure limit, pendulum velocity),
+    the critic grid over the same ranges, the reflex zone (ZONE_FRACTION of the arm range; the
+    pendulum's at zone_deg), ICO's rate and the policy gain."""
+    limit = {p["name"]: p["value"] for p in B.plant_info(plant)["params"]}["pendulum_limit"]
+    ranges = [setting["arm_range"], setting["arm_velocity_range"], limit, setting["pendulum_velocity_range"]]
+    return {"policy.input_range": ranges, "critic.range": ranges,
+            "policy.zone_x": ZONE_FRACTION * setting["arm_range"],
+            "policy.zone_theta": math.radians(setting["zone_deg"]),
+            "ico.rate": setting["ico.rate"], "policy.gain": setting["policy.gain"]}
 
 
-def _furuta() -> PlantSpec:
-    params = {p["name"]: p["value"] for p in B.plant_info("furuta")["params"]}
-    ranges = _furuta_ranges()
-    return PlantSpec("furuta", {
-        "policy.input_range": ranges, "critic.range": ranges,
-        "policy.zone_x": ZONE_FRACTION[0] * params["arm_limit"],
-        "policy.zone_theta": ZONE_FRACTION[1] * params["pendulum_limit"],
-    }, "the cart-pole's settings scaled to the Furuta's limits; velocity ranges from its sweep")
-
+# The Furuta's task setting, chosen by its sweep (docs/sweeps-furuta.md).
+FURUTA_SETTING = {"arm_range": 1.0, "arm_velocity_range": 2.3, "pendulum_velocity_range": 0.6, "zone_deg": 8.0,
+                  "ico.rate": 0.01, "policy.gain": 1.0}
 
 PLANTS: dict[str, PlantSpec] = {
     CART_POLE: PlantSpec(CART_POLE, {}, "the C defaults (the paper's task)"),
-    "furuta": _furuta(),
+    "furuta": PlantSpec("furuta", task_overrides("furuta", FURUTA_SETTING),
+                        "its sweep (docs/sweeps-furuta.md): input scaling, reflex zone, ICO rate, gain"),
 }
 # Registry plants the controller build cannot run, and why.
 UNRUNNABLE: dict[str, str] = {

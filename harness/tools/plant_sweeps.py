@@ -29,7 +29,7 @@ import numpy as np
 from .. import grid, store
 from ..bench import QUICK_CELLS
 from ..config import build_config
-from ..plants import ZONE_FRACTION
+from ..plants import task_overrides
 
 SAMPLES = 80
 STAGE_2_TOP = 5
@@ -58,15 +58,8 @@ def key(setting: dict) -> str:
 
 
 def overrides(plant: str, setting: dict) -> dict:
-    """The controller settings of a sample (the critic grid spans the input ranges)."""
-    from .. import _binding as B
-    limit = {p["name"]: p["value"] for p in B.plant_info(plant)["params"]}["pendulum_limit"]
-    ranges = [setting["arm_range"], setting["arm_velocity_range"], limit, setting["pendulum_velocity_range"]]
-    return {"policy.input_range": ranges, "critic.range": ranges,
-            "policy.zone_x": ZONE_FRACTION[0] * setting["arm_range"],
-            "policy.zone_theta": math.radians(setting["zone_deg"]),
-            "ico.rate": setting["ico.rate"], "policy.gain": setting["policy.gain"],
-            "max_trials": MAX_TRIALS, "success_steps": SUCCESS_STEPS}
+    """The controller settings of a sample, with the sweep's caps."""
+    return {**task_overrides(plant, setting), "max_trials": MAX_TRIALS, "success_steps": SUCCESS_STEPS}
 
 
 def run_one(plant: str, setting: dict, seed: int, cells: list[int]) -> dict:
