@@ -21,7 +21,7 @@ BENCH_DATA ?= docs/data/bench-$(BENCH_PROFILE).json
 FUZZ_TIME ?= 600
 FUZZ_JOBS ?= 2
 FUZZ_FLAGS ?=
-FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim
+FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim fuzz_model
 
 .PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz bench \
   bench-speed clean target-report sweeps sweeps-rl-alone

@@ -28,3 +28,14 @@ int fz_all_finite(const icoac_real_t *p, int n)
     }
     return 1;
 }
+
+int fz_all_finite_double(const double *p, int n)
+{
+    int i;
+    for (i = 0; i < n; ++i) {
+        if (!isfinite(p[i])) {
+            return 0;
+        }
+    }
+    return 1;
+}

@@ -21,7 +21,8 @@
 
 void fz_fail(const char *file, int line, const char *cond, const char *fmt, ...) FZ_NORETURN;
 
-/* 1 when the n reals at p are all finite. */
+/* 1 when the n reals (doubles) at p are all finite. */
 int fz_all_finite(const icoac_real_t *p, int n);
+int fz_all_finite_double(const double *p, int n);
 
 #endif /* ICOAC_FUZZ_CHECK_H */

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Write the committed seed corpus of the fuzz targets, tests/fuzz/corpus/<target>/.
 
-Inputs follow the formats documented at the top of fuzz_controller.c, fuzz_state.c and
-fuzz_sim.c; the value tables below mirror fuzz_input.c, the state fields fuzz_state.c. Files
-named repro-* are known reproducers.
+Inputs follow the formats documented at the top of fuzz_controller.c, fuzz_state.c,
+fuzz_sim.c and fuzz_model.c; the value tables below mirror fuzz_input.c, the state fields
+fuzz_state.c. Files named repro-* are known reproducers.
 
     python3 tests/fuzz/gen_corpus.py          # (re)write the corpus
     python3 tests/fuzz/gen_corpus.py --check  # exit 1 unless the committed corpus is current
@@ -749,6 +749,146 @@ def sim_seeds():
     }
 
 
+# ---- fuzz_model ----
+
+# The registry in its order (plant_registry.c): name, n_state.
+PLANTS = [("cart_pole", 4), ("furuta", 4), ("double_cart_pole", 6)]
+MAX_PARAMS = 16
+MODEL_FIELDS = ["plant", "integrator", "dt"]  # then 3 + i: param<i>, 3 + MAX_PARAMS + i: bound<i>
+# bound<i> selectors: a bound of the range, or past n_params -0, 0, DBL_TRUE_MIN, -DBL_TRUE_MIN
+BOUNDS = ["min", "max", "below", "above"]
+M_STEP, M_DERIVATIVES, M_FAILED, M_ENERGY, M_START, M_GRID, M_REGISTRY, M_PLANT = range(8)
+# NULL pointers of an op (o >= 0xC0): the state array (plant op: the plant), the output (start:
+# the cell; plant op: the model), the rng
+NULL_STATE, NULL_OUT, NULL_RNG = 0xC8, 0xD0, 0xE0
+GRID_SIZES = ["exact", 0, -1, "exact-1", "exact+1", "max", "min", 1]
+
+
+def model(of=0, **fields):
+    """icoac_sim_model_default of registry plant `of` with mutations (at most 7, in order):
+    plant, integrator (int32), dt, param<i> (doubles), bound<i> (a BOUNDS name)."""
+    assert len(fields) <= 7
+    out = bytes([len(fields) << 2, of])
+    for name, v in fields.items():
+        if name in ("plant", "integrator"):
+            out += bytes([MODEL_FIELDS.index(name)]) + int32(v)
+        elif name == "dt":
+            out += bytes([2]) + double(v)
+        elif name.startswith("param"):
+            out += bytes([3 + int(name[5:])]) + double(v)
+        else:
+            out += bytes([3 + MAX_PARAMS + int(name[5:]), BOUNDS.index(v)])
+    return out
+
+
+def model_raw(plant, integrator, dt, params, over=0):
+    """Raw icoac_sim_model_t bytes laid over the default of registry plant `over`."""
+    params = list(params) + [0.0] * (MAX_PARAMS - len(params))
+    return b"\x01" + bytes([over]) + struct.pack("<iid16d", plant, integrator, dt, *params)
+
+
+NULL_MODEL = b"\x03\x00"
+
+
+def op_state(kind, s, u=None, nulls=0):
+    """step, derivatives (with u), failed or energy on s (padded to 6 values with 0)."""
+    s = list(s) + ["0"] * (6 - len(s))
+    out = bytes([kind | nulls]) + b"".join(double(x) for x in s)
+    return out + (double(u) if kind in (M_STEP, M_DERIVATIVES) else b"")
+
+
+def op_start(x0, theta0, cell_seed, noise, rng_seed, nulls=0):
+    return (bytes([M_START | nulls]) + double(x0) + double(theta0) + bytes([cell_seed]) + double(noise)
+            + bytes([rng_seed]))
+
+
+def op_model_grid(index, size="exact", grid_seed=7, null=False):
+    return bytes([M_GRID]) + int32(index) + bytes([GRID_SIZES.index(size) | (0x80 if null else 0), grid_seed])
+
+
+def op_registry(index, name=None):
+    """name: None (NULL), ("plant", i) its name, ("truncated", i) less its last character, or a str."""
+    out = bytes([M_REGISTRY]) + int32(index)
+    if name is None:
+        return out + b"\x00"
+    if isinstance(name, tuple):
+        return out + bytes([1 if name[0] == "plant" else 2, name[1]])
+    raw = name.encode()
+    return out + bytes([3, len(raw)]) + raw
+
+
+def op_model_plant(s, force, reserved=0, nulls=0):
+    return bytes([M_PLANT | nulls]) + b"".join(double(x) for x in s) + double(force) + int32(reserved)
+
+
+def model_ops(p):
+    """Every op once on plant p's model, with small values."""
+    n = PLANTS[p][1]
+    s = [0.01 * (i + 1) for i in range(n)]
+    return (op_state(M_STEP, s, 0.5) + op_state(M_DERIVATIVES, s, -1.0) + op_state(M_FAILED, s)
+            + op_state(M_ENERGY, s) + op_start(0.5, 0.05, 1, 0.01, 2) + op_model_grid(p)
+            + op_registry(p, ("plant", p)) + op_model_plant((0.1, 0.0, 0.02, 0.0), 1.0))
+
+
+def model_seeds():
+    nulls = (op_state(M_STEP, [], 0.0, NULL_STATE) + op_state(M_DERIVATIVES, [0.1], 0.0, NULL_OUT)
+             + op_state(M_FAILED, [], nulls=NULL_STATE | NULL_OUT) + op_state(M_ENERGY, ["nan"], nulls=NULL_OUT)
+             + op_start(0.0, 0.0, 1, "0", 1, NULL_STATE) + op_start(0.0, 0.0, 1, "0", 1, NULL_OUT)
+             + op_start(0.0, 0.0, 1, "0", 1, NULL_RNG) + op_model_plant(("0",) * 4, "0", nulls=NULL_STATE)
+             + op_model_plant(("0",) * 4, "0", nulls=NULL_OUT))
+    s = {}
+    for p, (name, n) in enumerate(PLANTS):
+        s[f"{name}-default"] = model(p) + model_ops(p)
+        s[f"{name}-rk4"] = model(p, integrator=1) + model_ops(p) + op_state(M_STEP, [0.2] * n, 5.0)
+        s[f"{name}-bounds"] = (model(p, dt="1e-6", bound0="min", bound1="max", bound3="min", bound15="min")
+                               + model_ops(p) + op_state(M_STEP, [], 0.0))
+        s[f"{name}-param-below"] = model(p, bound0="below") + model_ops(p)
+        s[f"{name}-param-above"] = model(p, integrator=1, bound1="above") + model_ops(p)
+        s[f"{name}-unused-param"] = model(p, bound15="below") + model_ops(p)
+        s[f"{name}-param-nan"] = model(p, param2="nan") + model_ops(p)
+        s[f"{name}-nonfinite"] = (model(p) + op_state(M_STEP, ["nan"], 0.0) + op_state(M_STEP, [], "inf")
+                                  + op_state(M_DERIVATIVES, [0.0, "-inf"], 0.0) + op_state(M_DERIVATIVES, [], "nan")
+                                  + op_state(M_FAILED, ["0"] * (n - 1) + ["inf"]) + op_state(M_FAILED, ["nan"])
+                                  + op_state(M_ENERGY, ["0", "nan"]) + op_state(M_ENERGY, ["-inf"]))
+        s[f"{name}-overflow"] = (model(p, integrator=1) + op_state(M_STEP, [], "max")
+                                 + op_state(M_STEP, ["1e300"] * n, 0.0)
+                                 + op_state(M_DERIVATIVES, ["1e300"] * n, "max") + op_state(M_ENERGY, ["1e300"] * n)
+                                 + op_state(M_FAILED, ["1e300"] * n) + op_state(M_FAILED, [2.4, "0", "-2.4"]))
+        s[f"{name}-nulls"] = model(p) + nulls
+        s[f"{name}-start"] = (model(p) + op_start(0.5, 0.05, 1, "0", 2) + op_start(-2.4, "-2.4", 3, "1e-6", 4)
+                              + op_start("max", "-max", 5, 0.01, 6) + op_start(0.0, 0.0, 7, "1e-20", 8)
+                              + op_start(0.0, 0.0, 7, "1e6", 9) + op_start(0.0, 0.0, 7, "-1", 10)
+                              + op_start(0.0, 0.0, 7, "nan", 11) + op_start("inf", 0.0, 7, "0", 12)
+                              + op_start(0.0, "nan", 7, "0", 13) + op_start(0.0, 0.0, 7, "1e-310", 14))
+        s[f"{name}-grid"] = (model(p) + b"".join(op_model_grid(p, size, 3) for size in GRID_SIZES)
+                             + op_model_grid(p, null=True))
+    s.update({
+        "null-model": NULL_MODEL + model_ops(0) + nulls,
+        "raw-cart-pole": model_raw(0, 0, 0.01, [9.8, 1.0, 0.1, 0.5, 2.4, 12.0 * math.pi / 180.0]) + model_ops(0),
+        "raw-garbage": model_raw(7, 2, float("nan"), [float("inf")] * MAX_PARAMS, over=2) + model_ops(2),
+        "bad-plant-index": model(1, plant=-1) + model_ops(1),
+        "bad-plant-index-count": model(2, plant=3) + model_ops(2),
+        "bad-plant-index-max": model(0, plant=2**31 - 1) + model_ops(0),
+        "bad-dt": model(0, dt="1e-310") + model_ops(0),
+        "dt-max": model(1, dt="1", bound2="max") + model_ops(1),
+        "bad-dt-above": model(1, dt="2") + model_ops(1),
+        "bad-integrator": model(2, integrator=2) + model_ops(2),
+        "registry": (model(0) + op_registry(0, None) + op_registry(1, "") + op_registry(2, "no_such_plant")
+                     + op_registry(3, ("plant", 0)) + op_registry(-1, ("plant", 1))
+                     + op_registry(2**31 - 1, ("plant", 2))
+                     + op_registry(-2**31, ("truncated", 0)) + op_registry(1, ("truncated", 2))
+                     + op_registry(0, "cart_pole") + op_registry(1, "furuta_") + op_registry(2, "DOUBLE_CART_POLE")),
+        "grid-bad-index": (model(0) + op_model_grid(-1) + op_model_grid(3, "exact-1") + op_model_grid(2**31 - 1, "max")
+                           + op_model_grid(-2**31, "min", null=True)),
+        "from-plant": (model(0, integrator=1) + op_model_plant((0.1, 0.0, 0.02, 0.0), 10.0)
+                       + op_model_plant((2.4, 1.0, -0.25, "-1"), "-1e30") + op_model_plant(("nan", 0, 0, 0), 0.0)
+                       + op_model_plant(("1e300", "1e300", 0.1, "1e300"), "max", reserved=-1)),
+        "from-plant-furuta": model(1) + op_model_plant((0.1, 0.0, 0.02, 0.0), 1.0, reserved=2),
+        "from-plant-bad": model(0, param5="3.2", dt="0.25") + op_model_plant((0.1, 0.0, 0.02, 0.0), 1.0),
+    })
+    return s
+
+
 def corpus():
     """{target: {file name: bytes}}."""
     float_seeds = controller_seeds("f")
@@ -760,6 +900,7 @@ def corpus():
         "fuzz_state_mcu": state_seeds("f"),
         "fuzz_state_double": state_seeds("d"),
         "fuzz_sim": sim_seeds(),
+        "fuzz_model": model_seeds(),
     }
 
 
