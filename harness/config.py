@@ -628,6 +628,7 @@ def build_config(overrides: Mapping[str, Any] | None = None, condition: str | No
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
                               f"unknown condition {_short(condition)}; valid: {', '.join(CONDITIONS)}")
         items += CONDITION_OVERRIDES[condition].items()
+        items += plant_spec(plant).learners.get(REGISTRY[condition].base, {}).items()
     items += (overrides or {}).items()
     if plant != CART_POLE:
         params = plant_params(plant)

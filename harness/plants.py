@@ -22,6 +22,9 @@ class PlantSpec:
     name: str
     controller: dict[str, Any] = field(default_factory=dict)  # the task's controller settings
     why: str = ""  # where the settings come from
+    # a learner's settings on this plant where its cart-pole defaults do not carry over, by the
+    # learner's condition name (its control takes them too), from the plant's learner sweep
+    learners: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
 # The cart-pole's reflex zone along its position, 2.35 of 2.4 m, as a fraction of the input range.
@@ -48,7 +51,11 @@ FURUTA_SETTING = {"arm_range": 1.0, "arm_velocity_range": 2.3, "pendulum_velocit
 PLANTS: dict[str, PlantSpec] = {
     CART_POLE: PlantSpec(CART_POLE, {}, "the C defaults (the paper's task)"),
     "furuta": PlantSpec("furuta", task_overrides("furuta", FURUTA_SETTING),
-                        "its sweep (docs/sweeps-furuta.md): input scaling, reflex zone, ICO rate, gain"),
+                        "its sweep (docs/sweeps-furuta.md): input scaling, reflex zone, ICO rate, gain",
+                        # the exploration noise (V) by the learner sweeps of docs/sweeps-furuta.md; the
+                        # prior's decomposition takes the noise of the learner whose reading it shares
+                        learners={"ico-rl": {"actor.noise_std": 1.0}, "ico-mean-rl": {"actor.noise_std": 1.0},
+                                  "rl": {"actor.noise_std": 3.0}, "rl-ico-cov": {"actor.noise_std": 3.0}}),
 }
 # Registry plants the controller build cannot run, and why.
 UNRUNNABLE: dict[str, str] = {

@@ -14,6 +14,14 @@ STAGE_2_TOP of stage 1 on 49 cells evenly over the grid, seeds 0 and 1; stage 3 
 parameter at a time over its values around stage 2's best, on the same cells and seeds. The
 choice is the best of stages 2 and 3. Every stage resumes (finished settings are skipped);
 --report writes summary.md (docs/sweeps-<plant>.md).
+
+The learners (``--stage learners --prior-from ICO_DIR``, an ICO grid of the plant with the chosen
+task settings): their cart-pole settings carry over but for the scale of their exploration noise,
+which is in the plant's input units (N, V). Each actor-critic learner (LEARNER_SPACE) sweeps its
+noise on at most LEARNER_FAILED cells the ICO grid failed (evenly thinned) and on the 49 spread
+cells, 2 seeds, cap 1000 trials, as the cart-pole's learner sweeps; criterion fixed before the
+runs: success on the ICO-failed cells, ties within one point by the spread cells, then fewer
+median trials.
 """
 from __future__ import annotations
 
@@ -26,10 +34,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import grid, store
+from .. import _binding as B
+from .. import grid, results, store
 from ..bench import QUICK_CELLS
 from ..config import build_config
 from ..plants import task_overrides
+from ..sweep import SweepOptions, run_sweep
 
 SAMPLES = 80
 STAGE_2_TOP = 5
@@ -45,6 +55,10 @@ SPACE = (  # name, values (the pendulum angle range is its failure limit)
     ("policy.gain", (1.0, 3.0, 10.0)),
 )
 FIELDS = ["key", "seed", "cells", "success_rate", "median_trials", "wall_time"]
+LEARNER_SPACE = {"ico-rl": ("actor.noise_std", (0.1, 0.3, 1.0, 3.0)),
+                 "rl": ("actor.noise_std", (0.3, 1.0, 3.0, 12.0))}
+LEARNER_FAILED = 200
+LEARNER_MAX_TRIALS = 1000
 
 
 def samples(seed: int = 1) -> list[dict]:
@@ -154,21 +168,81 @@ def report(plant: str, out: Path) -> Path:
                   f"{_trials(r['median_trials'])} |" for i, r in enumerate(rows, 1)]
         lines.append("")
     if final:
-        lines += ["## Choice", "", f"`{final[0]['key']}` (harness/plants.py)."]
+        lines += ["## Choice", "", f"`{final[0]['key']}` (harness/plants.py).", ""]
+    if any(learner_ranking(out, c) for c in LEARNER_SPACE):
+        lines += ["## Learners", "",
+                  f"On the plant's ICO grid of seed 0 at the chosen task settings (`--stage learners`): each "
+                  f"actor-critic learner's exploration noise on at most {LEARNER_FAILED} cells that grid failed "
+                  f"(evenly thinned) and on the {len(SPREAD_CELLS)} spread cells, 2 seeds, cap "
+                  f"{LEARNER_MAX_TRIALS} trials. Criterion, fixed before the runs: success on the ICO-failed "
+                  "cells; within one point, the spread cells, then fewer median trials. The learners' other "
+                  "settings are the cart-pole's; the searches keep theirs.", ""]
+    for condition in LEARNER_SPACE:
+        table = learner_ranking(out, condition)
+        if not table:
+            continue
+        lines += [f"## Learner {condition}: exploration noise", "",
+                  "| rank | setting | success, ICO-failed cells | success, spread cells | median trials |",
+                  "|---|---|---|---|---|"]
+        lines += [f"| {i} | {r['key']} | {100 * r['ico_failed']:.1f} % | {100 * r['spread']:.1f} % | "
+                  f"{_trials(r['median_trials'])} |" for i, r in enumerate(table, 1)]
+        lines += ["", f"Choice: `{table[0]['key']}`.", ""]
     path = out / "summary.md"
     store.write_text(path, "\n".join(lines) + "\n")
     return path
+
+
+def learner_cells(ico_dir: Path) -> dict[str, list[int]]:
+    """The learner sweeps' cell sets: the ICO-failed cells (at most LEARNER_FAILED, evenly thinned)
+    and the spread cells."""
+    cells, _ = results.load(ico_dir, what="--prior-from")
+    failed = np.flatnonzero(cells["outcome"] == B.FAILED)
+    if failed.size > LEARNER_FAILED:
+        failed = failed[np.round(np.linspace(0, failed.size - 1, LEARNER_FAILED)).astype(int)]
+    return {"ico-failed": [int(i) for i in failed], "spread": SPREAD_CELLS}
+
+
+def run_learners(ico_dir: Path, out: Path) -> None:
+    for condition, (name, values) in LEARNER_SPACE.items():
+        for label, cells in learner_cells(ico_dir).items():
+            run_sweep(SweepOptions(prior_from=ico_dir, out=out / "learners" / f"{condition}-{label}",
+                                   params=[f"{name}={','.join(f'{v:g}' for v in values)}"], condition=condition,
+                                   cells=grid.format_cell_indices(cells), seeds=2, max_trials=LEARNER_MAX_TRIALS,
+                                   quiet=True))
+
+
+def learner_ranking(out: Path, condition: str) -> list[dict]:
+    """A learner's settings by the criterion (module docstring)."""
+    def rows(label):
+        path = out / "learners" / f"{condition}-{label}" / "sweep.csv"
+        return {r["key"]: r for r in read_rows(path)}
+    failed, spread = rows("ico-failed"), rows("spread")
+    table = [{"key": k, "ico_failed": float(r["success_rate_ico_failed"] or r["success_rate_mean"]),
+              "spread": float(spread[k]["success_rate_mean"]) if k in spread else math.nan,
+              "median_trials": float(r["median_trials"]) if r["median_trials"] else math.inf}
+             for k, r in failed.items()]
+    table.sort(key=lambda r: -r["ico_failed"])
+    if table:
+        best = table[0]["ico_failed"]
+        top = sorted([r for r in table if r["ico_failed"] >= best - 0.01], key=lambda r: (-r["spread"], r["median_trials"]))
+        table = top + [r for r in table if r["ico_failed"] < best - 0.01]
+    return table
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m harness.tools.plant_sweeps", description=__doc__.split("\n")[0])
     p.add_argument("--plant", required=True)
     p.add_argument("--out", required=True, type=Path)
-    p.add_argument("--stage", choices=("1", "2", "3", "all"), default="all")
+    p.add_argument("--stage", choices=("1", "2", "3", "all", "learners"), default="all")
+    p.add_argument("--prior-from", type=Path, default=None, help="the plant's ICO grid (stage learners)")
     p.add_argument("--report", action="store_true", help="only write summary.md")
     args = p.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
-    if not args.report:
+    if args.stage == "learners" and not args.report:
+        if args.prior_from is None:
+            p.error("--stage learners needs --prior-from ICO_DIR")
+        run_learners(args.prior_from, args.out)
+    elif not args.report:
         if args.stage in ("1", "all"):
             run_stage(args.plant, args.out / "stage1.csv", samples(), [0], list(QUICK_CELLS))
         if args.stage in ("2", "all"):
