@@ -227,7 +227,8 @@ def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] 
 def write_data(opt: "BenchOptions", agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None) -> Path:
     """The summary docs/results.md's tables are written from (harness.tools.results_tables): the
     aggregate, the ceiling's best w with its protocols, and what produced them."""
-    record = {"profile": opt.profile, "seeds": opt.seed_list(), "configuration": opt.configuration,
+    record = {**({} if opt.plant == CART_POLE else {"plant": opt.plant}),
+              "profile": opt.profile, "seeds": opt.seed_list(), "configuration": opt.configuration,
               "set": list(opt.sets), "prior_std": opt.prior_std, "git": results.git_info(),
               "timestamp": results.timestamp(), "aggregate": agg,
               "ceiling": None if ceiling is None else {"settings": ceiling["settings"], "best": ceiling["best"]}}

@@ -4,16 +4,7 @@
  * cannot observe is refused. */
 #include "test_common.h"
 
-#include "icoac_sim/icoac_sim.h"
-
-static icoac_sim_run_t small_run(int64_t max_trials, int64_t success_steps)
-{
-    icoac_sim_run_t run;
-    icoac_sim_run_default(&run);
-    run.max_trials = max_trials;
-    run.success_steps = success_steps;
-    return run;
-}
+#include "test_sim_common.h"
 
 static icoac_sim_model_t model_of(int32_t index)
 {
@@ -27,7 +18,7 @@ static icoac_sim_model_t model_of(int32_t index)
 static void test_cart_pole_model_bit_for_bit(void **unused)
 {
     static icoac_sim_cell_t by_plant[12], by_model[12];
-    const icoac_sim_run_t run = small_run(40, 400);
+    const icoac_sim_run_t run = test_small_run(40, 400);
     icoac_sim_plant_t plant;
     icoac_sim_model_t model;
     double states_p[101 * 4], states_m[101 * 4], forces_p[100], forces_m[100];
@@ -76,7 +67,7 @@ static void test_cart_pole_model_bit_for_bit(void **unused)
 static void test_furuta_grid(void **unused)
 {
     const int32_t furuta = icoac_sim_plant_find("furuta");
-    const icoac_sim_run_t run = small_run(3, 2000);
+    const icoac_sim_run_t run = test_small_run(3, 2000);
     const icoac_sim_model_t model = model_of(furuta);
     const icoac_sim_plant_desc_t *desc = icoac_sim_plant_info(furuta);
     const int64_t n = (int64_t)desc->rows.count * desc->cols.count;
@@ -147,7 +138,7 @@ static void test_furuta_trajectory(void **unused)
  * pendulum), a model outside its ranges, NULL; the cells are left as they were. */
 static void test_refused(void **unused)
 {
-    const icoac_sim_run_t run = small_run(2, 10);
+    const icoac_sim_run_t run = test_small_run(2, 10);
     icoac_config_t cfg = test_default_config();
     icoac_sim_model_t model = model_of(icoac_sim_plant_find("double_cart_pole"));
     icoac_sim_cell_t cells[2], before[2];
