@@ -113,7 +113,7 @@ int32_t icoac_sim_run_grid_model(const icoac_config_t *cfg, const icoac_sim_mode
     if (status != ICOAC_SIM_OK) {
         return status;
     }
-    if (cells == 0 || n_cells < 1 || n_threads < 0) {
+    if (run == 0 || cells == 0 || n_cells < 1 || n_threads < 0) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
     for (i = 0; i < n_cells; ++i) {

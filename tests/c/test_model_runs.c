@@ -167,6 +167,27 @@ static void test_refused(void **unused)
     assert_memory_equal(cells, before, sizeof cells);
 }
 
+/* A NULL run is refused like any NULL argument, the cells left as they were (found by fuzz_model:
+ * the grid runner passed the checks without a run, and its first trial start read through the
+ * NULL pointer). */
+static void test_grid_null_run(void **unused)
+{
+    icoac_config_t cfg = test_default_config();
+    const icoac_sim_model_t model = model_of(icoac_sim_plant_find("furuta"));
+    icoac_sim_plant_t plant;
+    icoac_sim_cell_t cells[2], before[2];
+    (void)unused;
+    icoac_sim_plant_default(&plant);
+    memset(cells, 0, sizeof cells);
+    cells[1].x0 = 0.1;
+    memcpy(before, cells, sizeof cells);
+    assert_int_equal(icoac_sim_run_grid_model(&cfg, &model, NULL, NULL, cells, 2, 1, NULL, NULL),
+                     ICOAC_SIM_ERR_BAD_ARGUMENT);
+    assert_int_equal(icoac_sim_run_grid(&cfg, &plant, NULL, NULL, cells, 2, 2, NULL, NULL), ICOAC_SIM_ERR_BAD_ARGUMENT);
+    assert_int_equal(icoac_sim_run_cell_model(&cfg, &model, NULL, NULL, cells, NULL, NULL), ICOAC_SIM_ERR_BAD_ARGUMENT);
+    assert_memory_equal(cells, before, sizeof cells);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -174,6 +195,7 @@ int main(void)
         cmocka_unit_test(test_furuta_grid),
         cmocka_unit_test(test_furuta_trajectory),
         cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_grid_null_run),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

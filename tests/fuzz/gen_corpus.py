@@ -821,6 +821,52 @@ def op_model_plant(s, force, reserved=0, nulls=0):
     return bytes([M_PLANT | nulls]) + b"".join(double(x) for x in s) + double(force) + int32(reserved)
 
 
+# Run ops (op bytes 0x80..0xBF): kind, and NULL pointers with RUN_NULLS (the configuration, the
+# cell / cells / trajectory states, the run / trajectory forces).
+R_CELL, R_GRID, R_TRAJECTORY, R_CANCELLED = 0x80, 0x81, 0x82, 0x83
+RUN_NULLS, NULL_CFG, NULL_CELLS, NULL_RUN = 0x20, 0x24, 0x28, 0x30
+PRESETS = [None, "success", "failed", "error"]
+
+
+def grid_cell(i, grid_seed=1, preset=None):
+    """Cell i of the plant byte's grid with grid_seed; preset: a finished outcome (grid op)."""
+    return bytes([PRESETS.index(preset) << 1, grid_seed]) + struct.pack("<H", i)
+
+
+def xy_cell(x0, theta0, cell_seed=1, preset=None):
+    return bytes([1 | PRESETS.index(preset) << 1]) + double(x0) + double(theta0) + bytes([cell_seed])
+
+
+def op_run_cell(cell, run_=None, cfg=None, prior_=NO_PRIOR, nulls=0):
+    """icoac_sim_run_cell_model; run_ and cfg default to run() and config()."""
+    return bytes([R_CELL | nulls]) + (run_ or run()) + (cfg or config()) + prior_ + cell
+
+
+def op_run_grid(cells, threads=1, run_=None, cfg=None, prior_=NO_PRIOR, nulls=0, cancelled=False):
+    """icoac_sim_run_grid_model on 0 to 4 cells (cell specs)."""
+    count = len(cells) - 1 if cells else 31
+    return (bytes([(R_CANCELLED if cancelled else R_GRID) | nulls]) + (run_ or run()) + (cfg or config()) + prior_
+            + bytes([count, {1: 0, 2: 13, -1: 15}[threads]]) + b"".join(cells))
+
+
+def op_run_trajectory(cell, noise, max_steps, cfg=None, prior_=NO_PRIOR, nulls=0, null_steps=False):
+    return (bytes([R_TRAJECTORY | nulls]) + (cfg or config()) + prior_ + cell + double(noise)
+            + bytes([(max_steps + 1) | (0x80 if null_steps else 0)]))
+
+
+SMALL_RUN = run(max_trials=3, success_steps=300)
+ONE_TRIAL = run(max_trials=1, success_steps=300)
+RL = config({"mode": 1})
+
+
+def run_ops(p):
+    """Each run op once on plant p's model within the tick budget (a cart-pole model runs twice,
+    through its plant struct too): ICO and RL cells, a grid with a finished cell, a trajectory."""
+    return (op_run_cell(grid_cell(600), ONE_TRIAL) + op_run_cell(xy_cell(0.1, 0.02, 3), SMALL_RUN, RL)
+            + op_run_grid([grid_cell(0, 2), grid_cell(612, 2, "success"), xy_cell(-0.5, -0.05, 4)], 2, ONE_TRIAL)
+            + op_run_trajectory(grid_cell(612, 5), "0.01", 64))
+
+
 def model_ops(p):
     """Every op once on plant p's model, with small values."""
     n = PLANTS[p][1]
@@ -862,7 +908,63 @@ def model_seeds():
                               + op_start(0.0, "nan", 7, "0", 13) + op_start(0.0, 0.0, 7, "1e-310", 14))
         s[f"{name}-grid"] = (model(p) + b"".join(op_model_grid(p, size, 3) for size in GRID_SIZES)
                              + op_model_grid(p, null=True))
+    for p, (name, n) in enumerate(PLANTS):
+        s[f"{name}-runs"] = model(p) + run_ops(p)
+        s[f"{name}-runs-rk4"] = model(p, integrator=1, dt=0.02) + run_ops(p)
+    run_nulls = (op_run_cell(grid_cell(1), nulls=NULL_CFG) + op_run_cell(grid_cell(1), nulls=NULL_CELLS)
+                 + op_run_cell(grid_cell(1), nulls=NULL_RUN)
+                 + op_run_grid([grid_cell(1)], nulls=NULL_CFG) + op_run_grid([grid_cell(1)], nulls=NULL_CELLS)
+                 + op_run_grid([grid_cell(1)], nulls=NULL_RUN)
+                 + op_run_trajectory(grid_cell(1), "0", 8, nulls=NULL_CFG)
+                 + op_run_trajectory(grid_cell(1), "0", 8, nulls=NULL_CELLS)
+                 + op_run_trajectory(grid_cell(1), "0", 8, nulls=NULL_RUN)
+                 + op_run_trajectory(grid_cell(1), "0", 8, null_steps=True))
+    bad_args = (op_run_cell(xy_cell("nan", 0.0)) + op_run_cell(xy_cell(0.0, "-inf"))
+                + op_run_grid([]) + op_run_grid([grid_cell(1)], threads=-1)
+                + op_run_grid([grid_cell(1), xy_cell("inf", 0.0, 2, "failed")])
+                + op_run_trajectory(grid_cell(1), "0", 0) + op_run_trajectory(grid_cell(1), "0", -1)
+                + op_run_trajectory(xy_cell("nan", 0.0), "0", 8) + op_run_trajectory(grid_cell(1), "1e-20", 8)
+                + op_run_trajectory(grid_cell(1), "-1", 8) + op_run_trajectory(grid_cell(1), "inf", 8)
+                + op_run_trajectory(grid_cell(1), "1e6", 8))
+    # checks in order: config, model, observation fit, run; then arguments, then the prior
+    bad_config = config({"mode": 3})
+    bad_run = run(max_trials=0)
+    bad_prior = prior(((2, 2), "-1"))
+    order = (op_run_cell(xy_cell("nan", 0.0), bad_run, bad_config, bad_prior)
+             + op_run_cell(xy_cell("nan", 0.0), bad_run, None, bad_prior)
+             + op_run_cell(xy_cell("nan", 0.0), None, None, bad_prior) + op_run_cell(grid_cell(1), None, None, bad_prior)
+             + op_run_grid([], -1, bad_run, bad_config, bad_prior) + op_run_grid([], -1, bad_run, None, bad_prior)
+             + op_run_grid([grid_cell(1)], 1, None, None, bad_prior)
+             + op_run_trajectory(xy_cell("nan", 0.0), "-1", 0, bad_config, bad_prior)
+             + op_run_trajectory(grid_cell(1), "0", 8, None, bad_prior))
     s.update({
+        "runs-nulls": model(0) + run_nulls,
+        "runs-null-model": NULL_MODEL + run_nulls + op_run_cell(grid_cell(1), cfg=config({"mode": 3})),
+        "runs-bad-arguments": model(1) + bad_args,
+        "runs-order-cart-pole": model(0) + order,
+        "runs-order-bad-model": model(1, param0="nan") + order,
+        "runs-order-unfit-plant": model(2) + order,
+        "runs-order-unused-param": model(0, param15=1.0) + order,
+        # -0 as an unused parameter: accepted, but no plant struct gives it back
+        "runs-unrepresentable": model(0, bound15="min") + run_ops(0),
+        "runs-cancelled": (model(1) + op_run_grid([grid_cell(3), grid_cell(5, 1, "failed")], 2, cancelled=True)
+                           + op_run_grid([grid_cell(3, 1, "error")], cancelled=True)
+                           + op_run_grid([grid_cell(3)], nulls=NULL_CFG, cancelled=True)),
+        "runs-presets": (model(0) + op_run_grid([grid_cell(0, 1, "success"), grid_cell(1, 1, "failed"),
+                                                 grid_cell(2, 1, "error"), xy_cell(0.0, 0.0, 1, "success")], 2)
+                         + op_run_grid([grid_cell(7), grid_cell(8), grid_cell(9), grid_cell(10)], 2, ONE_TRIAL)),
+        "runs-rl-prior": (model(1) + op_run_cell(grid_cell(100), SMALL_RUN, RL, prior(("mean2", 5.0), ("mean3", 1.0)))
+                          + op_run_trajectory(grid_cell(100), "0", 64, RL, prior(("mean2", 5.0)))),
+        "runs-search": (model(0) + op_run_cell(grid_cell(300), run(max_trials=3, success_steps=10),
+                                               config({"mode": 2, "search.batch": 1}))
+                        + op_run_grid([grid_cell(301), grid_cell(302)], 2, run(max_trials=3, success_steps=10),
+                                      config({"mode": 2, "search.batch": 2}))),
+        "runs-fall": (model(1, dt=0.1) + op_run_trajectory(xy_cell(0.0, 0.2, 9), "0.01", 64, config({"policy.gain": "0"}))
+                      + op_run_cell(xy_cell(0.0, 0.2, 9), SMALL_RUN, config({"policy.gain": "0"}))
+                      + op_run_trajectory(xy_cell("1e300", "-1e30", 9), "0", 64)),
+        "runs-noise": (model(0) + op_run_cell(grid_cell(11), run(max_trials=3, success_steps=300,
+                                                                 init_velocity_noise="1e-6"))
+                       + op_run_trajectory(grid_cell(11), "1e-6", 64) + op_run_trajectory(grid_cell(11), 3.0, 64)),
         "null-model": NULL_MODEL + model_ops(0) + nulls,
         "raw-cart-pole": model_raw(0, 0, 0.01, [9.8, 1.0, 0.1, 0.5, 2.4, 12.0 * math.pi / 180.0]) + model_ops(0),
         "raw-garbage": model_raw(7, 2, float("nan"), [float("inf")] * MAX_PARAMS, over=2) + model_ops(2),
