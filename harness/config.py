@@ -467,13 +467,22 @@ def check_model(model: B.Model) -> None:
     info = B.plant_info(model.plant)
     status = int(B.lib.icoac_sim_model_check(ctypes.byref(model)))
     if status != B.OK:
-        def valid(v, p):  # the C check's rule: 0 or a normal number in [min, max]
-            return (v == 0.0 or np.isfinite(v) and abs(v) >= np.finfo(np.float64).tiny) and p["min"] <= v <= p["max"]
-        bad = [f"{p['name']}={model.param[i]!r} (valid: 0 or normal in [{p['min']:g}, {p['max']:g}])"
-               for i, p in enumerate(info["params"]) if not valid(model.param[i], p)]
-        raise ConfigError(status, f"plant {info['name']}: "
-                                  + (", ".join(bad) if bad else f"dt={model.dt!r} or integrator={model.integrator!r}")
-                                  + " rejected", context="plant config")
+        # the culprits: each value the C check refuses when set alone on the plant's defaults
+        bad = []
+        for i, key in [(i, p["name"]) for i, p in enumerate(info["params"])] + [(None, "dt"), (None, "integrator")]:
+            probe = B.Model()
+            B.lib.icoac_sim_model_default(ctypes.byref(probe), model.plant)
+            value = model.param[i] if i is not None else getattr(model, key)
+            if i is None:
+                setattr(probe, key, value)
+            else:
+                probe.param[i] = value
+            if int(B.lib.icoac_sim_model_check(ctypes.byref(probe))) != B.OK:
+                rng = f" (valid: 0 or a normal number in [{info['params'][i]['min']:g}, " \
+                      f"{info['params'][i]['max']:g}])" if i is not None else ""
+                bad.append(f"{key}={value!r}{rng}")
+        raise ConfigError(status, f"plant {info['name']}: {', '.join(bad) or 'parameters'} rejected",
+                          context="plant config")
     if len(info["state"]) != B.N_INPUTS or info["observed"][:B.N_INPUTS] != list(range(B.N_INPUTS)):
         raise ConfigError(B.SIM_ERR_BAD_PLANT,
                           f"plant {info['name']} has {len(info['state'])} state components; this controller "
@@ -686,6 +695,8 @@ def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
             continue
         items = _controller_items(values) if group == "controller" else values.items()
         for name, value in items:
+            if group == "plant" and name == "name":  # the cart-pole, named
+                continue
             if name == "reserved" and group == "plant":
                 if not (isinstance(value, int) and not isinstance(value, bool) and value == 0):
                     raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant parameter reserved must be 0, got {_short(value)}")

@@ -41,9 +41,16 @@ class PlantGrid:
         self.col_last = self.col_first + (self.cols - 1) * self.col_step
 
     def _display(self, values, sweep: int) -> np.ndarray:
-        """Cell coordinates (plant units) in the axis' display units."""
         v = np.asarray(values, dtype=float)
         return np.degrees(v) if self._sweeps[sweep]["degrees"] else v
+
+    def col_display(self, x0) -> np.ndarray:
+        """Cells' x0 (plant units) in the column axis' display units."""
+        return self._display(x0, 1)
+
+    def row_display(self, theta0) -> np.ndarray:
+        """Cells' theta0 (plant units) in the row axis' display units."""
+        return self._display(theta0, 0)
 
     def _internal(self, values, sweep: int) -> np.ndarray:
         v = np.asarray(values, dtype=float)

@@ -72,8 +72,8 @@ def frame_mask(cells: np.ndarray, frame: tuple[float, float] | None,
     if frame is None:
         return np.ones(cells.size, dtype=bool)
     half_col, half_row = frame
-    return ((np.abs(grid._display(cells["x0"], 1)) <= half_col + _TOL)
-            & (np.abs(grid._display(cells["theta0"], 0)) <= half_row + _TOL))
+    return ((np.abs(grid.col_display(cells["x0"])) <= half_col + _TOL)
+            & (np.abs(grid.row_display(cells["theta0"])) <= half_row + _TOL))
 
 
 def parse_frame(text: str | None, x_max: float | None = None, theta_max_deg: float | None = None

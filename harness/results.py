@@ -17,7 +17,7 @@ from . import _binding as B
 from . import geometry, metrics
 from .config import CART_POLE, RunConfig, config_from_dict
 from .errors import ResultsError
-from .grid import make_cells, parse_cell_indices, plant_grid
+from .grid import make_cells, parse_cell_indices
 from .options import SEED_LIMIT
 from .registry import CONDITIONS
 
@@ -204,11 +204,6 @@ def record_plant(record: Mapping[str, Any]) -> str:
     return name if isinstance(name, str) else CART_POLE
 
 
-def _on_plant_grid(cells: np.ndarray, plant: str) -> np.ndarray:
-    points = set(zip(*(plant_grid(plant)[k].tolist() for k in ("x0", "theta0"))))
-    return np.array([p in points for p in zip(cells["x0"].tolist(), cells["theta0"].tolist())], dtype=bool)
-
-
 def check_cells(cells: np.ndarray, where: str = "cells", plant: str = CART_POLE) -> None:
     """Structural checks of a cell array: known outcomes, finite coordinates on the plant's grid."""
     bad = ~np.isin(cells["outcome"], list(B.OUTCOME_NAMES))
@@ -216,7 +211,10 @@ def check_cells(cells: np.ndarray, where: str = "cells", plant: str = CART_POLE)
         i = int(np.flatnonzero(bad)[0])
         raise _err(f"{where}: cell {i} has unknown outcome {int(cells['outcome'][i])} "
                    f"(valid: {', '.join(f'{k} {v}' for k, v in B.OUTCOME_NAMES.items())})")
-    on_grid = geometry.on_grid(cells) if plant == CART_POLE else _on_plant_grid(cells, plant)
+    try:
+        on_grid = geometry.of(plant).on_grid(cells)
+    except B.ConfigError:
+        raise _err(f"{where}: the record names the plant {plant!r:.40}, which the registry does not hold") from None
     if not on_grid.all():
         i = int(np.flatnonzero(~on_grid)[0])
         grid_name = "the paper grid" if plant == CART_POLE else f"the {plant} grid"
