@@ -224,6 +224,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"Fig. 1g trajectory length in s (default {O.TRAJECTORY_DURATION:g}); finite, > 0 and at "
                         f"most {f'{O.MAX_TRAJECTORY_STEPS:.0e}'.replace('e+0', 'e')} plant steps (duration / dt, i.e. 10000 s at the "
                         "default dt = 0.01 s)")
+    f.add_argument("--plant", type=_plant, default=None,
+                   help="the plant --results must hold (default: whichever it records)")
     f.set_defaults(func=cmd_figures)
 
     b = sub.add_parser("bench", help="benchmark stages: grids, figures, summary")
@@ -257,6 +259,8 @@ def build_parser() -> argparse.ArgumentParser:
     w = sub.add_parser("sweep", help="factorial sweep of RL parameters on a cell subset")
     w.add_argument("--prior-from", required=True, metavar="ICO_DIR", help="ICO results directory")
     w.add_argument("--out", required=True, help="sweep directory (sweep.csv, sweep.md)")
+    w.add_argument("--plant", type=_plant, default=None,
+                   help="the plant --prior-from must hold (the sweep runs on that grid's plant)")
     w.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2,...",
                    help="values of one parameter (repeatable; names as for --set); prior_frame=central,all "
                         "and prior_ridge allowed")
@@ -388,6 +392,7 @@ def cmd_figures(args) -> int:
     from . import figures, results, store
 
     cells, record = results.load(args.results, what="--results")
+    _check_plant(args.plant, record, "--results")
     figures.check_duration(record, args.duration)  # before anything is drawn
     store.check_writable(args.out)
     for path in figures.make_figures(cells, record, args.out, duration=args.duration):
@@ -408,8 +413,18 @@ def cmd_bench(args) -> int:
     return bench.run_bench(opt, argv=sys.argv[1:])
 
 
+def _check_plant(plant: str | None, record: dict, what: str) -> None:
+    """--plant, when given, must be the plant a results directory records."""
+    from . import results
+    if plant is not None and plant != results.record_plant(record):
+        raise UsageError(f"--plant {plant}, but {what} holds a grid of the {results.record_plant(record)}")
+
+
 def cmd_sweep(args) -> int:
-    from . import sweep
+    from . import results, sweep
+
+    if args.plant is not None:
+        _check_plant(args.plant, results.load(args.prior_from, what="--prior-from")[1], "--prior-from")
 
     opt = sweep.SweepOptions(
         prior_from=Path(args.prior_from), out=Path(args.out), params=args.param, condition=args.condition,

@@ -157,3 +157,17 @@ def test_sweep_ranking_and_the_furuta_choice():
         if learner in plant_sweeps.LEARNER_SPACE:
             picked = re.search(rf"## Learner {learner}: .*?Choice: `([^`]+)`", text, re.S).group(1)
             assert json.loads(picked) == settings
+
+
+def test_figures_and_sweep_take_the_recorded_plant(capsys, tmp_path):
+    out = tmp_path / "fur"
+    assert main(capsys, "grid", "--plant", "furuta", "--out", out, "--cells", CELLS, *TINY_ARGS)[0] == 0
+    line = one_line_error(*main(capsys, "figures", "--results", out, "--out", tmp_path / "f", "--plant",
+                                "cart_pole")[::2])
+    assert "furuta" in line and not (tmp_path / "f").exists()
+    line = one_line_error(*main(capsys, "sweep", "--prior-from", out, "--out", tmp_path / "s", "--plant",
+                                "cart_pole", "--param", "actor.noise_std=1")[::2])
+    assert "furuta" in line and not (tmp_path / "s").exists()
+    rc, printed, err = main(capsys, "figures", "--results", out, "--out", tmp_path / "f", "--plant", "furuta")
+    assert rc == 0, err
+    assert sorted(Path(p).name for p in printed.split()) == ["fig1b_success_map.png", "fig1cf_weights.png"]
