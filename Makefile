@@ -28,7 +28,7 @@ FUZZ_FLAGS ?=
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim fuzz_model
 
 .PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz bench \
-  bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants
+  bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
 
@@ -99,19 +99,21 @@ bench-speed: build
 	./build/release/sim_host/icoac_bench
 
 # BENCH_ARGS: more bench options, e.g. BENCH_ARGS=--resume to continue a stopped run.
-# Per plant, the linear-policy ceiling first (about 40 s; a rerun replays its cached search),
-# then the bench, which shows it in summary.md and Fig. 3a.
+# Per plant (bench-plant), the linear-policy ceiling first (about 40 s; a rerun replays its
+# cached search), then the bench, which shows it in summary.md and Fig. 3a.
 bench: build venv bench-speed
 	@plants="$(BENCH_PLANTS)"; \
 	if [ "$$plants" = all ]; then plants=$$($(VPY) -c 'from harness.plants import PLANTS; print(" ".join(PLANTS))'); fi; \
-	for p in $$plants; do \
-	  if [ "$$p" = cart_pole ]; then out=$(BENCH_OUT); fig=$(BENCH_FIGURES); data=$(BENCH_DATA); \
-	  else out=$(BENCH_OUT)-$$p; fig=$(BENCH_FIGURES)/$$p; data=$(basename $(BENCH_DATA))-$$p.json; fi; \
-	  echo "== bench: plant $$p -> $$out"; \
-	  $(VPY) -m harness ceiling --plant $$p --out $$out/ceiling --quiet && \
-	  $(VPY) -m harness bench --plant $$p --profile $(BENCH_PROFILE) --out $$out --figures $$fig \
-	    --data $$data $(BENCH_ARGS) || exit 1; \
-	done
+	for p in $$plants; do $(MAKE) --no-print-directory bench-plant PLANT=$$p || exit 1; done
+
+PLANT ?= cart_pole
+PLANT_OUT = $(if $(filter cart_pole,$(PLANT)),$(BENCH_OUT),$(BENCH_OUT)-$(PLANT))
+PLANT_FIGURES = $(if $(filter cart_pole,$(PLANT)),$(BENCH_FIGURES),$(BENCH_FIGURES)/$(PLANT))
+PLANT_DATA = $(if $(filter cart_pole,$(PLANT)),$(BENCH_DATA),$(basename $(BENCH_DATA))-$(PLANT).json)
+bench-plant:
+	$(VPY) -m harness ceiling --plant $(PLANT) --out $(PLANT_OUT)/ceiling --quiet
+	$(VPY) -m harness bench --plant $(PLANT) --profile $(BENCH_PROFILE) --out $(PLANT_OUT) \
+	  --figures $(PLANT_FIGURES) --data $(PLANT_DATA) $(BENCH_ARGS)
 
 # The learner sweeps that chose the defaults (docs/results.md), on the ICO grid of seed 0 of a
 # bench (make bench first); resumable, summary in $(SWEEP_OUT)/summary.md.
