@@ -621,6 +621,14 @@ _PROTOTYPES = {
     "icoac_sim_plant_grid": ([ctypes.c_int32, _cells_p, ctypes.c_int64, ctypes.c_uint64], ctypes.c_int32),
     "icoac_rng_seed": ([_P(Rng), ctypes.c_uint64, ctypes.c_uint64], None),
     "icoac_sim_model_start": ([_P(Model), ndpointer(CELL_DTYPE, shape=(1,), flags="C_CONTIGUOUS"), ctypes.c_double, _P(Rng), _state_w], ctypes.c_int32),
+    "icoac_sim_run_cell_model": ([_P(Config), _P(Model), _P(Run), _P(Prior), _cells_p,
+                                  _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)], ctypes.c_int32),
+    "icoac_sim_run_grid_model": ([_P(Config), _P(Model), _P(Run), _P(Prior), _cells_p, ctypes.c_int64,
+                                  ctypes.c_int32, _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)],
+                                 ctypes.c_int32),
+    "icoac_sim_trajectory_model": ([_P(Config), _P(Model), _P(Prior), ctypes.c_double, ctypes.c_double,
+                                    ctypes.c_double, ctypes.c_uint64, ctypes.c_int64, _f64_w, _f64_w,
+                                    _P(ctypes.c_int64)], ctypes.c_int32),
 }
 for _name, (_args, _res) in _PROTOTYPES.items():
     _fn = getattr(lib, _name)

@@ -28,6 +28,7 @@ from .config import build_config, command_overrides, named_sets
 from .errors import ResultsError
 from .metrics import percent
 from .options import PROFILE_NAMES
+from .plants import CART_POLE
 from .registry import CONDITIONS, PRIOR_CONDITIONS, REGISTRY
 
 # Paper (Fig. 1b, 2b, 3a): ~68 % ICO, ~84 % ICO->RL; RL alone only "smaller" and "very slow" (Fig. 3 bars).
@@ -113,7 +114,7 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, A
                                  "n_interior": recs[0]["summary"]["n_interior"],
                                  "max_trials": recs[0]["config"]["run"]["max_trials"],
                                  "success_steps": recs[0]["config"]["run"]["success_steps"],
-                                 "paper": PAPER.get(cond)}
+                                 "paper": PAPER.get(cond) if results.record_plant(recs[0]) == CART_POLE else None}
         for key, _ in STATS:
             values = [r["summary"].get(key) for r in recs]
             mean, sd, n = _mean_sd(values)
@@ -171,8 +172,10 @@ def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
     return lines
 
 
-def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> str:
-    lines = ["# ICO and the learners with their no-learning controls: mean ± sd over seeds", "",
+def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None,
+                     grid: geometry.PlantGrid = geometry.CART_POLE) -> str:
+    title = "" if grid is geometry.CART_POLE else f" ({grid.plant})"
+    lines = [f"# ICO and the learners with their no-learning controls{title}: mean ± sd over seeds", "",
              "| condition | seeds | caps (trials / steps) | success (all) | success (interior) | "
              "median trials to success | mean elapsed sim. time of successes (s) | paper |",
              "|---|---|---|---|---|---|---|---|"]
@@ -202,17 +205,21 @@ def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None =
     if ceiling is not None:
         lines += ceiling_markdown(ceiling)
     lines += tables.curve_tables(agg, ceiling)
-    lines += ["", f"Success rates use the cells run as denominator ({geometry.CELLS} / {geometry.N_INTERIOR} on "
-              f"the full grid). The paper's ~{percent(PAPER['ico']['success_rate'], 0)} / "
-              f"~{percent(PAPER['ico-rl']['success_rate'], 0)} are read as fractions of all {geometry.CELLS} cells."]
+    lines += ["", f"Success rates use the cells run as denominator ({grid.cells} / {grid.n_interior} on "
+              "the full grid)."]
+    if grid is geometry.CART_POLE:
+        lines[-1] += (f" The paper's ~{percent(PAPER['ico']['success_rate'], 0)} / "
+                      f"~{percent(PAPER['ico-rl']['success_rate'], 0)} are read as fractions of all "
+                      f"{geometry.CELLS} cells.")
     return "\n".join(lines) + "\n"
 
 
-def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> tuple[Path, Path]:
+def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None,
+                  grid: geometry.PlantGrid = geometry.CART_POLE) -> tuple[Path, Path]:
     out = Path(out)
     md = out / "summary.md"
     js = out / "summary.json"
-    store.write_text(md, summary_markdown(agg, ceiling))
+    store.write_text(md, summary_markdown(agg, ceiling, grid))
     store.write_json(js, agg)
     return md, js
 
@@ -220,7 +227,8 @@ def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] 
 def write_data(opt: "BenchOptions", agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None) -> Path:
     """The summary docs/results.md's tables are written from (harness.tools.results_tables): the
     aggregate, the ceiling's best w with its protocols, and what produced them."""
-    record = {"profile": opt.profile, "seeds": opt.seed_list(), "configuration": opt.configuration,
+    record = {**({} if opt.plant == CART_POLE else {"plant": opt.plant}),
+              "profile": opt.profile, "seeds": opt.seed_list(), "configuration": opt.configuration,
               "set": list(opt.sets), "prior_std": opt.prior_std, "git": results.git_info(),
               "timestamp": results.timestamp(), "aggregate": agg,
               "ceiling": None if ceiling is None else {"settings": ceiling["settings"], "best": ceiling["best"]}}
@@ -231,7 +239,8 @@ def write_data(opt: "BenchOptions", agg: Mapping[str, Any], ceiling: Mapping[str
 
 def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarray | None,
                        icorl_cells: np.ndarray | None, frame=None,
-                       ceiling: Mapping[str, Any] | None = None) -> list[Path]:
+                       ceiling: Mapping[str, Any] | None = None,
+                       grid: geometry.PlantGrid = geometry.CART_POLE) -> list[Path]:
     """Fig. 2b (first ICO->RL seed, ICO success domain outlined), Fig. 3a (with the linear-policy
     ceiling's reference lines when a ceiling record is given), Fig. 3b."""
     figdir = Path(figdir)
@@ -239,9 +248,9 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
     if icorl_cells is not None:
         outline = None
         if ico_cells is not None:
-            outline = geometry.to_grid(ico_cells, metrics.success_mask(ico_cells).astype(float), fill=0) > 0
+            outline = grid.to_grid(ico_cells, metrics.success_mask(ico_cells).astype(float), fill=0) > 0
         written.append(figures.plot_success_map(icorl_cells, figdir / "fig2b_icorl_success_map.png",
-                                                label="ICO->RL", outline=outline, frame=frame))
+                                                label="ICO->RL", outline=outline, frame=frame, grid=grid))
     conds = [c for c in CONDITIONS if c in agg]
     if conds:
         written.append(figures.plot_fig3a(figdir / "fig3a_success_rate.png", [REGISTRY[c].label for c in conds],
@@ -327,11 +336,12 @@ class BenchOptions:
     sets: Sequence[str] = ()
     resume: bool = False
     quiet: bool = False
-    frame: tuple[float, float] | None = P.DEFAULT_FRAME
+    frame: tuple[float, float] | str | None = P.CENTRAL  # the plant's central frame unless given
     ridge: float = P.DEFAULT_RIDGE
     prior_std: float = P.DEFAULT_STD
     ceiling: Path | None = None   # a ceiling.json (or its directory); default OUT/ceiling/ceiling.json
     dask: Any = None              # a harness.cluster.DaskSpec: every grid on that Dask cluster (None: threads)
+    plant: str = CART_POLE        # a plant of harness.plants: its grid, dynamics and task settings
 
     def seed_list(self) -> list[int]:
         n = self.seeds if self.seeds is not None else PROFILES[self.profile]["seeds"]
@@ -346,9 +356,12 @@ def stages(opt: BenchOptions) -> list[Stage]:
     out = Path(opt.out)
     figdir = Path(opt.figures) if opt.figures else None
     seeds = opt.seed_list()
-    ico_sets = command_overrides(opt.configuration, opt.sets)
-    rl_sets = command_overrides(opt.configuration, opt.sets, {"--rl-max-trials": ("max_trials", opt.rl_max_trials)})
+    ico_sets = command_overrides(opt.configuration, opt.sets, plant=opt.plant)
+    rl_sets = command_overrides(opt.configuration, opt.sets, {"--rl-max-trials": ("max_trials", opt.rl_max_trials)},
+                                plant=opt.plant)
     cells_spec = profile["cells"]
+    plant_grid = geometry.of(opt.plant)
+    frame = plant_grid.central_frame() if opt.frame == P.CENTRAL else opt.frame
 
     def overrides(condition):
         if condition == "ico":
@@ -362,7 +375,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
                 condition=condition, out=d, seed=seed, threads=opt.threads, overrides=overrides(condition),
                 cell_spec=cells_spec, resume=opt.resume and results.exists(d), fresh=not opt.resume,
                 progress=not opt.quiet, info=ctx.get(("prior", condition, seed)),
-                start_over="rerun bench without --resume", dask=ctx.get("dask"))
+                start_over="rerun bench without --resume", dask=ctx.get("dask"), plant=opt.plant)
             ctx[(condition, seed)] = (cells, record)
             s = record["summary"]
             progress(f"  {condition} seed {seed}: success {s['n_success']}/{s['n_cells']}, "
@@ -373,7 +386,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
 
     def prior_stage(seed: int):
         def run(ctx):
-            info = P.from_results(seed_dir(out, "ico", seed), opt.frame, opt.ridge)
+            info = P.from_results(seed_dir(out, "ico", seed), frame, opt.ridge)
             for cond in REGISTRY.values():
                 if cond.prior is not None and cond.learns:
                     ctx[("prior", cond.name, seed)] = P.condition_prior(cond.name, info, opt.prior_std)
@@ -402,7 +415,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
         for path in figures.make_figures(cells, record, figdir):
             progress(f"  wrote {path}")
         for path in comparison_figures(ctx["aggregate"], figdir, cells, ctx[("ico-rl", seeds[0])][0],
-                                       frame=opt.frame, ceiling=ceiling_record()):
+                                       frame=frame, ceiling=ceiling_record(), grid=plant_grid):
             progress(f"  wrote {path}")
 
     def summary_stage(ctx):
@@ -415,7 +428,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
                     {s: ctx[(condition, s)][0] for s in seeds if (condition, s) in ctx},
                     {s: ctx[(control, s)][0] for s in seeds if (control, s) in ctx})
         ctx["aggregate"] = agg
-        md, js = write_summary(out, agg, ceiling_record())
+        md, js = write_summary(out, agg, ceiling_record(), plant_grid)
         if opt.data is not None:
             write_data(opt, agg, ceiling_record())
             progress(f"  wrote {opt.data}")
@@ -438,7 +451,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
         return [Stage("complete grids", finished_stage), Stage("summary", summary_stage),
                 Stage("figures", figures_stage)]
     for condition in CONDITIONS:  # every override valid before the first grid runs
-        build_config(overrides(condition), condition=condition)
+        build_config(overrides(condition), condition=condition, plant=opt.plant)
     if opt.ceiling is not None:
         load_ceiling(opt.ceiling)
 

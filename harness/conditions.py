@@ -51,7 +51,8 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
                   cell_spec=None, resume: bool = False, fresh: bool = False, progress: bool = True,
                   checkpoint_every: float | None = None, checkpoint_cells: int | None = None,
                   info: P.PriorInfo | None = None, explicit: bool = True, cancel_after: float | None = None,
-                  start_over: str = "rerun with --overwrite", dask=None) -> tuple[np.ndarray, dict, bool]:
+                  start_over: str = "rerun with --overwrite", dask=None,
+                  plant: str = "cart_pole") -> tuple[np.ndarray, dict, bool]:
     """Run (or resume) one condition into a results directory; returns (cells, record, cancelled).
 
     ``dask`` (a harness.cluster.DaskSession, or a DaskSpec for a session opened after every check
@@ -82,7 +83,9 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
         raise UsageError(f"--cells: {exc}") from None
     extra = prior_extra(info)
     prior = info.prior() if info is not None else None
-    cfg = None if resume and not explicit else build_config(overrides, condition=condition, prior=prior)
+    cfg = None if resume and not explicit else build_config(overrides, condition=condition, prior=prior, plant=plant)
+    if dask is not None and cfg is not None and cfg.model is not None:
+        raise UsageError(f"--plant {plant}: the Dask backend runs the cart-pole only; run it on local threads")
     with store.ResultsStore(out, start_over=start_over) as st:
         have = st.present()
         if resume and not have:
@@ -107,7 +110,7 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
             if n_pending == 0:  # nothing to run: nothing is written, the record stays as it is
                 return cells, record, False
         else:
-            cells = grid.make_cells(seed, indices)
+            cells = grid.make_cells(seed, indices, plant=cfg.plant_name)
         return _run(st, cfg, cells, previous=record, condition=condition, seed=seed, threads=threads,
                     indices=indices, extra=extra, fresh=fresh, progress=progress, checkpoint_every=checkpoint_every,
                     checkpoint_cells=checkpoint_cells, cancel_after=cancel_after, dask=dask)

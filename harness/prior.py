@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from . import _binding as B
-from . import metrics, results
+from . import geometry, metrics, results
 from .config import make_prior
 from .errors import PriorError
 from .options import FRAME_NAMES, PRIOR_FRAME as DEFAULT_FRAME, PRIOR_RIDGE as DEFAULT_RIDGE
@@ -24,6 +24,7 @@ from .options import PRIOR_STD as DEFAULT_STD
 from .registry import COV_RULES, MEAN_RULES, REGISTRY
 
 _TOL = 1e-9
+CENTRAL = "central"  # parse_frame without bounds: the central frame of the prior's plant
 
 
 @dataclass
@@ -63,23 +64,29 @@ class PriorInfo:
         return make_prior(self.mean, self.cov)
 
 
-def frame_mask(cells: np.ndarray, frame: tuple[float, float] | None) -> np.ndarray:
-    """Cells with |x0| <= frame[0] m and |theta0| <= frame[1] deg (every cell when frame is None)."""
+def frame_mask(cells: np.ndarray, frame: tuple[float, float] | None,
+               grid: geometry.PlantGrid = geometry.CART_POLE) -> np.ndarray:
+    """Cells with |column value| <= frame[0] and |row value| <= frame[1] in the grid's display
+    units (the cart-pole: |x0| <= frame[0] m, |theta0| <= frame[1] deg); every cell when frame is
+    None."""
     if frame is None:
         return np.ones(cells.size, dtype=bool)
-    half_x, half_th = frame
-    return ((np.abs(cells["x0"]) <= half_x + _TOL)
-            & (np.abs(np.degrees(cells["theta0"])) <= half_th + _TOL))
+    half_col, half_row = frame
+    return ((np.abs(grid.col_display(cells["x0"])) <= half_col + _TOL)
+            & (np.abs(grid.row_display(cells["theta0"])) <= half_row + _TOL))
 
 
 def parse_frame(text: str | None, x_max: float | None = None, theta_max_deg: float | None = None
                 ) -> tuple[float, float] | None:
-    """'central' (default, bounds overridable) or 'all' -> frame tuple or None."""
+    """'central' (default, bounds overridable) or 'all' -> frame tuple, CENTRAL (no bound given:
+    the central frame of whichever plant's grid the prior comes from) or None."""
     name = (text or "central").strip().lower()
     if name not in FRAME_NAMES:
         raise PriorError(f"bad prior frame {text!r}; valid: {', '.join(FRAME_NAMES)}")
     if name == "all":
         return None
+    if x_max is None and theta_max_deg is None:
+        return CENTRAL
     x = DEFAULT_FRAME[0] if x_max is None else float(x_max)
     th = DEFAULT_FRAME[1] if theta_max_deg is None else float(theta_max_deg)
     if not (math.isfinite(x) and math.isfinite(th) and x > 0 and th > 0):
@@ -87,14 +94,18 @@ def parse_frame(text: str | None, x_max: float | None = None, theta_max_deg: flo
     return (x, th)
 
 
-def compute(cells: np.ndarray, frame: tuple[float, float] | None = DEFAULT_FRAME,
-            ridge: float = DEFAULT_RIDGE) -> PriorInfo:
-    """ICO->RL prior from an ICO cell array: successful cells inside frame, mean and sample cov + ridge*I."""
+def compute(cells: np.ndarray, frame: tuple[float, float] | str | None = DEFAULT_FRAME,
+            ridge: float = DEFAULT_RIDGE, grid: geometry.PlantGrid = geometry.CART_POLE) -> PriorInfo:
+    """ICO->RL prior from an ICO cell array of the plant's grid: successful cells inside frame
+    (CENTRAL: the grid's central frame), mean and sample cov + ridge*I."""
     if not (math.isfinite(ridge) and ridge >= 0):
         raise PriorError(f"prior ridge must be finite and >= 0, got {ridge}")
-    sel = metrics.success_mask(cells) & frame_mask(cells, frame)
+    if frame == CENTRAL:
+        frame = grid.central_frame()
+    sel = metrics.success_mask(cells) & frame_mask(cells, frame, grid)
     n = int(np.count_nonzero(sel))
-    where = "any cell" if frame is None else f"|x0| <= {frame[0]:g} m, |theta0| <= {frame[1]:g} deg"
+    where = "any cell" if frame is None else (f"|{grid.col_name}0| <= {frame[0]:g} {grid.col_unit}, "
+                                              f"|{grid.row_name}0| <= {frame[1]:g} {grid.row_unit}")
     if n == 0:
         raise PriorError(f"no ICO-successful cell in the prior frame ({where}); "
                          "widen the frame or use --prior-frame all")
@@ -143,7 +154,7 @@ def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_
                      ico_phase_simulated_time=ico.ico_phase_simulated_time, extra=extra)
 
 
-def from_results(path: str | Path, frame: tuple[float, float] | None = DEFAULT_FRAME,
+def from_results(path: str | Path, frame: tuple[float, float] | str | None = DEFAULT_FRAME,
                  ridge: float = DEFAULT_RIDGE) -> PriorInfo:
     """ICO->RL prior from an ICO results directory, with its provenance and ICO-phase simulated time."""
     path = Path(path)
@@ -152,7 +163,7 @@ def from_results(path: str | Path, frame: tuple[float, float] | None = DEFAULT_F
         raise PriorError(f"--prior-from: {str(path)!r} holds condition {record.get('condition')!r}, not ico")
     if not record.get("complete", False):
         raise PriorError(f"--prior-from: {str(path)!r} is incomplete (PENDING cells); finish it with --resume")
-    info = compute(cells, frame, ridge)
+    info = compute(cells, frame, ridge, geometry.of(results.record_plant(record)))
     info.source = str(path.resolve())
     info.source_commit = (record.get("git") or {}).get("commit")
     info.source_seed = record.get("seed")

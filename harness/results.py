@@ -15,7 +15,7 @@ import numpy as np
 
 from . import _binding as B
 from . import geometry, metrics
-from .config import RunConfig, config_from_dict
+from .config import CART_POLE, RunConfig, config_from_dict
 from .errors import ResultsError
 from .grid import make_cells, parse_cell_indices
 from .options import SEED_LIMIT
@@ -100,7 +100,7 @@ def make_record(cells: np.ndarray, cfg: RunConfig, *, condition: str, seed: int,
         "timestamp": timestamp(),
         "wall_time": float(wall_time),
         "threads": int(threads),
-        "summary": metrics.summary(cells),
+        "summary": metrics.summary(cells, geometry.of(cfg.plant_name)),
     }
     if extra:
         record.update(extra)
@@ -196,18 +196,30 @@ def _dtype_difference(dtype: np.dtype) -> str:
     return f"record size {dtype.itemsize}, expected {want.itemsize}"
 
 
-def check_cells(cells: np.ndarray, where: str = "cells") -> None:
-    """Structural checks of a cell array: known outcomes, finite coordinates on the paper grid."""
+def record_plant(record: Mapping[str, Any]) -> str:
+    """The plant a run record names (the cart-pole when it names none, as every record before the
+    registry plants)."""
+    plant = record.get("config", {}).get("plant") if isinstance(record.get("config"), Mapping) else None
+    name = plant.get("name", CART_POLE) if isinstance(plant, Mapping) else CART_POLE
+    return name if isinstance(name, str) else CART_POLE
+
+
+def check_cells(cells: np.ndarray, where: str = "cells", plant: str = CART_POLE) -> None:
+    """Structural checks of a cell array: known outcomes, finite coordinates on the plant's grid."""
     bad = ~np.isin(cells["outcome"], list(B.OUTCOME_NAMES))
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise _err(f"{where}: cell {i} has unknown outcome {int(cells['outcome'][i])} "
                    f"(valid: {', '.join(f'{k} {v}' for k, v in B.OUTCOME_NAMES.items())})")
-    on_grid = geometry.on_grid(cells)
+    try:
+        on_grid = geometry.of(plant).on_grid(cells)
+    except B.ConfigError:
+        raise _err(f"{where}: the record names the plant {plant!r:.40}, which the registry does not hold") from None
     if not on_grid.all():
         i = int(np.flatnonzero(~on_grid)[0])
+        grid_name = "the paper grid" if plant == CART_POLE else f"the {plant} grid"
         raise _err(f"{where}: cell {i} has x0 = {float(cells['x0'][i])!r}, theta0 = {float(cells['theta0'][i])!r}, "
-                   "not a point of the paper grid")
+                   f"not a point of {grid_name}")
 
 
 def _is_int(v: Any) -> bool:
@@ -308,14 +320,14 @@ def load(path: str | Path, what: str | None = None, follow: bool = True) -> tupl
     path = check_results_dir(path, what)
     record = read_record(path / RUN_FILE, follow)
     cells = read_cells(path / CELLS_FILE, follow)
-    check_cells(cells, repr(str(path / CELLS_FILE)))
+    check_cells(cells, repr(str(path / CELLS_FILE)), record_plant(record))
     return cells, record
 
 
 def check_cells_match(cells: np.ndarray, record: Mapping[str, Any], where: str = CELLS_FILE) -> None:
     """The cells of a results directory are exactly those its record describes: the number of cells
     and every (x0, theta0, seed) equal make_cells(record seed, record cells), bitwise."""
-    expected = make_cells(record["seed"], record["cells"])
+    expected = make_cells(record["seed"], record["cells"], plant=record_plant(record))
     if cells.size != expected.size:
         raise _err(f"{where} holds {cells.size} cells but run.json describes {expected.size} "
                    "(cell selection and seed); the two files do not belong together")

@@ -22,6 +22,7 @@ import numpy as np
 from . import _binding as B
 from . import geometry, grid, metrics, results, store
 from . import prior as P
+from .plants import CART_POLE
 from ._binding import ConfigError
 from .config import build_config, canonical, command_overrides, given_twice, named_sets, parse_sets, parse_value
 from .errors import SweepError, UsageError
@@ -214,20 +215,25 @@ def run_sweep(opt: SweepOptions) -> int:
         indices = subset_cells(opt.subset)
     else:
         indices = DEFAULT_CELLS
-    ico_cells, _ = results.load(ico_dir, what="--prior-from")
+    ico_cells, ico_record = results.load(ico_dir, what="--prior-from")
+    plant = results.record_plant(ico_record)  # the sweep runs on the plant of its ICO grid
+    plant_grid = geometry.of(plant)
+    if plant != CART_POLE and opt.dask is not None:
+        raise UsageError(f"the ICO grid of --prior-from is of the {plant}: the Dask backend runs the cart-pole "
+                         "only; run the sweep on local threads")
     priors: dict = {}
 
     # ICO outcome on the sweep cells (matched by grid position).
-    ico_rc = {(int(r), int(c)) for r, c in zip(*metrics.grid_index(ico_cells[metrics.success_mask(ico_cells)]))}
-    ico_known = {(int(r), int(c)) for r, c in zip(*metrics.grid_index(ico_cells))}
-    probe = grid.make_cells(0, indices)
-    pr, pc = metrics.grid_index(probe)
+    ico_rc = {(int(r), int(c)) for r, c in zip(*plant_grid.grid_index(ico_cells[metrics.success_mask(ico_cells)]))}
+    ico_known = {(int(r), int(c)) for r, c in zip(*plant_grid.grid_index(ico_cells))}
+    probe = grid.make_cells(0, indices, plant=plant)
+    pr, pc = plant_grid.grid_index(probe)
     ico_failed = np.array([(int(r), int(c)) in ico_known and (int(r), int(c)) not in ico_rc
                            for r, c in zip(pr, pc)], dtype=bool)
 
     flags = {"--max-trials": ("max_trials", opt.max_trials), "--success-steps": ("success_steps", opt.success_steps)}
-    fixed = command_overrides(opt.configuration, opt.sets, flags)
-    explicit = {name: f"--set {name}" for name in parse_sets(opt.sets)}
+    fixed = command_overrides(opt.configuration, opt.sets, flags, plant=plant)
+    explicit = {name: f"--set {name}" for name in parse_sets(opt.sets, plant=plant)}
     explicit.update({name: option for option, (name, value) in flags.items() if value is not None})
     for name in params:
         if name in explicit:
@@ -252,7 +258,7 @@ def run_sweep(opt: SweepOptions) -> int:
     def config_for(setting):
         over = dict(fixed)
         over.update({k: v for k, v in setting.items() if k not in PRIOR_PARAMS})
-        return build_config(over, condition=opt.condition, prior=prior_for(setting).prior())
+        return build_config(over, condition=opt.condition, prior=prior_for(setting).prior(), plant=plant)
 
     for setting in todo:  # every setting valid before the first grid runs (and before any write)
         config_for(setting)
@@ -300,7 +306,7 @@ def _run_settings(opt: SweepOptions, out: Path, held: store.DirectoryLock, meta:
             t0 = time.monotonic()
             rates, rates_failed, trials, elapsed = [], [], [], []
             for seed in seeds:
-                cells = grid.make_cells(seed, indices)
+                cells = grid.make_cells(seed, indices, plant=cfg.plant_name)
                 res = (grid.run_grid(cfg, cells, threads=opt.threads, progress=False) if session is None
                    else session.run_grid(cfg, cells, progress=False))
                 if res.cancelled:

@@ -3,15 +3,17 @@ dt times the initial velocities only (x1 = x0 + dt x_dot0, theta1 = theta0 + dt 
 force changes only the velocities, which stay finite. So a cell on a failure threshold
 (|x0| = 2.4 m or |theta0| = 12 deg; the grid's last x0 is 2.400000000000001 in double) whose
 first draw points outward fails at step 1 whatever any controller does. The engine's first
-draws are recomputed through the C API (``icoac_sim_trajectory`` with one step gives the start
-state of the cell's first trial), stepped once by ``icoac_sim_plant_step`` under several forces
-from -1e4 N to 1e4 N and tested with ``icoac_sim_failed``; the cells failing under every force
+draws are recomputed through the C API (``icoac_sim_trajectory_model`` with one step gives the
+start state of the cell's first trial), stepped once by ``icoac_sim_model_step`` under several
+forces from -1e4 N to 1e4 N and tested with ``icoac_sim_model_failed``; the cells failing under
+every force
 are lost, and failure must not depend on the force (checked). The same set is checked against
 the engine itself: one trial of 1 step per cell. The bound - cells minus lost cells - is an upper
 bound on the successes of ANY controller under the first-trial protocol with this seed's draws;
 with retries a boundary cell may still succeed on a later, inward draw. It is defined for the
 Euler integrator only (with RK4 the force enters x1 and theta1) and reported as not computed
-otherwise.
+otherwise. Any registry plant integrated by Euler (positions move by their velocities only) has the
+same bound on its own grid and limits.
 """
 from __future__ import annotations
 
@@ -37,11 +39,12 @@ def initial_states(cfg: RunConfig, cells: np.ndarray) -> np.ndarray:
     forces = np.zeros(1)
     n = ctypes.c_int64(0)
     prior = ctypes.byref(cfg.prior) if cfg.prior is not None else None
+    model = cfg.engine_model()
     for i, cell in enumerate(cells):
-        status = B.lib.icoac_sim_trajectory(ctypes.byref(cfg.controller), ctypes.byref(cfg.plant), prior,
-                                            float(cell["x0"]), float(cell["theta0"]),
-                                            float(cfg.run.init_velocity_noise), int(cell["seed"]), 1,
-                                            states, forces, ctypes.byref(n))
+        status = B.lib.icoac_sim_trajectory_model(ctypes.byref(cfg.controller), ctypes.byref(model), prior,
+                                                  float(cell["x0"]), float(cell["theta0"]),
+                                                  float(cfg.run.init_velocity_noise), int(cell["seed"]), 1,
+                                                  states, forces, ctypes.byref(n))
         B.check_status(status, "trajectory")
         out[i] = states[:B.N_INPUTS]
     return out
@@ -51,30 +54,35 @@ def first_step_bound(cfg: RunConfig, cells: np.ndarray, threads: int = 0) -> dic
     """Cells lost at the first step whatever the force (module docstring), for the cells of
     ``cells`` (PENDING template) and the run's initial-velocity noise; cfg gives plant and noise."""
     n = int(cells.size)
-    inner = geometry.interior_mask(cells)
+    plant_grid = geometry.of(cfg.plant_name)
+    inner = plant_grid.interior_mask(cells)
     base = {"protocol": "first", "n_cells": n, "n_interior": int(inner.sum())}
-    if int(cfg.plant.integrator) != B.INTEGRATORS["euler"]:
+    model = cfg.engine_model()
+    if int(model.integrator) != B.INTEGRATORS["euler"]:
         return {**base, "computed": False,
                 "reason": "defined for the Euler integrator only (with RK4 the force enters x and theta "
                           "within the first step)"}
-    plant = ctypes.byref(cfg.plant)
     s0 = initial_states(cfg, cells)
     failed = np.zeros((len(BOUND_FORCES), n), dtype=bool)
     after = np.zeros((n, B.N_INPUTS))
+    flag = ctypes.c_int32(0)
     for k, force in enumerate(BOUND_FORCES):
         for i in range(n):
-            s = s0[i].copy()
-            B.check_status(B.lib.icoac_sim_plant_step(plant, s, float(force)), "plant step")
-            failed[k, i] = bool(B.lib.icoac_sim_failed(plant, s))
+            s = np.zeros(B.MAX_STATE)
+            s[: B.N_INPUTS] = s0[i]
+            B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(model), s, float(force)), "plant step")
+            B.check_status(B.lib.icoac_sim_model_failed(ctypes.byref(model), s, ctypes.byref(flag)), "plant failed")
+            failed[k, i] = bool(flag.value)
             if force == 0.0:
-                after[i] = s
+                after[i] = s[: B.N_INPUTS]
     lost = failed.all(axis=0)
     if not np.array_equal(lost, failed.any(axis=0)):
         raise LibraryError("failure at the first Euler step depends on the force; the first-step bound's "
                            "premise does not hold for this plant")
     # The engine itself: one trial of 1 step per cell; the lost cells are exactly its failures.
     probe = RunConfig(controller=B.Config.from_buffer_copy(cfg.controller), plant=B.Plant.from_buffer_copy(cfg.plant),
-                      run=B.Run.from_buffer_copy(cfg.run), prior=cfg.prior)
+                      run=B.Run.from_buffer_copy(cfg.run), prior=cfg.prior,
+                      model=None if cfg.model is None else B.Model.from_buffer_copy(cfg.model))
     probe.run.max_trials, probe.run.success_steps = 1, 1
     eng = cells.copy()
     run = grid.run_grid(probe, eng, threads=threads, progress=False)
@@ -84,15 +92,15 @@ def first_step_bound(cfg: RunConfig, cells: np.ndarray, threads: int = 0) -> dic
     if not np.array_equal(eng_lost, lost):
         raise LibraryError(f"first-step bound: the engine loses {int(eng_lost.sum())} cells at step 1, the plant "
                            f"steps {int(lost.sum())}; the recomputed initial velocities do not match the engine's")
-    rows, cols = geometry.grid_index(cells)
+    rows, cols = plant_grid.grid_index(cells)
     xl, tl = float(cfg.plant.x_limit), float(cfg.plant.theta_limit)
     lost_cells = []
     for i in np.flatnonzero(lost):
         x1, th1 = after[i, 0], after[i, 2]
         exits = [name for name, hit in (("x > x_limit", x1 > xl), ("x < -x_limit", x1 < -xl),
                                         ("theta > theta_limit", th1 > tl), ("theta < -theta_limit", th1 < -tl))
-                 if hit]
-        lost_cells.append({"cell": int(geometry.cell_index(rows[i], cols[i])), "x0": float(s0[i, 0]),
+                 if hit] if cfg.model is None else ["outside the plant's limits"]
+        lost_cells.append({"cell": int(plant_grid.cell_index(rows[i], cols[i])), "x0": float(s0[i, 0]),
                            "theta0_deg": float(np.degrees(s0[i, 2])), "x_dot0": float(s0[i, 1]),
                            "theta_dot0": float(s0[i, 3]), "exits": exits})
     n_lost, n_lost_in = int(lost.sum()), int((lost & inner).sum())

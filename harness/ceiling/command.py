@@ -14,6 +14,7 @@ from .. import _binding as B
 from .. import grid, results, store
 from .. import prior as P
 from ..errors import UsageError
+from ..plants import CART_POLE
 from ..options import (CEILING_CANDIDATES, CEILING_CONFIRM, CEILING_FILE, CEILING_MAX_CANDIDATES, CEILING_MAX_TRIALS,
                        CEILING_PROTOCOLS, CEILING_SCREEN_STEPS, INT64_MAX, TYPICAL_ICO_WEIGHTS)
 from .bound import first_step_bound
@@ -42,6 +43,7 @@ class CeilingOptions:
     threads: int = 0
     sets: Sequence[str] = ()
     quiet: bool = False
+    plant: str = CART_POLE
 
 
 def _positive(name: str, value: Any, hi: int = INT64_MAX) -> int:
@@ -64,13 +66,13 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
     seed = grid.check_seed(opt.seed, "--seed")
     threads = grid.check_threads(opt.threads)
     max_trials = _positive("--max-trials", opt.max_trials)
-    overrides = check_overrides(opt.sets)
+    overrides = check_overrides(opt.sets, opt.plant)
     try:
         indices = grid.parse_cell_indices(opt.cells)
     except B.ConfigError as exc:
         raise UsageError(f"--cells: {exc}") from None
     probe = fixed_config(TYPICAL_ICO_WEIGHTS, "retries", max_trials=max_trials, success_steps=opt.success_steps,
-                         overrides=overrides)  # C checks of everything
+                         overrides=overrides, plant=opt.plant)  # C checks of everything
     success_steps = int(probe.run.success_steps)
     given = None
     if opt.w is not None:
@@ -79,7 +81,7 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
                                       ("--screen-steps", opt.screen_steps), ("--confirm", opt.confirm)) if v is not None]
         if extra:
             raise UsageError(f"--w evaluates the given w without a search; {', '.join(extra)} apply to the search")
-        fixed_config(given, "first", success_steps=success_steps, overrides=overrides)
+        fixed_config(given, "first", success_steps=success_steps, overrides=overrides, plant=opt.plant)
     candidates = _positive("--candidates", CEILING_CANDIDATES if opt.candidates is None else opt.candidates,
                            CEILING_MAX_CANDIDATES)
     screen_steps = _positive("--screen-steps", CEILING_SCREEN_STEPS if opt.screen_steps is None else opt.screen_steps)
@@ -92,10 +94,11 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
     if opt.prior_from is not None:
         prior_info = P.from_results(opt.prior_from)
         typical = ("ICO mean (--prior-from)", as_weights(prior_info.mean, "--prior-from mean"))
-    template = grid.make_cells(seed, indices)
+    template = grid.make_cells(seed, indices, plant=opt.plant)
     screen_settings = None
     if given is None:
-        base = fixed_config(TYPICAL_ICO_WEIGHTS, "first", success_steps=screen_steps, overrides=overrides).to_dict()
+        base = fixed_config(TYPICAL_ICO_WEIGHTS, "first", success_steps=screen_steps, overrides=overrides,
+                            plant=opt.plant).to_dict()
         base["prior"] = None
         screen_settings = {"seed": seed, "cells": indices, "screen_steps": screen_steps, "config": base}
     with store.DirectoryLock(out) as held:  # the whole run: search.json, evals/, ceiling.json
@@ -107,6 +110,7 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
 
         settings = {"seed": seed, "cells": indices, "n_cells": int(template.size), "protocol": opt.protocol,
                     "max_trials": max_trials, "success_steps": success_steps, "set": overrides,
+                    **({} if opt.plant == CART_POLE else {"plant": opt.plant}),
                     "w": list(given) if given is not None else None, "threads": threads,
                     "prior_from": None if prior_info is None else {
                         "path": prior_info.source, "mean": list(prior_info.mean), "n_cells": prior_info.n_cells,
@@ -123,7 +127,7 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
             d = eval_dir(out, w, protocol, success_steps, max_trials)
             cells, rec = evaluate_into(d, w, protocol, seed=seed, indices=indices, max_trials=max_trials,
                                        success_steps=success_steps, overrides=overrides, threads=threads,
-                                       progress=not opt.quiet)
+                                       progress=not opt.quiet, plant=opt.plant)
             return protocol_summary(cells, rec, out, d)
 
         try:
@@ -140,7 +144,8 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
                 def cfg_for(w):
                     if w not in cfg_cache:
                         cfg_cache.clear()
-                        cfg_cache[w] = fixed_config(w, "first", success_steps=screen_steps, overrides=overrides)
+                        cfg_cache[w] = fixed_config(w, "first", success_steps=screen_steps, overrides=overrides,
+                                                    plant=opt.plant)
                     return cfg_cache[w]
 
                 def screen(w):

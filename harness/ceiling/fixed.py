@@ -18,9 +18,10 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from .. import _binding as B
-from .. import grid, metrics, results
+from .. import geometry, grid, metrics, results
 from ..conditions import run_condition
 from ..config import RunConfig, build_config, make_prior, parse_sets
+from ..plants import CART_POLE
 from ..errors import LibraryError, UsageError
 from ..options import CEILING_MAX_TRIALS, CEILING_PROTOCOL_CHOICES, CEILING_PROTOCOLS
 from .weights import as_weights, format_w, weights_key
@@ -31,9 +32,10 @@ RESERVED = {"mode": "ICO mode is the fixed-w evaluation", "learn": "every update
             "max_trials": "use --protocol and --max-trials", "success_steps": "use --success-steps"}
 
 
-def check_overrides(sets: Sequence[str] | Mapping[str, Any] | None) -> dict[str, Any]:
-    """--set items (or a mapping) as canonical overrides, refusing the parameters the command sets."""
-    over = dict(sets) if isinstance(sets, Mapping) else parse_sets(sets or [])
+def check_overrides(sets: Sequence[str] | Mapping[str, Any] | None, plant: str = CART_POLE) -> dict[str, Any]:
+    """--set items (or a mapping) as canonical overrides (a plant's parameters by name), refusing
+    the parameters the command sets."""
+    over = dict(sets) if isinstance(sets, Mapping) else parse_sets(sets or [], plant=plant)
     for name in over:
         if name in RESERVED:
             raise UsageError(f"--set {name}: set by the ceiling command ({RESERVED[name]})")
@@ -41,16 +43,18 @@ def check_overrides(sets: Sequence[str] | Mapping[str, Any] | None) -> dict[str,
 
 
 def fixed_config(w: Sequence[float], protocol: str = "first", *, max_trials: int = CEILING_MAX_TRIALS,
-                 success_steps: int | None = None, overrides: Mapping[str, Any] | None = None) -> RunConfig:
-    """Condition ico, learn = 0, prior mean w and covariance I: the engine evaluates w. Protocol
-    first: max_trials = 1; retries: max_trials as given. success_steps None: the C default (1e5)."""
+                 success_steps: int | None = None, overrides: Mapping[str, Any] | None = None,
+                 plant: str = CART_POLE) -> RunConfig:
+    """Condition ico, learn = 0, prior mean w and covariance I on the plant: the engine evaluates w.
+    Protocol first: max_trials = 1; retries: max_trials as given. success_steps None: the C
+    default (1e5)."""
     check_protocol(protocol)
-    over = dict(check_overrides(overrides))
+    over = dict(check_overrides(overrides, plant))
     over["learn"] = 0
     over["max_trials"] = 1 if protocol == "first" else max_trials
     if success_steps is not None:
         over["success_steps"] = success_steps
-    return build_config(over, condition="ico", prior=make_prior(as_weights(w), np.eye(B.N_INPUTS)))
+    return build_config(over, condition="ico", prior=make_prior(as_weights(w), np.eye(B.N_INPUTS)), plant=plant)
 
 
 def check_protocol(protocol: Any) -> str:
@@ -90,11 +94,12 @@ def check_weights_kept(cells: np.ndarray, w: Sequence[float]) -> None:
 
 def evaluate(w: Sequence[float], protocol: str = "first", *, seed: int = 0, cells=None,
              max_trials: int = CEILING_MAX_TRIALS, success_steps: int | None = None,
-             overrides: Mapping[str, Any] | None = None, threads: int = 0) -> np.ndarray:
+             overrides: Mapping[str, Any] | None = None, threads: int = 0, plant: str = CART_POLE) -> np.ndarray:
     """Fixed-w evaluation in memory: the cells (all, or the indices / 'a-b' string ``cells``) of
     one grid run of fixed_config. KeyboardInterrupt if cancelled."""
-    cfg = fixed_config(w, protocol, max_trials=max_trials, success_steps=success_steps, overrides=overrides)
-    arr = grid.make_cells(seed, grid.parse_cell_indices(cells))
+    cfg = fixed_config(w, protocol, max_trials=max_trials, success_steps=success_steps, overrides=overrides,
+                       plant=plant)
+    arr = grid.make_cells(seed, grid.parse_cell_indices(cells), plant=plant)
     res = grid.run_grid(cfg, arr, threads=threads, progress=False)
     if res.cancelled:
         raise KeyboardInterrupt
@@ -109,7 +114,7 @@ def eval_dir(out: Path, w: Sequence[float], protocol: str, success_steps: int, m
 
 def evaluate_into(out: Path, w: Sequence[float], protocol: str, *, seed: int, indices, max_trials: int,
                   success_steps: int, overrides: Mapping[str, Any], threads: int,
-                  progress: bool) -> tuple[np.ndarray, dict]:
+                  progress: bool, plant: str = CART_POLE) -> tuple[np.ndarray, dict]:
     """Fixed-w evaluation into a results directory (run_condition: checkpoints, resume of a
     matching directory); KeyboardInterrupt if interrupted (its finished cells are saved)."""
     over = dict(overrides)
@@ -117,7 +122,7 @@ def evaluate_into(out: Path, w: Sequence[float], protocol: str, *, seed: int, in
     cells, record, cancelled = run_condition(
         condition="ico", out=out, seed=seed, threads=threads, overrides=over, cell_spec=indices,
         resume=results.exists(out), progress=progress, info=FixedWeights(tuple(w), protocol),
-        start_over="use another --out")
+        start_over="use another --out", plant=plant)
     if cancelled:
         raise KeyboardInterrupt
     check_weights_kept(cells, w)
@@ -131,7 +136,7 @@ SUMMARY_KEYS = ("n_cells", "n_interior", "n_success", "n_success_interior", "suc
 
 def protocol_summary(cells: np.ndarray, record: Mapping[str, Any] | None = None,
                      root: Path | None = None, directory: Path | None = None) -> dict[str, Any]:
-    s = metrics.summary(cells)
+    s = metrics.summary(cells, geometry.of(results.record_plant(record)) if record is not None else geometry.CART_POLE)
     out = {k: s[k] for k in SUMMARY_KEYS}
     if record is not None:
         out["max_trials"] = record["config"]["run"]["max_trials"]

@@ -1,5 +1,5 @@
 """The LQR starting points of the search: the discrete-time LQR gains of the plant linearised at the
-upright state (A, B by central differences of the C plant step ``icoac_sim_plant_step``; Q =
+upright state (A, B by central differences of the C plant step ``icoac_sim_model_step``; Q =
 diag(1 / input_range^2), R = 1 / F^2 for F = 1, 3, 10, 30 N), converted to weights by
 w_i = -K_i * input_range_i / G (so F = G w^T x~ equals -K s while no input is clipped). The
 Riccati equation is solved by scipy.linalg.solve_discrete_are."""
@@ -17,14 +17,15 @@ LQR_FORCES = (1.0, 3.0, 10.0, 30.0)           # N: R = 1 / F^2
 
 
 def linearise(cfg: RunConfig, h: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
-    """(A, B) of one plant step at the upright state with zero force, by central differences of
-    the C plant step (icoac_sim_plant_step): s' ~ A s + B F."""
-    plant = cfg.plant
+    """(A, B) of one plant step at the upright state with zero input, by central differences of
+    the C plant step (icoac_sim_model_step): s' ~ A s + B u."""
+    model = cfg.engine_model()
 
     def step(s, force):
-        s = np.array(s, dtype=np.float64)
-        B.check_status(B.lib.icoac_sim_plant_step(ctypes.byref(plant), s, float(force)), "plant step")
-        return s
+        full = np.zeros(B.MAX_STATE)
+        full[: B.N_INPUTS] = s
+        B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(model), full, float(force)), "plant step")
+        return full[: B.N_INPUTS]
 
     eye = np.eye(B.N_INPUTS)
     a = np.column_stack([(step(h * eye[j], 0.0) - step(-h * eye[j], 0.0)) / (2 * h) for j in range(B.N_INPUTS)])

@@ -12,10 +12,12 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any, Mapping
 
+from .. import _binding as B
 from .. import results, store
 from ..errors import ResultsError, UsageError
 from ..metrics import percent
 from ..options import CEILING_DIR, CEILING_FILE, CEILING_PROTOCOLS
+from ..plants import CART_POLE
 from .search import Screen
 from .weights import as_weights, format_w
 
@@ -86,9 +88,12 @@ def summary_markdown(record: Mapping[str, Any]) -> str:
     st = record["settings"]
     best = record["best"]
     pol = record.get("policy", {})
+    plant = st.get("plant", CART_POLE)
+    unit = B.plant_info(plant)["input"][1]
     lines = ["# Linear-policy ceiling (method.md, L5)", "",
-             f"Policy F = G·wᵀx̃ + U with G = {pol.get('gain', 'n/a'):g} N, reflex {pol.get('reflex_mode')} "
-             f"({pol.get('reflex_force', 'n/a'):g} N), no learning (learn = 0); seed {st['seed']}, "
+             f"Policy F = G·wᵀx̃ + U with G = {pol.get('gain', 'n/a'):g} {unit}, reflex {pol.get('reflex_mode')} "
+             f"({pol.get('reflex_force', 'n/a'):g} {unit}), no learning (learn = 0); "
+             f"{'' if plant == CART_POLE else f'plant {plant}; '}seed {st['seed']}, "
              f"{st['n_cells']} cells{'' if st['cells'] is None else ' (subset)'}, horizon {st['success_steps']:g} "
              f"steps{'' if not st['set'] else ', --set ' + ', '.join(f'{k}={v}' for k, v in st['set'].items())}.",
              "", f"Best w = (w_x, w_ẋ, w_θ, w_θ̇) = {format_w(best['w'], 6)} ({best['source']}).", "",

@@ -70,7 +70,8 @@ def screen_cells(w: Sequence[float], cells: np.ndarray, cfg_for: Callable[[Seque
         raise KeyboardInterrupt
     check_weights_kept(arr, w)
     ok = metrics.success_mask(arr)
-    return Screen(int(ok.sum()), int((ok & geometry.interior_mask(arr)).sum()), int(arr["total_steps"].sum()))
+    inner = geometry.of(cfg_for(w).plant_name).interior_mask(arr)
+    return Screen(int(ok.sum()), int((ok & inner).sum()), int(arr["total_steps"].sum()))
 
 
 def rank_key(entry: Mapping[str, Any]) -> tuple[int, int]:

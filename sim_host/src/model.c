@@ -182,11 +182,26 @@ int32_t icoac_sim_plant_grid(int32_t index, icoac_sim_cell_t *cells, int64_t n_c
     return ICOAC_SIM_OK;
 }
 
+void sim_start_trial(const icoac_sim_plant_desc_t *desc, const icoac_sim_cell_t *cell, double noise,
+                     icoac_rng_t *rng, double s[ICOAC_SIM_MAX_STATE])
+{
+    int32_t i;
+    for (i = 0; i < desc->n_state; ++i) {
+        s[i] = desc->start[i];
+    }
+    s[desc->rows.component] = cell->theta0;
+    s[desc->cols.component] = cell->x0;
+    for (i = 0; i < desc->n_state; ++i) {
+        if (desc->drawn[i]) {
+            s[i] = sim_uniform_symmetric(rng, noise);
+        }
+    }
+}
+
 int32_t icoac_sim_model_start(const icoac_sim_model_t *model, const icoac_sim_cell_t *cell, double noise,
                               icoac_rng_t *rng, double state[ICOAC_SIM_MAX_STATE])
 {
     int32_t status;
-    int32_t i;
     const icoac_sim_plant_desc_t *desc = checked(model, state, &status);
     if (desc == 0) {
         return status;
@@ -195,15 +210,6 @@ int32_t icoac_sim_model_start(const icoac_sim_model_t *model, const icoac_sim_ce
         !sim_velocity_noise_valid(noise)) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
-    for (i = 0; i < desc->n_state; ++i) {
-        state[i] = desc->start[i];
-    }
-    state[desc->rows.component] = cell->theta0;
-    state[desc->cols.component] = cell->x0;
-    for (i = 0; i < desc->n_state; ++i) {
-        if (desc->drawn[i]) {
-            state[i] = sim_uniform_symmetric(rng, noise);
-        }
-    }
+    sim_start_trial(desc, cell, noise, rng, state);
     return ICOAC_SIM_OK;
 }

@@ -31,19 +31,44 @@ int32_t icoac_sim_run_check(const icoac_sim_run_t *run)
     return ICOAC_SIM_OK;
 }
 
-int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+/* The engine hands the controller the plant's first ICOAC_N_INPUTS state components: a plant
+ * with another state size, or observing a component elsewhere, needs a controller build that
+ * takes its inputs. */
+static int observation_fits(const icoac_sim_plant_desc_t *desc)
+{
+    int32_t i;
+    if (desc->n_state != ICOAC_N_INPUTS) {
+        return 0;
+    }
+    for (i = 0; i < ICOAC_N_INPUTS; ++i) {
+        if (desc->observed[i] != i) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_model_t *model,
                       const icoac_sim_run_t *run)
 {
     int32_t status;
-    if (cfg == 0 || plant == 0) {
+    if (cfg == 0 || model == 0) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
     status = (int32_t)icoac_config_check(cfg);
     if (status == ICOAC_SIM_OK) {
-        status = icoac_sim_plant_check(plant);
+        status = icoac_sim_model_check(model);
+    }
+    if (status == ICOAC_SIM_OK && !observation_fits(icoac_sim_plant_info(model->plant))) {
+        status = ICOAC_SIM_ERR_BAD_PLANT;
     }
     if (status == ICOAC_SIM_OK && run != 0) {
         status = icoac_sim_run_check(run);
     }
     return status;
+}
+
+const icoac_sim_model_t *sim_model_of(const icoac_sim_plant_t *plant, icoac_sim_model_t *model)
+{
+    return icoac_sim_model_from_plant(plant, model) == ICOAC_SIM_OK ? model : 0;
 }

@@ -73,10 +73,12 @@ typedef enum {
     ICOAC_SIM_ERROR = 3    /* the controller reported an error (e.g. ICOAC_ERR_NUMERIC); see status */
 } icoac_sim_outcome_t;
 
-/* One cell: the caller fills x0, theta0, seed; the run fills the rest. */
+/* One cell: the caller fills x0, theta0, seed; the run fills the rest. For a registry plant
+ * (icoac_sim_plant_grid), x0 is the start of the grid's column component and theta0 that of its
+ * row component, in the plant's units. */
 typedef struct {
-    double x0;                  /* m */
-    double theta0;              /* rad */
+    double x0;                  /* m (the cart-pole's x; a plant's column component) */
+    double theta0;              /* rad (the cart-pole's theta; a plant's row component) */
     uint64_t seed;              /* drives initial velocities and exploration */
     int32_t outcome;            /* icoac_sim_outcome_t */
     int32_t status;             /* icoac_status_t / icoac_sim_status_t of the run */
@@ -274,6 +276,25 @@ int32_t icoac_sim_plant_grid(int32_t index, icoac_sim_cell_t *cells, int64_t n_c
 #define ICOAC_SIM_START_STREAM 2u
 int32_t icoac_sim_model_start(const icoac_sim_model_t *model, const icoac_sim_cell_t *cell, double noise,
                               icoac_rng_t *rng, double state[ICOAC_SIM_MAX_STATE]);
+
+/* The benchmark on any registry plant: icoac_sim_run_cell, icoac_sim_run_grid and
+ * icoac_sim_trajectory with a model in place of the cart-pole struct (those three are these with
+ * the model of their plant, bit for bit). Trials start by icoac_sim_model_start; the controller
+ * reads the plant's first ICOAC_N_INPUTS state components, so a plant with another state size is
+ * refused with ICOAC_SIM_ERR_BAD_PLANT by this controller build. The trajectory's states hold
+ * (max_steps + 1) rows of the plant's n_state values. */
+int32_t icoac_sim_run_cell_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                                 const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                                 icoac_sim_cell_t *cell, const volatile int32_t *cancel,
+                                 volatile int64_t *progress);
+int32_t icoac_sim_run_grid_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                                 const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                                 icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
+                                 const volatile int32_t *cancel, volatile int64_t *progress);
+int32_t icoac_sim_trajectory_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                                   const icoac_prior_t *prior, double x0, double theta0,
+                                   double init_velocity_noise, uint64_t seed, int64_t max_steps,
+                                   double *states, double *forces, int64_t *n_steps);
 
 #ifdef __cplusplus
 }

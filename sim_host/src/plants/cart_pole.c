@@ -6,7 +6,7 @@
 #include "sim_integrate.h"
 #include "sim_internal.h"
 
-enum { GRAVITY, CART_MASS, POLE_MASS, HALF_LENGTH, X_LIMIT, THETA_LIMIT, N_PARAMS };
+enum { GRAVITY, CART_MASS, POLE_MASS, HALF_LENGTH, X_LIMIT = SIM_CART_POLE_X_LIMIT, THETA_LIMIT, N_PARAMS };
 
 /* d/dt (x, x_dot, theta, theta_dot) under force: Sutton's equations. */
 static void derivatives(const double *p, const double *s, double force, double *ds)
@@ -25,7 +25,7 @@ static void derivatives(const double *p, const double *s, double force, double *
     ds[3] = theta_acc;
 }
 
-static void step(const double *p, double dt, int32_t integrator, double *s, double force)
+void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *s, double force)
 {
     sim_integrate(derivatives, 4, p, dt, integrator, s, force);
 }
@@ -68,7 +68,7 @@ const icoac_sim_plant_desc_t sim_cart_pole = {
     {0.0, 0.0, 0.0, 0.0},
     {0, 1, 0, 1},
     {0, 1, 2, 3},
-    step,
+    sim_cart_pole_step,
     derivatives,
     failed,
     energy,
@@ -110,7 +110,7 @@ int32_t icoac_sim_plant_step(const icoac_sim_plant_t *plant, double state[4], do
     {
         const double p[N_PARAMS] = {plant->gravity, plant->cart_mass, plant->pole_mass,
                                     plant->half_length, plant->x_limit, plant->theta_limit};
-        step(p, plant->dt, plant->integrator, state, force);
+        sim_cart_pole_step(p, plant->dt, plant->integrator, state, force);
     }
     return ICOAC_SIM_OK;
 }
