@@ -48,13 +48,16 @@ def task_overrides(plant: str, setting: dict[str, float]) -> dict[str, Any]:
 FURUTA_SETTING = {"arm_range": 1.0, "arm_velocity_range": 2.3, "pendulum_velocity_range": 0.6, "zone_deg": 8.0,
                   "ico.rate": 0.01, "policy.gain": 1.0}
 
+FURUTA_ICO_RL = {"actor.update": "mean", "actor.likelihood_std": 0.1, "actor.scale": 0.1, "actor.noise_std": 1.0}
+
 PLANTS: dict[str, PlantSpec] = {
     CART_POLE: PlantSpec(CART_POLE, {}, "the C defaults (the paper's task)"),
     "furuta": PlantSpec("furuta", task_overrides("furuta", FURUTA_SETTING),
                         "its sweep (docs/sweeps-furuta.md): input scaling, reflex zone, ICO rate, gain",
-                        # the exploration noise (V) by the learner sweeps of docs/sweeps-furuta.md; the
-                        # prior's decomposition takes the noise of the learner whose reading it shares
-                        learners={"ico-rl": {"actor.noise_std": 1.0}, "ico-mean-rl": {"actor.noise_std": 1.0},
+                        # reading and exploration noise (V) by the learner sweeps of docs/sweeps-furuta.md:
+                        # ICO->RL takes RL alone's (mean) reading here; the prior's decomposition takes
+                        # the settings of the learner whose prior mean it shares
+                        learners={"ico-rl": FURUTA_ICO_RL, "ico-mean-rl": FURUTA_ICO_RL,
                                   "rl": {"actor.noise_std": 3.0}, "rl-ico-cov": {"actor.noise_std": 3.0}}),
 }
 # Registry plants the controller build cannot run, and why.

@@ -16,17 +16,19 @@ choice is the best of stages 2 and 3. Every stage resumes (finished settings are
 --report writes summary.md (docs/sweeps-<plant>.md).
 
 The learners (``--stage learners --prior-from ICO_DIR``, an ICO grid of the plant with the chosen
-task settings): their cart-pole settings carry over but for the scale of their exploration noise,
-which is in the plant's input units (N, V). Each actor-critic learner (LEARNER_SPACE) sweeps its
-noise on at most LEARNER_FAILED cells the ICO grid failed (evenly thinned) and on the 49 spread
-cells, 2 seeds, cap 1000 trials, as the cart-pole's learner sweeps; criterion fixed before the
-runs: success on the ICO-failed cells, ties within one point by the spread cells, then fewer
-median trials.
+task settings): the scale of their exploration noise is in the plant's input unit (N, V), and the
+actor reading each took from the cart-pole's sweeps may not carry over. Each actor-critic learner
+(LEARNER_SPACE) runs its own reading at four noise scales and the other learner's reading at three,
+on at most LEARNER_FAILED cells the ICO grid failed (evenly thinned) and on the 49 spread cells,
+2 seeds, cap 1000 trials, as the cart-pole's learner sweeps; criterion fixed before the runs:
+success on the ICO-failed cells, ties within one point by the spread cells, then fewer median
+trials.
 """
 from __future__ import annotations
 
 import argparse
 import csv
+import json
 import math
 import sys
 import time
@@ -57,6 +59,13 @@ SPACE = (  # name, values (the pendulum angle range is its failure limit)
 FIELDS = ["key", "seed", "cells", "success_rate", "median_trials", "wall_time"]
 LEARNER_SPACE = {"ico-rl": ("actor.noise_std", (0.1, 0.3, 1.0, 3.0)),
                  "rl": ("actor.noise_std", (0.3, 1.0, 3.0, 12.0))}
+# The two actor readings the cart-pole's sweeps chose (ICO->RL's, the C defaults; RL alone's), and
+# each learner's own. Each learner also runs the other's reading at OTHER_READING_NOISE, so both
+# get the same settings: their own reading at four noise scales, the other's at three.
+READINGS = {"gradient": {"actor.update": "gradient", "actor.likelihood_std": 0, "actor.scale": 0.5},
+            "mean": {"actor.update": "mean", "actor.likelihood_std": 0.1, "actor.scale": 0.1}}
+OWN_READING = {"ico-rl": "gradient", "rl": "mean"}
+OTHER_READING_NOISE = (0.3, 1.0, 3.0)
 LEARNER_FAILED = 200
 LEARNER_MAX_TRIALS = 1000
 
@@ -172,19 +181,22 @@ def report(plant: str, out: Path) -> Path:
     if any(learner_ranking(out, c) for c in LEARNER_SPACE):
         lines += ["## Learners", "",
                   f"On the plant's ICO grid of seed 0 at the chosen task settings (`--stage learners`): each "
-                  f"actor-critic learner's exploration noise on at most {LEARNER_FAILED} cells that grid failed "
-                  f"(evenly thinned) and on the {len(SPREAD_CELLS)} spread cells, 2 seeds, cap "
-                  f"{LEARNER_MAX_TRIALS} trials. Criterion, fixed before the runs: success on the ICO-failed "
-                  "cells; within one point, the spread cells, then fewer median trials. The learners' other "
-                  "settings are the cart-pole's; the searches keep theirs.", ""]
+                  "actor-critic learner at its own reading (from the cart-pole's sweeps) and four exploration "
+                  f"noise scales, and at the other learner's reading and noise {list(OTHER_READING_NOISE)}, on at "
+                  f"most {LEARNER_FAILED} cells that grid failed (evenly thinned) and on the {len(SPREAD_CELLS)} "
+                  f"spread cells, 2 seeds, cap {LEARNER_MAX_TRIALS} trials. Readings: "
+                  + "; ".join(f"{r}: {', '.join(f'{k}={v}' for k, v in s.items())}" for r, s in READINGS.items())
+                  + ". Criterion, fixed before the runs: success on the ICO-failed cells; within one point, the "
+                  "spread cells, then fewer median trials. The learners' other settings are the cart-pole's; "
+                  "the searches keep theirs.", ""]
     for condition in LEARNER_SPACE:
         table = learner_ranking(out, condition)
         if not table:
             continue
-        lines += [f"## Learner {condition}: exploration noise", "",
-                  "| rank | setting | success, ICO-failed cells | success, spread cells | median trials |",
-                  "|---|---|---|---|---|"]
-        lines += [f"| {i} | {r['key']} | {100 * r['ico_failed']:.1f} % | {100 * r['spread']:.1f} % | "
+        lines += [f"## Learner {condition}: reading and exploration noise", "",
+                  "| rank | reading | setting | success, ICO-failed cells | success, spread cells | median trials |",
+                  "|---|---|---|---|---|---|"]
+        lines += [f"| {i} | {r['reading']} | {r['key']} | {100 * r['ico_failed']:.1f} % | {100 * r['spread']:.1f} % | "
                   f"{_trials(r['median_trials'])} |" for i, r in enumerate(table, 1)]
         lines += ["", f"Choice: `{table[0]['key']}`.", ""]
     path = out / "summary.md"
@@ -202,25 +214,43 @@ def learner_cells(ico_dir: Path) -> dict[str, list[int]]:
     return {"ico-failed": [int(i) for i in failed], "spread": SPREAD_CELLS}
 
 
+def _other(condition: str) -> str:
+    return next(r for r in READINGS if r != OWN_READING[condition])
+
+
+def learner_dirs(out: Path, condition: str) -> dict[str, tuple[str, list[float]]]:
+    """{directory stem: (reading, noise values)} of a learner's sweeps (its own reading's under
+    learners/<condition>-<cells>, the other's under learners/<condition>-<reading>-<cells>)."""
+    name, values = LEARNER_SPACE[condition]
+    return {f"{condition}": (OWN_READING[condition], list(values)),
+            f"{condition}-{_other(condition)}": (_other(condition), list(OTHER_READING_NOISE))}
+
+
 def run_learners(ico_dir: Path, out: Path) -> None:
-    for condition, (name, values) in LEARNER_SPACE.items():
-        for label, cells in learner_cells(ico_dir).items():
-            run_sweep(SweepOptions(prior_from=ico_dir, out=out / "learners" / f"{condition}-{label}",
-                                   params=[f"{name}={','.join(f'{v:g}' for v in values)}"], condition=condition,
-                                   cells=grid.format_cell_indices(cells), seeds=2, max_trials=LEARNER_MAX_TRIALS,
-                                   quiet=True))
+    for condition, (name, _) in LEARNER_SPACE.items():
+        for stem, (reading, values) in learner_dirs(out, condition).items():
+            fixed = [] if reading == OWN_READING[condition] else [f"{k}={v}" for k, v in READINGS[reading].items()]
+            for label, cells in learner_cells(ico_dir).items():
+                run_sweep(SweepOptions(prior_from=ico_dir, out=out / "learners" / f"{stem}-{label}",
+                                       params=[f"{name}={','.join(f'{v:g}' for v in values)}"], condition=condition,
+                                       cells=grid.format_cell_indices(cells), seeds=2, sets=fixed,
+                                       max_trials=LEARNER_MAX_TRIALS, quiet=True))
 
 
 def learner_ranking(out: Path, condition: str) -> list[dict]:
-    """A learner's settings by the criterion (module docstring)."""
-    def rows(label):
-        path = out / "learners" / f"{condition}-{label}" / "sweep.csv"
-        return {r["key"]: r for r in read_rows(path)}
-    failed, spread = rows("ico-failed"), rows("spread")
-    table = [{"key": k, "ico_failed": float(r["success_rate_ico_failed"] or r["success_rate_mean"]),
-              "spread": float(spread[k]["success_rate_mean"]) if k in spread else math.nan,
-              "median_trials": float(r["median_trials"]) if r["median_trials"] else math.inf}
-             for k, r in failed.items()]
+    """A learner's settings (reading and noise) by the criterion (module docstring)."""
+    table = []
+    for stem, (reading, _) in learner_dirs(out, condition).items():
+        def rows(label):
+            return {r["key"]: r for r in read_rows(out / "learners" / f"{stem}-{label}" / "sweep.csv")}
+        failed, spread = rows("ico-failed"), rows("spread")
+        table += [{"key": json.dumps({**({} if reading == OWN_READING[condition] else READINGS[reading]),
+                                      **json.loads(k)}),
+                   "reading": reading,
+                   "ico_failed": float(r["success_rate_ico_failed"] or r["success_rate_mean"]),
+                   "spread": float(spread[k]["success_rate_mean"]) if k in spread else math.nan,
+                   "median_trials": float(r["median_trials"]) if r["median_trials"] else math.inf}
+                  for k, r in failed.items()]
     table.sort(key=lambda r: -r["ico_failed"])
     if table:
         best = table[0]["ico_failed"]
