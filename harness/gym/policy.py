@@ -1,5 +1,7 @@
 """IcoacPolicy: an icoac controller (any mode, learning as it acts) driving a Gymnasium env whose
-observation is (x m, x_dot m/s, theta rad, theta_dot rad/s) and whose action is one force (N).
+observation is four numbers, (x m, x_dot m/s, theta rad, theta_dot rad/s) for the cart-pole or
+another plant's state in the same places (``plant``: its task settings, harness.plants), and whose
+action is one number, a force (N) or the plant's input.
 
 Per episode, as the engine per trial: icoac_reset, then per env step one icoac_step on the
 observation, its force the action; the observation of a terminating step (terminated=True) goes
@@ -46,14 +48,15 @@ def check_layout(env: gymnasium.Env) -> None:
 
 class IcoacPolicy:
     """A controller state initialised from ``config`` (a RunConfig: its controller and prior; e.g.
-    harness.ceiling.fixed.fixed_config(w) for a fixed w) or else from ``condition``, ``overrides`` and
-    ``prior`` as harness.config.build_config takes them. ``seed`` seeds the exploration noise
-    (icoac_init)."""
+    harness.ceiling.fixed.fixed_config(w) for a fixed w) or else from ``condition``, ``overrides``,
+    ``prior`` and ``plant`` as harness.config.build_config takes them (``plant="furuta"`` for
+    icoac/Furuta-v0: the Furuta's task settings). ``seed`` seeds the exploration noise (icoac_init)."""
 
     def __init__(self, config: RunConfig | None = None, *, condition: str = "ico",
-                 overrides: Mapping[str, Any] | None = None, prior: B.Prior | None = None, seed: int = 0):
+                 overrides: Mapping[str, Any] | None = None, prior: B.Prior | None = None, seed: int = 0,
+                 plant: str = "cart_pole"):
         if config is None:
-            config = build_config(overrides, condition=condition, prior=prior)
+            config = build_config(overrides, condition=condition, prior=prior, plant=plant)
         elif overrides is not None or prior is not None:
             raise ValueError("give either config or condition/overrides/prior, not both")
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < 2 ** 64:

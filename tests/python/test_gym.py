@@ -325,3 +325,24 @@ def test_registry_plant_parameters_and_bad_input(env_id, plant):
 def test_policy_refuses_the_six_state_env():
     with pytest.raises(ValueError, match="observation must be a Box of 4"):
         hg.IcoacPolicy().run_episode(gymnasium.make("icoac/DoubleCartPole-v0"))
+
+
+def test_furuta_episodes_equal_the_engine_trial_loop():
+    """IcoacPolicy with the Furuta's task settings on icoac/Furuta-v0 = the engine's cell run on the
+    Furuta model: same trial lengths, same learned weights (no initial velocity noise, so that every
+    trial of the engine starts where the env's reset puts it)."""
+    trials, horizon, cell = 10, 300, 269  # alpha0 = -7 deg, theta0 = 0
+    cfg = build_config({"max_trials": trials, "success_steps": horizon, "init_velocity_noise": 0}, plant="furuta")
+    assert hg.IcoacPolicy(condition="ico", plant="furuta").weights.shape == (B.N_INPUTS,)
+    cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
+    B.check_status(B.lib.icoac_sim_plant_grid(B.plant_index("furuta"), cells, cells.size, 0))
+    seed = int(cells[cell]["seed"])
+    engine = run_cell(cfg, cells[cell]["x0"], cells[cell]["theta0"], seed=seed)
+    env = gymnasium.make("icoac/Furuta-v0", max_episode_steps=horizon, init_velocity_noise=0)
+    policy = hg.IcoacPolicy(cfg, seed=int(B.lib.icoac_mix_seed(seed, 1)))
+    episodes = []
+    while len(episodes) < trials and not (episodes and episodes[-1].truncated):
+        episodes.append(policy.run_episode(env, options={"cell": cell, "grid_seed": 0}))
+    assert len(episodes) == engine["trials"]
+    assert sum(e.steps for e in episodes) == engine["total_steps"]
+    assert np.array_equal(policy.weights, engine["weights"]) and np.any(policy.weights != 0)
