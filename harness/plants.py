@@ -27,8 +27,18 @@ class PlantSpec:
     learners: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
-# The cart-pole's reflex zone along its position, 2.35 of 2.4 m, as a fraction of the input range.
+# The cart-pole's reflex zone along its position, 2.35 of 2.4 m, as a fraction of the input range
+# (checked against the C defaults below).
 ZONE_FRACTION = 2.35 / 2.4
+
+
+def _check_zone_fraction() -> None:
+    default = B.Config()
+    B.lib.icoac_config_default(default)
+    assert math.isclose(ZONE_FRACTION, default.policy.zone_x / default.policy.input_range[0], rel_tol=1e-6)
+
+
+_check_zone_fraction()
 
 
 def task_overrides(plant: str, setting: dict[str, float]) -> dict[str, Any]:
@@ -48,6 +58,7 @@ def task_overrides(plant: str, setting: dict[str, float]) -> dict[str, Any]:
 FURUTA_SETTING = {"arm_range": 1.0, "arm_velocity_range": 2.3, "pendulum_velocity_range": 0.6, "zone_deg": 8.0,
                   "ico.rate": 0.01, "policy.gain": 1.0}
 
+# ICO->RL's reading and noise on the Furuta, chosen by its learner sweep (docs/sweeps-furuta.md).
 FURUTA_ICO_RL = {"actor.update": "mean", "actor.likelihood_std": 0.1, "actor.scale": 0.1, "actor.noise_std": 1.0}
 
 PLANTS: dict[str, PlantSpec] = {
