@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
 import json
 import math
 import sys
@@ -37,17 +38,17 @@ from pathlib import Path
 import numpy as np
 
 from .. import _binding as B
-from .. import grid, results, store
+from .. import grid, metrics, results, store
 from ..bench import QUICK_CELLS
 from ..config import build_config
 from ..plants import task_overrides
-from ..sweep import SweepOptions, run_sweep
+from ..sweep import DEFAULT_CELLS, SweepOptions, run_sweep
 
 SAMPLES = 80
 STAGE_2_TOP = 5
 MAX_TRIALS = 20000
 SUCCESS_STEPS = 2000
-SPREAD_CELLS = list(range(0, 1225, 25))
+SPREAD_CELLS = DEFAULT_CELLS  # 49 cells evenly over a 25 x 49 grid
 SPACE = (  # name, values (the pendulum angle range is its failure limit)
     ("arm_range", (0.5, 1.0, 1.5708, 3.0)),
     ("arm_velocity_range", (1.0, 2.3, 6.4, 15.0, 40.0)),
@@ -92,7 +93,7 @@ def run_one(plant: str, setting: dict, seed: int, cells: list[int]) -> dict:
     run = grid.run_grid(cfg, arr, progress=False)
     if run.cancelled:
         raise KeyboardInterrupt
-    ok = arr["outcome"] == 1
+    ok = metrics.success_mask(arr)
     return {"key": key(setting), "seed": seed, "cells": len(cells), "success_rate": float(ok.mean()),
             "median_trials": float(np.median(arr["trials"][ok])) if ok.any() else "",
             "wall_time": round(time.monotonic() - t0, 2)}
@@ -113,11 +114,11 @@ def run_stage(plant: str, path: Path, settings: list[dict], seeds: list[int], ce
             if (key(setting), seed) in done:
                 continue
             rows.append(run_one(plant, setting, seed, cells))
-            with open(path.with_suffix(".tmp"), "w", newline="") as f:
-                w = csv.DictWriter(f, fieldnames=FIELDS)
-                w.writeheader()
-                w.writerows(rows)
-            path.with_suffix(".tmp").replace(path)
+            text = io.StringIO(newline="")
+            writer = csv.DictWriter(text, fieldnames=FIELDS)
+            writer.writeheader()
+            writer.writerows(rows)
+            store.write_text(path, text.getvalue())
             r = rows[-1]
             print(f"[{i}/{len(settings)}] seed {seed}: {r['key']}: success {r['success_rate']:.3f}", file=sys.stderr)
     return rows

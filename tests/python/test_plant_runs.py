@@ -171,3 +171,16 @@ def test_figures_and_sweep_take_the_recorded_plant(capsys, tmp_path):
     rc, printed, err = main(capsys, "figures", "--results", out, "--out", tmp_path / "f", "--plant", "furuta")
     assert rc == 0, err
     assert sorted(Path(p).name for p in printed.split()) == ["fig1b_success_map.png", "fig1cf_weights.png"]
+
+
+def test_sweep_stage_writes_its_rows_and_resumes(tmp_path, monkeypatch):
+    monkeypatch.setattr(plant_sweeps, "MAX_TRIALS", 20)
+    monkeypatch.setattr(plant_sweeps, "SUCCESS_STEPS", 100)
+    path = tmp_path / "stage.csv"
+    setting = plant_sweeps.samples()[0]
+    rows = plant_sweeps.run_stage("furuta", path, [setting], [0, 1], [600, 601])
+    assert [r["seed"] for r in plant_sweeps.read_rows(path)] == ["0", "1"] and len(rows) == 2
+    assert plant_sweeps.setting_of(rows[0]["key"]) == setting
+    before = path.read_bytes()
+    plant_sweeps.run_stage("furuta", path, [setting], [0, 1], [600, 601])  # nothing left to run
+    assert path.read_bytes() == before
