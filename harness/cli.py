@@ -251,7 +251,7 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--ceiling", default=None, metavar="CEILING",
                    help="ceiling.json of `ceiling` (or its directory) shown in summary.md and Fig. 3a "
                         f"(default OUT/{O.CEILING_DIR}/{O.CEILING_FILE} if it exists)")
-    b.add_argument("--plant", type=_plant, default="cart_pole", help=PLANT_HELP)
+    b.add_argument("--plant", type=_plant, default=O.CART_POLE, help=PLANT_HELP)
     _add_prior_args(b)
     _add_backend(b)
     b.set_defaults(func=cmd_bench)
@@ -318,7 +318,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--threads", type=_threads, default=0, help=f"C threads in [0, {O.MAX_THREADS}] (0: all cores)")
     c.add_argument("--set", action="append", metavar="NAME=VALUE",
                    help=SET_HELP + "; mode, learn, max_trials and success_steps are set by the command")
-    c.add_argument("--plant", type=_plant, default="cart_pole", help=PLANT_HELP)
+    c.add_argument("--plant", type=_plant, default=O.CART_POLE, help=PLANT_HELP)
     c.add_argument("--quiet", action="store_true", help="no progress output")
     c.set_defaults(func=cmd_ceiling)
     return p
@@ -328,10 +328,10 @@ def build_parser() -> argparse.ArgumentParser:
 def _overrides(args) -> dict:
     """--configuration's items, replaced by --set's, with --max-trials and --success-steps (each
     field given once)."""
-    from .config import CART_POLE, command_overrides
+    from .config import command_overrides
     return command_overrides(args.configuration, args.set, {"--max-trials": ("max_trials", args.max_trials),
                                                             "--success-steps": ("success_steps", args.success_steps)},
-                             plant=getattr(args, "plant", None) or CART_POLE)
+                             plant=getattr(args, "plant", None) or O.CART_POLE)
 
 
 def _frame(args):
@@ -377,7 +377,7 @@ def cmd_grid(args) -> int:
         overrides=_overrides(args), cell_spec=args.cells, resume=args.resume, fresh=args.overwrite,
         progress=not args.quiet, checkpoint_every=args.checkpoint_every,
         checkpoint_cells=args.checkpoint_cells, explicit=explicit or not args.resume, info=info, dask=spec,
-        plant=args.plant or "cart_pole")
+        plant=args.plant or O.CART_POLE)
     print(metrics.format_summary(record["condition"], record["summary"]))
     where = "Dask worker threads" if spec is not None else "threads"
     print(f"wall time {record['wall_time']:.1f} s on {record['threads']} {where} -> {args.out}")

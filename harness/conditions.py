@@ -17,7 +17,7 @@ from . import grid, results, store
 from . import prior as P
 from .config import RunConfig, build_config
 from .errors import UsageError
-from .options import DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY
+from .options import CART_POLE, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY
 from .registry import CONDITIONS, REGISTRY
 
 
@@ -52,7 +52,7 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
                   checkpoint_every: float | None = None, checkpoint_cells: int | None = None,
                   info: P.PriorInfo | None = None, explicit: bool = True, cancel_after: float | None = None,
                   start_over: str = "rerun with --overwrite", dask=None,
-                  plant: str = "cart_pole") -> tuple[np.ndarray, dict, bool]:
+                  plant: str = CART_POLE) -> tuple[np.ndarray, dict, bool]:
     """Run (or resume) one condition into a results directory; returns (cells, record, cancelled).
 
     ``dask`` (a harness.cluster.DaskSession, or a DaskSpec for a session opened after every check

@@ -15,6 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from . import _binding as B
+from .options import CART_POLE as CART_POLE_NAME
 
 TOL = 1e-6  # plant units (m, rad): a cell coordinate must be this close to a grid point
 
@@ -125,13 +126,13 @@ class PlantGrid:
 
 
 @lru_cache(maxsize=None)
-def of(plant: str = "cart_pole") -> PlantGrid:
+def of(plant: str = CART_POLE_NAME) -> PlantGrid:
     """The grid of a registry plant."""
     return PlantGrid(plant)
 
 
 # The cart-pole's, the paper's grid, under its historical names.
-CART_POLE = of("cart_pole")
+CART_POLE = of(CART_POLE_NAME)
 THETAS = CART_POLE.rows
 XS = CART_POLE.cols
 CELLS = CART_POLE.cells

@@ -15,7 +15,7 @@ import numpy as np
 
 from . import _binding as B
 from .config import RunConfig
-from .options import (DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, MAX_THREADS,  # noqa: F401
+from .options import (CART_POLE, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, MAX_THREADS,  # noqa: F401
                       MAX_TRAJECTORY_STEPS, SEED_LIMIT, TRAJECTORY_DURATION)
 
 # What icoac_sim_run_grid_model fills in; the caller sets the others (icoac_sim_cell_t).
@@ -133,7 +133,7 @@ def plant_grid(plant: str, seed: int = 0) -> np.ndarray:
     return cells
 
 
-def make_cells(seed: int = 0, indices: Iterable[int] | None = None, plant: str = "cart_pole") -> np.ndarray:
+def make_cells(seed: int = 0, indices: Iterable[int] | None = None, plant: str = CART_POLE) -> np.ndarray:
     """Grid cells of the plant (seeds as in the full grid), optionally a subset of cell indices."""
     cells = plant_grid(plant, seed)
     if indices is None:

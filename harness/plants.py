@@ -13,8 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from . import _binding as B
-
-CART_POLE = "cart_pole"  # the registry's first plant, the one of the B.Plant struct
+from .options import CART_POLE
 
 
 @dataclass(frozen=True)

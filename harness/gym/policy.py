@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import _binding as B
 from ..config import RunConfig, build_config
+from ..options import CART_POLE
 
 
 @dataclass
@@ -54,7 +55,7 @@ class IcoacPolicy:
 
     def __init__(self, config: RunConfig | None = None, *, condition: str = "ico",
                  overrides: Mapping[str, Any] | None = None, prior: B.Prior | None = None, seed: int = 0,
-                 plant: str = "cart_pole"):
+                 plant: str = CART_POLE):
         if config is None:
             config = build_config(overrides, condition=condition, prior=prior, plant=plant)
         elif overrides is not None or prior is not None:
