@@ -17,14 +17,18 @@ BENCH_OUT ?= results/$(if $(BENCH_SUFFIX),$(BENCH_PROFILE),bench)
 BENCH_FIGURES ?= docs/figures$(BENCH_SUFFIX)
 # The summary docs/results.md's tables come from (python -m harness.tools.results_tables --update).
 BENCH_DATA ?= docs/data/bench-$(BENCH_PROFILE).json
+# Plants the bench runs (harness/plants.py; `all`: every plant the controller build takes). The
+# cart-pole writes the directories above, another plant P their names with -P (results, data) or
+# /P (figures) added.
+BENCH_PLANTS ?= cart_pole
 # `make fuzz`: seconds per target, targets run at once, extra libFuzzer options.
 FUZZ_TIME ?= 600
 FUZZ_JOBS ?= 2
 FUZZ_FLAGS ?=
-FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim
+FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim fuzz_model
 
 .PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz bench \
-  bench-speed clean target-report sweeps sweeps-rl-alone
+  bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
 
@@ -95,12 +99,21 @@ bench-speed: build
 	./build/release/sim_host/icoac_bench
 
 # BENCH_ARGS: more bench options, e.g. BENCH_ARGS=--resume to continue a stopped run.
-# The linear-policy ceiling first (about 40 s; a rerun replays its cached search), then the
-# bench, which shows it in summary.md and Fig. 3a.
+# Per plant (bench-plant), the linear-policy ceiling first (about 40 s; a rerun replays its
+# cached search), then the bench, which shows it in summary.md and Fig. 3a.
 bench: build venv bench-speed
-	$(VPY) -m harness ceiling --out $(BENCH_OUT)/ceiling --quiet
-	$(VPY) -m harness bench --profile $(BENCH_PROFILE) --out $(BENCH_OUT) --figures $(BENCH_FIGURES) \
-	  --data $(BENCH_DATA) $(BENCH_ARGS)
+	@plants="$(BENCH_PLANTS)"; \
+	if [ "$$plants" = all ]; then plants=$$($(VPY) -c 'from harness.plants import PLANTS; print(" ".join(PLANTS))'); fi; \
+	for p in $$plants; do $(MAKE) --no-print-directory bench-plant PLANT=$$p || exit 1; done
+
+PLANT ?= cart_pole
+PLANT_OUT = $(if $(filter cart_pole,$(PLANT)),$(BENCH_OUT),$(BENCH_OUT)-$(PLANT))
+PLANT_FIGURES = $(if $(filter cart_pole,$(PLANT)),$(BENCH_FIGURES),$(BENCH_FIGURES)/$(PLANT))
+PLANT_DATA = $(if $(filter cart_pole,$(PLANT)),$(BENCH_DATA),$(basename $(BENCH_DATA))-$(PLANT).json)
+bench-plant:
+	$(VPY) -m harness ceiling --plant $(PLANT) --out $(PLANT_OUT)/ceiling --quiet
+	$(VPY) -m harness bench --plant $(PLANT) --profile $(BENCH_PROFILE) --out $(PLANT_OUT) \
+	  --figures $(PLANT_FIGURES) --data $(PLANT_DATA) $(BENCH_ARGS)
 
 # The learner sweeps that chose the defaults (docs/results.md), on the ICO grid of seed 0 of a
 # bench (make bench first); resumable, summary in $(SWEEP_OUT)/summary.md.
@@ -117,15 +130,31 @@ sweeps: build venv
 	cp $(SWEEP_OUT)/summary.md docs/sweeps.md
 
 # RL alone's own sweep (N(0, sigma_w^2 I), nothing from ICO; the ICO grid only names the
-# ICO-failed cells): stage 1, readings x sigma_w; stage 2 around its choice (RL_ALONE_BASE).
+# ICO-failed cells): stage 1, readings x sigma_w; stage 2 one at a time around its choice
+# (RL_ALONE_BASE), the schedule grid, the noise grid at the schedule's choice (RL_ALONE_SCHEDULE);
+# then 5-seed grids of every cell for the best 3 settings (--confirm).
 RL_ALONE_OUT ?= results/sweeps-rl-alone
 RL_ALONE_BASE ?= --base actor.update=gradient --base actor.rate=0.03
+RL_ALONE_SCHEDULE ?= --base actor.update=gradient --base actor.explore_ticks=1000 --base actor.batch=0
 RL_ALONE_SWEEP = $(VPY) -m harness.tools.learner_sweeps --prior-from $(SWEEP_ICO) --out $(RL_ALONE_OUT)
 sweeps-rl-alone: build venv
 	$(RL_ALONE_SWEEP) --stage rl-alone
-	$(RL_ALONE_SWEEP) --stage rl-alone-2 $(RL_ALONE_BASE)
+	$(RL_ALONE_SWEEP) --stage rl-alone-2 --only rl-alone-stage2 $(RL_ALONE_BASE)
+	$(RL_ALONE_SWEEP) --stage rl-alone-2 --only rl-alone-schedule-grid --base actor.update=gradient
+	$(RL_ALONE_SWEEP) --stage rl-alone-2 --only rl-alone-noise-grid $(RL_ALONE_SCHEDULE)
+	$(RL_ALONE_SWEEP) --confirm
 	$(RL_ALONE_SWEEP) --report
 	cp $(RL_ALONE_OUT)/summary.md docs/sweeps-rl-alone.md
+
+# The task settings and learner noise of each plant but the cart-pole (harness/plants.py), by
+# their sweeps (harness.tools.plant_sweeps; resumable): the task on spread cells, then the
+# learners on the plant's ICO grid of seed 0 (make bench BENCH_PLANTS=furuta first).
+PLANT_SWEEPS = $(VPY) -m harness.tools.plant_sweeps --plant furuta --out results/sweeps-furuta
+sweeps-plants: build venv
+	$(PLANT_SWEEPS)
+	$(PLANT_SWEEPS) --stage learners --prior-from $(BENCH_OUT)-furuta/ico/seed-0
+	$(PLANT_SWEEPS) --report
+	cp results/sweeps-furuta/summary.md docs/sweeps-furuta.md
 
 # Microcontroller resource report: cross builds, QEMU runs, table in docs/porting.md.
 target-report: deps

@@ -1,11 +1,13 @@
 """Python harness of the icoac controller: ctypes binding of libicoac_sim, grid runs, results, figures.
 
-Layers (no import cycle; `python -m harness.tools.imports` prints the graph): errors, options,
+Layers (no import cycle; `python -m harness.tools.imports` prints the graph): errors, options, registry,
 literals (no dependencies) < _binding (the C library, its constants and checked struct mirrors)
 < geometry, config < metrics, grid < results < store (every write into an output directory),
 prior < figures, conditions < bench, sweep < cli (arguments and reports only; imported by
 __main__ alone). The Dask backend: _worker (what a worker runs;
 errors and options at import, the binding only inside a task) < cluster (the client side, after
 grid; imported by bench and sweep, and by conditions inside a function).
+Gymnasium: gym (the simulator's plants as envs, the controller as a policy; after config) is
+imported by no other module.
 """
 __version__ = "0.1.0"

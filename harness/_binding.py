@@ -31,7 +31,7 @@ DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.s
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
 ABI_VERSION = 8
-SIM_ABI_VERSION = 2
+SIM_ABI_VERSION = 3
 
 
 class IcoacError(HarnessError):
@@ -218,6 +218,7 @@ SIM_ERR_BAD_RUN = int(constant("ICOAC_SIM_ERR_BAD_RUN"))
 SIM_ERR_BAD_ARGUMENT = int(constant("ICOAC_SIM_ERR_BAD_ARGUMENT"))
 SIM_ERR_THREAD = int(constant("ICOAC_SIM_ERR_THREAD"))
 SIM_CANCELLED = int(constant("ICOAC_SIM_CANCELLED"))
+SIM_ERR_NONFINITE = int(constant("ICOAC_SIM_ERR_NONFINITE"))
 
 # Status ranges, from the names: icoac_status_t (ICOAC_OK, ICOAC_ERR_*), the bad-parameter
 # statuses of both libraries (a rejected configuration, prior, plant, run or argument).
@@ -243,6 +244,11 @@ GRID_THETA_FIRST_DEG = float(constant("ICOAC_SIM_GRID_THETA_FIRST_DEG"))
 GRID_X_FIRST = float(constant("ICOAC_SIM_GRID_X_FIRST"))
 GRID_X_STEP = float(constant("ICOAC_SIM_GRID_X_STEP"))
 PI = float(constant("ICOAC_SIM_PI"))
+
+# The plant registry (docs/plants.md).
+MAX_STATE = int(constant("ICOAC_SIM_MAX_STATE"))
+MAX_PARAMS = int(constant("ICOAC_SIM_MAX_PARAMS"))
+CART_POLE = int(constant("ICOAC_SIM_CART_POLE"))
 
 # -- structure mirrors ------------------------------------------------------------------------------
 _SIZEOF_REAL = lib.icoac_sizeof_real()
@@ -405,6 +411,58 @@ class Run(ctypes.Structure):
     ]
 
 
+class Axis(ctypes.Structure):
+    """icoac_sim_axis_t: name and unit of a state component or of a plant's input."""
+    _fields_ = [("name", ctypes.c_char_p), ("unit", ctypes.c_char_p)]
+
+
+class Param(ctypes.Structure):
+    """icoac_sim_param_t: one plant parameter, its default and valid range."""
+    _fields_ = [("name", ctypes.c_char_p), ("unit", ctypes.c_char_p), ("value", ctypes.c_double),
+                ("min", ctypes.c_double), ("max", ctypes.c_double)]
+
+
+class Sweep(ctypes.Structure):
+    """icoac_sim_sweep_t: a swept start coordinate of a plant's grid."""
+    _fields_ = [("component", ctypes.c_int32), ("count", ctypes.c_int32), ("first", ctypes.c_double),
+                ("step", ctypes.c_double), ("degrees", ctypes.c_int32), ("reserved", ctypes.c_int32)]
+
+
+class PlantDesc(ctypes.Structure):
+    """icoac_sim_plant_desc_t: a registry plant (read only; its functions are opaque pointers)."""
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("title", ctypes.c_char_p),
+        ("source", ctypes.c_char_p),
+        ("input", Axis),
+        ("n_state", ctypes.c_int32),
+        ("n_params", ctypes.c_int32),
+        ("state", Axis * MAX_STATE),
+        ("params", ctypes.POINTER(Param)),
+        ("rows", Sweep),
+        ("cols", Sweep),
+        ("start", ctypes.c_double * MAX_STATE),
+        ("drawn", ctypes.c_int32 * MAX_STATE),
+        ("observed", ctypes.c_int32 * MAX_STATE),
+        ("step", ctypes.c_void_p),
+        ("derivatives", ctypes.c_void_p),
+        ("failed", ctypes.c_void_p),
+        ("energy", ctypes.c_void_p),
+    ]
+
+
+class Rng(ctypes.Structure):
+    """icoac_rng_t: a PCG32 generator's state (seeded by icoac_rng_seed)."""
+    _fields_ = [("state", ctypes.c_uint64), ("increment", ctypes.c_uint64), ("spare_normal", c_real),
+                ("has_spare", ctypes.c_int32)]
+
+
+class Model(ctypes.Structure):
+    """icoac_sim_model_t: a registry plant's parameter block with dt and the integrator."""
+    _fields_ = [("plant", ctypes.c_int32), ("integrator", ctypes.c_int32), ("dt", ctypes.c_double),
+                ("param", ctypes.c_double * MAX_PARAMS)]
+
+
 CELL_DTYPE = np.dtype([
     ("x0", np.float64),
     ("theta0", np.float64),
@@ -415,8 +473,8 @@ CELL_DTYPE = np.dtype([
     ("total_steps", np.int64),
     ("last_trial_steps", np.int64),
     ("elapsed_time", np.float64),
-    ("weights", np.float64, (N_INPUTS,)),
-    ("cov", np.float64, (N_INPUTS, N_INPUTS)),
+    ("weights", np.float64, (MAX_INPUTS,)),
+    ("cov", np.float64, (MAX_INPUTS, MAX_INPUTS)),
 ], align=True)
 
 Mirror = Union[type, np.dtype]
@@ -432,6 +490,12 @@ MIRRORS: dict[str, tuple[Mirror, str | None]] = {
     "icoac_sim_plant_t": (Plant, "icoac_sim_sizeof_plant"),
     "icoac_sim_run_t": (Run, "icoac_sim_sizeof_run"),
     "icoac_sim_cell_t": (CELL_DTYPE, "icoac_sim_sizeof_cell"),
+    "icoac_sim_axis_t": (Axis, None),
+    "icoac_sim_param_t": (Param, None),
+    "icoac_sim_sweep_t": (Sweep, None),
+    "icoac_sim_plant_desc_t": (PlantDesc, None),
+    "icoac_sim_model_t": (Model, None),
+    "icoac_rng_t": (Rng, None),
 }
 
 
@@ -518,6 +582,10 @@ _cancel_p = ndpointer(np.int32, ndim=1, flags="C_CONTIGUOUS")
 _f64_w = ndpointer(np.float64, ndim=1, flags="C_CONTIGUOUS,WRITEABLE")
 
 
+_state_w = ndpointer(np.float64, ndim=1, shape=(MAX_STATE,), flags="C_CONTIGUOUS,WRITEABLE")
+_state_r = ndpointer(np.float64, ndim=1, shape=(MAX_STATE,), flags="C_CONTIGUOUS")
+
+
 class _NullableNdpointer:
     """ndpointer that also accepts None (passed as NULL)."""
 
@@ -562,6 +630,27 @@ _PROTOTYPES = {
     "icoac_sim_trajectory": ([_P(Config), _P(Plant), _P(Prior), ctypes.c_double, ctypes.c_double,
                               ctypes.c_double, ctypes.c_uint64, ctypes.c_int64, _f64_w, _f64_w,
                               _P(ctypes.c_int64)], ctypes.c_int32),
+    "icoac_sim_plant_count": ([], ctypes.c_int32),
+    "icoac_sim_plant_info": ([ctypes.c_int32], _P(PlantDesc)),
+    "icoac_sim_plant_find": ([ctypes.c_char_p], ctypes.c_int32),
+    "icoac_sim_model_default": ([_P(Model), ctypes.c_int32], ctypes.c_int32),
+    "icoac_sim_model_check": ([_P(Model)], ctypes.c_int32),
+    "icoac_sim_model_from_plant": ([_P(Plant), _P(Model)], ctypes.c_int32),
+    "icoac_sim_model_step": ([_P(Model), _state_w, ctypes.c_double], ctypes.c_int32),
+    "icoac_sim_model_derivatives": ([_P(Model), _state_r, ctypes.c_double, _state_w], ctypes.c_int32),
+    "icoac_sim_model_failed": ([_P(Model), _state_r, _P(ctypes.c_int32)], ctypes.c_int32),
+    "icoac_sim_model_energy": ([_P(Model), _state_r, _P(ctypes.c_double)], ctypes.c_int32),
+    "icoac_sim_plant_grid": ([ctypes.c_int32, _cells_p, ctypes.c_int64, ctypes.c_uint64], ctypes.c_int32),
+    "icoac_rng_seed": ([_P(Rng), ctypes.c_uint64, ctypes.c_uint64], None),
+    "icoac_sim_model_start": ([_P(Model), ndpointer(CELL_DTYPE, shape=(1,), flags="C_CONTIGUOUS"), ctypes.c_double, _P(Rng), _state_w], ctypes.c_int32),
+    "icoac_sim_run_cell_model": ([_P(Config), _P(Model), _P(Run), _P(Prior), _cells_p,
+                                  _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)], ctypes.c_int32),
+    "icoac_sim_run_grid_model": ([_P(Config), _P(Model), _P(Run), _P(Prior), _cells_p, ctypes.c_int64,
+                                  ctypes.c_int32, _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)],
+                                 ctypes.c_int32),
+    "icoac_sim_trajectory_model": ([_P(Config), _P(Model), _P(Prior), ctypes.c_double, ctypes.c_double,
+                                    ctypes.c_double, ctypes.c_uint64, ctypes.c_int64, _f64_w, _f64_w,
+                                    _P(ctypes.c_int64)], ctypes.c_int32),
 }
 for _name, (_args, _res) in _PROTOTYPES.items():
     _fn = getattr(lib, _name)
@@ -625,3 +714,56 @@ def abi_info() -> dict:
         "critic_kernel": "dense" if CONSTANTS["ICOAC_CRITIC_DENSE"] else "sparse",
         "lanes": int(CONSTANTS["ICOAC_SIM_LANES"]),
     }
+
+
+# -- the plant registry ------------------------------------------------------------------------------
+def plant_index(name: str) -> int:
+    """Registry index of the plant called name (ConfigError when none is)."""
+    index = int(lib.icoac_sim_plant_find(name.encode()))
+    if index < 0:
+        names = [plant_info(i)["name"] for i in range(int(lib.icoac_sim_plant_count()))]
+        raise ConfigError(SIM_ERR_BAD_PLANT, f"unknown plant {name!r}; the registry has {', '.join(names)}")
+    return index
+
+
+def plant_info(plant: Union[int, str]) -> dict:
+    """A registry plant's descriptor as plain data: name, title, source, input (name, unit),
+    state [(name, unit)], params [{name, unit, value, min, max}], rows and cols of its grid
+    ({component, count, first, step, degrees}), start, drawn, observed, has_energy."""
+    index = plant_index(plant) if isinstance(plant, str) else int(plant)
+    ptr = lib.icoac_sim_plant_info(index)
+    if not ptr:
+        raise ConfigError(SIM_ERR_BAD_PLANT, f"no plant {index} in the registry")
+    d = ptr.contents
+    n = d.n_state
+    sweep = lambda w: {"component": w.component, "count": w.count, "first": w.first, "step": w.step,  # noqa: E731
+                       "degrees": bool(w.degrees)}
+    return {
+        "index": index,
+        "name": d.name.decode(), "title": d.title.decode(), "source": d.source.decode(),
+        "input": (d.input.name.decode(), d.input.unit.decode()),
+        "state": [(d.state[i].name.decode(), d.state[i].unit.decode()) for i in range(n)],
+        "params": [{"name": p.name.decode(), "unit": p.unit.decode(), "value": p.value, "min": p.min,
+                    "max": p.max} for p in (d.params[i] for i in range(d.n_params))],
+        "rows": sweep(d.rows), "cols": sweep(d.cols),
+        "start": list(d.start[:n]), "drawn": [bool(v) for v in d.drawn[:n]], "observed": list(d.observed[:n]),
+        "has_energy": bool(d.energy),
+    }
+
+
+def model_default(plant: Union[int, str], **params: float) -> Model:
+    """A model of the plant with its default parameters, dt 0.01 s and Euler, then params (by
+    name, plus dt and integrator) set and the result checked."""
+    index = plant_index(plant) if isinstance(plant, str) else int(plant)
+    model = Model()
+    check_status(lib.icoac_sim_model_default(ctypes.byref(model), index), "plant model")
+    names = [p["name"] for p in plant_info(index)["params"]]
+    for key, value in params.items():
+        if key in ("dt", "integrator"):
+            setattr(model, key, INTEGRATORS[value] if key == "integrator" and isinstance(value, str) else value)
+        elif key in names:
+            model.param[names.index(key)] = float(value)
+        else:
+            raise ConfigError(SIM_ERR_BAD_PLANT, f"plant {plant_info(index)['name']} has no parameter {key!r}")
+    check_status(lib.icoac_sim_model_check(ctypes.byref(model)), "plant model")
+    return model

@@ -19,14 +19,17 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from . import ceiling as C
 from . import figures, geometry, grid, metrics, results, store, tables
 from . import prior as P
+from .ceiling.records import bench_ceiling, load_ceiling, reference_lines
+from .ceiling.weights import format_w
 from .conditions import run_condition
 from .config import build_config, command_overrides, named_sets
 from .errors import ResultsError
 from .metrics import percent
-from .options import CONDITION_LABELS as LABELS, CONDITIONS, CONTROL_OF, PRIOR_RULES, PROFILE_NAMES
+from .options import PROFILE_NAMES
+from .plants import CART_POLE
+from .registry import CONDITIONS, PRIOR_CONDITIONS, REGISTRY
 
 # Paper (Fig. 1b, 2b, 3a): ~68 % ICO, ~84 % ICO->RL; RL alone only "smaller" and "very slow" (Fig. 3 bars).
 PAPER = {
@@ -35,7 +38,7 @@ PAPER = {
     "rl": {"success_rate": None, "note": "Fig. 3: smaller domain than ICO, very slow; no number in the text"},
 }
 # The learners after ICO and its prior, in stage order.
-LEARNERS = tuple(c for c in CONDITIONS if c != "ico")
+LEARNERS = PRIOR_CONDITIONS
 
 # Spread subset for smoke tests: rows (theta0 + 12 deg) x columns ((x0 + 2.4) / 0.1); includes
 # Fig. 1g's start (row 8, column 19) and enough central cells for a prior.
@@ -111,7 +114,7 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, A
                                  "n_interior": recs[0]["summary"]["n_interior"],
                                  "max_trials": recs[0]["config"]["run"]["max_trials"],
                                  "success_steps": recs[0]["config"]["run"]["success_steps"],
-                                 "paper": PAPER.get(cond)}
+                                 "paper": PAPER.get(cond) if results.record_plant(recs[0]) == CART_POLE else None}
         for key, _ in STATS:
             values = [r["summary"].get(key) for r in recs]
             mean, sd, n = _mean_sd(values)
@@ -159,7 +162,7 @@ def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
         cap = "one trial per cell" if p == "first" else f"retries up to {s.get('max_trials', st['max_trials']):g} trials"
         parts.append(f"{cap}: {percent(s['success_rate'])} of {s['n_cells']} cells, "
                      f"{percent(s['success_rate_interior'])} of {s['n_interior']} interior")
-    lines = ["", f"Linear-policy ceiling (method.md, L5; no learning, the best single w = {C.format_w(best['w'])} "
+    lines = ["", f"Linear-policy ceiling (method.md, L5; no learning, the best single w = {format_w(best['w'])} "
              f"of `python -m harness ceiling`, seed {st['seed']}, horizon {st['success_steps']:g} steps): "
              + "; ".join(parts) + "."]
     b = record.get("first_step_bound") or {}
@@ -169,8 +172,10 @@ def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
     return lines
 
 
-def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> str:
-    lines = ["# ICO and the learners with their no-learning controls: mean ± sd over seeds", "",
+def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None,
+                     grid: geometry.PlantGrid = geometry.CART_POLE) -> str:
+    title = "" if grid is geometry.CART_POLE else f" ({grid.plant})"
+    lines = [f"# ICO and the learners with their no-learning controls{title}: mean ± sd over seeds", "",
              "| condition | seeds | caps (trials / steps) | success (all) | success (interior) | "
              "median trials to success | mean elapsed sim. time of successes (s) | paper |",
              "|---|---|---|---|---|---|---|---|"]
@@ -180,7 +185,7 @@ def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None =
         e = agg[cond]
         paper = e["paper"] or {}
         ptxt = (f"{percent(paper['success_rate'], 0)}; " if paper.get("success_rate") else "") + paper.get("note", "")
-        lines.append(f"| {LABELS[cond]} | {len(e['seeds'])} | {e['max_trials']:g} / {e['success_steps']:g} | "
+        lines.append(f"| {REGISTRY[cond].label} | {len(e['seeds'])} | {e['max_trials']:g} / {e['success_steps']:g} | "
                      f"{_fmt(e['success_rate'], True)} of {e['n_cells']} | "
                      f"{_fmt(e['success_rate_interior'], True)} of {e['n_interior']} | "
                      f"{_fmt(e['median_trials_to_success'])} | {_fmt(e['mean_elapsed_time_success'])} | {ptxt} |")
@@ -191,8 +196,8 @@ def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None =
                   "| condition | control | points of success (all) | cells gained | cells lost |",
                   "|---|---|---|---|---|"]
         for cond, g in gains:
-            control = next(k for k, v in CONTROL_OF.items() if v == cond)
-            lines.append(f"| {LABELS[cond]} | {LABELS[control]} | {_fmt(g['points'])} | "
+            control = REGISTRY[REGISTRY[cond].control]
+            lines.append(f"| {REGISTRY[cond].label} | {control.label} | {_fmt(g['points'])} | "
                          f"{_fmt(g['cells_gained'])} | {_fmt(g['cells_lost'])} |")
     if "ico-rl" in agg and agg["ico-rl"].get("ico_phase_simulated_time", {}).get("mean") is not None:
         lines += ["", "ICO->RL counts RL-phase trials only (A17); the ICO phase that produced each prior took "
@@ -200,17 +205,21 @@ def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None =
     if ceiling is not None:
         lines += ceiling_markdown(ceiling)
     lines += tables.curve_tables(agg, ceiling)
-    lines += ["", f"Success rates use the cells run as denominator ({geometry.CELLS} / {geometry.N_INTERIOR} on "
-              f"the full grid). The paper's ~{percent(PAPER['ico']['success_rate'], 0)} / "
-              f"~{percent(PAPER['ico-rl']['success_rate'], 0)} are read as fractions of all {geometry.CELLS} cells."]
+    lines += ["", f"Success rates use the cells run as denominator ({grid.cells} / {grid.n_interior} on "
+              "the full grid)."]
+    if grid is geometry.CART_POLE:
+        lines[-1] += (f" The paper's ~{percent(PAPER['ico']['success_rate'], 0)} / "
+                      f"~{percent(PAPER['ico-rl']['success_rate'], 0)} are read as fractions of all "
+                      f"{geometry.CELLS} cells.")
     return "\n".join(lines) + "\n"
 
 
-def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> tuple[Path, Path]:
+def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None,
+                  grid: geometry.PlantGrid = geometry.CART_POLE) -> tuple[Path, Path]:
     out = Path(out)
     md = out / "summary.md"
     js = out / "summary.json"
-    store.write_text(md, summary_markdown(agg, ceiling))
+    store.write_text(md, summary_markdown(agg, ceiling, grid))
     store.write_json(js, agg)
     return md, js
 
@@ -218,7 +227,8 @@ def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] 
 def write_data(opt: "BenchOptions", agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None) -> Path:
     """The summary docs/results.md's tables are written from (harness.tools.results_tables): the
     aggregate, the ceiling's best w with its protocols, and what produced them."""
-    record = {"profile": opt.profile, "seeds": opt.seed_list(), "configuration": opt.configuration,
+    record = {**({} if opt.plant == CART_POLE else {"plant": opt.plant}),
+              "profile": opt.profile, "seeds": opt.seed_list(), "configuration": opt.configuration,
               "set": list(opt.sets), "prior_std": opt.prior_std, "git": results.git_info(),
               "timestamp": results.timestamp(), "aggregate": agg,
               "ceiling": None if ceiling is None else {"settings": ceiling["settings"], "best": ceiling["best"]}}
@@ -229,7 +239,8 @@ def write_data(opt: "BenchOptions", agg: Mapping[str, Any], ceiling: Mapping[str
 
 def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarray | None,
                        icorl_cells: np.ndarray | None, frame=None,
-                       ceiling: Mapping[str, Any] | None = None) -> list[Path]:
+                       ceiling: Mapping[str, Any] | None = None,
+                       grid: geometry.PlantGrid = geometry.CART_POLE) -> list[Path]:
     """Fig. 2b (first ICO->RL seed, ICO success domain outlined), Fig. 3a (with the linear-policy
     ceiling's reference lines when a ceiling record is given), Fig. 3b."""
     figdir = Path(figdir)
@@ -237,24 +248,24 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
     if icorl_cells is not None:
         outline = None
         if ico_cells is not None:
-            outline = geometry.to_grid(ico_cells, metrics.success_mask(ico_cells).astype(float), fill=0) > 0
+            outline = grid.to_grid(ico_cells, metrics.success_mask(ico_cells).astype(float), fill=0) > 0
         written.append(figures.plot_success_map(icorl_cells, figdir / "fig2b_icorl_success_map.png",
-                                                label="ICO->RL", outline=outline, frame=frame))
+                                                label="ICO->RL", outline=outline, frame=frame, grid=grid))
     conds = [c for c in CONDITIONS if c in agg]
     if conds:
-        written.append(figures.plot_fig3a(figdir / "fig3a_success_rate.png", [LABELS[c] for c in conds],
+        written.append(figures.plot_fig3a(figdir / "fig3a_success_rate.png", [REGISTRY[c].label for c in conds],
                                           [agg[c]["success_rate"] for c in conds],
                                           [agg[c]["success_rate_interior"] for c in conds],
                                           [(PAPER.get(c) or {}).get("success_rate") for c in conds],
-                                          ceiling=C.reference_lines(ceiling)))
-        written.append(figures.plot_fig3b(figdir / "fig3b_elapsed_time.png", [LABELS[c] for c in conds],
+                                          ceiling=reference_lines(ceiling)))
+        written.append(figures.plot_fig3b(figdir / "fig3b_elapsed_time.png", [REGISTRY[c].label for c in conds],
                                           [agg[c]["mean_elapsed_time_success"] for c in conds]))
         curved = [c for c in conds if agg[c].get("success_within")]
         if curved:
-            bases = [c for c in CONDITIONS if c not in CONTROL_OF]
-            curves = [{"label": LABELS[c], "mean": agg[c]["success_within"]["all"]["mean"],
-                       "sd": agg[c]["success_within"]["all"]["sd"], "control": c in CONTROL_OF,
-                       "color": bases.index(CONTROL_OF.get(c, c))} for c in curved]
+            bases = [c.name for c in REGISTRY.values() if c.learns]
+            curves = [{"label": REGISTRY[c].label, "mean": agg[c]["success_within"]["all"]["mean"],
+                       "sd": agg[c]["success_within"]["all"]["sd"], "control": not REGISTRY[c].learns,
+                       "color": bases.index(REGISTRY[c].base)} for c in curved]
             retries = ((ceiling or {}).get("best", {}).get("protocols", {}) or {}).get("retries") or {}
             line = None
             if retries.get("success_within"):
@@ -325,11 +336,12 @@ class BenchOptions:
     sets: Sequence[str] = ()
     resume: bool = False
     quiet: bool = False
-    frame: tuple[float, float] | None = P.DEFAULT_FRAME
+    frame: tuple[float, float] | str | None = P.CENTRAL  # the plant's central frame unless given
     ridge: float = P.DEFAULT_RIDGE
     prior_std: float = P.DEFAULT_STD
     ceiling: Path | None = None   # a ceiling.json (or its directory); default OUT/ceiling/ceiling.json
     dask: Any = None              # a harness.cluster.DaskSpec: every grid on that Dask cluster (None: threads)
+    plant: str = CART_POLE        # a plant of harness.plants: its grid, dynamics and task settings
 
     def seed_list(self) -> list[int]:
         n = self.seeds if self.seeds is not None else PROFILES[self.profile]["seeds"]
@@ -344,9 +356,12 @@ def stages(opt: BenchOptions) -> list[Stage]:
     out = Path(opt.out)
     figdir = Path(opt.figures) if opt.figures else None
     seeds = opt.seed_list()
-    ico_sets = command_overrides(opt.configuration, opt.sets)
-    rl_sets = command_overrides(opt.configuration, opt.sets, {"--rl-max-trials": ("max_trials", opt.rl_max_trials)})
+    ico_sets = command_overrides(opt.configuration, opt.sets, plant=opt.plant)
+    rl_sets = command_overrides(opt.configuration, opt.sets, {"--rl-max-trials": ("max_trials", opt.rl_max_trials)},
+                                plant=opt.plant)
     cells_spec = profile["cells"]
+    plant_grid = geometry.of(opt.plant)
+    frame = plant_grid.central_frame() if opt.frame == P.CENTRAL else opt.frame
 
     def overrides(condition):
         if condition == "ico":
@@ -360,7 +375,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
                 condition=condition, out=d, seed=seed, threads=opt.threads, overrides=overrides(condition),
                 cell_spec=cells_spec, resume=opt.resume and results.exists(d), fresh=not opt.resume,
                 progress=not opt.quiet, info=ctx.get(("prior", condition, seed)),
-                start_over="rerun bench without --resume", dask=ctx.get("dask"))
+                start_over="rerun bench without --resume", dask=ctx.get("dask"), plant=opt.plant)
             ctx[(condition, seed)] = (cells, record)
             s = record["summary"]
             progress(f"  {condition} seed {seed}: success {s['n_success']}/{s['n_cells']}, "
@@ -371,11 +386,13 @@ def stages(opt: BenchOptions) -> list[Stage]:
 
     def prior_stage(seed: int):
         def run(ctx):
-            info = P.from_results(seed_dir(out, "ico", seed), opt.frame, opt.ridge)
-            for condition in PRIOR_RULES:
-                ctx[("prior", condition, seed)] = P.condition_prior(condition, info, opt.prior_std)
-            for control, condition in CONTROL_OF.items():
-                ctx[("prior", control, seed)] = ctx[("prior", condition, seed)]
+            info = P.from_results(seed_dir(out, "ico", seed), frame, opt.ridge)
+            for cond in REGISTRY.values():
+                if cond.prior is not None and cond.learns:
+                    ctx[("prior", cond.name, seed)] = P.condition_prior(cond.name, info, opt.prior_std, plant_grid.n_inputs)
+            for cond in REGISTRY.values():  # a control shares its condition's prior
+                if not cond.learns:
+                    ctx[("prior", cond.name, seed)] = ctx[("prior", cond.base, seed)]
             progress(f"  prior seed {seed}: {info.n_cells} cells, mean "
                      + ", ".join(f"{v:.4g}" for v in info.mean))
         return Stage(f"prior seed-{seed}", run)
@@ -384,7 +401,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
         """The ceiling shown (--ceiling, else OUT/ceiling/ceiling.json if present); a damaged default
         file is reported and skipped rather than failing the bench at its end."""
         try:
-            return C.bench_ceiling(out, opt.ceiling)
+            return bench_ceiling(out, opt.ceiling)
         except ResultsError as exc:
             if opt.ceiling is not None:
                 raise
@@ -398,19 +415,20 @@ def stages(opt: BenchOptions) -> list[Stage]:
         for path in figures.make_figures(cells, record, figdir):
             progress(f"  wrote {path}")
         for path in comparison_figures(ctx["aggregate"], figdir, cells, ctx[("ico-rl", seeds[0])][0],
-                                       frame=opt.frame, ceiling=ceiling_record()):
+                                       frame=frame, ceiling=ceiling_record(), grid=plant_grid):
             progress(f"  wrote {path}")
 
     def summary_stage(ctx):
         recs = {c: [ctx[(c, s)][1] for s in seeds if (c, s) in ctx] for c in CONDITIONS}
         agg = aggregate(recs)
-        for control, condition in CONTROL_OF.items():
-            if condition in agg and control in agg:
+        for cond in REGISTRY.values():
+            condition, control = cond.name, cond.control
+            if control is not None and condition in agg and control in agg:
                 agg[condition]["gain_over_control"] = gain_over_control(
                     {s: ctx[(condition, s)][0] for s in seeds if (condition, s) in ctx},
                     {s: ctx[(control, s)][0] for s in seeds if (control, s) in ctx})
         ctx["aggregate"] = agg
-        md, js = write_summary(out, agg, ceiling_record())
+        md, js = write_summary(out, agg, ceiling_record(), plant_grid)
         if opt.data is not None:
             write_data(opt, agg, ceiling_record())
             progress(f"  wrote {opt.data}")
@@ -433,9 +451,9 @@ def stages(opt: BenchOptions) -> list[Stage]:
         return [Stage("complete grids", finished_stage), Stage("summary", summary_stage),
                 Stage("figures", figures_stage)]
     for condition in CONDITIONS:  # every override valid before the first grid runs
-        build_config(overrides(condition), condition=condition)
+        build_config(overrides(condition), condition=condition, plant=opt.plant)
     if opt.ceiling is not None:
-        C.load_ceiling(opt.ceiling)
+        load_ceiling(opt.ceiling)
 
     out_stages = [grid_stage("ico", s) for s in seeds]
     out_stages += [prior_stage(s) for s in seeds]

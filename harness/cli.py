@@ -3,7 +3,8 @@
 This module only parses arguments and reports; the work is done by harness.conditions (one
 condition's grid and prior), harness.bench (the benchmark stages), harness.sweep,
 harness.ceiling and harness.figures. Nothing imports this module. The parser is built without loading the shared
-library (names and limits come from harness.options), so `--help` works without it.
+library (names and limits come from harness.options, the conditions from harness.registry), so `--help`
+works without it.
 
 Options have one meaning in every command: ``--seed S`` is the first (for `grid` the only) seed
 and ``--seeds N`` the number of seeds, S .. S+N-1; ``--set NAME=VALUE`` takes canonical names
@@ -18,6 +19,7 @@ from pathlib import Path
 
 from . import literals
 from . import options as O
+from . import registry as R
 from .errors import HarnessError, UsageError
 
 PROG = "icoac-harness"
@@ -91,9 +93,24 @@ def _positive_float(hi: float, what: str):
     return parse
 
 
+def _plant(text: str) -> str:
+    """--plant NAME: a plant of the C registry."""
+    from . import _binding as B
+    try:
+        B.plant_index(text)
+    except B.ConfigError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+_plant.__name__ = "plant"
+
+
 _checkpoint_seconds = _positive_float(86400.0, "seconds in (0, 86400]")
 _duration = _positive_float(1e300, "a finite duration > 0 (s)")
 
+PLANT_HELP = ("registry plant (docs/plants.md; default cart_pole): its grid, dynamics and task settings "
+              "(harness/plants.py); its parameters by name through --set")
 SET_HELP = ("override a parameter (repeatable): NAME is group.field (policy.gain, ico.timing, critic.range, "
             "actor.noise_std, ...), a plant or run parameter (dt, integrator, max_trials, ...) or a flat "
             "alias (gain, ico_timing, noise_std, ...); reals must be finite and normal, integers must fit "
@@ -165,7 +182,7 @@ def build_parser() -> argparse.ArgumentParser:
                f"{every:g} s + 0.2 s before the kill. Cells in progress (at most one per thread) "
                "are lost too and rerun by --resume, which finishes the grid with bitwise the same cells. "
                "Ctrl-C (SIGINT) saves every finished cell and exits with status 130.")
-    g.add_argument("--condition", choices=O.CONDITIONS, default=None,
+    g.add_argument("--condition", choices=R.CONDITIONS, default=None,
                    help="learning condition (default ico); rl and ico-rl run the actor-critic")
     g.add_argument("--prior-from", default=None, metavar="ICO_DIR",
                    help="ICO results directory the rl / ico-rl prior is computed from")
@@ -180,7 +197,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="named configuration applied before --set: the defaults, or the paper's literal "
                         "reading of the actor-critic (posterior actor, exploration always on, per-tick updates)")
     g.add_argument("--set", action="append", metavar="NAME=VALUE", help=SET_HELP)
-    g.add_argument("--cells", default=None, help="subset of the paper grid's cell indices (row-major, from 0), e.g. 0,5,600-610")
+    g.add_argument("--plant", type=_plant, default=None, help=PLANT_HELP)
+    g.add_argument("--cells", default=None, help="subset of the plant grid's cell indices (row-major, from 0), e.g. 0,5,600-610")
     again = g.add_mutually_exclusive_group()
     again.add_argument("--resume", action="store_true",
                        help="continue the PENDING cells of --out with its recorded settings")
@@ -206,6 +224,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"Fig. 1g trajectory length in s (default {O.TRAJECTORY_DURATION:g}); finite, > 0 and at "
                         f"most {f'{O.MAX_TRAJECTORY_STEPS:.0e}'.replace('e+0', 'e')} plant steps (duration / dt, i.e. 10000 s at the "
                         "default dt = 0.01 s)")
+    f.add_argument("--plant", type=_plant, default=None,
+                   help="the plant --results must hold (default: whichever it records)")
     f.set_defaults(func=cmd_figures)
 
     b = sub.add_parser("bench", help="benchmark stages: grids, figures, summary")
@@ -231,6 +251,7 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--ceiling", default=None, metavar="CEILING",
                    help="ceiling.json of `ceiling` (or its directory) shown in summary.md and Fig. 3a "
                         f"(default OUT/{O.CEILING_DIR}/{O.CEILING_FILE} if it exists)")
+    b.add_argument("--plant", type=_plant, default=O.CART_POLE, help=PLANT_HELP)
     _add_prior_args(b)
     _add_backend(b)
     b.set_defaults(func=cmd_bench)
@@ -238,10 +259,12 @@ def build_parser() -> argparse.ArgumentParser:
     w = sub.add_parser("sweep", help="factorial sweep of RL parameters on a cell subset")
     w.add_argument("--prior-from", required=True, metavar="ICO_DIR", help="ICO results directory")
     w.add_argument("--out", required=True, help="sweep directory (sweep.csv, sweep.md)")
+    w.add_argument("--plant", type=_plant, default=None,
+                   help="the plant --prior-from must hold (the sweep runs on that grid's plant)")
     w.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2,...",
                    help="values of one parameter (repeatable; names as for --set); prior_frame=central,all "
                         "and prior_ridge allowed")
-    w.add_argument("--condition", choices=O.RL_CONDITIONS + O.SEARCH_CONDITIONS, default=O.RL_CONDITIONS[0])
+    w.add_argument("--condition", choices=R.PRIOR_CONDITIONS, default=R.PRIOR_CONDITIONS[0])
     sel = w.add_mutually_exclusive_group()
     sel.add_argument("--cells", default=None, help="cell indices, e.g. 0,5,600-610")
     sel.add_argument("--subset", type=_subset, default=None, help="N evenly spread cells, at most the grid's cell count")
@@ -295,6 +318,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--threads", type=_threads, default=0, help=f"C threads in [0, {O.MAX_THREADS}] (0: all cores)")
     c.add_argument("--set", action="append", metavar="NAME=VALUE",
                    help=SET_HELP + "; mode, learn, max_trials and success_steps are set by the command")
+    c.add_argument("--plant", type=_plant, default=O.CART_POLE, help=PLANT_HELP)
     c.add_argument("--quiet", action="store_true", help="no progress output")
     c.set_defaults(func=cmd_ceiling)
     return p
@@ -306,7 +330,8 @@ def _overrides(args) -> dict:
     field given once)."""
     from .config import command_overrides
     return command_overrides(args.configuration, args.set, {"--max-trials": ("max_trials", args.max_trials),
-                                                            "--success-steps": ("success_steps", args.success_steps)})
+                                                            "--success-steps": ("success_steps", args.success_steps)},
+                             plant=getattr(args, "plant", None) or O.CART_POLE)
 
 
 def _frame(args):
@@ -341,17 +366,19 @@ def cmd_grid(args) -> int:
     from . import conditions, metrics
 
     explicit = any(v is not None for v in (args.condition, args.seed, args.max_trials, args.success_steps,
-                                            args.cells, args.prior_from)) or bool(_overrides(args))
-    condition = args.condition or O.CONDITIONS[0]
+                                            args.cells, args.prior_from, args.plant)) or bool(_overrides(args))
+    condition = args.condition or R.CONDITIONS[0]
     info = None
     if explicit or not args.resume:
-        info = conditions.condition_prior(condition, args.prior_from, _frame(args), args.prior_ridge, args.prior_std)
+        info = conditions.condition_prior(condition, args.prior_from, _frame(args), args.prior_ridge, args.prior_std,
+                                           plant=args.plant or O.CART_POLE)
     spec = _dask_spec(args)
     cells, record, cancelled = conditions.run_condition(
         condition=condition, out=Path(args.out), seed=args.seed or 0, threads=_threads_arg(args),
         overrides=_overrides(args), cell_spec=args.cells, resume=args.resume, fresh=args.overwrite,
         progress=not args.quiet, checkpoint_every=args.checkpoint_every,
-        checkpoint_cells=args.checkpoint_cells, explicit=explicit or not args.resume, info=info, dask=spec)
+        checkpoint_cells=args.checkpoint_cells, explicit=explicit or not args.resume, info=info, dask=spec,
+        plant=args.plant or O.CART_POLE)
     print(metrics.format_summary(record["condition"], record["summary"]))
     where = "Dask worker threads" if spec is not None else "threads"
     print(f"wall time {record['wall_time']:.1f} s on {record['threads']} {where} -> {args.out}")
@@ -366,6 +393,7 @@ def cmd_figures(args) -> int:
     from . import figures, results, store
 
     cells, record = results.load(args.results, what="--results")
+    _check_plant(args.plant, record, "--results")
     figures.check_duration(record, args.duration)  # before anything is drawn
     store.check_writable(args.out)
     for path in figures.make_figures(cells, record, args.out, duration=args.duration):
@@ -382,12 +410,22 @@ def cmd_bench(args) -> int:
         seed=args.seed, seeds=args.seeds, rl_max_trials=args.rl_max_trials, threads=_threads_arg(args),
         configuration=args.configuration, sets=args.set or [], resume=args.resume, quiet=args.quiet,
         frame=_frame(args), ridge=args.prior_ridge, prior_std=args.prior_std,
-        ceiling=Path(args.ceiling) if args.ceiling else None, dask=_dask_spec(args))
+        ceiling=Path(args.ceiling) if args.ceiling else None, dask=_dask_spec(args), plant=args.plant)
     return bench.run_bench(opt, argv=sys.argv[1:])
 
 
+def _check_plant(plant: str | None, record: dict, what: str) -> None:
+    """--plant, when given, must be the plant a results directory records."""
+    from . import results
+    if plant is not None and plant != results.record_plant(record):
+        raise UsageError(f"--plant {plant}, but {what} holds a grid of the {results.record_plant(record)}")
+
+
 def cmd_sweep(args) -> int:
-    from . import sweep
+    from . import results, sweep
+
+    if args.plant is not None:
+        _check_plant(args.plant, results.load(args.prior_from, what="--prior-from")[1], "--prior-from")
 
     opt = sweep.SweepOptions(
         prior_from=Path(args.prior_from), out=Path(args.out), params=args.param, condition=args.condition,
@@ -399,13 +437,13 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_ceiling(args) -> int:
-    from . import ceiling
+    from .ceiling import command as ceiling
 
     opt = ceiling.CeilingOptions(
         out=Path(args.out), prior_from=Path(args.prior_from) if args.prior_from else None, w=args.w,
         protocol=args.protocol, max_trials=args.max_trials, success_steps=args.success_steps, cells=args.cells,
         candidates=args.candidates, screen_steps=args.screen_steps, confirm=args.confirm, seed=args.seed,
-        threads=args.threads, sets=args.set or [], quiet=args.quiet)
+        threads=args.threads, sets=args.set or [], quiet=args.quiet, plant=args.plant)
     return ceiling.run_ceiling(opt, argv=sys.argv[1:])
 
 

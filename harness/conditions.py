@@ -15,9 +15,10 @@ import numpy as np
 from . import _binding as B
 from . import grid, results, store
 from . import prior as P
-from .config import RunConfig, build_config
+from .config import RunConfig, build_config, plant_inputs
 from .errors import UsageError
-from .options import CONDITIONS, CONTROL_OF, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, PRIOR_RULES
+from .options import CART_POLE, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY
+from .registry import CONDITIONS, REGISTRY
 
 
 def check_condition(condition: Any) -> str:
@@ -26,19 +27,20 @@ def check_condition(condition: Any) -> str:
     return condition
 
 
-def condition_prior(condition: str, prior_from, frame, ridge: float, std: float = P.DEFAULT_STD) -> P.PriorInfo | None:
-    """PriorInfo of a condition (None for ico) by its rule (options.PRIOR_RULES); a no-learning
+def condition_prior(condition: str, prior_from, frame, ridge: float, std: float = P.DEFAULT_STD,
+                    plant: str = CART_POLE) -> P.PriorInfo | None:
+    """PriorInfo of a condition (None for ico) by its rule (harness.registry); a no-learning
     control has the prior of its condition. --prior-from is required exactly when the rule takes
     the mean or the covariance from ICO: a condition that takes nothing from ICO refuses it."""
-    condition = CONTROL_OF.get(check_condition(condition), condition)
-    rule = PRIOR_RULES.get(condition)
-    if rule is None or "ico" not in rule:
+    cond = REGISTRY[check_condition(condition)]
+    condition, rule = cond.base, cond.prior
+    if rule is None or not rule.takes_ico:
         if prior_from is not None:
             raise UsageError(f"condition {condition} takes nothing from ICO; drop --prior-from")
-        return None if rule is None else P.condition_prior(condition, None, std)
+        return None if rule is None else P.condition_prior(condition, None, std, plant_inputs(plant))
     if prior_from is None:
         raise UsageError(f"condition {condition} needs --prior-from ICO_RESULTS_DIR")
-    return P.condition_prior(condition, P.from_results(prior_from, frame, ridge), std)
+    return P.condition_prior(condition, P.from_results(prior_from, frame, ridge), std, plant_inputs(plant))
 
 
 def prior_extra(info: P.PriorInfo | None) -> dict | None:
@@ -50,7 +52,8 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
                   cell_spec=None, resume: bool = False, fresh: bool = False, progress: bool = True,
                   checkpoint_every: float | None = None, checkpoint_cells: int | None = None,
                   info: P.PriorInfo | None = None, explicit: bool = True, cancel_after: float | None = None,
-                  start_over: str = "rerun with --overwrite", dask=None) -> tuple[np.ndarray, dict, bool]:
+                  start_over: str = "rerun with --overwrite", dask=None,
+                  plant: str = CART_POLE) -> tuple[np.ndarray, dict, bool]:
     """Run (or resume) one condition into a results directory; returns (cells, record, cancelled).
 
     ``dask`` (a harness.cluster.DaskSession, or a DaskSpec for a session opened after every check
@@ -81,7 +84,9 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
         raise UsageError(f"--cells: {exc}") from None
     extra = prior_extra(info)
     prior = info.prior() if info is not None else None
-    cfg = None if resume and not explicit else build_config(overrides, condition=condition, prior=prior)
+    cfg = None if resume and not explicit else build_config(overrides, condition=condition, prior=prior, plant=plant)
+    if dask is not None and cfg is not None and cfg.model is not None:
+        raise UsageError(f"--plant {plant}: the Dask backend runs the cart-pole only; run it on local threads")
     with store.ResultsStore(out, start_over=start_over) as st:
         have = st.present()
         if resume and not have:
@@ -106,7 +111,7 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
             if n_pending == 0:  # nothing to run: nothing is written, the record stays as it is
                 return cells, record, False
         else:
-            cells = grid.make_cells(seed, indices)
+            cells = grid.make_cells(seed, indices, plant=cfg.plant_name)
         return _run(st, cfg, cells, previous=record, condition=condition, seed=seed, threads=threads,
                     indices=indices, extra=extra, fresh=fresh, progress=progress, checkpoint_every=checkpoint_every,
                     checkpoint_cells=checkpoint_cells, cancel_after=cancel_after, dask=dask)

@@ -22,6 +22,8 @@ import numpy as np
 
 from . import _binding as B
 from . import literals, options
+from .plants import CART_POLE, spec as plant_spec
+from .registry import CONDITIONS, REGISTRY
 from ._binding import ConfigError
 from .errors import UsageError
 
@@ -79,25 +81,9 @@ ENUMS: dict[str, dict[str, int]] = {
 BOOLS = ("learn", "policy.clip_inputs", "critic.quirks", "actor.reflex", "actor.act_with_sample", "actor.batch")
 _BOOL_NAMES = {"true": 1, "false": 0, "on": 1, "off": 0, "yes": 1, "no": 0, "1": 1, "0": 0}
 
-# Overrides of each learning condition on top of the defaults; a no-learning control has its
-# condition's overrides plus learn = 0.
-_LEARNER_OVERRIDES: dict[str, dict[str, Any]] = {
-    "ico": {"mode": "ico"},
-    "ico-rl": {"mode": "rl"},   # prior from an ICO grid (method.md, priors); the C defaults' reading
-    "ico-mean-rl": {"mode": "rl"},  # the ICO mean with sigma_w^2 I: ICO->RL's reading
-    # mean 0 with the ICO covariance (method.md, A16): the reading the learner sweeps chose for it
-    "rl-ico-cov": {"mode": "rl", "actor.update": "mean", "actor.likelihood_std": 0.1, "actor.noise_std": 5,
-                   "actor.scale": 0.1, "actor.explore_ticks": 1000},
-    # RL alone, N(0, sigma_w^2 I): the reading of its own sweep (docs/sweeps.md)
-    "rl": {"mode": "rl", "actor.update": "mean", "actor.likelihood_std": 0.1, "actor.noise_std": 5,
-           "actor.scale": 0.1, "actor.explore_ticks": 1000},
-    "ico-search": {"mode": "search"},  # prior from an ICO grid, Sigma0 = search.cov_scale * its covariance
-    "search": {"mode": "search", "search.cov_scale": 4},  # prior N(0, I) (method.md, L4); Sigma0 = 4 I by the sweeps
-}
-CONDITION_OVERRIDES: dict[str, dict[str, Any]] = {
-    c: {**_LEARNER_OVERRIDES[options.CONTROL_OF[c]], "learn": 0} if c in options.CONTROL_OF else _LEARNER_OVERRIDES[c]
-    for c in options.CONDITIONS}
-assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS)
+# Every field each condition sets over the C defaults (harness.registry defines them).
+CONDITION_OVERRIDES: dict[str, dict[str, Any]] = {c.name: c.config_overrides() for c in REGISTRY.values()}
+assert {c.mode for c in REGISTRY.values()} <= set(B.MODES), B.MODES
 
 
 # Named configurations: --set items applied before the command's own --set. "literal" restores the
@@ -380,16 +366,26 @@ def given_twice(name: str, first: str, second: str) -> UsageError:
     return UsageError(f"{first} and {second} both set {name}; give it once")
 
 
-def parse_sets(items: Iterable[str] | None, option: str = "--set") -> dict[str, Any]:
-    """``NAME=VALUE`` strings -> {canonical name: value}. UsageError for an item without '=' and
-    for a field given twice (under any of its names); ConfigError for an unknown name."""
+def plant_params(plant: str) -> set[str]:
+    """The names --set takes for a registry plant's model (none for the cart-pole, whose fields
+    are canonical names)."""
+    if plant == CART_POLE:
+        return set()
+    return {p["name"] for p in B.plant_info(B.plant_index(plant))["params"]} | {"dt", "integrator"}
+
+
+def parse_sets(items: Iterable[str] | None, option: str = "--set", plant: str = CART_POLE) -> dict[str, Any]:
+    """``NAME=VALUE`` strings -> {canonical name: value} (a plant's parameters by their own names).
+    UsageError for an item without '=' and for a field given twice (under any of its names);
+    ConfigError for an unknown name."""
     out: dict[str, Any] = {}
     given: dict[str, str] = {}
+    own = plant_params(plant)
     for item in items or []:
         if "=" not in item:
             raise UsageError(f"{option} expects name=value, got {_short(item)}")
         name, value = item.split("=", 1)
-        name = canonical(name.strip())
+        name = name.strip() if name.strip() in own else canonical(name.strip())
         if name in given:
             raise given_twice(name, f"{option} {given[name]}", f"{option} {item[:60]}")
         given[name] = item[:60]
@@ -398,12 +394,12 @@ def parse_sets(items: Iterable[str] | None, option: str = "--set") -> dict[str, 
 
 
 def command_overrides(configuration: str, sets: Iterable[str] | None,
-                      flags: Mapping[str, tuple[str, Any]] | None = None) -> dict[str, Any]:
+                      flags: Mapping[str, tuple[str, Any]] | None = None, plant: str = CART_POLE) -> dict[str, Any]:
     """The overrides of a command: the items of the named ``configuration``, replaced field by field
     by the ``sets`` items (--set), and the options that set one field each (``flags``: option ->
     (canonical name, value, None when not given)). A field set by --set and by its own option is
     a UsageError naming both, as is a field given twice by --set."""
-    user = parse_sets(sets)
+    user = parse_sets(sets, plant=plant)
     for option, (name, value) in (flags or {}).items():
         if value is None:
             continue
@@ -416,18 +412,38 @@ def command_overrides(configuration: str, sets: Iterable[str] | None,
 # -- configurations ------------------------------------------------------------------------------------
 @dataclass
 class RunConfig:
-    """Controller, plant and run parameters of one benchmark, plus an optional prior."""
+    """Controller, plant and run parameters of one benchmark, plus an optional prior. The plant is
+    the cart-pole of ``plant`` unless ``model`` holds another registry plant (docs/plants.md)."""
     controller: B.Config = field(default_factory=B.Config)
     plant: B.Plant = field(default_factory=B.Plant)
     run: B.Run = field(default_factory=B.Run)
     prior: B.Prior | None = None
+    model: B.Model | None = None
+
+    @property
+    def plant_name(self) -> str:
+        return CART_POLE if self.model is None else B.plant_info(self.model.plant)["name"]
+
+    @property
+    def n_inputs(self) -> int:
+        """The task's inputs n: the leading n entries of the weights and the prior are used."""
+        return int(self.controller.task.n_inputs)
+
+    def engine_model(self) -> B.Model:
+        """The model the engine runs: ``model``, or the cart-pole's of ``plant``."""
+        if self.model is not None:
+            return self.model
+        model = B.Model()
+        B.check_status(B.lib.icoac_sim_model_from_plant(ctypes.byref(self.plant), ctypes.byref(model)), "plant")
+        return model
 
     def to_dict(self) -> dict[str, Any]:
-        """The record of run.json: canonical names, the controller nested by group."""
-        plant = _struct_to_dict(self.plant)
+        """The record of run.json: canonical names, the controller nested by group; the plant of a
+        model by its name, dt, integrator and parameters."""
+        plant = _struct_to_dict(self.plant) if self.model is None else model_to_dict(self.model)
         return {"controller": _struct_to_dict(self.controller), "plant": plant,
                 "run": _struct_to_dict(self.run),
-                "prior": prior_to_dict(self.prior) if self.prior is not None else None}
+                "prior": prior_to_dict(self.prior, self.n_inputs) if self.prior is not None else None}
 
     def flat(self) -> dict[str, Any]:
         """{canonical name: value as in to_dict} of every parameter (plant.reserved excluded)."""
@@ -449,9 +465,16 @@ class RunConfig:
             if status not in B.CONFIG_STATUSES:
                 B.check_status(status, "controller config")
             raise ConfigError(status, text, context="controller config")
-        for label, struct, check_fn, default_fn in (
-                ("plant config", self.plant, B.lib.icoac_sim_plant_check, B.lib.icoac_sim_plant_default),
-                ("run config", self.run, B.lib.icoac_sim_run_check, B.lib.icoac_sim_run_default)):
+        if self.model is not None:
+            check_model(self.model)
+        if self.n_inputs != plant_inputs(self.plant_name):  # the engine's refusal, said before a run
+            raise ConfigError(B.SIM_ERR_BAD_PLANT, f"task.n_inputs={self.n_inputs}: plant {self.plant_name} has "
+                              f"{plant_inputs(self.plant_name)} state components, one input each",
+                              context="plant config")
+        checks = ((("plant config", self.plant, B.lib.icoac_sim_plant_check, B.lib.icoac_sim_plant_default),)
+                  if self.model is None else ())
+        for label, struct, check_fn, default_fn in checks + (
+                ("run config", self.run, B.lib.icoac_sim_run_check, B.lib.icoac_sim_run_default),):
             status = int(check_fn(ctypes.byref(struct)))
             if status != B.OK:
                 culprits = _culprits(struct, check_fn, default_fn)
@@ -460,8 +483,81 @@ class RunConfig:
                     B.check_status(status, label)
                 raise ConfigError(status, text, context=label)
         if self.prior is not None:
-            check_prior(self.prior)
+            check_prior(self.prior, self.n_inputs)
         return self
+
+
+# -- registry plants -----------------------------------------------------------------------------------
+def model_to_dict(model: B.Model) -> dict[str, Any]:
+    """A model's record: plant name, dt, integrator, then its parameters by name."""
+    info = B.plant_info(model.plant)
+    return {"name": info["name"], "dt": model.dt, "integrator": _value_out("integrator", ctypes.c_int32, model.integrator),
+            **{p["name"]: model.param[i] for i, p in enumerate(info["params"])}}
+
+
+def check_model(model: B.Model) -> None:
+    """The C check of a model, and that this controller build observes the plant (its state
+    components are the controller's inputs); ConfigError naming the plant otherwise."""
+    info = B.plant_info(model.plant)
+    status = int(B.lib.icoac_sim_model_check(ctypes.byref(model)))
+    if status != B.OK:
+        # the culprits: each value the C check refuses when set alone on the plant's defaults
+        bad = []
+        for i, key in [(i, p["name"]) for i, p in enumerate(info["params"])] + [(None, "dt"), (None, "integrator")]:
+            probe = B.Model()
+            B.lib.icoac_sim_model_default(ctypes.byref(probe), model.plant)
+            value = model.param[i] if i is not None else getattr(model, key)
+            if i is None:
+                setattr(probe, key, value)
+            else:
+                probe.param[i] = value
+            if int(B.lib.icoac_sim_model_check(ctypes.byref(probe))) != B.OK:
+                rng = f" (valid: 0 or a normal number in [{info['params'][i]['min']:g}, " \
+                      f"{info['params'][i]['max']:g}])" if i is not None else ""
+                bad.append(f"{key}={value!r}{rng}")
+        raise ConfigError(status, f"plant {info['name']}: {', '.join(bad) or 'parameters'} rejected",
+                          context="plant config")
+    n = len(info["state"])
+    if n > B.MAX_INPUTS or info["observed"][:n] != list(range(n)):
+        raise ConfigError(B.SIM_ERR_BAD_PLANT,
+                          f"plant {info['name']} has {n} state components; this controller build takes "
+                          f"at most {B.MAX_INPUTS} inputs, one per component in order", context="plant config")
+
+
+def plant_inputs(plant: str) -> int:
+    """The controller inputs of a plant's task: one per state component (the engine's rule)."""
+    return len(B.plant_info(plant)["state"])
+
+
+def build_model(name: str, values: Mapping[str, Any]) -> B.Model:
+    """The registry plant called name with its defaults, then values by parameter name (and dt,
+    integrator), parsed as --set values are; unknown names raise ConfigError listing the valid."""
+    index = B.plant_index(name)
+    info = B.plant_info(index)
+    names = [p["name"] for p in info["params"]]
+    model = B.Model()
+    B.check_status(B.lib.icoac_sim_model_default(ctypes.byref(model), index), "plant model")
+    for key, value in values.items():
+        if key in ("dt", "integrator"):  # parsed as the cart-pole's fields of these names
+            setattr(model, key, _parse_scalar(key, dict(B.Model._fields_)[key], value))
+        elif key in names:
+            model.param[names.index(key)] = _parse_param(name, key, value)
+        else:
+            raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {name} has no parameter {_short(key)}; valid: "
+                                                  f"{', '.join(names + ['dt', 'integrator'])}")
+    return model
+
+
+def _parse_param(plant: str, key: str, value: Any) -> float:
+    """A finite number for a plant parameter (its range is the C check's)."""
+    try:
+        number = literals.real(value) if isinstance(value, str) else float(value) if _is_number(value) else None
+    except (literals.NumberError, OverflowError):
+        number = None
+    if number is None or not math.isfinite(number):
+        raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {plant} parameter {key}: bad value {_short(value)}; "
+                                               "expected a finite number")
+    return number
 
 
 _DESIGNATOR = re.compile(r"([a-z_.]+)((?:\[[0-9]+\])*)")
@@ -507,9 +603,8 @@ def _same(a, b) -> bool:
 
 
 # -- priors --------------------------------------------------------------------------------------------
-def prior_to_dict(prior: B.Prior) -> dict[str, Any]:
-    """The cart-pole prior's leading N_INPUTS entries (the others are unused, 0)."""
-    n = B.N_INPUTS
+def prior_to_dict(prior: B.Prior, n: int) -> dict[str, Any]:
+    """A prior's leading n entries (a task of n inputs; the others are unused, 0)."""
     return {"mean": [_real_out(v) for v in prior.mean[:n]],
             "cov": [[_real_out(v) for v in row[:n]] for row in prior.cov[:n]]}
 
@@ -537,14 +632,18 @@ def _prior_array(value: Any, shape: tuple[int, ...], what: str) -> np.ndarray:
 
 
 def make_prior(mean, cov) -> B.Prior:
-    """icoac_prior_t from a mean (4,) and covariance (4, 4); order (w_x, w_xdot, w_theta, w_thetadot)."""
-    mean = _prior_array(mean, (B.N_INPUTS,), "mean")
-    cov = _prior_array(cov, (B.N_INPUTS, B.N_INPUTS), "cov")
+    """icoac_prior_t from a mean (n,) and covariance (n, n), n the task's inputs (1 to MAX_INPUTS;
+    the cart-pole's order w_x, w_xdot, w_theta, w_thetadot); the entries after n are 0."""
+    n = len(mean) if isinstance(mean, (list, tuple, np.ndarray)) else 0
+    if not 1 <= n <= B.MAX_INPUTS:
+        raise ConfigError(B.ERR_BAD_PRIOR, f"prior mean: expected 1 to {B.MAX_INPUTS} numbers, got {_short(mean)}")
+    mean = _prior_array(mean, (n,), "mean")
+    cov = _prior_array(cov, (n, n), "cov")
     prior = B.Prior()
     with np.errstate(over="ignore"):
-        for i in range(B.N_INPUTS):
+        for i in range(n):
             prior.mean[i] = float(mean[i])
-            for j in range(B.N_INPUTS):
+            for j in range(n):
                 prior.cov[i][j] = float(cov[i, j])
     return prior
 
@@ -553,20 +652,21 @@ def prior_from_dict(data: Mapping[str, Any] | None) -> B.Prior | None:
     if data is None:
         return None
     if not isinstance(data, Mapping) or set(data) != {"mean", "cov"}:
-        raise ConfigError(B.ERR_BAD_PRIOR, f"prior must be null or {{\"mean\": [4], \"cov\": [4][4]}}, got {_short(data)}")
+        raise ConfigError(B.ERR_BAD_PRIOR, f"prior must be null or {{\"mean\": [n], \"cov\": [n][n]}}, got {_short(data)}")
     return make_prior(data["mean"], data["cov"])
 
 
-def check_prior(prior: B.Prior) -> None:
-    """Prior validation is the C library's (icoac_prior_check, also run by icoac_init)."""
-    B.check_status(B.lib.icoac_prior_check(ctypes.byref(prior), B.N_INPUTS), "prior")
+def check_prior(prior: B.Prior, n: int) -> None:
+    """Prior validation is the C library's (icoac_prior_check of the leading n, also run by icoac_init)."""
+    B.check_status(B.lib.icoac_prior_check(ctypes.byref(prior), n), "prior")
 
 
 # -- building and reading configurations ---------------------------------------------------------------
 def build_config(overrides: Mapping[str, Any] | None = None, condition: str | None = None,
-                 prior: B.Prior | None = None, check: bool = True) -> RunConfig:
+                 prior: B.Prior | None = None, check: bool = True, plant: str = CART_POLE) -> RunConfig:
     """C defaults, then the condition's overrides, then ``overrides`` by field name (canonical or
-    alias; a later name for the same field wins); validated by C."""
+    alias; a later name for the same field wins); validated by C. A registry plant other than the
+    cart-pole takes the overrides named after its parameters (and dt, integrator)."""
     if overrides is not None and not isinstance(overrides, Mapping):
         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"overrides must be a mapping name -> value, got {_short(overrides)}")
     if prior is not None and not isinstance(prior, B.Prior):
@@ -575,15 +675,22 @@ def build_config(overrides: Mapping[str, Any] | None = None, condition: str | No
     B.lib.icoac_config_default(ctypes.byref(cfg.controller))
     B.lib.icoac_sim_plant_default(ctypes.byref(cfg.plant))
     B.lib.icoac_sim_run_default(ctypes.byref(cfg.run))
-    items: list[tuple[Any, Any]] = []
+    items: list[tuple[Any, Any]] = list(plant_spec(plant).controller.items())  # the plant's task
     if condition is not None:
         if not isinstance(condition, str) or condition not in CONDITION_OVERRIDES:
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
-                              f"unknown condition {_short(condition)}; valid: {', '.join(options.CONDITIONS)}")
+                              f"unknown condition {_short(condition)}; valid: {', '.join(CONDITIONS)}")
         items += CONDITION_OVERRIDES[condition].items()
+        items += plant_spec(plant).learners.get(REGISTRY[condition].base, {}).items()
     items += (overrides or {}).items()
+    if plant != CART_POLE:
+        params = plant_params(plant)
+        cfg.model = build_model(plant, {name: value for name, value in items if name in params})
+        items = [(name, value) for name, value in items if name not in params]
     for name, value in items:
         name = canonical(name)
+        if cfg.model is not None and group_of(name) == "plant":
+            raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {plant} has no parameter {name}")
         _set_field(cfg._struct(name), name, value)
     if check:
         cfg.check()
@@ -617,14 +724,23 @@ def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
                           f"unknown configuration group {_short(unknown[0])}; valid: {', '.join(GROUPS)}, prior")
     overrides: list[tuple[str, Any]] = []
+    plant = CART_POLE
     for group in GROUPS:
         values = data.get(group)
         if values is None:
             continue
         if not isinstance(values, Mapping):
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"configuration group {group!r} must be a mapping, got {_short(values)}")
+        if group == "plant" and "name" in values and values["name"] != CART_POLE:
+            plant = values["name"]
+            if not isinstance(plant, str):
+                raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant name must be a string, got {_short(plant)}")
+            overrides += [(k, v) for k, v in values.items() if k != "name"]
+            continue
         items = _controller_items(values) if group == "controller" else values.items()
         for name, value in items:
+            if group == "plant" and name == "name":  # the cart-pole, named
+                continue
             if name == "reserved" and group == "plant":
                 if not (isinstance(value, int) and not isinstance(value, bool) and value == 0):
                     raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant parameter reserved must be 0, got {_short(value)}")
@@ -639,5 +755,5 @@ def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
         # a record from before the learners (ABI <= 5): its controller ran the literal reading
         literal = parse_sets(NAMED_CONFIGURATIONS["literal"])
         overrides = [(n, v) for n, v in literal.items() if n in LEARNER_FIELDS] + overrides
-    cfg = build_config(dict(overrides), prior=prior_from_dict(data.get("prior")), check=False)
+    cfg = build_config(dict(overrides), prior=prior_from_dict(data.get("prior")), check=False, plant=plant)
     return cfg.check() if check else cfg

@@ -34,8 +34,9 @@ STYLE = {
     "path.simplify": False,
     "svg.hashsalt": "icoac",
 }
-# Map extent: cells centred on the grid points (x0 = -2.4..2.4 m, theta0 = -12..12 deg).
-MAP_EXTENT = geometry.map_extent()
+# Maps: cells centred on the grid points of the plant's grid (harness.geometry; the cart-pole's
+# x0 = -2.4..2.4 m, theta0 = -12..12 deg), the column component horizontal.
+CART_POLE = geometry.CART_POLE
 # Paper panel order of Fig. 1c-f and index into (w_x, w_xdot, w_theta, w_thetadot).
 WEIGHT_PANELS = (("c", r"$w_\theta$", 2), ("d", r"$w_x$", 0), ("e", r"$w_{\dot\theta}$", 3), ("f", r"$w_{\dot x}$", 1))
 FIG1G_START = (-0.5, -4.0)  # x0 m, theta0 deg
@@ -55,58 +56,61 @@ def _figure(size):
         return plt.figure(figsize=size)
 
 
-def draw_frame(ax, half_x: float, half_theta_deg: float, **kw) -> None:
-    """Dashed rectangle |x0| <= half_x, |theta0| <= half_theta_deg on a map axis."""
+def draw_frame(ax, half_x: float, half_theta_deg: float, grid: geometry.PlantGrid = CART_POLE, **kw) -> None:
+    """Dashed rectangle |x0| <= half_x, |theta0| <= half_theta_deg (the grid's display units) on a
+    map axis."""
     style = dict(fill=False, linestyle="--", linewidth=1.2, edgecolor="black")
     style.update(kw)
-    dx, dth = geometry.X_STEP, geometry.THETA_STEP_DEG  # the frame encloses whole cells
+    dx, dth = grid.col_step, grid.row_step  # the frame encloses whole cells
     ax.add_patch(Rectangle((-half_x - dx / 2, -half_theta_deg - dth / 2), 2 * half_x + dx, 2 * half_theta_deg + dth,
                            **style))
 
 
-def draw_outline(ax, mask: np.ndarray, **kw) -> None:
-    """Outline of a (25, 49) boolean domain (e.g. the ICO success domain on an RL map)."""
+def draw_outline(ax, mask: np.ndarray, grid: geometry.PlantGrid = CART_POLE, **kw) -> None:
+    """Outline of a (rows, cols) boolean domain (e.g. the ICO success domain on an RL map)."""
     style = dict(colors="black", linewidths=1.0, linestyles="--")
     style.update(kw)
-    x = np.linspace(MAP_EXTENT[0], MAP_EXTENT[1], geometry.XS + 1)
-    y = np.linspace(MAP_EXTENT[2], MAP_EXTENT[3], geometry.THETAS + 1)
+    extent = grid.map_extent()
+    x = np.linspace(extent[0], extent[1], grid.cols + 1)
+    y = np.linspace(extent[2], extent[3], grid.rows + 1)
     m = np.asarray(mask, dtype=bool)
-    for i in range(geometry.THETAS):
-        for j in range(geometry.XS):
+    for i in range(grid.rows):
+        for j in range(grid.cols):
             if not m[i, j]:
                 continue
             if i == 0 or not m[i - 1, j]:
                 ax.hlines(y[i], x[j], x[j + 1], **style)
-            if i == geometry.THETAS - 1 or not m[i + 1, j]:
+            if i == grid.rows - 1 or not m[i + 1, j]:
                 ax.hlines(y[i + 1], x[j], x[j + 1], **style)
             if j == 0 or not m[i, j - 1]:
                 ax.vlines(x[j], y[i], y[i + 1], **style)
-            if j == geometry.XS - 1 or not m[i, j + 1]:
+            if j == grid.cols - 1 or not m[i, j + 1]:
                 ax.vlines(x[j + 1], y[i], y[i + 1], **style)
 
 
 def plot_map(ax, values: np.ndarray, *, cmap="viridis", norm=None, title: str | None = None,
              colorbar_label: str | None = None, frame: tuple[float, float] | None = None,
-             outline: np.ndarray | None = None):
-    """A (25, 49) map, x0 horizontal and theta0 vertical; NaN cells are white. Returns the image."""
+             outline: np.ndarray | None = None, grid: geometry.PlantGrid = CART_POLE):
+    """A (rows, cols) map of the plant's grid, x0 (its column component) horizontal and theta0
+    (its row component) vertical; NaN cells are white. Returns the image."""
     cm = plt.get_cmap(cmap)
     cm = cm.with_extremes(bad="white") if hasattr(cm, "with_extremes") else cm.copy()
     if not hasattr(cm, "with_extremes"):  # matplotlib < 3.4
         cm.set_bad("white")
-    img = ax.imshow(np.ma.masked_invalid(values), origin="lower", extent=MAP_EXTENT, aspect="auto",
+    img = ax.imshow(np.ma.masked_invalid(values), origin="lower", extent=grid.map_extent(), aspect="auto",
                     cmap=cm, norm=norm, interpolation="nearest")
-    ax.set_xlabel(r"$x_0$ (m)")
-    ax.set_ylabel(r"$\theta_0$ (deg)")
-    ax.set_xticks(np.linspace(geometry.X_FIRST, geometry.X_LAST, 5).round(6))
-    ax.set_yticks(np.linspace(geometry.THETA_FIRST_DEG, geometry.THETA_LAST_DEG, 5).round(6))
+    ax.set_xlabel(r"$x_0$ (m)" if grid is CART_POLE else grid.col_label())
+    ax.set_ylabel(r"$\theta_0$ (deg)" if grid is CART_POLE else grid.row_label())
+    ax.set_xticks(np.linspace(grid.col_first, grid.col_last, 5).round(6))
+    ax.set_yticks(np.linspace(grid.row_first, grid.row_last, 5).round(6))
     for side in ax.spines.values():
         side.set_linewidth(0.8)
     if title:
         ax.set_title(title)
     if frame is not None:
-        draw_frame(ax, *frame)
+        draw_frame(ax, *frame, grid=grid)
     if outline is not None:
-        draw_outline(ax, outline)
+        draw_outline(ax, outline, grid=grid)
     if colorbar_label is not None:
         cb = ax.figure.colorbar(img, ax=ax, fraction=0.046, pad=0.03)
         cb.set_label(colorbar_label)
@@ -120,12 +124,13 @@ def success_title(label: str, summary: Mapping) -> str:
 
 def plot_success_map(cells: np.ndarray, path: str | Path, *, label: str = "ICO",
                      frame: tuple[float, float] | None = None, outline: np.ndarray | None = None,
-                     vmin: float | None = None, vmax: float | None = None) -> Path:
+                     vmin: float | None = None, vmax: float | None = None,
+                     grid: geometry.PlantGrid = CART_POLE) -> Path:
     """Fig. 1b style: colour = trials to success (log scale, whole decades around the data unless
     vmin/vmax are given, e.g. to compare conditions), failed cells white."""
     trials = metrics.trials_to_success(cells)
-    grid = metrics.to_grid(cells, trials)
-    finite = grid[np.isfinite(grid)]
+    values = grid.to_grid(cells, trials)
+    finite = values[np.isfinite(values)]
     lo_data = float(finite.min()) if finite.size else 1.0
     hi_data = float(finite.max()) if finite.size else 10.0
     lo = vmin if vmin is not None else 10.0 ** math.floor(math.log10(max(lo_data, 1.0)))
@@ -135,21 +140,28 @@ def plot_success_map(cells: np.ndarray, path: str | Path, *, label: str = "ICO",
     norm = colors.LogNorm(vmin=lo, vmax=hi)
     with plt.rc_context(STYLE):
         fig, ax = plt.subplots(figsize=(6.4, 3.6))
-        plot_map(ax, grid, cmap="viridis", norm=norm, title=success_title(label, metrics.summary(cells)),
-                 colorbar_label="trials to success", frame=frame, outline=outline)
+        plot_map(ax, values, cmap="viridis", norm=norm, title=success_title(label, metrics.summary(cells, grid)),
+                 colorbar_label="trials to success", frame=frame, outline=outline, grid=grid)
         fig.tight_layout()
         return save_figure(fig, path)
 
 
 def plot_weight_maps(cells: np.ndarray, path: str | Path, *, label: str = "ICO",
-                     frame: tuple[float, float] | None = PRIOR_FRAME) -> Path:
-    """Fig. 1c-f: learned weights per cell (w_theta, w_x, w_thetadot, w_xdot); failed cells blank."""
-    w = metrics.weights(cells, successful_only=True)
+                     frame: tuple[float, float] | None = PRIOR_FRAME,
+                     grid: geometry.PlantGrid = CART_POLE) -> Path:
+    """Fig. 1c-f: learned weights per cell (the cart-pole's w_theta, w_x, w_thetadot, w_xdot; another
+    plant's in its input order, named by its state components); failed cells blank."""
+    w = metrics.weights(cells, successful_only=True, grid=grid)
+    panels = WEIGHT_PANELS if grid.plant == CART_POLE.plant else tuple(
+        (chr(ord("c") + i), f"$w$ {name}", i) for i, name in enumerate(grid.state_names))
+    rows = (len(panels) + 1) // 2
     with plt.rc_context(STYLE):
-        fig, axes = plt.subplots(2, 2, figsize=(9.0, 5.8))
-        for ax, (letter, name, idx) in zip(axes.flat, WEIGHT_PANELS):
-            grid = metrics.to_grid(cells, w[:, idx])
-            finite = grid[np.isfinite(grid)]
+        fig, axes = plt.subplots(rows, 2, figsize=(9.0, 2.9 * rows))
+        for ax in axes.flat[len(panels):]:
+            ax.set_visible(False)
+        for ax, (letter, name, idx) in zip(axes.flat, panels):
+            values = grid.to_grid(cells, w[:, idx])
+            finite = values[np.isfinite(values)]
             # A few edge cells learn weights 10-100x the central ones; clip the colour scale at the
             # 95th percentile so the structure of the band stays visible.
             lim = float(np.percentile(np.abs(finite), 95)) if finite.size else 1.0
@@ -158,8 +170,8 @@ def plot_weight_maps(cells: np.ndarray, path: str | Path, *, label: str = "ICO",
                 cmap, norm = "viridis", colors.Normalize(0.0, lim, clip=True)
             else:
                 cmap, norm = "RdBu_r", colors.Normalize(-lim, lim, clip=True)
-            plot_map(ax, grid, cmap=cmap, norm=norm, title=f"({letter}) {label} {name}",
-                     colorbar_label=f"{name} (clipped at 95th pct.)", frame=frame)
+            plot_map(ax, values, cmap=cmap, norm=norm, title=f"({letter}) {label} {name}",
+                     colorbar_label=f"{name} (clipped at 95th pct.)", frame=frame, grid=grid)
         fig.tight_layout()
         return save_figure(fig, path)
 
@@ -210,7 +222,7 @@ def fig1g_trajectory(cells: np.ndarray, cfg, duration: float = TRAJECTORY_DURATI
     if hit.size == 0:
         return None, None
     cell = cells[hit[0]]
-    cfg.prior = make_prior(cell["weights"], np.eye(B.N_INPUTS))
+    cfg.prior = make_prior(cell["weights"][:cfg.n_inputs], np.eye(cfg.n_inputs))
     traj = trajectory(cfg, x0, math.radians(th0), duration=duration, seed=seed)
     return traj, cell
 
@@ -218,7 +230,7 @@ def fig1g_trajectory(cells: np.ndarray, cfg, duration: float = TRAJECTORY_DURATI
 def check_duration(record: Mapping, duration: float) -> int:
     """Plant steps of the Fig. 1g trajectory for a run record; ConfigError if the duration is not
     finite and > 0 or needs more than options.MAX_TRAJECTORY_STEPS steps at the record's dt."""
-    return trajectory_steps(duration, config_from_dict(record["config"]).plant.dt)
+    return trajectory_steps(duration, config_from_dict(record["config"]).engine_model().dt)
 
 
 def make_figures(cells: np.ndarray, record: Mapping, out: str | Path, *, label: str | None = None,
@@ -227,9 +239,13 @@ def make_figures(cells: np.ndarray, record: Mapping, out: str | Path, *, label: 
     out = Path(out)
     label = label or str(record.get("condition", "ICO")).upper()
     cfg = config_from_dict(record["config"])
-    trajectory_steps(duration, cfg.plant.dt)  # a bad duration fails before any file is written
-    written = [plot_success_map(cells, out / f"{prefix}b_success_map.png", label=label),
-               plot_weight_maps(cells, out / f"{prefix}cf_weights.png", label=label)]
+    trajectory_steps(duration, cfg.engine_model().dt)  # a bad duration fails before any file is written
+    grid = geometry.of(cfg.plant_name)
+    frame = PRIOR_FRAME if grid is CART_POLE else grid.central_frame()
+    written = [plot_success_map(cells, out / f"{prefix}b_success_map.png", label=label, grid=grid),
+               plot_weight_maps(cells, out / f"{prefix}cf_weights.png", label=label, frame=frame, grid=grid)]
+    if grid is not CART_POLE:  # Fig. 1g is the cart-pole's trajectory from the paper's start
+        return written
     traj, cell = fig1g_trajectory(cells, cfg, duration=duration, seed=int(record.get("seed", 0)))
     if traj is not None:
         state = B.OUTCOME_NAMES.get(int(cell["outcome"]), "?")

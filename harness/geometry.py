@@ -1,111 +1,173 @@
-"""The paper's grid of initial conditions, defined once: row i is theta0 = FIRST_DEG + i deg,
-column j is x0 = X_FIRST + j * X_STEP m (icoac_sim_paper_grid, row-major over theta then x).
+"""Grids of initial conditions, defined once per plant by its C descriptor (icoac_sim_plant_grid):
+row i starts the row component at rows.first + i * rows.step, column j the column component at
+cols.first + j * cols.step (in degrees when the sweep says so), row-major. A cell stores the
+column value as x0 and the row value as theta0, in the plant's units (radians for angles).
 
-The counts, first values and the x step come from the C constant table; the theta step is part
-of C's row definition and is read off icoac_sim_paper_grid at import, which also checks that the
-index maths below reproduces every cell of the C grid.
+PlantGrid(name) is that geometry for any registry plant; the module-level names are the
+cart-pole's, the paper's grid: row i is theta0 = -12 + i deg, column j is x0 = -2.4 + 0.1 j m.
+At import the cart-pole's geometry is checked against the C paper grid cell by cell.
 """
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
 from . import _binding as B
+from .options import CART_POLE as CART_POLE_NAME
 
-THETAS = B.GRID_THETAS              # rows
-XS = B.GRID_XS                      # columns
-CELLS = B.GRID_CELLS
-THETA_FIRST_DEG = B.GRID_THETA_FIRST_DEG
-X_FIRST = B.GRID_X_FIRST
-X_STEP = B.GRID_X_STEP
-X_TOL = 1e-6                        # m, rad: a cell coordinate must be this close to a grid point
-
-# Interior cells: every cell off the outermost rows (|theta0| = 12 deg) and columns (|x0| = 2.4 m).
-N_INTERIOR = (THETAS - 2) * (XS - 2)
+TOL = 1e-6  # plant units (m, rad): a cell coordinate must be this close to a grid point
 
 
-def _c_grid() -> np.ndarray:
-    cells = np.zeros(CELLS, dtype=B.CELL_DTYPE)
-    B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, 0), "paper grid")
-    return cells
+class PlantGrid:
+    """The grid of a registry plant: shape, axis values and labels, (row, column) of cells, the
+    interior (off the outermost rows and columns) and maps."""
+
+    def __init__(self, plant: str):
+        info = B.plant_info(plant)
+        self.plant = info["name"]
+        self.n_inputs = len(info["state"])  # the task's inputs: one per state component
+        self.state_names = tuple(name for name, _ in info["state"])
+        self.rows, self.cols = info["rows"]["count"], info["cols"]["count"]
+        self.cells = self.rows * self.cols
+        self.n_interior = max(self.rows - 2, 0) * max(self.cols - 2, 0)
+        self._sweeps = (info["rows"], info["cols"])
+        (rname, runit), (cname, cunit) = (info["state"][s["component"]] for s in self._sweeps)
+        self.row_name, self.col_name = rname, cname
+        # axes in display units: degrees for a sweep given in degrees
+        self.row_unit = "deg" if info["rows"]["degrees"] else runit
+        self.col_unit = "deg" if info["cols"]["degrees"] else cunit
+        self.row_first, self.row_step = info["rows"]["first"], info["rows"]["step"]
+        self.col_first, self.col_step = info["cols"]["first"], info["cols"]["step"]
+        self.row_last = self.row_first + (self.rows - 1) * self.row_step
+        self.col_last = self.col_first + (self.cols - 1) * self.col_step
+
+    def _display(self, values, sweep: int) -> np.ndarray:
+        v = np.asarray(values, dtype=float)
+        return np.degrees(v) if self._sweeps[sweep]["degrees"] else v
+
+    def col_display(self, x0) -> np.ndarray:
+        """Cells' x0 (plant units) in the column axis' display units."""
+        return self._display(x0, 1)
+
+    def row_display(self, theta0) -> np.ndarray:
+        """Cells' theta0 (plant units) in the row axis' display units."""
+        return self._display(theta0, 0)
+
+    def _internal(self, values, sweep: int) -> np.ndarray:
+        v = np.asarray(values, dtype=float)
+        return np.radians(v) if self._sweeps[sweep]["degrees"] else v
+
+    def row_value(self, row):
+        """The row component's start (display units) of a row."""
+        return self.row_first + np.asarray(row) * self.row_step
+
+    def col_value(self, col):
+        """The column component's start (display units) of a column."""
+        return self.col_first + np.asarray(col) * self.col_step
+
+    def row_col(self, col_display, row_display) -> tuple[np.ndarray, np.ndarray]:
+        """Nearest (row, column) of column and row values in display units; not range-checked."""
+        rows = np.rint((np.asarray(row_display, dtype=float) - self.row_first) / self.row_step).astype(int)
+        cols = np.rint((np.asarray(col_display, dtype=float) - self.col_first) / self.col_step).astype(int)
+        return rows, cols
+
+    def grid_index(self, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(row, column) of each cell."""
+        return self.row_col(self._display(cells["x0"], 1), self._display(cells["theta0"], 0))
+
+    def cell_index(self, row, col):
+        """Index in the full grid of (row, column)."""
+        return np.asarray(row) * self.cols + np.asarray(col)
+
+    def interior(self, rows, cols) -> np.ndarray:
+        rows, cols = np.asarray(rows), np.asarray(cols)
+        return (rows > 0) & (rows < self.rows - 1) & (cols > 0) & (cols < self.cols - 1)
+
+    def interior_mask(self, cells: np.ndarray) -> np.ndarray:
+        """True for the interior cells of a cell array."""
+        return self.interior(*self.grid_index(cells))
+
+    def on_grid(self, cells: np.ndarray) -> np.ndarray:
+        """True for cells with finite coordinates within TOL of a grid point."""
+        with np.errstate(all="ignore"):  # absurd values are found here, not warned about
+            x0, th0 = cells["x0"], cells["theta0"]
+            finite = np.isfinite(x0) & np.isfinite(th0)
+            rows, cols = self.row_col(self._display(np.where(finite, x0, 0.0), 1),
+                                      self._display(np.where(finite, th0, 0.0), 0))
+            rows, cols = np.where(finite, rows, -1), np.where(finite, cols, -1)
+            inside = finite & (cols >= 0) & (cols < self.cols) & (rows >= 0) & (rows < self.rows)
+            return (inside & (np.abs(x0 - self._internal(self.col_value(cols), 1)) <= TOL)
+                    & (np.abs(th0 - self._internal(self.row_value(rows), 0)) <= TOL))
+
+    def to_grid(self, cells: np.ndarray, values: np.ndarray, fill: float = np.nan) -> np.ndarray:
+        """Scatter per-cell values into a (rows, cols) map (both ascending)."""
+        values = np.asarray(values, dtype=float)
+        out = np.full((self.rows, self.cols) + values.shape[1:], fill, dtype=float)
+        rows, cols = self.grid_index(cells)
+        out[rows, cols] = values
+        return out
+
+    def map_extent(self) -> tuple[float, float, float, float]:
+        """(left, right, bottom, top) of a map whose cells are centred on the grid points."""
+        return tuple(round(v, 9) for v in (self.col_first - self.col_step / 2, self.col_last + self.col_step / 2,
+                                           self.row_first - self.row_step / 2, self.row_last + self.row_step / 2))
+
+    def col_label(self) -> str:
+        return f"{self.col_name}0 ({self.col_unit})"
+
+    def row_label(self) -> str:
+        return f"{self.row_name}0 ({self.row_unit})"
+
+    def central_frame(self) -> tuple[float, float]:
+        """Half the grid's half-extent along each axis (display units): the default prior frame
+        (|x0| <= 1.2 m, |theta0| <= 6 deg for the cart-pole)."""
+        return (round(max(abs(self.col_first), abs(self.col_last)) / 2, 9),
+                round(max(abs(self.row_first), abs(self.row_last)) / 2, 9))
 
 
-_GRID = _c_grid()
-THETA_STEP_DEG = float(np.rint(1e9 * np.degrees(_GRID["theta0"][XS] - _GRID["theta0"][0])) / 1e9)
-THETA_LAST_DEG = THETA_FIRST_DEG + (THETAS - 1) * THETA_STEP_DEG
-X_LAST = X_FIRST + (XS - 1) * X_STEP
+@lru_cache(maxsize=None)
+def of(plant: str = CART_POLE_NAME) -> PlantGrid:
+    """The grid of a registry plant."""
+    return PlantGrid(plant)
 
 
-def theta_deg(row):
-    """theta0 (deg) of a row."""
-    return THETA_FIRST_DEG + np.asarray(row) * THETA_STEP_DEG
-
-
-def x_of(col):
-    """x0 (m) of a column."""
-    return X_FIRST + np.asarray(col) * X_STEP
-
-
-def row_col(x0, theta0_deg) -> tuple[np.ndarray, np.ndarray]:
-    """Nearest (row, column) of positions x0 (m), theta0 (deg); not range-checked."""
-    rows = np.rint((np.asarray(theta0_deg, dtype=float) - THETA_FIRST_DEG) / THETA_STEP_DEG).astype(int)
-    cols = np.rint((np.asarray(x0, dtype=float) - X_FIRST) / X_STEP).astype(int)
-    return rows, cols
-
-
-def grid_index(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(row, column) of each cell in the paper grid."""
-    return row_col(cells["x0"], np.degrees(cells["theta0"]))
-
-
-def cell_index(row, col):
-    """Index in the full paper grid of (row, column)."""
-    return np.asarray(row) * XS + np.asarray(col)
-
-
-def interior(rows, cols) -> np.ndarray:
-    """True for interior (row, column) pairs: the outermost rows and columns excluded."""
-    rows, cols = np.asarray(rows), np.asarray(cols)
-    return (rows > 0) & (rows < THETAS - 1) & (cols > 0) & (cols < XS - 1)
-
-
-def interior_mask(cells: np.ndarray) -> np.ndarray:
-    """True for the interior cells of a cell array."""
-    return interior(*grid_index(cells))
-
-
-def on_grid(cells: np.ndarray) -> np.ndarray:
-    """True for cells with finite coordinates within X_TOL of a paper-grid point."""
-    with np.errstate(all="ignore"):  # absurd values are found here, not warned about
-        x0, th0 = cells["x0"], np.degrees(cells["theta0"])
-        finite = np.isfinite(x0) & np.isfinite(th0)
-        rows, cols = row_col(np.where(finite, x0, X_FIRST - 10 * X_STEP), np.where(finite, th0, 0.0))
-        inside = finite & (cols >= 0) & (cols < XS) & (rows >= 0) & (rows < THETAS)
-        return (inside & (np.abs(x0 - x_of(cols)) <= X_TOL)
-                & (np.abs(np.radians(th0) - np.radians(theta_deg(rows))) <= X_TOL))
-
-
-def to_grid(cells: np.ndarray, values: np.ndarray, fill: float = np.nan) -> np.ndarray:
-    """Scatter per-cell values into a (THETAS, XS) map (rows theta0 ascending, columns x0 ascending)."""
-    values = np.asarray(values, dtype=float)
-    out = np.full((THETAS, XS) + values.shape[1:], fill, dtype=float)
-    rows, cols = grid_index(cells)
-    out[rows, cols] = values
-    return out
-
-
-def map_extent() -> tuple[float, float, float, float]:
-    """(left, right, bottom, top) of a map whose cells are centred on the grid points."""
-    return tuple(round(v, 9) for v in (X_FIRST - X_STEP / 2, X_LAST + X_STEP / 2,
-                                       THETA_FIRST_DEG - THETA_STEP_DEG / 2, THETA_LAST_DEG + THETA_STEP_DEG / 2))
+# The cart-pole's, the paper's grid, under its historical names.
+CART_POLE = of(CART_POLE_NAME)
+THETAS = CART_POLE.rows
+XS = CART_POLE.cols
+CELLS = CART_POLE.cells
+N_INTERIOR = CART_POLE.n_interior
+THETA_FIRST_DEG = CART_POLE.row_first
+THETA_STEP_DEG = CART_POLE.row_step
+THETA_LAST_DEG = CART_POLE.row_last
+X_FIRST = CART_POLE.col_first
+X_STEP = CART_POLE.col_step
+X_LAST = CART_POLE.col_last
+X_TOL = TOL
+theta_deg = CART_POLE.row_value
+x_of = CART_POLE.col_value
+row_col = CART_POLE.row_col
+grid_index = CART_POLE.grid_index
+cell_index = CART_POLE.cell_index
+interior = CART_POLE.interior
+interior_mask = CART_POLE.interior_mask
+on_grid = CART_POLE.on_grid
+to_grid = CART_POLE.to_grid
+map_extent = CART_POLE.map_extent
 
 
 def _check() -> None:
-    rows, cols = grid_index(_GRID)
+    """The cart-pole's geometry reproduces every cell of the C paper grid, and its constants are
+    the C table's."""
+    cells = np.zeros(CELLS, dtype=B.CELL_DTYPE)
+    B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, 0), "paper grid")
+    rows, cols = grid_index(cells)
     k = np.arange(CELLS)
-    if not (np.array_equal(rows, k // XS) and np.array_equal(cols, k % XS) and on_grid(_GRID).all()
-            and math.isclose(THETA_STEP_DEG, round(THETA_STEP_DEG, 6))):
+    if not ((THETAS, XS, CELLS) == (B.GRID_THETAS, B.GRID_XS, B.GRID_CELLS) and THETA_FIRST_DEG == B.GRID_THETA_FIRST_DEG
+            and X_FIRST == B.GRID_X_FIRST and X_STEP == B.GRID_X_STEP and math.isclose(THETA_STEP_DEG, 1.0)
+            and np.array_equal(rows, k // XS) and np.array_equal(cols, k % XS) and on_grid(cells).all()):
         raise B.LibraryError("icoac_sim_paper_grid does not follow the grid constants "
                              "(ICOAC_SIM_GRID_*); rebuild the library")
 

@@ -1,4 +1,4 @@
-"""Run grids of cells through icoac_sim_run_grid with progress, Ctrl-C cancellation and checkpoints."""
+"""Run grids of cells through icoac_sim_run_grid_model (any registry plant) with progress, Ctrl-C cancellation and checkpoints."""
 from __future__ import annotations
 
 import ctypes
@@ -15,10 +15,10 @@ import numpy as np
 
 from . import _binding as B
 from .config import RunConfig
-from .options import (DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, MAX_THREADS,  # noqa: F401
+from .options import (CART_POLE, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, MAX_THREADS,  # noqa: F401
                       MAX_TRAJECTORY_STEPS, SEED_LIMIT, TRAJECTORY_DURATION)
 
-# What icoac_sim_run_grid fills in; the caller sets the others (icoac_sim_cell_t).
+# What icoac_sim_run_grid_model fills in; the caller sets the others (icoac_sim_cell_t).
 INPUT_FIELDS = ("x0", "theta0", "seed")
 RESULT_FIELDS = tuple(n for n in B.CELL_DTYPE.names if n not in INPUT_FIELDS)
 
@@ -124,9 +124,18 @@ def format_cell_indices(indices: Iterable[int]) -> str:
     return ",".join(parts)
 
 
-def make_cells(seed: int = 0, indices: Iterable[int] | None = None) -> np.ndarray:
-    """Paper-grid cells (seeds as in the full grid), optionally a subset of cell indices."""
-    cells = paper_grid(seed)
+def plant_grid(plant: str, seed: int = 0) -> np.ndarray:
+    """The grid of initial conditions of a registry plant (icoac_sim_plant_grid): x0 the start of
+    its column component, theta0 of its row component; the cart-pole's is the paper grid."""
+    info = B.plant_info(plant)
+    cells = np.zeros(info["rows"]["count"] * info["cols"]["count"], dtype=B.CELL_DTYPE)
+    B.check_status(B.lib.icoac_sim_plant_grid(info["index"], cells, cells.size, check_seed(seed)), "plant grid")
+    return cells
+
+
+def make_cells(seed: int = 0, indices: Iterable[int] | None = None, plant: str = CART_POLE) -> np.ndarray:
+    """Grid cells of the plant (seeds as in the full grid), optionally a subset of cell indices."""
+    cells = plant_grid(plant, seed)
     if indices is None:
         return cells
     indices = list(indices)
@@ -253,11 +262,12 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
     counters = np.zeros(B.PROGRESS_LEN, dtype=np.int64)
     result: dict[str, object] = {}
     prior = ctypes.byref(cfg.prior) if cfg.prior is not None else None
+    model = cfg.engine_model()
 
     def worker() -> None:
         try:
-            result["status"] = B.lib.icoac_sim_run_grid(
-                ctypes.byref(cfg.controller), ctypes.byref(cfg.plant), ctypes.byref(cfg.run), prior,
+            result["status"] = B.lib.icoac_sim_run_grid_model(
+                ctypes.byref(cfg.controller), ctypes.byref(model), ctypes.byref(cfg.run), prior,
                 cells, cells.size, int(threads), cancel, counters)
         except BaseException as exc:  # pragma: no cover - ctypes argument errors
             result["error"] = exc
@@ -317,13 +327,13 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
 
 
 def run_cell(cfg: RunConfig, x0: float, theta0: float, seed: int = 0) -> np.ndarray:
-    """One independent run of one cell (icoac_sim_run_cell); returns a 0-d CELL_DTYPE record."""
+    """One independent run of one cell (icoac_sim_run_cell_model); returns a 0-d CELL_DTYPE record."""
     cfg.check()
     cell = np.zeros(1, dtype=B.CELL_DTYPE)
     cell["x0"], cell["theta0"], cell["seed"] = x0, theta0, check_seed(seed)
     prior = ctypes.byref(cfg.prior) if cfg.prior is not None else None
-    status = B.lib.icoac_sim_run_cell(ctypes.byref(cfg.controller), ctypes.byref(cfg.plant),
-                                      ctypes.byref(cfg.run), prior, cell, None, None)
+    status = B.lib.icoac_sim_run_cell_model(ctypes.byref(cfg.controller), ctypes.byref(cfg.engine_model()),
+                                            ctypes.byref(cfg.run), prior, cell, None, None)
     B.check_status(status, "run cell")
     return cell[0]
 
@@ -361,17 +371,19 @@ def trajectory_steps(duration: float, dt: float) -> int:
 def trajectory(cfg: RunConfig, x0: float, theta0: float, duration: float = TRAJECTORY_DURATION,
                seed: int = 0, init_velocity_noise: float | None = None) -> Trajectory:
     """One trial from (x0, theta0) with the controller initialised from cfg.prior (learning on),
-    recorded for up to ``duration`` simulated seconds (icoac_sim_trajectory)."""
+    recorded for up to ``duration`` simulated seconds (icoac_sim_trajectory_model)."""
     cfg.check()
-    max_steps = trajectory_steps(duration, cfg.plant.dt)
+    model = cfg.engine_model()
+    max_steps = trajectory_steps(duration, model.dt)
     noise = cfg.run.init_velocity_noise if init_velocity_noise is None else float(init_velocity_noise)
-    states = np.zeros((max_steps + 1) * B.N_INPUTS)
+    n_state = len(B.plant_info(model.plant)["state"])
+    states = np.zeros((max_steps + 1) * n_state)
     forces = np.zeros(max_steps)
     n = ctypes.c_int64(0)
     prior = ctypes.byref(cfg.prior) if cfg.prior is not None else None
-    status = B.lib.icoac_sim_trajectory(ctypes.byref(cfg.controller), ctypes.byref(cfg.plant), prior,
-                                        float(x0), float(theta0), noise, check_seed(seed), max_steps,
-                                        states, forces, ctypes.byref(n))
+    status = B.lib.icoac_sim_trajectory_model(ctypes.byref(cfg.controller), ctypes.byref(model), prior,
+                                              float(x0), float(theta0), noise, check_seed(seed), max_steps,
+                                              states, forces, ctypes.byref(n))
     B.check_status(status, "trajectory")
     k = int(n.value)
-    return Trajectory(states.reshape(-1, B.N_INPUTS)[: k + 1].copy(), forces[:k].copy(), cfg.plant.dt)
+    return Trajectory(states.reshape(-1, n_state)[: k + 1].copy(), forces[:k].copy(), model.dt)

@@ -7,7 +7,8 @@ from typing import Any
 import numpy as np
 
 from . import _binding as B
-from .geometry import grid_index, interior_mask, to_grid  # noqa: F401 (part of this API)
+from . import geometry
+from .geometry import grid_index, interior_mask, to_grid  # noqa: F401 (part of this API; the cart-pole's)
 
 
 def success_mask(cells: np.ndarray) -> np.ndarray:
@@ -28,11 +29,12 @@ CURVE_BUDGETS = tuple(m * 10 ** e for e in range(6) for m in (1, 2, 3, 5) if m *
 QUANTILES = (0.1, 0.25, 0.5, 0.75, 0.9)
 
 
-def success_within(cells: np.ndarray, budgets=CURVE_BUDGETS, interior: bool = False) -> list[float | None]:
-    """Fraction of the cells (all, or the interior ones) that succeeded within k trials, per budget
-    k: the learning curve of a run, read from the recorded trials to success (no rerun). None
-    when there is no such cell."""
-    mask = interior_mask(cells) if interior else np.ones(cells.size, dtype=bool)
+def success_within(cells: np.ndarray, budgets=CURVE_BUDGETS, interior: bool = False,
+                   grid: geometry.PlantGrid = geometry.CART_POLE) -> list[float | None]:
+    """Fraction of the cells (all, or the interior ones of the plant's grid) that succeeded within
+    k trials, per budget k: the learning curve of a run, read from the recorded trials to success
+    (no rerun). None when there is no such cell."""
+    mask = grid.interior_mask(cells) if interior else np.ones(cells.size, dtype=bool)
     trials = cells["trials"][success_mask(cells) & mask]
     n = int(np.count_nonzero(mask))
     return [float(np.count_nonzero(trials <= k)) / n if n else None for k in budgets]
@@ -45,9 +47,11 @@ def quantiles(values: np.ndarray) -> dict[str, float] | None:
     return {f"{q:g}": float(v) for q, v in zip(QUANTILES, np.quantile(values.astype(float), QUANTILES))}
 
 
-def weights(cells: np.ndarray, successful_only: bool = False) -> np.ndarray:
-    """Learned weights per cell (w_x, w_xdot, w_theta, w_thetadot); NaN rows for unsuccessful cells if asked."""
-    w = cells["weights"].astype(float).copy()
+def weights(cells: np.ndarray, successful_only: bool = False,
+            grid: geometry.PlantGrid = geometry.CART_POLE) -> np.ndarray:
+    """Learned weights per cell, one per input of the plant's task (the cart-pole's w_x, w_xdot,
+    w_theta, w_thetadot); NaN rows for unsuccessful cells if asked."""
+    w = cells["weights"][:, :grid.n_inputs].astype(float)
     if successful_only:
         w[~success_mask(cells)] = np.nan
     return w
@@ -72,11 +76,11 @@ def _rate(num: int, den: int) -> float:
     return float(num) / den if den else float("nan")
 
 
-def summary(cells: np.ndarray) -> dict[str, Any]:
-    """Aggregate metrics. Success rates use the full paper grid as denominator when every cell is
-    present (1225 / 1081), otherwise the cells given."""
+def summary(cells: np.ndarray, grid: geometry.PlantGrid = geometry.CART_POLE) -> dict[str, Any]:
+    """Aggregate metrics. Success rates use the cells given as denominator (the full grid's 1225
+    / 1081 when every cell is present); interior cells are those of the plant's grid."""
     ok = success_mask(cells)
-    inner = interior_mask(cells)
+    inner = grid.interior_mask(cells)
     trials = cells["trials"][ok]
     elapsed = cells["elapsed_time"][ok]
     counts = {name: int(np.count_nonzero(cells["outcome"] == code)) for code, name in B.OUTCOME_NAMES.items()}
@@ -99,10 +103,10 @@ def summary(cells: np.ndarray) -> dict[str, Any]:
         "trials_to_success_quantiles": quantiles(trials),
         "elapsed_time_quantiles": quantiles(elapsed),
         "success_within": {"k": list(CURVE_BUDGETS), "all": success_within(cells),
-                           "interior": success_within(cells, interior=True)},
+                           "interior": success_within(cells, interior=True, grid=grid)},
     }
     if trials.size:
-        w = cells["weights"][ok]
+        w = cells["weights"][ok][:, :grid.n_inputs]
         out["mean_weights_success"] = [float(v) for v in w.mean(axis=0)]
     else:
         out["mean_weights_success"] = None

@@ -3,7 +3,8 @@
 ICO->RL: mean and 4x4 sample covariance (ddof 1) of the final ICO weights of the ICO-successful cells
 inside a frame (default |x0| <= 1.2 m, |theta0| <= 6 deg; or every successful cell), plus ridge * I.
 The other actor-critic priors take the ICO mean, the ICO covariance, both or neither
-(options.PRIOR_RULES; method.md, A16 and L6); the search's is N(0, I) or the ICO prior.
+(each condition's rule: harness.registry; method.md, A16 and L6); the search's is N(0, I) or the
+ICO prior.
 """
 from __future__ import annotations
 
@@ -15,13 +16,15 @@ from typing import Any
 import numpy as np
 
 from . import _binding as B
-from . import metrics, results
+from . import geometry, metrics, results
 from .config import make_prior
 from .errors import PriorError
-from .options import FRAME_NAMES, PRIOR_FRAME as DEFAULT_FRAME, PRIOR_RIDGE as DEFAULT_RIDGE, PRIOR_RULES
+from .options import FRAME_NAMES, PRIOR_FRAME as DEFAULT_FRAME, PRIOR_RIDGE as DEFAULT_RIDGE
 from .options import PRIOR_STD as DEFAULT_STD
+from .registry import COV_RULES, MEAN_RULES, REGISTRY
 
 _TOL = 1e-9
+CENTRAL = "central"  # parse_frame without bounds: the central frame of the prior's plant
 
 
 @dataclass
@@ -61,23 +64,29 @@ class PriorInfo:
         return make_prior(self.mean, self.cov)
 
 
-def frame_mask(cells: np.ndarray, frame: tuple[float, float] | None) -> np.ndarray:
-    """Cells with |x0| <= frame[0] m and |theta0| <= frame[1] deg (every cell when frame is None)."""
+def frame_mask(cells: np.ndarray, frame: tuple[float, float] | None,
+               grid: geometry.PlantGrid = geometry.CART_POLE) -> np.ndarray:
+    """Cells with |column value| <= frame[0] and |row value| <= frame[1] in the grid's display
+    units (the cart-pole: |x0| <= frame[0] m, |theta0| <= frame[1] deg); every cell when frame is
+    None."""
     if frame is None:
         return np.ones(cells.size, dtype=bool)
-    half_x, half_th = frame
-    return ((np.abs(cells["x0"]) <= half_x + _TOL)
-            & (np.abs(np.degrees(cells["theta0"])) <= half_th + _TOL))
+    half_col, half_row = frame
+    return ((np.abs(grid.col_display(cells["x0"])) <= half_col + _TOL)
+            & (np.abs(grid.row_display(cells["theta0"])) <= half_row + _TOL))
 
 
 def parse_frame(text: str | None, x_max: float | None = None, theta_max_deg: float | None = None
                 ) -> tuple[float, float] | None:
-    """'central' (default, bounds overridable) or 'all' -> frame tuple or None."""
+    """'central' (default, bounds overridable) or 'all' -> frame tuple, CENTRAL (no bound given:
+    the central frame of whichever plant's grid the prior comes from) or None."""
     name = (text or "central").strip().lower()
     if name not in FRAME_NAMES:
         raise PriorError(f"bad prior frame {text!r}; valid: {', '.join(FRAME_NAMES)}")
     if name == "all":
         return None
+    if x_max is None and theta_max_deg is None:
+        return CENTRAL
     x = DEFAULT_FRAME[0] if x_max is None else float(x_max)
     th = DEFAULT_FRAME[1] if theta_max_deg is None else float(theta_max_deg)
     if not (math.isfinite(x) and math.isfinite(th) and x > 0 and th > 0):
@@ -85,23 +94,27 @@ def parse_frame(text: str | None, x_max: float | None = None, theta_max_deg: flo
     return (x, th)
 
 
-def compute(cells: np.ndarray, frame: tuple[float, float] | None = DEFAULT_FRAME,
-            ridge: float = DEFAULT_RIDGE) -> PriorInfo:
-    """ICO->RL prior from an ICO cell array: successful cells inside frame, mean and sample cov + ridge*I."""
+def compute(cells: np.ndarray, frame: tuple[float, float] | str | None = DEFAULT_FRAME,
+            ridge: float = DEFAULT_RIDGE, grid: geometry.PlantGrid = geometry.CART_POLE) -> PriorInfo:
+    """ICO->RL prior from an ICO cell array of the plant's grid: successful cells inside frame
+    (CENTRAL: the grid's central frame), mean and sample cov + ridge*I."""
     if not (math.isfinite(ridge) and ridge >= 0):
         raise PriorError(f"prior ridge must be finite and >= 0, got {ridge}")
-    sel = metrics.success_mask(cells) & frame_mask(cells, frame)
+    if frame == CENTRAL:
+        frame = grid.central_frame()
+    sel = metrics.success_mask(cells) & frame_mask(cells, frame, grid)
     n = int(np.count_nonzero(sel))
-    where = "any cell" if frame is None else f"|x0| <= {frame[0]:g} m, |theta0| <= {frame[1]:g} deg"
+    where = "any cell" if frame is None else (f"|{grid.col_name}0| <= {frame[0]:g} {grid.col_unit}, "
+                                              f"|{grid.row_name}0| <= {frame[1]:g} {grid.row_unit}")
     if n == 0:
         raise PriorError(f"no ICO-successful cell in the prior frame ({where}); "
                          "widen the frame or use --prior-frame all")
     if n < 2:
         raise PriorError(f"only {n} ICO-successful cell in the prior frame ({where}); "
                          "a sample covariance needs at least 2")
-    w = cells["weights"][sel].astype(np.float64)
+    w = cells["weights"][sel][:, :grid.n_inputs].astype(np.float64)
     mean = w.mean(axis=0)
-    cov = np.cov(w, rowvar=False, ddof=1) + ridge * np.eye(B.N_INPUTS)
+    cov = np.cov(w, rowvar=False, ddof=1) + ridge * np.eye(grid.n_inputs)
     cov = 0.5 * (cov + cov.T)
     # entries that would be subnormal in the controller's reals are 0 to it on a host that
     # flushes subnormals, so the C prior check rejects them: store them as 0
@@ -109,20 +122,33 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | None = DEFAULT_FRAME
     return PriorInfo(mean=mean, cov=cov, frame=frame, n_cells=n, ridge=float(ridge))
 
 
-def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_STD) -> PriorInfo:
-    """The prior of a condition by its rule (options.PRIOR_RULES): the mean and the covariance each
-    from the ICO prior ``ico`` or not ("zero" mean, "isotropic" std^2 I, "identity" I). Provenance is
-    recorded only for what came from ICO: a prior that takes nothing from it carries no source."""
-    mean_rule, cov_rule = PRIOR_RULES[condition]
-    from_ico = mean_rule == "ico" or cov_rule == "ico"
+# The words of a prior rule (harness.registry) -> the mean (from the ICO prior) and covariance (from
+# the ICO prior and sigma_w).
+_MEANS = {"ico": lambda ico, n: ico.mean.copy(), "zero": lambda ico, n: np.zeros(n)}
+_COVS = {"ico": lambda ico, std, n: ico.cov.copy(), "isotropic": lambda ico, std, n: std ** 2 * np.eye(n),
+         "identity": lambda ico, std, n: np.eye(n)}
+assert tuple(_MEANS) == MEAN_RULES and tuple(_COVS) == COV_RULES
+
+
+def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_STD,
+                    n_inputs: int = B.N_INPUTS) -> PriorInfo:
+    """The prior of a condition by its rule (harness.registry) for a task of n_inputs inputs (the
+    cart-pole's 4 unless given; an ICO prior of another size is refused): the
+    mean and the covariance each from the ICO prior ``ico`` or not ("zero" mean, "isotropic" std^2 I,
+    "identity" I). Provenance is recorded only for what came from ICO: a prior that takes nothing
+    from it carries no source."""
+    rule = REGISTRY[condition].prior
+    if rule is None:
+        raise PriorError(f"condition {condition} has no prior")
+    mean_rule, cov_rule = rule
+    from_ico = rule.takes_ico
     if from_ico and ico is None:
         raise PriorError(f"condition {condition} needs an ICO prior (--prior-from ICO_RESULTS_DIR)")
     if cov_rule == "isotropic" and not (math.isfinite(std) and std > 0):
         raise PriorError(f"--prior-std must be a finite number > 0, got {std!r}")
-    n = B.N_INPUTS
-    mean = ico.mean.copy() if mean_rule == "ico" else np.zeros(n)
-    cov = {"ico": lambda: ico.cov.copy(), "isotropic": lambda: std ** 2 * np.eye(n),
-           "identity": lambda: np.eye(n)}[cov_rule]()
+    if ico is not None and len(ico.mean) != n_inputs:
+        raise PriorError(f"condition {condition}: the ICO prior has {len(ico.mean)} weights, the task {n_inputs} inputs")
+    mean, cov = _MEANS[mean_rule](ico, n_inputs), _COVS[cov_rule](ico, std, n_inputs)
     extra = {"mean_from": mean_rule, "cov_from": cov_rule}
     if cov_rule == "isotropic":
         extra["prior_std"] = float(std)
@@ -133,7 +159,7 @@ def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_
                      ico_phase_simulated_time=ico.ico_phase_simulated_time, extra=extra)
 
 
-def from_results(path: str | Path, frame: tuple[float, float] | None = DEFAULT_FRAME,
+def from_results(path: str | Path, frame: tuple[float, float] | str | None = DEFAULT_FRAME,
                  ridge: float = DEFAULT_RIDGE) -> PriorInfo:
     """ICO->RL prior from an ICO results directory, with its provenance and ICO-phase simulated time."""
     path = Path(path)
@@ -142,7 +168,7 @@ def from_results(path: str | Path, frame: tuple[float, float] | None = DEFAULT_F
         raise PriorError(f"--prior-from: {str(path)!r} holds condition {record.get('condition')!r}, not ico")
     if not record.get("complete", False):
         raise PriorError(f"--prior-from: {str(path)!r} is incomplete (PENDING cells); finish it with --resume")
-    info = compute(cells, frame, ridge)
+    info = compute(cells, frame, ridge, geometry.of(results.record_plant(record)))
     info.source = str(path.resolve())
     info.source_commit = (record.get("git") or {}).get("commit")
     info.source_seed = record.get("seed")

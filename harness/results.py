@@ -15,10 +15,11 @@ import numpy as np
 
 from . import _binding as B
 from . import geometry, metrics
-from .config import RunConfig, config_from_dict
+from .config import CART_POLE, RunConfig, config_from_dict
 from .errors import ResultsError
 from .grid import make_cells, parse_cell_indices
-from .options import CONDITIONS, SEED_LIMIT
+from .options import SEED_LIMIT
+from .registry import CONDITIONS
 
 CELLS_FILE = "cells.npz"
 RUN_FILE = "run.json"
@@ -99,7 +100,7 @@ def make_record(cells: np.ndarray, cfg: RunConfig, *, condition: str, seed: int,
         "timestamp": timestamp(),
         "wall_time": float(wall_time),
         "threads": int(threads),
-        "summary": metrics.summary(cells),
+        "summary": metrics.summary(cells, geometry.of(cfg.plant_name)),
     }
     if extra:
         record.update(extra)
@@ -132,6 +133,24 @@ def open_file(file: Path, follow: bool = True):
     return os.fdopen(fd, "rb")
 
 
+# The cell layout of the versions whose controller read 4 inputs (simulator ABI 2): read, and
+# widened to today's (the weights and covariance after the fourth input are 0, as the engine now
+# writes them for a 4-input task).
+FOUR_INPUT_CELL_DTYPE = np.dtype([(name, B.CELL_DTYPE.fields[name][0].base, (B.N_INPUTS,) * len(shape))
+                                  if (shape := B.CELL_DTYPE.fields[name][0].shape) else
+                                  (name, B.CELL_DTYPE.fields[name][0]) for name in B.CELL_DTYPE.names], align=True)
+
+
+def _widened(old: np.ndarray) -> np.ndarray:
+    cells = np.zeros(old.shape, dtype=B.CELL_DTYPE)
+    for name in B.CELL_DTYPE.names:
+        if cells[name].ndim == 1:
+            cells[name] = old[name]
+    cells["weights"][:, :B.N_INPUTS] = old["weights"]
+    cells["cov"][:, :B.N_INPUTS, :B.N_INPUTS] = old["cov"]
+    return cells
+
+
 def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
     """The cell array of a cells.npz, read without trusting it: one member ``cells.npy`` whose
     header says a 1-D CELL_DTYPE array of at most GRID_CELLS cells and whose size matches.
@@ -153,12 +172,13 @@ def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
                     shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
                 else:
                     raise _err(f"{where}: unsupported .npy version {version}")
-                if dtype != B.CELL_DTYPE:
+                layout = B.CELL_DTYPE if dtype != FOUR_INPUT_CELL_DTYPE else FOUR_INPUT_CELL_DTYPE
+                if dtype != layout:
                     raise _err(f"{where} has a different cell layout than this library "
                                f"({_dtype_difference(dtype)}); it was written by another version")
                 if len(shape) != 1 or not 1 <= shape[0] <= B.GRID_CELLS:
                     raise _err(f"{where}: expected 1 to {B.GRID_CELLS} cells, got shape {shape}")
-                nbytes = shape[0] * B.CELL_DTYPE.itemsize
+                nbytes = shape[0] * layout.itemsize
                 if info.file_size != fh.tell() + nbytes:
                     raise _err(f"{where}: size {info.file_size} does not match its header ({shape[0]} cells)")
                 data = fh.read(nbytes + 1)
@@ -172,7 +192,8 @@ def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
         raise _err(f"cannot read {where}: {exc.strerror or exc}") from None
     except Exception as exc:  # any other decoding failure of untrusted bytes: zlib, EOF, header syntax
         raise _err(f"{where} is not a valid cells file ({type(exc).__name__}: {str(exc):.100})") from None
-    return np.frombuffer(data, dtype=B.CELL_DTYPE).copy()
+    cells = np.frombuffer(data, dtype=layout).copy()
+    return cells if layout is B.CELL_DTYPE else _widened(cells)
 
 
 def _dtype_difference(dtype: np.dtype) -> str:
@@ -195,18 +216,30 @@ def _dtype_difference(dtype: np.dtype) -> str:
     return f"record size {dtype.itemsize}, expected {want.itemsize}"
 
 
-def check_cells(cells: np.ndarray, where: str = "cells") -> None:
-    """Structural checks of a cell array: known outcomes, finite coordinates on the paper grid."""
+def record_plant(record: Mapping[str, Any]) -> str:
+    """The plant a run record names (the cart-pole when it names none, as every record before the
+    registry plants)."""
+    plant = record.get("config", {}).get("plant") if isinstance(record.get("config"), Mapping) else None
+    name = plant.get("name", CART_POLE) if isinstance(plant, Mapping) else CART_POLE
+    return name if isinstance(name, str) else CART_POLE
+
+
+def check_cells(cells: np.ndarray, where: str = "cells", plant: str = CART_POLE) -> None:
+    """Structural checks of a cell array: known outcomes, finite coordinates on the plant's grid."""
     bad = ~np.isin(cells["outcome"], list(B.OUTCOME_NAMES))
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise _err(f"{where}: cell {i} has unknown outcome {int(cells['outcome'][i])} "
                    f"(valid: {', '.join(f'{k} {v}' for k, v in B.OUTCOME_NAMES.items())})")
-    on_grid = geometry.on_grid(cells)
+    try:
+        on_grid = geometry.of(plant).on_grid(cells)
+    except B.ConfigError:
+        raise _err(f"{where}: the record names the plant {plant!r:.40}, which the registry does not hold") from None
     if not on_grid.all():
         i = int(np.flatnonzero(~on_grid)[0])
+        grid_name = "the paper grid" if plant == CART_POLE else f"the {plant} grid"
         raise _err(f"{where}: cell {i} has x0 = {float(cells['x0'][i])!r}, theta0 = {float(cells['theta0'][i])!r}, "
-                   "not a point of the paper grid")
+                   f"not a point of {grid_name}")
 
 
 def _is_int(v: Any) -> bool:
@@ -307,14 +340,14 @@ def load(path: str | Path, what: str | None = None, follow: bool = True) -> tupl
     path = check_results_dir(path, what)
     record = read_record(path / RUN_FILE, follow)
     cells = read_cells(path / CELLS_FILE, follow)
-    check_cells(cells, repr(str(path / CELLS_FILE)))
+    check_cells(cells, repr(str(path / CELLS_FILE)), record_plant(record))
     return cells, record
 
 
 def check_cells_match(cells: np.ndarray, record: Mapping[str, Any], where: str = CELLS_FILE) -> None:
     """The cells of a results directory are exactly those its record describes: the number of cells
     and every (x0, theta0, seed) equal make_cells(record seed, record cells), bitwise."""
-    expected = make_cells(record["seed"], record["cells"])
+    expected = make_cells(record["seed"], record["cells"], plant=record_plant(record))
     if cells.size != expected.size:
         raise _err(f"{where} holds {cells.size} cells but run.json describes {expected.size} "
                    "(cell selection and seed); the two files do not belong together")

@@ -22,11 +22,13 @@ import numpy as np
 from . import _binding as B
 from . import geometry, grid, metrics, results, store
 from . import prior as P
+from .plants import CART_POLE
 from ._binding import ConfigError
 from .config import build_config, canonical, command_overrides, given_twice, named_sets, parse_sets, parse_value
 from .errors import SweepError, UsageError
 from .metrics import percent
-from .options import CONTROL_OF, FRAME_NAMES, PRIOR_RULES, PRIOR_STD, SWEEP_MAX_TRIALS
+from .options import FRAME_NAMES, PRIOR_STD, SWEEP_MAX_TRIALS
+from .registry import REGISTRY
 
 PRIOR_PARAMS = ("prior_frame", "prior_ridge", "prior_std")
 DEFAULT_CELLS = list(range(0, geometry.CELLS, 25))  # 49 cells spread over the grid
@@ -213,20 +215,25 @@ def run_sweep(opt: SweepOptions) -> int:
         indices = subset_cells(opt.subset)
     else:
         indices = DEFAULT_CELLS
-    ico_cells, _ = results.load(ico_dir, what="--prior-from")
+    ico_cells, ico_record = results.load(ico_dir, what="--prior-from")
+    plant = results.record_plant(ico_record)  # the sweep runs on the plant of its ICO grid
+    plant_grid = geometry.of(plant)
+    if plant != CART_POLE and opt.dask is not None:
+        raise UsageError(f"the ICO grid of --prior-from is of the {plant}: the Dask backend runs the cart-pole "
+                         "only; run the sweep on local threads")
     priors: dict = {}
 
     # ICO outcome on the sweep cells (matched by grid position).
-    ico_rc = {(int(r), int(c)) for r, c in zip(*metrics.grid_index(ico_cells[metrics.success_mask(ico_cells)]))}
-    ico_known = {(int(r), int(c)) for r, c in zip(*metrics.grid_index(ico_cells))}
-    probe = grid.make_cells(0, indices)
-    pr, pc = metrics.grid_index(probe)
+    ico_rc = {(int(r), int(c)) for r, c in zip(*plant_grid.grid_index(ico_cells[metrics.success_mask(ico_cells)]))}
+    ico_known = {(int(r), int(c)) for r, c in zip(*plant_grid.grid_index(ico_cells))}
+    probe = grid.make_cells(0, indices, plant=plant)
+    pr, pc = plant_grid.grid_index(probe)
     ico_failed = np.array([(int(r), int(c)) in ico_known and (int(r), int(c)) not in ico_rc
                            for r, c in zip(pr, pc)], dtype=bool)
 
     flags = {"--max-trials": ("max_trials", opt.max_trials), "--success-steps": ("success_steps", opt.success_steps)}
-    fixed = command_overrides(opt.configuration, opt.sets, flags)
-    explicit = {name: f"--set {name}" for name in parse_sets(opt.sets)}
+    fixed = command_overrides(opt.configuration, opt.sets, flags, plant=plant)
+    explicit = {name: f"--set {name}" for name in parse_sets(opt.sets, plant=plant)}
     explicit.update({name: option for option, (name, value) in flags.items() if value is not None})
     for name in params:
         if name in explicit:
@@ -236,22 +243,22 @@ def run_sweep(opt: SweepOptions) -> int:
 
     def prior_for(setting):
         """The condition's prior; the ICO grid of --prior-from reaches it only when its rule takes
-        the mean or the covariance from ICO (options.PRIOR_RULES)."""
-        condition = CONTROL_OF.get(opt.condition, opt.condition)
+        the mean or the covariance from ICO (its rule: harness.registry)."""
+        condition = REGISTRY[opt.condition].base
         std = float(setting.get("prior_std", opt.prior_std))
-        if "ico" not in PRIOR_RULES[condition]:
-            return P.condition_prior(condition, None, std)
+        if not REGISTRY[condition].prior.takes_ico:
+            return P.condition_prior(condition, None, std, plant_grid.n_inputs)
         frame = P.parse_frame(str(setting.get("prior_frame", FRAME_NAMES[0])))
         ridge = float(setting.get("prior_ridge", P.DEFAULT_RIDGE))
         k = (frame, ridge)
         if k not in priors:
             priors[k] = P.from_results(ico_dir, frame, ridge)
-        return P.condition_prior(condition, priors[k], std)
+        return P.condition_prior(condition, priors[k], std, plant_grid.n_inputs)
 
     def config_for(setting):
         over = dict(fixed)
         over.update({k: v for k, v in setting.items() if k not in PRIOR_PARAMS})
-        return build_config(over, condition=opt.condition, prior=prior_for(setting).prior())
+        return build_config(over, condition=opt.condition, prior=prior_for(setting).prior(), plant=plant)
 
     for setting in todo:  # every setting valid before the first grid runs (and before any write)
         config_for(setting)
@@ -299,7 +306,7 @@ def _run_settings(opt: SweepOptions, out: Path, held: store.DirectoryLock, meta:
             t0 = time.monotonic()
             rates, rates_failed, trials, elapsed = [], [], [], []
             for seed in seeds:
-                cells = grid.make_cells(seed, indices)
+                cells = grid.make_cells(seed, indices, plant=cfg.plant_name)
                 res = (grid.run_grid(cfg, cells, threads=opt.threads, progress=False) if session is None
                    else session.run_grid(cfg, cells, progress=False))
                 if res.cancelled:

@@ -7,13 +7,14 @@ from __future__ import annotations
 from typing import Any, Mapping, Sequence
 
 from .metrics import percent
-from .options import CONDITION_LABELS as LABELS, CONDITIONS, CONTROL_OF, PRIOR_RULES
+from .registry import CONDITIONS, COV_RULES, MEAN_RULES, REGISTRY
 
 # The budgets k of the success-within-k table (those up to the largest cap of the summary).
 TABLE_BUDGETS = (1, 10, 100, 1000, 10_000, 100_000)
 # The actor-critic priors, ICO->RL first: (condition, what its mean and covariance are).
 PRIOR_WORDS = {"ico": "ICO", "zero": "0", "isotropic": "σ_w²·I", "identity": "I"}
-PRIOR_TABLE = ("ico-rl", "ico-mean-rl", "rl-ico-cov", "rl")
+assert set(PRIOR_WORDS) == set(MEAN_RULES + COV_RULES)
+PRIOR_TABLE = tuple(c.name for c in REGISTRY.values() if c.mode == "rl" and c.learns)
 
 
 def _pct(stat: Mapping[str, Any] | None) -> str:
@@ -32,10 +33,6 @@ def _at(series: Mapping[str, Sequence], i: int) -> dict[str, Any]:
     return {"mean": series["mean"][i], "sd": series["sd"][i]}
 
 
-def control_of(condition: str) -> str | None:
-    return next((c for c, base in CONTROL_OF.items() if base == condition), None)
-
-
 def prior_table(agg: Mapping[str, Any]) -> list[str]:
     """The actor-critic from the four priors (mean ICO or 0, covariance ICO or σ_w²·I), each beside
     its no-learning control: success (all cells, interior), median trials to success."""
@@ -47,10 +44,10 @@ def prior_table(agg: Mapping[str, Any]) -> list[str]:
              "|---|---|---|---|---|---|---|---|---|"]
     for cond in rows:
         e = agg[cond]
-        mean, cov = PRIOR_RULES[cond]
-        c = agg.get(control_of(cond) or "", {})
+        mean, cov = REGISTRY[cond].prior
+        c = agg.get(REGISTRY[cond].control or "", {})
         gain = (e.get("gain_over_control") or {}).get("points")
-        lines.append(f"| {LABELS[cond]} | {PRIOR_WORDS[mean]} | {PRIOR_WORDS[cov]} | {_pct(e['success_rate'])} | "
+        lines.append(f"| {REGISTRY[cond].label} | {PRIOR_WORDS[mean]} | {PRIOR_WORDS[cov]} | {_pct(e['success_rate'])} | "
                      f"{_pct(e['success_rate_interior'])} | {_num(e['median_trials_to_success'])} | "
                      f"{_pct(c.get('success_rate'))} | {_num(c.get('median_trials_to_success'))} | {_num(gain)} |")
     return lines
@@ -78,7 +75,7 @@ def within_table(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = Non
         cells = []
         for k in ks:
             cells.append(_pct(_at(curve["all"], curve["k"].index(k))) if k <= e["max_trials"] else "")
-        lines.append(f"| {LABELS[cond]} | {e['max_trials']:g} | " + " | ".join(cells) + " |")
+        lines.append(f"| {REGISTRY[cond].label} | {e['max_trials']:g} | " + " | ".join(cells) + " |")
     for name, proto in ((ceiling or {}).get("best", {}).get("protocols", {}) or {}).items():
         curve = proto.get("success_within")
         cap = proto.get("max_trials", 1 if name == "first" else None)
@@ -100,7 +97,7 @@ def quantile_table(agg: Mapping[str, Any], key: str = "trials_to_success_quantil
     lines = ["| condition | " + " | ".join(f"{float(q) * 100:g} %" for q in qs) + " |", "|---|" + "---|" * len(qs)]
     for cond in conds:
         series = agg[cond][key]
-        lines.append(f"| {LABELS[cond]} | " + " | ".join(_num(_at(series, i)) for i in range(len(qs))) + " |")
+        lines.append(f"| {REGISTRY[cond].label} | " + " | ".join(_num(_at(series, i)) for i in range(len(qs))) + " |")
     return lines
 
 

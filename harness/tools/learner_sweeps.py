@@ -15,13 +15,15 @@ from __future__ import annotations
 
 import argparse
 import csv
+import hashlib
 import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from .. import results, store
+from .. import geometry, results, store
+from ..config import NAMED_CONFIGURATIONS
 from ..sweep import SweepOptions, run_sweep
 
 SEEDS = 2
@@ -76,7 +78,9 @@ STAGE_2 = (
 # ICO-failed cells, ties (within one point) broken by the spread cells, then by fewer median
 # trials. Stage 1 varies the reading with its rate and the prior's sigma_w; stage 2 (``--base``
 # the stage-1 choice) the exploration schedule, the batch, the critic quirks, sigma_u, alpha and
-# sigma_w around it, then grids. At least the settings ICO->RL was given (63 rows).
+# sigma_w one at a time, then grids over what the chosen reading uses, and the mean reading at
+# the schedule stage 1 left out; --confirm runs the best 3 on every cell with 5 seeds. More
+# settings than ICO->RL was given (63 rows).
 RL_ALONE_1 = (
     ("rl-alone-control", "rl-control", ["actor.update=posterior"], False),
     ("rl-alone-posterior", "rl", ["actor.update=posterior", "actor.likelihood_std=1,10", "prior_std=0.1,1,10"],
@@ -89,10 +93,19 @@ RL_ALONE_2 = (
     ("rl-alone-stage2", "rl", ["actor.explore_ticks=0,100,1000", "actor.batch=0,1", "critic.quirks=0,1",
                                "actor.noise_std=1,0.5,2,3,5", "actor.scale=0.5,0.1,0.25,2", "prior_std=1,0.3,3"],
      True),
-    ("rl-alone-noise-grid", "rl", ["actor.explore_ticks=1000", "actor.noise_std=2,3,5,8", "actor.scale=0.1,0.25,0.5"],
-     False),
-    ("rl-alone-schedule-grid", "rl", ["actor.noise_std=3", "actor.explore_ticks=100,300,1000",
-                                      "prior_std=0.3,1,3"], False),
+    # The grids vary what the gradient reading uses (beta, sigma_u, the schedule, the batch);
+    # alpha and sigma_w play no part in it (the spread cells of stage 2: identical rows).
+    ("rl-alone-schedule-grid", "rl", ["actor.explore_ticks=300,1000,3000", "actor.batch=0,1",
+                                      "actor.rate=0.01,0.03,0.1"], False),
+    # sigma_u x beta at the schedule grid's choice (--base)
+    ("rl-alone-noise-grid", "rl", ["actor.noise_std=0.5,1,2,3", "actor.rate=0.01,0.03,0.1"], False),
+    # The mean reading at the schedule its stage 1 never tried (exploring until tick 1000, alpha =
+    # 0.1): sigma_u x sigma_w, which it uses as the preconditioner of every step.
+    ("rl-alone-mean-grid", "rl", ["actor.update=mean", "actor.likelihood_std=0.1", "actor.explore_ticks=1000",
+                                  "actor.scale=0.1", "actor.noise_std=3,5,8", "prior_std=0.3,1,3"], False),
+    # past the mean grid's edge (its best sigma_u, 8 N, was the largest tried)
+    ("rl-alone-mean-edge", "rl", ["actor.update=mean", "actor.likelihood_std=0.1", "actor.explore_ticks=1000",
+                                  "actor.scale=0.1", "actor.noise_std=12,16", "prior_std=1"], False),
 )
 
 
@@ -153,7 +166,112 @@ def report(out: Path) -> str:
                          (r or {}).get("median_trials") or "n/a"]
             lines.append(f"| {setting} | " + " | ".join(cols) + " |")
         lines.append("")
-    return "\n".join(lines)
+    return "\n".join(lines + rl_alone_report(out))
+
+
+def rl_alone_report(out: Path, prefix: str = "rl-alone", top: int = 10) -> list[str]:
+    """RL alone's ranking by the criterion and its 5-seed confirmations (every cell)."""
+    rows = ranked_rows(out, prefix)
+    if not rows:
+        return []
+    lines = [f"## RL alone: the best {top} distinct settings by the criterion", "",
+             "Highest success on the ICO-failed cells; rows within one point of the best ordered by the spread "
+             "cells, then by fewer median trials (2 seeds, cap 1000).", "",
+             "| rank | sweep | setting (beside the literal configuration) | ICO-failed % (± sd) | spread % | "
+             "median trials |", "|---|---|---|---|---|---|"]
+    for i, r in enumerate(rows[:top], 1):
+        lines.append(f"| {i} | {r['sweep']} | {', '.join(literal_items(r['setting']))} | "
+                     f"{100 * r['ico_failed']:.1f} ± {100 * r['ico_failed_sd']:.1f} | {100 * r['spread']:.1f} | "
+                     f"{r['median_trials']:g} |")
+    confirmed = sorted(out.glob(f"{prefix}-confirm-*/sweep.csv"))
+    if confirmed:
+        lines += ["", f"## RL alone: {CONFIRM_SEEDS}-seed grids of every cell (`--confirm`)", "",
+                  "| setting | success, all cells % (± sd) | ICO-failed cells % | median trials |", "|---|---|---|---|"]
+        for path in confirmed:
+            with open(path, newline="") as fh:
+                for r in csv.DictReader(fh):
+                    setting = ", ".join(f"{a}={b}" for a, b in json.loads(r["key"]).items())
+                    lines.append(f"| {setting} | {_pct(r, 'success_rate_mean')} ± {_pct(r, 'success_rate_sd')} | "
+                                 f"{_pct(r, 'success_rate_ico_failed')} | {r['median_trials'] or 'n/a'} |")
+    return lines + [""]
+
+
+# RL alone's confirmation: the best few distinct settings of its sweeps, on every cell of the grid
+# with 5 seeds, ranked by the same criterion (its ICO-failed cells are those of --prior-from).
+CONFIRM_SEEDS = 5
+CONFIRM_FEW = 3
+ALL_CELLS = f"0-{geometry.CELLS - 1}"
+ONE_POINT = 0.01
+
+
+def _effective(items: list[str]) -> dict[str, str]:
+    """NAME=VALUE items applied in order (a later item overrides an earlier one)."""
+    return dict(item.split("=", 1) for item in items)
+
+
+def ranked_rows(out: Path, prefix: str) -> list[dict]:
+    """Every learning row of the sweeps OUT/PREFIX-*-ico-failed (no-learning controls and
+    confirmations left out), each with its full setting (the sweep's fixed items, then the row's)
+    and its spread row, best first by the criterion: the highest ICO-failed success; rows within
+    one point of the best are ordered by spread success, then by fewer median trials. Rows with
+    identical results on both selections (parameters the reading does not use) count once."""
+    rows, seen = [], set()
+    for path in sorted(out.glob(f"{prefix}-*-ico-failed/sweep.csv")):
+        name = path.parent.name[: -len("-ico-failed")]
+        meta = json.loads((path.parent / "sweep.json").read_text())
+        if meta["condition"].endswith("-control") or "-confirm" in name:
+            continue
+        spread_path = out / f"{name}-spread" / "sweep.csv"
+        spread = {}
+        if spread_path.is_file():
+            with open(spread_path, newline="") as fh:
+                spread = {r["key"]: r for r in csv.DictReader(fh)}
+        with open(path, newline="") as fh:
+            for r in csv.DictReader(fh):
+                s = spread.get(r["key"], {})
+                setting = _effective(meta["set"] + [f"{a}={b}" for a, b in json.loads(r["key"]).items()])
+                row = {"sweep": name, "setting": setting, "ico_failed": float(r["success_rate_mean"]),
+                       "ico_failed_sd": float(r["success_rate_sd"]),
+                       "spread": float(s["success_rate_mean"]) if s else float("nan"),
+                       "median_trials": float(r["median_trials"]) if r["median_trials"] else float("inf")}
+                signature = (r["success_rate_mean"], r["success_rate_sd"], r["median_trials"],
+                             s.get("success_rate_mean"), s.get("median_trials"))
+                if signature not in seen:
+                    seen.add(signature)
+                    rows.append(row)
+    rows.sort(key=lambda r: -r["ico_failed"])
+    if rows:
+        best = rows[0]["ico_failed"]
+        near = [r for r in rows if r["ico_failed"] >= best - ONE_POINT]
+        near.sort(key=lambda r: (-r["spread"], r["median_trials"]))
+        rows = near + rows[len(near):]
+    return rows
+
+
+def literal_items(setting: dict[str, str]) -> list[str]:
+    """The items of a full setting that differ from the literal configuration."""
+    base = _effective(list(NAMED_CONFIGURATIONS["literal"]))
+    return [f"{k}={v}" for k, v in setting.items() if base.get(k) != v]
+
+
+def confirm_name(prefix: str, items: list[str]) -> str:
+    """Directory of a setting's confirmation, named by the setting (a later ranking keeps it)."""
+    return f"{prefix}-confirm-" + hashlib.sha1(",".join(items).encode()).hexdigest()[:8]
+
+
+def confirm(args, prefix: str = "rl-alone") -> int:
+    """5-seed grids (every cell) of the best few settings of the sweeps OUT/PREFIX-*."""
+    for row in ranked_rows(args.out, prefix)[:CONFIRM_FEW]:
+        items = literal_items(row["setting"])
+        name = confirm_name(prefix, items)
+        print(f"[learner_sweeps] {name}: {', '.join(items)}", file=sys.stderr, flush=True)
+        code = run_sweep(SweepOptions(prior_from=args.prior_from, out=args.out / name,
+                                      params=items, condition="rl", seeds=CONFIRM_SEEDS, cells=ALL_CELLS,
+                                      max_trials=MAX_TRIALS, configuration="literal", sets=[],
+                                      one_at_a_time=False, threads=args.threads, quiet=True))
+        if code:
+            return code
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -168,12 +286,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", action="append", default=[], help="run only the sweeps of these names")
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--report", action="store_true", help="only write OUT/summary.md from the finished sweeps")
+    ap.add_argument("--confirm", action="store_true",
+                    help=f"RL alone: {CONFIRM_SEEDS}-seed grids of every cell for the best {CONFIRM_FEW} settings "
+                         "of OUT's rl-alone sweeps")
     args = ap.parse_args(argv)
     if args.report:
         path = args.out / "summary.md"
         store.write_text(path, report(args.out))
         print(path)
         return 0
+    if args.confirm:
+        return confirm(args)
     selections = {"spread": dict(subset=SPREAD_CELLS), "ico-failed": dict(cells=ico_failed_cells(args.prior_from))}
     plan = PLANS[args.stage]
     for name, condition, params, one_at_a_time in plan:

@@ -48,7 +48,8 @@ TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
 def provenance(data: Mapping[str, Any]) -> str:
     git = data.get("git") or {}
     commit = (git.get("commit") or "unknown")[:7] + ("+dirty" if git.get("dirty") else "")
-    return (f"*From docs/data: profile {data['profile']}, seeds {data['seeds']}, configuration "
+    plant = f"plant {data['plant']}, " if data.get("plant") else ""
+    return (f"*From docs/data: {plant}profile {data['profile']}, seeds {data['seeds']}, configuration "
             f"{data['configuration']}{' ' + ' '.join(data['set']) if data.get('set') else ''}, commit {commit}.*")
 
 

@@ -98,14 +98,14 @@ static int32_t thread_count(int32_t requested, int64_t n_cells)
     return (int32_t)n;
 }
 
-int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                           icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
-                           const volatile int32_t *cancel, volatile int64_t *progress)
+int32_t icoac_sim_run_grid_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                                 const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                                 icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
+                                 const volatile int32_t *cancel, volatile int64_t *progress)
 {
     pthread_t threads[SIM_MAX_THREADS];
     grid_job_t job;
-    int32_t status = sim_check_all(cfg, plant, run);
+    int32_t status = sim_check_all(cfg, model, run);
     int32_t n;
     int32_t started = 0;
     int32_t t;
@@ -113,7 +113,7 @@ int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_plant_t *p
     if (status != ICOAC_SIM_OK) {
         return status;
     }
-    if (cells == 0 || n_cells < 1 || n_threads < 0) {
+    if (run == 0 || cells == 0 || n_cells < 1 || n_threads < 0) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
     for (i = 0; i < n_cells; ++i) {
@@ -130,7 +130,8 @@ int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_plant_t *p
         }
     }
     job.sim.cfg = cfg;
-    job.sim.plant = plant;
+    job.sim.model = model;
+    job.sim.desc = icoac_sim_plant_info(model->plant);
     job.sim.run = run;
     job.sim.prior = prior;
     job.sim.cancel = cancel;
@@ -153,4 +154,14 @@ int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_plant_t *p
         (void)pthread_join(threads[t], 0);
     }
     return job.cancelled ? ICOAC_SIM_CANCELLED : ICOAC_SIM_OK;
+}
+
+int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                           icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
+                           const volatile int32_t *cancel, volatile int64_t *progress)
+{
+    icoac_sim_model_t model;
+    return icoac_sim_run_grid_model(cfg, sim_model_of(plant, &model), run, prior, cells, n_cells, n_threads,
+                                    cancel, progress);
 }

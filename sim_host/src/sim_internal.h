@@ -6,33 +6,63 @@
 
 #include "icoac_sim/icoac_sim.h"
 
+/* Time step of every default plant and model (s). */
+#define SIM_DT_DEFAULT 0.01
+
 /* Failure test of the plant (method.md) with strict limits; written so that NaN counts as failure.
  * Non-finite velocities fail too (icoac_sim_failed contract: "or not finite"); otherwise the
  * next tick hands them to the controller, which rejects the observation and the cell ends
  * as ICOAC_SIM_ERROR instead of a failed trial. */
-static inline int32_t sim_failed(const icoac_sim_plant_t *plant, const double s[ICOAC_CARTPOLE_INPUTS])
+static inline int32_t sim_cart_pole_failed(double x_limit, double theta_limit, const double s[4])
 {
-    return !(s[0] >= -plant->x_limit && s[0] <= plant->x_limit && s[2] >= -plant->theta_limit &&
-             s[2] <= plant->theta_limit && isfinite(s[1]) && isfinite(s[3]));
+    return !(s[0] >= -x_limit && s[0] <= x_limit && s[2] >= -theta_limit && s[2] <= theta_limit &&
+             isfinite(s[1]) && isfinite(s[3]));
 }
 
-/* Check the controller configuration, plant and (if not NULL) run parameters (params.c). */
-int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+/* The cart-pole's step (plants/cart_pole.c) and where its limits sit in its parameter block
+ * (x_limit, then theta_limit), so that the trial loop can call the one and test the others
+ * without going through the descriptor. */
+void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *s, double force);
+#define SIM_CART_POLE_X_LIMIT 4
+#define SIM_CART_POLE_THETA_LIMIT 5
+
+static inline int32_t sim_failed(const icoac_sim_plant_t *plant, const double s[ICOAC_CARTPOLE_INPUTS])
+{
+    return sim_cart_pole_failed(plant->x_limit, plant->theta_limit, s);
+}
+
+/* Check the controller configuration, model and (if not NULL) run parameters, and that the
+ * controller build takes the plant's observation (params.c). */
+int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_model_t *model,
                       const icoac_sim_run_t *run);
+
+/* The model of a plant struct, or NULL when plant is NULL (the check then refuses it). */
+const icoac_sim_model_t *sim_model_of(const icoac_sim_plant_t *plant, icoac_sim_model_t *model);
 
 /* Initial velocity noise a: 0, or in [ICOAC_SIM_NOISE_MIN, ICOAC_SIM_NOISE_MAX] (params.c). */
 int sim_velocity_noise_valid(double a);
 
-/* Start state of a trial from cell (x0, theta0) with velocities U(-noise, noise) (trial.c). */
-void sim_start_trial(const icoac_sim_cell_t *cell, double noise, icoac_rng_t *rng, double s[ICOAC_CARTPOLE_INPUTS]);
+/* Uniform in (-a, a) from the plant's own generator, in double. */
+static inline double sim_uniform_symmetric(icoac_rng_t *rng, double a)
+{
+    const double u = (double)icoac_rng_next_u32(rng) * (1.0 / 4294967296.0);
+    return a * (2.0 * u - 1.0);
+}
 
-/* The plant state as the controller's input; values outside its real range become NaN. */
-void sim_to_input(const double s[ICOAC_CARTPOLE_INPUTS], uint32_t flags, icoac_input_t *in);
+/* Start state of a trial of a checked model from cell: the plant's start values, the swept
+ * components from the cell, the drawn ones U(-noise, noise) in index order (model.c). */
+void sim_start_trial(const icoac_sim_plant_desc_t *desc, const icoac_sim_cell_t *cell, double noise,
+                     icoac_rng_t *rng, double s[ICOAC_SIM_MAX_STATE]);
 
-/* What every cell of a run shares. */
+/* The plant state as the controller's input; values outside its real range become NaN. The
+ * plant's observation is its first n components, n = task.n_inputs (sim_check_all). */
+void sim_to_input(const double *s, int32_t n, uint32_t flags, icoac_input_t *in);
+
+/* What every cell of a run shares: the checked model and its descriptor. */
 typedef struct {
     const icoac_config_t *cfg;
-    const icoac_sim_plant_t *plant;
+    const icoac_sim_model_t *model;
+    const icoac_sim_plant_desc_t *desc;
     const icoac_sim_run_t *run;
     const icoac_prior_t *prior;
     const volatile int32_t *cancel;
@@ -45,8 +75,8 @@ typedef struct {
  * plant -> next observation) with the other's. */
 typedef struct {
     icoac_state_t ctrl;
-    icoac_rng_t rng; /* the plant's: start velocities */
-    double s[ICOAC_CARTPOLE_INPUTS];
+    icoac_rng_t rng; /* the plant's: the drawn start components */
+    double s[ICOAC_SIM_MAX_STATE];
     icoac_sim_cell_t *cell;
     int64_t trials; /* finished trials */
     int64_t total;  /* their steps */

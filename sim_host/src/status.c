@@ -4,11 +4,12 @@
 const char *icoac_sim_status_str(int32_t status)
 {
     switch (status) {
-    case ICOAC_SIM_ERR_BAD_PLANT: return "invalid plant parameter (gravity, masses, half_length, x_limit in [1e-6, 1e6]; dt in [1e-6, 1] s; theta_limit in [1e-6, pi] rad; integrator 0 or 1)";
+    case ICOAC_SIM_ERR_BAD_PLANT: return "invalid plant parameter (gravity, masses, half_length, x_limit in [1e-6, 1e6]; dt in [1e-6, 1] s; theta_limit in [1e-6, pi] rad; integrator 0 or 1; a registry plant's parameters in their ranges, unused ones 0) or unknown plant";
     case ICOAC_SIM_ERR_BAD_RUN: return "invalid run parameter (max_trials >= 1, success_steps >= 1, init_velocity_noise 0 or in [1e-12, 1e3])";
     case ICOAC_SIM_ERR_BAD_ARGUMENT: return "invalid argument (NULL pointer, empty or wrong-sized array, non-finite cell)";
     case ICOAC_SIM_ERR_THREAD: return "could not start a worker thread";
     case ICOAC_SIM_CANCELLED: return "cancelled (finished cells are kept)";
+    case ICOAC_SIM_ERR_NONFINITE: return "plant state or input not finite, or made non-finite by the step (the state is left as it was)";
     default: return icoac_status_str((icoac_status_t)status);
     }
 }

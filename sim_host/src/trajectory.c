@@ -5,20 +5,22 @@
 #include "icoac_sim/icoac_sim.h"
 #include "sim_internal.h"
 
-int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                             const icoac_prior_t *prior, double x0, double theta0,
-                             double init_velocity_noise, uint64_t seed, int64_t max_steps,
-                             double *states, double *forces, int64_t *n_steps)
+int32_t icoac_sim_trajectory_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                                   const icoac_prior_t *prior, double x0, double theta0,
+                                   double init_velocity_noise, uint64_t seed, int64_t max_steps,
+                                   double *states, double *forces, int64_t *n_steps)
 {
+    const icoac_sim_plant_desc_t *desc;
     icoac_state_t ctrl;
     icoac_rng_t rng;
     icoac_sim_cell_t cell;
     icoac_input_t in;
     icoac_output_t out;
-    double s[4];
+    double s[ICOAC_SIM_MAX_STATE];
+    size_t row;
     int64_t k;
     uint32_t fpu_mode;
-    int32_t status = sim_check_all(cfg, plant, 0);
+    int32_t status = sim_check_all(cfg, model, 0);
     if (status != ICOAC_SIM_OK) {
         return status;
     }
@@ -30,28 +32,40 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t 
     if (status != ICOAC_SIM_OK) {
         return status;
     }
+    desc = icoac_sim_plant_info(model->plant);
+    row = (size_t)desc->n_state;
     fpu_mode = sim_fpu_flush_subnormals();
     memset(&cell, 0, sizeof cell);
     cell.x0 = x0;
     cell.theta0 = theta0;
-    icoac_rng_seed(&rng, seed, 2u);
-    sim_start_trial(&cell, init_velocity_noise, &rng, s);
-    memcpy(states, s, sizeof s);
+    icoac_rng_seed(&rng, seed, ICOAC_SIM_START_STREAM);
+    sim_start_trial(desc, &cell, init_velocity_noise, &rng, s);
+    memcpy(states, s, row * sizeof s[0]);
     *n_steps = 0;
     for (k = 0; k < max_steps; ++k) {
-        sim_to_input(s, 0u, &in);
+        sim_to_input(s, cfg->task.n_inputs, 0u, &in);
         status = (int32_t)icoac_step(&ctrl, &in, &out);
         if (status != ICOAC_SIM_OK) {
             break;
         }
         forces[k] = (double)out.force;
-        icoac_sim_plant_step(plant, s, forces[k]);
-        memcpy(states + 4 * (k + 1), s, sizeof s);
+        desc->step(model->param, model->dt, model->integrator, s, forces[k]);
+        memcpy(states + row * (size_t)(k + 1), s, row * sizeof s[0]);
         *n_steps = k + 1;
-        if (sim_failed(plant, s)) {
+        if (desc->failed(model->param, s)) {
             break;
         }
     }
     sim_fpu_restore(fpu_mode);
     return status;
+}
+
+int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
+                             const icoac_prior_t *prior, double x0, double theta0,
+                             double init_velocity_noise, uint64_t seed, int64_t max_steps,
+                             double *states, double *forces, int64_t *n_steps)
+{
+    icoac_sim_model_t model;
+    return icoac_sim_trajectory_model(cfg, sim_model_of(plant, &model), prior, x0, theta0, init_velocity_noise,
+                                      seed, max_steps, states, forces, n_steps);
 }

@@ -6,22 +6,13 @@
 #include <pthread.h>
 #include <time.h>
 
-#include "icoac_sim/icoac_sim.h"
+#include "test_sim_common.h"
 
 static icoac_sim_plant_t default_plant(void)
 {
     icoac_sim_plant_t p;
     icoac_sim_plant_default(&p);
     return p;
-}
-
-static icoac_sim_run_t small_run(int64_t max_trials, int64_t success_steps)
-{
-    icoac_sim_run_t r;
-    icoac_sim_run_default(&r);
-    r.max_trials = max_trials;
-    r.success_steps = success_steps;
-    return r;
 }
 
 static icoac_sim_cell_t make_cell(double x0, double theta0, uint64_t seed)
@@ -54,7 +45,7 @@ static void check_accounting(const icoac_sim_cell_t *c, const icoac_sim_run_t *r
 static void test_run_cell_deterministic(void **unused)
 {
     const icoac_sim_plant_t plant = default_plant();
-    const icoac_sim_run_t run = small_run(15, 1500);
+    const icoac_sim_run_t run = test_small_run(15, 1500);
     int mode;
     (void)unused;
     for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
@@ -77,7 +68,7 @@ static void test_run_cell_outcomes(void **unused)
 {
     const icoac_sim_plant_t plant = default_plant();
     icoac_config_t cfg = test_default_config();
-    icoac_sim_run_t run = small_run(5, 1);
+    icoac_sim_run_t run = test_small_run(5, 1);
     icoac_sim_cell_t c = make_cell(0.0, 0.0, 1u);
     int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
     (void)unused;
@@ -91,7 +82,7 @@ static void test_run_cell_outcomes(void **unused)
     assert_int_equal(progress[ICOAC_SIM_PROGRESS_STEPS], 1);
     check_accounting(&c, &run);
     /* leaning 11.9 deg with w = 0 and the 1 N reflex: every trial falls */
-    run = small_run(4, 100000);
+    run = test_small_run(4, 100000);
     c = make_cell(0.0, DEG(11.9), 1u);
     assert_int_equal(icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL), ICOAC_SIM_OK);
     assert_int_equal(c.outcome, ICOAC_SIM_FAILED);
@@ -110,7 +101,7 @@ static void test_numeric_fault_marks_cell_error(void **unused)
 {
     const icoac_sim_plant_t plant = default_plant();
     icoac_config_t cfg = test_default_config();
-    icoac_sim_run_t run = small_run(50, 5000);
+    icoac_sim_run_t run = test_small_run(50, 5000);
     icoac_sim_cell_t cells[2];
     const icoac_prior_t prior = test_prior(0.1, 0.1, 0.5, 0.1, (double)ICOAC_PRIOR_COV_MAX);
     int i, j, k;
@@ -140,7 +131,7 @@ static void test_failure_at_the_last_step(void **unused)
 {
     const icoac_sim_plant_t plant = default_plant();
     icoac_config_t cfg = test_default_config();
-    icoac_sim_run_t run = small_run(1, 100000);
+    icoac_sim_run_t run = test_small_run(1, 100000);
     icoac_sim_cell_t c = make_cell(0.0, DEG(11.9), 1u);
     int64_t n;
     (void)unused;
@@ -150,14 +141,14 @@ static void test_failure_at_the_last_step(void **unused)
     assert_int_equal(c.outcome, ICOAC_SIM_FAILED);
     n = c.last_trial_steps;
     assert_true(n > 1 && n < 1000);
-    run = small_run(2, n);
+    run = test_small_run(2, n);
     c = make_cell(0.0, DEG(11.9), 1u);
     assert_int_equal(icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL), ICOAC_SIM_OK);
     assert_int_equal(c.outcome, ICOAC_SIM_FAILED);
     assert_int_equal(c.trials, 2);
     assert_int_equal(c.last_trial_steps, n);
     check_accounting(&c, &run);
-    run = small_run(2, n - 1);
+    run = test_small_run(2, n - 1);
     c = make_cell(0.0, DEG(11.9), 1u);
     assert_int_equal(icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL), ICOAC_SIM_OK);
     assert_int_equal(c.outcome, ICOAC_SIM_SUCCESS);
@@ -169,7 +160,7 @@ static void run_grid_ok(const icoac_config_t *cfg, icoac_sim_cell_t *cells, int6
                         int64_t progress[ICOAC_SIM_PROGRESS_LEN])
 {
     const icoac_sim_plant_t plant = default_plant();
-    const icoac_sim_run_t run = small_run(10, 1000);
+    const icoac_sim_run_t run = test_small_run(10, 1000);
     assert_int_equal(icoac_sim_run_grid(cfg, &plant, &run, NULL, cells, n, threads, NULL, progress), ICOAC_SIM_OK);
 }
 
@@ -191,7 +182,7 @@ static void test_grid_thread_independent(void **unused)
     icoac_sim_cell_t one[NSUB], two[NSUB], solo[NSUB];
     int64_t p1[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0}, p2[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
     const icoac_sim_plant_t plant = default_plant();
-    const icoac_sim_run_t run = small_run(10, 1000);
+    const icoac_sim_run_t run = test_small_run(10, 1000);
     int mode, i;
     (void)unused;
     for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
@@ -231,7 +222,7 @@ static void test_lanes_match_single_cells(void **unused)
     static const int pick[NLANE] = {612, 0, 1224, 600, 24, 611, 613, 100, 1000, 587, 637};
     static icoac_sim_cell_t grid[ICOAC_SIM_GRID_CELLS];
     const icoac_sim_plant_t plant = default_plant();
-    const icoac_sim_run_t run = small_run(40, 600);
+    const icoac_sim_run_t run = test_small_run(40, 600);
     const icoac_prior_t prior = test_prior(0.094, 0.066, 0.365, 0.080, 1e-3);
     icoac_sim_cell_t solo[NLANE], cells[NLANE];
     int mode, threads, i;
@@ -293,7 +284,7 @@ static void test_cancel_mid_run(void **unused)
 {
     icoac_config_t cfg = test_default_config();
     const icoac_sim_plant_t plant = default_plant();
-    const icoac_sim_run_t run = small_run(300, 1000);
+    const icoac_sim_run_t run = test_small_run(300, 1000);
     icoac_sim_cell_t cells[NSUB], reference[NSUB], before[NSUB];
     volatile int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
     volatile int32_t cancel = 0;
@@ -331,7 +322,7 @@ static void test_cancel_and_resume(void **unused)
 {
     icoac_config_t cfg = test_default_config();
     const icoac_sim_plant_t plant = default_plant();
-    const icoac_sim_run_t run = small_run(10, 1000);
+    const icoac_sim_run_t run = test_small_run(10, 1000);
     icoac_sim_cell_t cells[NSUB], reference[NSUB], before[NSUB];
     int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
     volatile int32_t cancel = 1;
@@ -368,7 +359,7 @@ static void test_bad_parameters(void **unused)
 {
     const icoac_config_t good_cfg = test_default_config();
     const icoac_sim_plant_t good_plant = default_plant();
-    const icoac_sim_run_t good_run = small_run(3, 100);
+    const icoac_sim_run_t good_run = test_small_run(3, 100);
     icoac_config_t cfg = good_cfg;
     icoac_sim_plant_t plant = good_plant;
     icoac_sim_run_t run = good_run;
@@ -504,7 +495,7 @@ static void test_fpu_mode_restored(void **unused)
 {
     const icoac_config_t cfg = test_default_config();
     const icoac_sim_plant_t plant = default_plant();
-    const icoac_sim_run_t run = small_run(2, 50);
+    const icoac_sim_run_t run = test_small_run(2, 50);
     icoac_sim_cell_t c = make_cell(0.0, 0.0, 5u);
     double states[(50 + 1) * 4], forces[50];
     int64_t n;

@@ -18,6 +18,9 @@ static const type_size_t types[] = {
     {"icoac_counters_t", sizeof(icoac_counters_t)},   {"icoac_input_t", sizeof(icoac_input_t)},
     {"icoac_output_t", sizeof(icoac_output_t)},       {"icoac_sim_plant_t", sizeof(icoac_sim_plant_t)},
     {"icoac_sim_run_t", sizeof(icoac_sim_run_t)},     {"icoac_sim_cell_t", sizeof(icoac_sim_cell_t)},
+    {"icoac_sim_axis_t", sizeof(icoac_sim_axis_t)},   {"icoac_sim_param_t", sizeof(icoac_sim_param_t)},
+    {"icoac_sim_sweep_t", sizeof(icoac_sim_sweep_t)}, {"icoac_sim_plant_desc_t", sizeof(icoac_sim_plant_desc_t)},
+    {"icoac_sim_model_t", sizeof(icoac_sim_model_t)},       {"icoac_rng_t", sizeof(icoac_rng_t)},
 };
 
 #define N_TYPES (sizeof types / sizeof types[0])
@@ -87,12 +90,13 @@ static void test_constants_table(void **unused)
     assert_true(constant("ICOAC_ABI_VERSION") == ICOAC_ABI_VERSION);
     assert_true(constant("ICOAC_ABI_VERSION") == 8);
     assert_true(constant("ICOAC_SIM_ABI_VERSION") == ICOAC_SIM_ABI_VERSION);
-    assert_true(constant("ICOAC_SIM_ABI_VERSION") == 2);
+    assert_true(constant("ICOAC_SIM_ABI_VERSION") == 3);
     assert_true(constant("ICOAC_CARTPOLE_INPUTS") == ICOAC_CARTPOLE_INPUTS);
     assert_true(constant("ICOAC_CARTPOLE_CRITIC_UNITS") == ICOAC_CARTPOLE_CRITIC_UNITS);
     assert_true(constant("ICOAC_STATE_SIZE") == ICOAC_STATE_SIZE);
     assert_true(constant("ICOAC_STATE_SIZE") == (double)icoac_sizeof_state());
     assert_true(constant("ICOAC_INPUT_TERMINAL") == ICOAC_INPUT_TERMINAL);
+    assert_true(constant("ICOAC_FORCE_MAX") == (double)ICOAC_FORCE_MAX);
     assert_true(constant("ICOAC_MODE_ICO") == ICOAC_MODE_ICO);
     assert_true(constant("ICOAC_MODE_RL") == ICOAC_MODE_RL);
     assert_true(constant("ICOAC_MODE_SEARCH") == ICOAC_MODE_SEARCH);
@@ -117,6 +121,11 @@ static void test_constants_table(void **unused)
     assert_true(constant("ICOAC_SIM_GRID_X_STEP") == ICOAC_SIM_GRID_X_STEP);
     assert_true(constant("ICOAC_SIM_GRID_THETA_FIRST_DEG") == ICOAC_SIM_GRID_THETA_FIRST_DEG);
     assert_true(constant("ICOAC_SIM_PI") == ICOAC_SIM_PI);
+    assert_true(constant("ICOAC_SIM_MAX_STATE") == ICOAC_SIM_MAX_STATE);
+    assert_true(constant("ICOAC_SIM_MAX_PARAMS") == ICOAC_SIM_MAX_PARAMS);
+    assert_true(constant("ICOAC_SIM_CART_POLE") == ICOAC_SIM_CART_POLE);
+    assert_true(constant("ICOAC_SIM_START_STREAM") == ICOAC_SIM_START_STREAM);
+    assert_true(constant("ICOAC_SIM_ERR_NONFINITE") == ICOAC_SIM_ERR_NONFINITE);
 }
 
 /* Byte coverage of one type by its listed members. */
@@ -236,6 +245,11 @@ static void test_fields_spot_checks(void **unused)
     SPOT(icoac_sim_plant_t, integrator);
     SPOT(icoac_sim_run_t, init_velocity_noise);
     SPOT(icoac_sim_cell_t, cov);
+    SPOT(icoac_sim_param_t, max);
+    SPOT(icoac_sim_sweep_t, degrees);
+    SPOT(icoac_sim_plant_desc_t, observed);
+    SPOT(icoac_sim_plant_desc_t, energy);
+    SPOT(icoac_sim_model_t, param);
     /* the nested layout, as the table names it */
     assert_int_equal(find_field("icoac_config_t", "critic.range")->size, ICOAC_MAX_INPUTS * sizeof(icoac_real_t));
     assert_int_equal(find_field("icoac_config_t", "task.rule_input")->size, ICOAC_MAX_RULES * sizeof(int32_t));

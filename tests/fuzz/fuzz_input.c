@@ -310,3 +310,32 @@ int fz_config_equal(const icoac_config_t *a, const icoac_config_t *b)
     }
     return 1;
 }
+
+#if defined(ICOAC_FUZZ_SIM) && ICOAC_FUZZ_SIM
+void fz_run(fz_reader_t *r, icoac_sim_run_t *run)
+{
+    const uint8_t mode = fz_u8(r);
+    int n;
+    icoac_sim_run_default(run);
+    if (mode & 1u) {
+        fz_overlay(r, run, sizeof *run);
+        return;
+    }
+    for (n = (mode >> 1) % 4; n > 0; --n) {
+        const int field = fz_u8(r) % 3;
+        if (field == 0) {
+            run->max_trials = fz_i64(r);
+        } else if (field == 1) {
+            run->success_steps = fz_i64(r);
+        } else {
+            run->init_velocity_noise = fz_double(r);
+        }
+    }
+}
+
+int32_t fz_threads(fz_reader_t *r)
+{
+    const uint8_t b = fz_u8(r) % 16;
+    return b == 15 ? -1 : (b >= 13 ? 2 : 1);
+}
+#endif

@@ -5,7 +5,7 @@
  *           icoac_sim_plant_default; b even: the default with (b >> 1) % 8 mutations, each a
  *           field byte (% 9: 0 gravity, 1 cart_mass, 2 pole_mass, 3 half_length, 4 dt,
  *           5 x_limit, 6 theta_limit as doubles; 7 integrator, 8 reserved as int32) and a value.
- *   run     mode byte b. b odd: raw bytes over icoac_sim_run_default; b even: (b >> 1) % 4
+ *   run     (fz_run) mode byte b. b odd: raw bytes over icoac_sim_run_default; b even: (b >> 1) % 4
  *           mutations, each a field byte (% 3: 0 max_trials, 1 success_steps as int64;
  *           2 init_velocity_noise as double) and a value.
  *   config, prior   as in fuzz_controller.c (float controller).
@@ -48,9 +48,6 @@
 #include "icoac_sim/icoac_sim.h"
 
 #define FZ_SIM_OPS 4
-#define FZ_SIM_MAX_TRIALS 3
-#define FZ_SIM_SUCCESS_STEPS 300
-#define FZ_SIM_TICK_BUDGET 3600
 #define FZ_SIM_MAX_CELLS 4
 #define FZ_TRAJ_MAX_STEPS 64
 #define N ICOAC_CARTPOLE_INPUTS
@@ -64,17 +61,12 @@ typedef struct {
     icoac_sim_run_t run;          /* clamped */
     icoac_prior_t prior_storage;
     const icoac_prior_t *prior;
-    int32_t failing[3];           /* statuses of the failing checks: config, plant, run */
+    int32_t failing[3];           /* statuses of the failing checks: config, plant or observation, run */
     int n_failing;                /* config and plant only */
     int run_failing;              /* the run check failed (failing[n_failing]) */
     int32_t prior_status;
     int64_t budget;               /* controller ticks left for cells and grids */
 } setup_t;
-
-static int known_status(int32_t status)
-{
-    return strcmp(icoac_sim_status_str(status), "unknown status") != 0;
-}
 
 static int finite_positive(double v)
 {
@@ -88,12 +80,6 @@ static int plant_documented(const icoac_sim_plant_t *p)
            finite_positive(p->half_length) && finite_positive(p->dt) && p->dt <= 1.0 &&
            finite_positive(p->x_limit) && finite_positive(p->theta_limit) &&
            (p->integrator == ICOAC_SIM_EULER || p->integrator == ICOAC_SIM_RK4);
-}
-
-static int run_documented(const icoac_sim_run_t *run)
-{
-    return run->max_trials >= 1 && run->success_steps >= 1 && isfinite(run->init_velocity_noise) &&
-           run->init_velocity_noise >= 0.0;
 }
 
 /* Definition of icoac_sim_failed: outside the strict limits, or not finite. */
@@ -131,34 +117,12 @@ static void decode_plant(fz_reader_t *r, icoac_sim_plant_t *plant)
     }
 }
 
-static void decode_run(fz_reader_t *r, icoac_sim_run_t *run)
-{
-    const uint8_t mode = fz_u8(r);
-    int n;
-    icoac_sim_run_default(run);
-    if (mode & 1u) {
-        fz_overlay(r, run, sizeof *run);
-        return;
-    }
-    for (n = (mode >> 1) % 4; n > 0; --n) {
-        const int field = fz_u8(r) % 3;
-        if (field == 0) {
-            run->max_trials = fz_i64(r);
-        } else if (field == 1) {
-            run->success_steps = fz_i64(r);
-        } else {
-            run->init_velocity_noise = fz_double(r);
-        }
-    }
-}
-
 /* Decode the setup, run the checks and clamp the run. */
 static void decode_setup(fz_reader_t *r, setup_t *su)
 {
     int32_t status;
-    int32_t clamped_status;
     decode_plant(r, &su->plant);
-    decode_run(r, &su->run);
+    fz_run(r, &su->run);
     fz_config(r, &su->cfg);
     su->prior = fz_prior(r, &su->prior_storage);
     su->n_failing = 0;
@@ -166,10 +130,7 @@ static void decode_setup(fz_reader_t *r, setup_t *su)
     su->budget = FZ_SIM_TICK_BUDGET;
 
     status = (int32_t)icoac_config_check(&su->cfg);
-    /* the engine's plant is the cart-pole: a task of another input count is a bad argument */
-    if (status == ICOAC_OK && su->cfg.task.n_inputs != ICOAC_CARTPOLE_INPUTS) {
-        status = ICOAC_SIM_ERR_BAD_ARGUMENT;
-    }
+    const int config_ok = status == ICOAC_OK;
     if (status != ICOAC_OK) {
         su->failing[su->n_failing++] = status;
     }
@@ -182,19 +143,11 @@ static void decode_setup(fz_reader_t *r, setup_t *su)
     if (status != ICOAC_SIM_OK) {
         su->failing[su->n_failing++] = status;
     }
-    status = icoac_sim_run_check(&su->run);
-    FZ_CHECK(status == ICOAC_SIM_OK || status == ICOAC_SIM_ERR_BAD_RUN, "run_check returned %d", (int)status);
-    FZ_CHECK(status != ICOAC_SIM_OK || run_documented(&su->run), "run_check accepted trials %lld steps %lld noise %g",
-             (long long)su->run.max_trials, (long long)su->run.success_steps, su->run.init_velocity_noise);
-    if (su->run.max_trials > FZ_SIM_MAX_TRIALS) {
-        su->run.max_trials = FZ_SIM_MAX_TRIALS;
+    /* the plant is the cart-pole: a task of another input count does not fit its observation */
+    if (config_ok && status == ICOAC_SIM_OK && su->cfg.task.n_inputs != ICOAC_CARTPOLE_INPUTS) {
+        su->failing[su->n_failing++] = ICOAC_SIM_ERR_BAD_PLANT;
     }
-    if (su->run.success_steps > FZ_SIM_SUCCESS_STEPS) {
-        su->run.success_steps = FZ_SIM_SUCCESS_STEPS;
-    }
-    clamped_status = icoac_sim_run_check(&su->run);
-    FZ_CHECK(clamped_status == status, "run_check: %d before clamping max_trials / success_steps, %d after",
-             (int)status, (int)clamped_status);
+    status = fz_run_clamp(&su->run);
     if (status != ICOAC_SIM_OK) {
         su->failing[su->n_failing] = status;
         su->run_failing = 1;
@@ -220,60 +173,6 @@ static int checks_fail(const setup_t *su, int with_run)
     return su->n_failing > 0 || (with_run && su->run_failing);
 }
 
-static int finite_cell_posterior(const icoac_sim_cell_t *cell)
-{
-    int i;
-    int j;
-    for (i = 0; i < N; ++i) {
-        if (!isfinite(cell->weights[i])) {
-            return 0;
-        }
-        for (j = 0; j < N; ++j) {
-            if (!isfinite(cell->cov[i][j])) {
-                return 0;
-            }
-        }
-    }
-    return 1;
-}
-
-/* A cell after a run that returned OK. */
-static void check_finished_cell(const setup_t *su, const icoac_sim_cell_t *cell, const char *what)
-{
-    const int32_t outcome = cell->outcome;
-    FZ_CHECK(outcome == ICOAC_SIM_SUCCESS || outcome == ICOAC_SIM_FAILED || outcome == ICOAC_SIM_ERROR,
-             "%s: outcome %d after the run", what, (int)outcome);
-    FZ_CHECK(known_status(cell->status), "%s: unknown cell status %d", what, (int)cell->status);
-    FZ_CHECK(cell->trials >= 0 && cell->trials <= su->run.max_trials && cell->last_trial_steps >= 0 &&
-                 cell->last_trial_steps <= su->run.success_steps && cell->total_steps >= cell->last_trial_steps &&
-                 cell->total_steps <= cell->trials * su->run.success_steps,
-             "%s: counts trials %lld total %lld last %lld (max_trials %lld, success_steps %lld)", what,
-             (long long)cell->trials, (long long)cell->total_steps, (long long)cell->last_trial_steps,
-             (long long)su->run.max_trials, (long long)su->run.success_steps);
-    FZ_CHECK(cell->elapsed_time == su->plant.dt * (double)cell->total_steps,
-             "%s: elapsed_time %g, dt * total_steps %g", what, cell->elapsed_time,
-             su->plant.dt * (double)cell->total_steps);
-    if (outcome == ICOAC_SIM_ERROR) {
-        FZ_CHECK(cell->status != ICOAC_SIM_OK, "%s: ERROR cell with status OK", what);
-        return;
-    }
-    FZ_CHECK(cell->status == ICOAC_SIM_OK, "%s: outcome %d with status %d (%s)", what, (int)outcome,
-             (int)cell->status, icoac_sim_status_str(cell->status));
-    FZ_CHECK(finite_cell_posterior(cell), "%s: outcome %d with non-finite weights (%g %g %g %g) or cov", what,
-             (int)outcome, cell->weights[0], cell->weights[1], cell->weights[2], cell->weights[3]);
-    if (outcome == ICOAC_SIM_SUCCESS) {
-        FZ_CHECK(cell->trials >= 1 && cell->last_trial_steps == su->run.success_steps,
-                 "%s: SUCCESS after %lld trials, last %lld steps", what, (long long)cell->trials,
-                 (long long)cell->last_trial_steps);
-    } else {
-        /* a trial that fails at its last step is a failure: last_trial_steps may equal the cap */
-        FZ_CHECK(cell->trials == su->run.max_trials && cell->last_trial_steps >= 1 &&
-                     cell->last_trial_steps <= su->run.success_steps,
-                 "%s: FAILED after %lld trials, last %lld steps", what, (long long)cell->trials,
-                 (long long)cell->last_trial_steps);
-    }
-}
-
 static void op_plant(fz_reader_t *r, const setup_t *su)
 {
     double s[N];
@@ -294,19 +193,6 @@ static void op_plant(fz_reader_t *r, const setup_t *su)
     }
 }
 
-/* Charge the tick budget for n cells; 0 when it is spent (the op is skipped). */
-static int charge(setup_t *su, int64_t n_cells)
-{
-    int64_t trials = su->run.max_trials > 0 ? su->run.max_trials : 1;
-    int64_t steps = su->run.success_steps > 0 ? su->run.success_steps : 1;
-    const int64_t cost = n_cells * trials * steps;
-    if (cost > su->budget) {
-        return 0;
-    }
-    su->budget -= cost;
-    return 1;
-}
-
 static void op_cell(fz_reader_t *r, setup_t *su)
 {
     icoac_sim_cell_t cell;
@@ -316,12 +202,12 @@ static void op_cell(fz_reader_t *r, setup_t *su)
     cell.x0 = fz_double(r);
     cell.theta0 = fz_double(r);
     cell.seed = fz_u8(r);
-    if (!charge(su, 1)) {
+    if (!fz_charge(&su->budget, &su->run, 1)) {
         return;
     }
     given = cell;
     status = icoac_sim_run_cell(&su->cfg, &su->plant, &su->run, su->prior, &cell, 0, 0);
-    FZ_CHECK(known_status(status), "run_cell returned unknown status %d", (int)status);
+    FZ_CHECK(fz_sim_status_known(status), "run_cell returned unknown status %d", (int)status);
     if (checks_fail(su, 1)) {
         FZ_CHECK(refused_as_expected(su, status, 1), "run_cell returned %d (%s) though a check failed with %d",
                  (int)status, icoac_sim_status_str(status), (int)su->failing[0]);
@@ -340,7 +226,7 @@ static void op_cell(fz_reader_t *r, setup_t *su)
              icoac_sim_status_str(status));
     FZ_CHECK(cell.x0 == given.x0 && cell.theta0 == given.theta0 && cell.seed == given.seed,
              "run_cell changed the cell's inputs");
-    check_finished_cell(su, &cell, "run_cell");
+    fz_check_finished_cell(&su->run, su->plant.dt, &cell, "run_cell");
 }
 
 static void op_grid(fz_reader_t *r, setup_t *su)
@@ -350,8 +236,7 @@ static void op_grid(fz_reader_t *r, setup_t *su)
     int preset[FZ_SIM_MAX_CELLS];
     const uint8_t count = fz_u8(r);
     const int n = count % 32 == 31 ? 0 : 1 + count % FZ_SIM_MAX_CELLS;
-    const uint8_t threads_byte = fz_u8(r) % 16;
-    const int32_t threads = threads_byte == 15 ? -1 : (threads_byte >= 13 ? 2 : 1);
+    const int32_t threads = fz_threads(r);
     int all_finite = 1;
     int pending = 0;
     int32_t status;
@@ -372,12 +257,12 @@ static void op_grid(fz_reader_t *r, setup_t *su)
         }
         all_finite = all_finite && isfinite(cells[i].x0) && isfinite(cells[i].theta0);
     }
-    if (!charge(su, pending)) {
+    if (!fz_charge(&su->budget, &su->run, pending)) {
         return;
     }
     memcpy(given, cells, sizeof cells);
     status = icoac_sim_run_grid(&su->cfg, &su->plant, &su->run, su->prior, cells, n, threads, 0, 0);
-    FZ_CHECK(known_status(status), "run_grid returned unknown status %d", (int)status);
+    FZ_CHECK(fz_sim_status_known(status), "run_grid returned unknown status %d", (int)status);
     if (status != ICOAC_SIM_OK) {
         FZ_CHECK(memcmp(cells, given, sizeof cells) == 0, "run_grid returned %d (%s) but changed cells",
                  (int)status, icoac_sim_status_str(status));
@@ -405,7 +290,7 @@ static void op_grid(fz_reader_t *r, setup_t *su)
         if (preset[i]) {
             FZ_CHECK(memcmp(&cells[i], &given[i], sizeof cells[i]) == 0, "run_grid reran finished cell %d", i);
         } else {
-            check_finished_cell(su, &cells[i], "run_grid");
+            fz_check_finished_cell(&su->run, su->plant.dt, &cells[i], "run_grid");
         }
     }
 }
@@ -431,7 +316,7 @@ static void op_trajectory(fz_reader_t *r, const setup_t *su)
     }
     status = icoac_sim_trajectory(&su->cfg, &su->plant, su->prior, x0, theta0, noise, seed, max_steps, states,
                                   forces, &n_steps);
-    FZ_CHECK(known_status(status), "trajectory returned unknown status %d", (int)status);
+    FZ_CHECK(fz_sim_status_known(status), "trajectory returned unknown status %d", (int)status);
     if (checks_fail(su, 0)) {
         FZ_CHECK(refused_as_expected(su, status, 0), "trajectory returned %d though a check failed with %d",
                  (int)status, (int)su->failing[0]);

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Write the committed seed corpus of the fuzz targets, tests/fuzz/corpus/<target>/.
 
-Inputs follow the formats documented at the top of fuzz_controller.c, fuzz_state.c and
-fuzz_sim.c; the value tables below mirror fuzz_input.c, the state fields fuzz_state.c. Files
-named repro-* are known reproducers.
+Inputs follow the formats documented at the top of fuzz_controller.c, fuzz_state.c,
+fuzz_sim.c and fuzz_model.c; the value tables below mirror fuzz_input.c, the state fields
+fuzz_state.c. Files named repro-* are known reproducers.
 
     python3 tests/fuzz/gen_corpus.py          # (re)write the corpus
     python3 tests/fuzz/gen_corpus.py --check  # exit 1 unless the committed corpus is current
@@ -829,6 +829,248 @@ def sim_seeds():
     }
 
 
+# ---- fuzz_model ----
+
+# The registry in its order (plant_registry.c): name, n_state.
+PLANTS = [("cart_pole", 4), ("furuta", 4), ("double_cart_pole", 6)]
+MAX_PARAMS = 16
+MODEL_FIELDS = ["plant", "integrator", "dt"]  # then 3 + i: param<i>, 3 + MAX_PARAMS + i: bound<i>
+# bound<i> selectors: a bound of the range, or past n_params -0, 0, DBL_TRUE_MIN, -DBL_TRUE_MIN
+BOUNDS = ["min", "max", "below", "above"]
+M_STEP, M_DERIVATIVES, M_FAILED, M_ENERGY, M_START, M_GRID, M_REGISTRY, M_PLANT = range(8)
+# NULL pointers of an op (o >= 0xC0): the state array (plant op: the plant), the output (start:
+# the cell; plant op: the model), the rng
+NULL_STATE, NULL_OUT, NULL_RNG = 0xC8, 0xD0, 0xE0
+GRID_SIZES = ["exact", 0, -1, "exact-1", "exact+1", "max", "min", 1]
+
+
+def model(of=0, **fields):
+    """icoac_sim_model_default of registry plant `of` with mutations (at most 7, in order):
+    plant, integrator (int32), dt, param<i> (doubles), bound<i> (a BOUNDS name)."""
+    assert len(fields) <= 7
+    out = bytes([len(fields) << 2, of])
+    for name, v in fields.items():
+        if name in ("plant", "integrator"):
+            out += bytes([MODEL_FIELDS.index(name)]) + int32(v)
+        elif name == "dt":
+            out += bytes([2]) + double(v)
+        elif name.startswith("param"):
+            out += bytes([3 + int(name[5:])]) + double(v)
+        else:
+            out += bytes([3 + MAX_PARAMS + int(name[5:]), BOUNDS.index(v)])
+    return out
+
+
+def model_raw(plant, integrator, dt, params, over=0):
+    """Raw icoac_sim_model_t bytes laid over the default of registry plant `over`."""
+    params = list(params) + [0.0] * (MAX_PARAMS - len(params))
+    return b"\x01" + bytes([over]) + struct.pack("<iid16d", plant, integrator, dt, *params)
+
+
+NULL_MODEL = b"\x03\x00"
+
+
+def op_state(kind, s, u=None, nulls=0):
+    """step, derivatives (with u), failed or energy on s (padded to 6 values with 0)."""
+    s = list(s) + ["0"] * (6 - len(s))
+    out = bytes([kind | nulls]) + b"".join(double(x) for x in s)
+    return out + (double(u) if kind in (M_STEP, M_DERIVATIVES) else b"")
+
+
+def op_start(x0, theta0, cell_seed, noise, rng_seed, nulls=0):
+    return (bytes([M_START | nulls]) + double(x0) + double(theta0) + bytes([cell_seed]) + double(noise)
+            + bytes([rng_seed]))
+
+
+def op_model_grid(index, size="exact", grid_seed=7, null=False):
+    return bytes([M_GRID]) + int32(index) + bytes([GRID_SIZES.index(size) | (0x80 if null else 0), grid_seed])
+
+
+def op_registry(index, name=None):
+    """name: None (NULL), ("plant", i) its name, ("truncated", i) less its last character, or a str."""
+    out = bytes([M_REGISTRY]) + int32(index)
+    if name is None:
+        return out + b"\x00"
+    if isinstance(name, tuple):
+        return out + bytes([1 if name[0] == "plant" else 2, name[1]])
+    raw = name.encode()
+    return out + bytes([3, len(raw)]) + raw
+
+
+def op_model_plant(s, force, reserved=0, nulls=0):
+    return bytes([M_PLANT | nulls]) + b"".join(double(x) for x in s) + double(force) + int32(reserved)
+
+
+# Run ops (op bytes 0x80..0xBF): kind, and NULL pointers with RUN_NULLS (the configuration, the
+# cell / cells / trajectory states, the run / trajectory forces).
+R_CELL, R_GRID, R_TRAJECTORY, R_CANCELLED = 0x80, 0x81, 0x82, 0x83
+RUN_NULLS, NULL_CFG, NULL_CELLS, NULL_RUN = 0x20, 0x24, 0x28, 0x30
+PRESETS = [None, "success", "failed", "error"]
+
+
+def grid_cell(i, grid_seed=1, preset=None):
+    """Cell i of the plant byte's grid with grid_seed; preset: a finished outcome (grid op)."""
+    return bytes([PRESETS.index(preset) << 1, grid_seed]) + struct.pack("<H", i)
+
+
+def xy_cell(x0, theta0, cell_seed=1, preset=None):
+    return bytes([1 | PRESETS.index(preset) << 1]) + double(x0) + double(theta0) + bytes([cell_seed])
+
+
+def op_run_cell(cell, run_=None, cfg=None, prior_=NO_PRIOR, nulls=0):
+    """icoac_sim_run_cell_model; run_ and cfg default to run() and config()."""
+    return bytes([R_CELL | nulls]) + (run_ or run()) + (cfg or config()) + prior_ + cell
+
+
+def op_run_grid(cells, threads=1, run_=None, cfg=None, prior_=NO_PRIOR, nulls=0, cancelled=False):
+    """icoac_sim_run_grid_model on 0 to 4 cells (cell specs)."""
+    count = len(cells) - 1 if cells else 31
+    return (bytes([(R_CANCELLED if cancelled else R_GRID) | nulls]) + (run_ or run()) + (cfg or config()) + prior_
+            + bytes([count, {1: 0, 2: 13, -1: 15}[threads]]) + b"".join(cells))
+
+
+def op_run_trajectory(cell, noise, max_steps, cfg=None, prior_=NO_PRIOR, nulls=0, null_steps=False):
+    return (bytes([R_TRAJECTORY | nulls]) + (cfg or config()) + prior_ + cell + double(noise)
+            + bytes([(max_steps + 1) | (0x80 if null_steps else 0)]))
+
+
+SMALL_RUN = run(max_trials=3, success_steps=300)
+ONE_TRIAL = run(max_trials=1, success_steps=300)
+RL = config({"mode": 1})
+
+
+def run_ops(p):
+    """Each run op once on plant p's model within the tick budget (a cart-pole model runs twice,
+    through its plant struct too): ICO and RL cells, a grid with a finished cell, a trajectory."""
+    return (op_run_cell(grid_cell(600), ONE_TRIAL) + op_run_cell(xy_cell(0.1, 0.02, 3), SMALL_RUN, RL)
+            + op_run_grid([grid_cell(0, 2), grid_cell(612, 2, "success"), xy_cell(-0.5, -0.05, 4)], 2, ONE_TRIAL)
+            + op_run_trajectory(grid_cell(612, 5), "0.01", 64))
+
+
+def model_ops(p):
+    """Every op once on plant p's model, with small values."""
+    n = PLANTS[p][1]
+    s = [0.01 * (i + 1) for i in range(n)]
+    return (op_state(M_STEP, s, 0.5) + op_state(M_DERIVATIVES, s, -1.0) + op_state(M_FAILED, s)
+            + op_state(M_ENERGY, s) + op_start(0.5, 0.05, 1, 0.01, 2) + op_model_grid(p)
+            + op_registry(p, ("plant", p)) + op_model_plant((0.1, 0.0, 0.02, 0.0), 1.0))
+
+
+def model_seeds():
+    nulls = (op_state(M_STEP, [], 0.0, NULL_STATE) + op_state(M_DERIVATIVES, [0.1], 0.0, NULL_OUT)
+             + op_state(M_FAILED, [], nulls=NULL_STATE | NULL_OUT) + op_state(M_ENERGY, ["nan"], nulls=NULL_OUT)
+             + op_start(0.0, 0.0, 1, "0", 1, NULL_STATE) + op_start(0.0, 0.0, 1, "0", 1, NULL_OUT)
+             + op_start(0.0, 0.0, 1, "0", 1, NULL_RNG) + op_model_plant(("0",) * 4, "0", nulls=NULL_STATE)
+             + op_model_plant(("0",) * 4, "0", nulls=NULL_OUT))
+    s = {}
+    for p, (name, n) in enumerate(PLANTS):
+        s[f"{name}-default"] = model(p) + model_ops(p)
+        s[f"{name}-rk4"] = model(p, integrator=1) + model_ops(p) + op_state(M_STEP, [0.2] * n, 5.0)
+        s[f"{name}-bounds"] = (model(p, dt="1e-6", bound0="min", bound1="max", bound3="min", bound15="min")
+                               + model_ops(p) + op_state(M_STEP, [], 0.0))
+        s[f"{name}-param-below"] = model(p, bound0="below") + model_ops(p)
+        s[f"{name}-param-above"] = model(p, integrator=1, bound1="above") + model_ops(p)
+        s[f"{name}-unused-param"] = model(p, bound15="below") + model_ops(p)
+        s[f"{name}-param-nan"] = model(p, param2="nan") + model_ops(p)
+        s[f"{name}-nonfinite"] = (model(p) + op_state(M_STEP, ["nan"], 0.0) + op_state(M_STEP, [], "inf")
+                                  + op_state(M_DERIVATIVES, [0.0, "-inf"], 0.0) + op_state(M_DERIVATIVES, [], "nan")
+                                  + op_state(M_FAILED, ["0"] * (n - 1) + ["inf"]) + op_state(M_FAILED, ["nan"])
+                                  + op_state(M_ENERGY, ["0", "nan"]) + op_state(M_ENERGY, ["-inf"]))
+        s[f"{name}-overflow"] = (model(p, integrator=1) + op_state(M_STEP, [], "max")
+                                 + op_state(M_STEP, ["1e300"] * n, 0.0)
+                                 + op_state(M_DERIVATIVES, ["1e300"] * n, "max") + op_state(M_ENERGY, ["1e300"] * n)
+                                 + op_state(M_FAILED, ["1e300"] * n) + op_state(M_FAILED, [2.4, "0", "-2.4"]))
+        s[f"{name}-nulls"] = model(p) + nulls
+        s[f"{name}-start"] = (model(p) + op_start(0.5, 0.05, 1, "0", 2) + op_start(-2.4, "-2.4", 3, "1e-6", 4)
+                              + op_start("max", "-max", 5, 0.01, 6) + op_start(0.0, 0.0, 7, "1e-20", 8)
+                              + op_start(0.0, 0.0, 7, "1e6", 9) + op_start(0.0, 0.0, 7, "-1", 10)
+                              + op_start(0.0, 0.0, 7, "nan", 11) + op_start("inf", 0.0, 7, "0", 12)
+                              + op_start(0.0, "nan", 7, "0", 13) + op_start(0.0, 0.0, 7, "1e-310", 14))
+        s[f"{name}-grid"] = (model(p) + b"".join(op_model_grid(p, size, 3) for size in GRID_SIZES)
+                             + op_model_grid(p, null=True))
+    for p, (name, n) in enumerate(PLANTS):
+        s[f"{name}-runs"] = model(p) + run_ops(p)
+        s[f"{name}-runs-rk4"] = model(p, integrator=1, dt=0.02) + run_ops(p)
+    run_nulls = (op_run_cell(grid_cell(1), nulls=NULL_CFG) + op_run_cell(grid_cell(1), nulls=NULL_CELLS)
+                 + op_run_cell(grid_cell(1), nulls=NULL_RUN)
+                 + op_run_grid([grid_cell(1)], nulls=NULL_CFG) + op_run_grid([grid_cell(1)], nulls=NULL_CELLS)
+                 + op_run_grid([grid_cell(1)], nulls=NULL_RUN)
+                 + op_run_trajectory(grid_cell(1), "0", 8, nulls=NULL_CFG)
+                 + op_run_trajectory(grid_cell(1), "0", 8, nulls=NULL_CELLS)
+                 + op_run_trajectory(grid_cell(1), "0", 8, nulls=NULL_RUN)
+                 + op_run_trajectory(grid_cell(1), "0", 8, null_steps=True))
+    bad_args = (op_run_cell(xy_cell("nan", 0.0)) + op_run_cell(xy_cell(0.0, "-inf"))
+                + op_run_grid([]) + op_run_grid([grid_cell(1)], threads=-1)
+                + op_run_grid([grid_cell(1), xy_cell("inf", 0.0, 2, "failed")])
+                + op_run_trajectory(grid_cell(1), "0", 0) + op_run_trajectory(grid_cell(1), "0", -1)
+                + op_run_trajectory(xy_cell("nan", 0.0), "0", 8) + op_run_trajectory(grid_cell(1), "1e-20", 8)
+                + op_run_trajectory(grid_cell(1), "-1", 8) + op_run_trajectory(grid_cell(1), "inf", 8)
+                + op_run_trajectory(grid_cell(1), "1e6", 8))
+    # checks in order: config, model, observation fit, run; then arguments, then the prior
+    bad_config = config({"mode": 3})
+    bad_run = run(max_trials=0)
+    bad_prior = prior(((2, 2), "-1"))
+    order = (op_run_cell(xy_cell("nan", 0.0), bad_run, bad_config, bad_prior)
+             + op_run_cell(xy_cell("nan", 0.0), bad_run, None, bad_prior)
+             + op_run_cell(xy_cell("nan", 0.0), None, None, bad_prior) + op_run_cell(grid_cell(1), None, None, bad_prior)
+             + op_run_grid([], -1, bad_run, bad_config, bad_prior) + op_run_grid([], -1, bad_run, None, bad_prior)
+             + op_run_grid([grid_cell(1)], 1, None, None, bad_prior)
+             + op_run_trajectory(xy_cell("nan", 0.0), "-1", 0, bad_config, bad_prior)
+             + op_run_trajectory(grid_cell(1), "0", 8, None, bad_prior))
+    s.update({
+        "runs-nulls": model(0) + run_nulls,
+        "runs-null-model": NULL_MODEL + run_nulls + op_run_cell(grid_cell(1), cfg=config({"mode": 3})),
+        "runs-bad-arguments": model(1) + bad_args,
+        "runs-order-cart-pole": model(0) + order,
+        "runs-order-bad-model": model(1, param0="nan") + order,
+        "runs-order-unfit-plant": model(2) + order,
+        "runs-order-unused-param": model(0, param15=1.0) + order,
+        # -0 as an unused parameter: accepted, but no plant struct gives it back
+        "runs-unrepresentable": model(0, bound15="min") + run_ops(0),
+        "runs-cancelled": (model(1) + op_run_grid([grid_cell(3), grid_cell(5, 1, "failed")], 2, cancelled=True)
+                           + op_run_grid([grid_cell(3, 1, "error")], cancelled=True)
+                           + op_run_grid([grid_cell(3)], nulls=NULL_CFG, cancelled=True)),
+        "runs-presets": (model(0) + op_run_grid([grid_cell(0, 1, "success"), grid_cell(1, 1, "failed"),
+                                                 grid_cell(2, 1, "error"), xy_cell(0.0, 0.0, 1, "success")], 2)
+                         + op_run_grid([grid_cell(7), grid_cell(8), grid_cell(9), grid_cell(10)], 2, ONE_TRIAL)),
+        "runs-rl-prior": (model(1) + op_run_cell(grid_cell(100), SMALL_RUN, RL, prior(("mean2", 5.0), ("mean3", 1.0)))
+                          + op_run_trajectory(grid_cell(100), "0", 64, RL, prior(("mean2", 5.0)))),
+        "runs-search": (model(0) + op_run_cell(grid_cell(300), run(max_trials=3, success_steps=10),
+                                               config({"mode": 2, "search.batch": 1}))
+                        + op_run_grid([grid_cell(301), grid_cell(302)], 2, run(max_trials=3, success_steps=10),
+                                      config({"mode": 2, "search.batch": 2}))),
+        "runs-fall": (model(1, dt=0.1) + op_run_trajectory(xy_cell(0.0, 0.2, 9), "0.01", 64, config({"policy.gain": "0"}))
+                      + op_run_cell(xy_cell(0.0, 0.2, 9), SMALL_RUN, config({"policy.gain": "0"}))
+                      + op_run_trajectory(xy_cell("1e300", "-1e30", 9), "0", 64)),
+        "runs-noise": (model(0) + op_run_cell(grid_cell(11), run(max_trials=3, success_steps=300,
+                                                                 init_velocity_noise="1e-6"))
+                       + op_run_trajectory(grid_cell(11), "1e-6", 64) + op_run_trajectory(grid_cell(11), 3.0, 64)),
+        "null-model": NULL_MODEL + model_ops(0) + nulls,
+        "raw-cart-pole": model_raw(0, 0, 0.01, [9.8, 1.0, 0.1, 0.5, 2.4, 12.0 * math.pi / 180.0]) + model_ops(0),
+        "raw-garbage": model_raw(7, 2, float("nan"), [float("inf")] * MAX_PARAMS, over=2) + model_ops(2),
+        "bad-plant-index": model(1, plant=-1) + model_ops(1),
+        "bad-plant-index-count": model(2, plant=3) + model_ops(2),
+        "bad-plant-index-max": model(0, plant=2**31 - 1) + model_ops(0),
+        "bad-dt": model(0, dt="1e-310") + model_ops(0),
+        "dt-max": model(1, dt="1", bound2="max") + model_ops(1),
+        "bad-dt-above": model(1, dt="2") + model_ops(1),
+        "bad-integrator": model(2, integrator=2) + model_ops(2),
+        "registry": (model(0) + op_registry(0, None) + op_registry(1, "") + op_registry(2, "no_such_plant")
+                     + op_registry(3, ("plant", 0)) + op_registry(-1, ("plant", 1))
+                     + op_registry(2**31 - 1, ("plant", 2))
+                     + op_registry(-2**31, ("truncated", 0)) + op_registry(1, ("truncated", 2))
+                     + op_registry(0, "cart_pole") + op_registry(1, "furuta_") + op_registry(2, "DOUBLE_CART_POLE")),
+        "grid-bad-index": (model(0) + op_model_grid(-1) + op_model_grid(3, "exact-1") + op_model_grid(2**31 - 1, "max")
+                           + op_model_grid(-2**31, "min", null=True)),
+        "from-plant": (model(0, integrator=1) + op_model_plant((0.1, 0.0, 0.02, 0.0), 10.0)
+                       + op_model_plant((2.4, 1.0, -0.25, "-1"), "-1e30") + op_model_plant(("nan", 0, 0, 0), 0.0)
+                       + op_model_plant(("1e300", "1e300", 0.1, "1e300"), "max", reserved=-1)),
+        "from-plant-furuta": model(1) + op_model_plant((0.1, 0.0, 0.02, 0.0), 1.0, reserved=2),
+        "from-plant-bad": model(0, param5="3.2", dt="0.25") + op_model_plant((0.1, 0.0, 0.02, 0.0), 1.0),
+    })
+    return s
+
+
 def corpus():
     """{target: {file name: bytes}}."""
     float_seeds = controller_seeds("f")
@@ -840,6 +1082,7 @@ def corpus():
         "fuzz_state_mcu": state_seeds("f"),
         "fuzz_state_double": state_seeds("d"),
         "fuzz_sim": sim_seeds(),
+        "fuzz_model": model_seeds(),
     }
 
 

@@ -8,6 +8,7 @@ from harness import _binding as B
 from harness import geometry, options
 from harness.config import CONDITION_OVERRIDES, NAMED_CONFIGURATIONS, build_config, named_sets, parse_sets
 from harness.errors import LibraryError
+from harness.registry import CONDITIONS, REGISTRY
 
 
 def test_struct_sizes_match_c():
@@ -59,7 +60,7 @@ def test_state_is_opaque_aligned_storage():
 
 def test_abi_versions():
     assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 8
-    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 2
+    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 3
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
     # the host build's defaults: the dense critic kernel, two lanes per engine thread
@@ -227,35 +228,34 @@ def test_condition_overrides():
     two RL conditions with a zero mean on the readings their sweeps chose (mean reading, sigma_L
     0.1, sigma_u 5, alpha 0.1, exploration until tick 1000); nothing else overridden. Each
     actor-critic and search condition has its prior rule."""
-    assert set(CONDITION_OVERRIDES) == set(options.CONDITIONS) and options.CONDITIONS == (
+    assert set(CONDITION_OVERRIDES) == set(CONDITIONS) and CONDITIONS == (
         "ico", "ico-rl", "ico-rl-control", "ico-mean-rl", "ico-mean-rl-control", "rl-ico-cov", "rl-ico-cov-control",
         "rl", "rl-control", "ico-search", "ico-search-control", "search", "search-control")
-    assert options.CONTROL_OF == {"ico-rl-control": "ico-rl", "ico-mean-rl-control": "ico-mean-rl",
-                                  "rl-ico-cov-control": "rl-ico-cov", "rl-control": "rl",
-                                  "ico-search-control": "ico-search", "search-control": "search"}
-    assert options.PRIOR_RULES == {"ico-rl": ("ico", "ico"), "ico-mean-rl": ("ico", "isotropic"),
-                                   "rl-ico-cov": ("zero", "ico"), "rl": ("zero", "isotropic"),
-                                   "ico-search": ("ico", "ico"), "search": ("zero", "identity")}
+    assert {c.name: c.control_of for c in REGISTRY.values() if not c.learns} == {
+        "ico-rl-control": "ico-rl", "ico-mean-rl-control": "ico-mean-rl", "rl-ico-cov-control": "rl-ico-cov",
+        "rl-control": "rl", "ico-search-control": "ico-search", "search-control": "search"}
+    assert {c.name: c.prior for c in REGISTRY.values() if c.learns and c.prior} == {
+        "ico-rl": ("ico", "ico"), "ico-mean-rl": ("ico", "isotropic"), "rl-ico-cov": ("zero", "ico"),
+        "rl": ("zero", "isotropic"), "ico-search": ("ico", "ico"), "search": ("zero", "identity")}
     default = build_config().flat()
     modes = {"ico": "ico", "ico-rl": "rl", "ico-mean-rl": "rl", "rl-ico-cov": "rl", "rl": "rl",
              "ico-search": "search", "search": "search"}
     zero_mean = ("rl-ico-cov", "rl")
-    for condition in options.CONDITIONS:
+    for condition in CONDITIONS:
         flat = build_config(condition=condition).flat()
-        base = options.CONTROL_OF.get(condition, condition)
-        assert flat["mode"] == modes[base] and flat["learn"] is (condition not in options.CONTROL_OF)
+        base = REGISTRY[condition].base
+        assert flat["mode"] == modes[base] and flat["learn"] is REGISTRY[condition].learns
         assert flat["search.cov_scale"] == (4.0 if base == "search" else 64.0)
         changed = {n for n in flat if flat[n] != default[n]}
         reading = {"actor.update", "actor.likelihood_std", "actor.noise_std", "actor.scale"}
         assert changed <= {"mode", "learn", "search.cov_scale"} | (reading if base in zero_mean else set()), condition
-        if base in zero_mean:
+        if base in zero_mean:  # each from its own sweep: RL alone's explores wider (sigma_u 12 N)
             assert (flat["actor.update"], flat["actor.likelihood_std"], flat["actor.noise_std"], flat["actor.scale"],
-                    flat["actor.explore_ticks"]) == ("mean", pytest.approx(0.1), 5.0, pytest.approx(0.1), 1000)
-        if condition in options.CONTROL_OF:  # a control is its condition with every update off
+                    flat["actor.explore_ticks"]) == ("mean", pytest.approx(0.1), {"rl-ico-cov": 5.0, "rl": 12.0}[base],
+                                                     pytest.approx(0.1), 1000)
+        if not REGISTRY[condition].learns:  # a control is its condition with every update off
             assert {n: v for n, v in flat.items() if n != "learn"} == \
                 {n: v for n, v in build_config(condition=base).flat().items() if n != "learn"}
-    assert set(options.SEARCH_CONDITIONS) == {c for c in options.CONDITIONS if modes[options.CONTROL_OF.get(c, c)]
-                                               == "search"}
 
 
 def test_literal_configuration():

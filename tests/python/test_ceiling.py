@@ -12,8 +12,12 @@ import numpy as np
 import pytest
 
 from harness import _binding as B
-from harness import bench, ceiling, figures, geometry, grid, results
+from harness import bench, figures, geometry, grid, options, results
+from harness.ceiling import fixed, lqr, records, weights
+from harness.ceiling.bound import first_step_bound, initial_states
+from harness.ceiling import search as S
 from harness.config import build_config, make_prior
+from harness.errors import UsageError
 
 REPO = Path(__file__).resolve().parents[2]
 W = (0.3, 0.5, 0.8, 1.2)
@@ -31,14 +35,15 @@ def run(*args, timeout=120):
 # -- fixed-w evaluation ----------------------------------------------------------------------------------
 @pytest.mark.parametrize("protocol, cap", [("first", 1), ("retries", 20)])
 def test_fixed_w_equals_a_grid_run_with_learning_off(protocol, cap):
-    got = ceiling.evaluate(W, protocol, seed=3, cells=CELLS, max_trials=20, success_steps=2000, threads=2)
+    got = fixed.evaluate(W, protocol, seed=3, cells=CELLS, max_trials=20, success_steps=2000, threads=2)
     cfg = build_config({"learn": 0, "max_trials": cap, "success_steps": 2000}, condition="ico",
                        prior=make_prior(W, np.eye(4)))
     ref = grid.make_cells(3, CELLS)
     grid.run_grid(cfg, ref, threads=1, progress=False)
     assert got.tobytes() == ref.tobytes()
     # the weights stay exactly w (as the controller's reals)
-    assert np.all(got["weights"] == np.asarray(W, dtype=B.real_dtype).astype(np.float64))
+    assert np.all(got["weights"][:, :4] == np.asarray(W, dtype=B.real_dtype).astype(np.float64))
+    assert np.all(got["weights"][:, 4:] == 0)  # the inputs the cart-pole task does not use
     # ... and acting is that of ICO learning at rate 0
     same = grid.make_cells(3, CELLS)
     grid.run_grid(build_config({"max_trials": cap, "success_steps": 2000, "ico.rate": 0}, condition="ico",
@@ -49,9 +54,9 @@ def test_fixed_w_equals_a_grid_run_with_learning_off(protocol, cap):
 
 
 def test_first_protocol_runs_one_trial_per_cell_and_retries_up_to_the_cap():
-    first = ceiling.evaluate(ceiling.TYPICAL_ICO_WEIGHTS, "first", cells=CELLS, success_steps=2000)
+    first = fixed.evaluate(options.TYPICAL_ICO_WEIGHTS, "first", cells=CELLS, success_steps=2000)
     assert np.all(first["trials"] == 1)
-    retries = ceiling.evaluate(ceiling.TYPICAL_ICO_WEIGHTS, "retries", cells=CELLS, max_trials=7,
+    retries = fixed.evaluate(options.TYPICAL_ICO_WEIGHTS, "retries", cells=CELLS, max_trials=7,
                                success_steps=2000)
     failed = retries["outcome"] == B.FAILED
     assert failed.any() and np.all(retries["trials"][failed] == 7)
@@ -62,13 +67,17 @@ def test_first_protocol_runs_one_trial_per_cell_and_retries_up_to_the_cap():
 
 
 def test_weights_are_validated_and_rounded():
-    w = ceiling.parse_weights("0.1, 0.2,0.3,0.4")
+    w = weights.parse_weights("0.1, 0.2,0.3,0.4")
     assert w == tuple(float(B.real_dtype.type(v)) for v in (0.1, 0.2, 0.3, 0.4))
     for bad in ("1,2,3", "1,2,3,nan", "a,b,c,d", "1,2,3,1e7", "1,2,3,1e-45"):
-        with pytest.raises(ceiling.UsageError):
-            ceiling.parse_weights(bad)
-    with pytest.raises(ceiling.UsageError, match="set by the ceiling command"):
-        ceiling.check_overrides(["learn=1"])
+        with pytest.raises(UsageError):
+            weights.parse_weights(bad, n=4)  # a task of 4 inputs
+    # without a task's n: 1 to MAX_INPUTS weights
+    assert len(weights.parse_weights(",".join(["1"] * B.MAX_INPUTS))) == B.MAX_INPUTS
+    with pytest.raises(UsageError, match="expected"):
+        weights.parse_weights(",".join(["1"] * (B.MAX_INPUTS + 1)))
+    with pytest.raises(UsageError, match="set by the ceiling command"):
+        fixed.check_overrides(["learn=1"])
 
 
 # -- search ----------------------------------------------------------------------------------------------
@@ -77,14 +86,14 @@ def _synthetic(w):
     w = np.asarray(w)
     d = np.sum(np.log(np.abs(w) / np.array([0.5, 0.5, 4.0, 4.0])) ** 2) + 5.0 * np.sum(w < 0)
     n = int(1000 / (1.0 + d))
-    return ceiling.Screen(n, n, int(1e6 / (1.0 + d)))
+    return S.Screen(n, n, int(1e6 / (1.0 + d)))
 
 
 def test_search_budget_phases_and_determinism():
     starts = [("a", (0.1, 0.1, 0.4, 0.1)), ("b", (1.0, 2.0, 1.0, 3.0))]
-    r1 = ceiling.search(_synthetic, starts, 80, seed=5)
-    r2 = ceiling.search(_synthetic, starts, 80, seed=5)
-    r3 = ceiling.search(_synthetic, starts, 80, seed=6)
+    r1 = S.search(_synthetic, starts, 80, seed=5)
+    r2 = S.search(_synthetic, starts, 80, seed=5)
+    r3 = S.search(_synthetic, starts, 80, seed=6)
     assert r1.trace == r2.trace and r1.best == r2.best
     assert r1.trace != r3.trace
     assert len(r1.trace) == 80 and r1.stop == "budget"
@@ -92,13 +101,13 @@ def test_search_budget_phases_and_determinism():
     phases = [e["phase"] for e in r1.trace]
     assert phases[:2] == ["start", "start"] and phases.count("random") == 39 and phases.count("refine") == 39
     for e in r1.trace:  # every candidate is what the controller runs
-        assert tuple(e["w"]) == ceiling.as_weights(e["w"])
-    assert all(ceiling._key(r1.best) >= ceiling._key(e) for e in r1.trace)
-    long = ceiling.search(_synthetic, starts, 400, seed=5)
-    before = max(ceiling._key(e) for e in long.trace if e["phase"] != "refine")
-    assert ceiling._key(long.best) > before and long.best["phase"] == "refine"
+        assert tuple(e["w"]) == weights.as_weights(e["w"])
+    assert all(S.rank_key(r1.best) >= S.rank_key(e) for e in r1.trace)
+    long = S.search(_synthetic, starts, 400, seed=5)
+    before = max(S.rank_key(e) for e in long.trace if e["phase"] != "refine")
+    assert S.rank_key(long.best) > before and long.best["phase"] == "refine"
     assert long.best["n_success"] > 900  # the refinement found the optimum's neighbourhood
-    tiny = ceiling.search(_synthetic, starts, 1, seed=5)
+    tiny = S.search(_synthetic, starts, 1, seed=5)
     assert [e["label"] for e in tiny.trace] == ["a"]
 
 
@@ -106,28 +115,64 @@ def test_search_on_the_engine_is_deterministic_and_no_worse_than_its_starts():
     cells = grid.make_cells(0, list(range(0, geometry.CELLS, 30)))
 
     def cfg_for(w):
-        return ceiling.fixed_config(w, "first", success_steps=300)
+        return fixed.fixed_config(w, "first", success_steps=300)
 
     def screen(w):
-        return ceiling.screen_cells(w, cells, cfg_for, threads=2)
+        return S.screen_cells(w, cells, cfg_for, threads=2)
 
-    starts = [("typical", ceiling.TYPICAL_ICO_WEIGHTS)] + ceiling.lqr_starts(cfg_for(W))
-    r1 = ceiling.search(screen, starts, 24, seed=1)
-    r2 = ceiling.search(screen, starts, 24, seed=1)
+    starts = [("typical", options.TYPICAL_ICO_WEIGHTS)] + lqr.lqr_starts(cfg_for(W))
+    r1 = S.search(screen, starts, 24, seed=1)
+    r2 = S.search(screen, starts, 24, seed=1)
     assert r1.trace == r2.trace
     for e in r1.trace[:len(starts)]:
-        assert e["phase"] == "start" and ceiling._key(r1.best) >= ceiling._key(e)
+        assert e["phase"] == "start" and S.rank_key(r1.best) >= S.rank_key(e)
     # a screen is one first-trial run at the screening horizon
-    best = ceiling.evaluate(r1.best["w"], "first", cells=list(range(0, geometry.CELLS, 30)), success_steps=300)
+    best = fixed.evaluate(r1.best["w"], "first", cells=list(range(0, geometry.CELLS, 30)), success_steps=300)
     assert int((best["outcome"] == B.SUCCESS).sum()) == r1.best["n_success"]
     assert int(best["total_steps"].sum()) == r1.best["total_steps"]
 
 
+def _riccati_iteration(a, b, q, r, iterations=20_000):
+    """The plain fixed-point iteration of the discrete Riccati equation (the solver the harness had)."""
+    p, rr = q.copy(), np.array([[r]])
+    for _ in range(iterations):
+        k = np.linalg.solve(rr + b.T @ p @ b, b.T @ p @ a)
+        p = q + a.T @ p @ (a - b @ k)
+    return k.ravel()
+
+
+@pytest.mark.parametrize("force", lqr.LQR_FORCES)
+def test_dare_gain_solves_the_riccati_equation(force):
+    """The gain of scipy's DARE solver: its P solves the discrete Riccati equation, the closed loop
+    of the linearised C plant is stable, and K is the fixed point of the Riccati iteration."""
+    import scipy.linalg
+
+    cfg = fixed.fixed_config(W)
+    a, b = lqr.linearise(cfg)
+    q = np.diag(1.0 / np.array(list(cfg.controller.policy.input_range)[:4], dtype=float) ** 2)
+    r = 1.0 / force ** 2
+    k = lqr.lqr_gain(a, b, q, r)
+    p = scipy.linalg.solve_discrete_are(a, b, q, np.array([[r]]))
+    gain = np.linalg.solve(r + b.T @ p @ b, b.T @ p @ a)
+    residual = a.T @ p @ a - p - a.T @ p @ b @ gain + q
+    assert np.max(np.abs(residual)) <= 1e-9 * np.max(np.abs(p))
+    np.testing.assert_allclose(k, gain.ravel(), rtol=1e-12)
+    assert np.max(np.abs(np.linalg.eigvals(a - b @ k.reshape(1, 4)))) < 1.0
+    np.testing.assert_allclose(k, _riccati_iteration(a, b, q, r), rtol=1e-9)
+
+
+def test_dare_gain_none_without_a_stabilising_solution():
+    a = np.diag([1.5, 0.5, 0.5, 0.5])       # an unstable mode the input cannot reach
+    b = np.array([[0.0], [1.0], [0.0], [0.0]])
+    assert lqr.lqr_gain(a, b, np.eye(4), 1.0) is None
+    assert lqr.lqr_gain(np.diag([0.5, 0.5, 0.5, 0.5]), b, np.eye(4), 1.0) is not None
+
+
 def test_lqr_starting_points_stabilise_the_linearised_plant():
-    cfg = ceiling.fixed_config(W)
-    a, b = ceiling.linearise(cfg)
-    starts = ceiling.lqr_starts(cfg)
-    assert len(starts) == len(ceiling.LQR_FORCES)
+    cfg = fixed.fixed_config(W)
+    a, b = lqr.linearise(cfg)
+    starts = lqr.lqr_starts(cfg)
+    assert len(starts) == len(lqr.LQR_FORCES)
     ranges = np.array(list(cfg.controller.policy.input_range)[:B.N_INPUTS], dtype=float)
     for _, w in starts:
         assert all(v > 0 for v in w)  # the sign pattern of a stabilising linear policy here
@@ -137,10 +182,10 @@ def test_lqr_starting_points_stabilise_the_linearised_plant():
 
 # -- first-step bound ------------------------------------------------------------------------------------
 def test_first_step_bound_is_the_outward_boundary_draws():
-    cfg = ceiling.fixed_config(W, success_steps=1000)
+    cfg = fixed.fixed_config(W, success_steps=1000)
     cells = grid.make_cells(2)
-    bound = ceiling.first_step_bound(cfg, cells, threads=2)
-    s0 = ceiling.initial_states(cfg, cells)  # the engine's first draws, through icoac_sim_trajectory
+    bound = first_step_bound(cfg, cells, threads=2)
+    s0 = initial_states(cfg, cells)  # the engine's first draws, through icoac_sim_trajectory
     assert np.array_equal(s0[:, 0], cells["x0"]) and np.array_equal(s0[:, 2], cells["theta0"])
     assert np.all(np.abs(s0[:, [1, 3]]) <= cfg.run.init_velocity_noise)
     rows, cols = geometry.grid_index(cells)
@@ -153,20 +198,20 @@ def test_first_step_bound_is_the_outward_boundary_draws():
     assert bound["max_success_interior"] == geometry.N_INTERIOR
     # the engine agrees: one first trial of 1 step (any controller) fails exactly there
     probe = grid.make_cells(2)
-    grid.run_grid(ceiling.fixed_config(ceiling.TYPICAL_ICO_WEIGHTS, success_steps=1), probe, progress=False)
+    grid.run_grid(fixed.fixed_config(options.TYPICAL_ICO_WEIGHTS, success_steps=1), probe, progress=False)
     assert np.array_equal(probe["outcome"] == B.FAILED, outward)
     # ... and so does every controller's first trial at the full horizon: no lost cell succeeds
-    first = ceiling.evaluate(W, "first", seed=2, success_steps=300, threads=2)
+    first = fixed.evaluate(W, "first", seed=2, success_steps=300, threads=2)
     assert not np.any(first["outcome"][outward] == B.SUCCESS)
 
 
 def test_first_step_bound_without_noise_and_with_rk4():
     cells = grid.make_cells(0)
-    cfg = ceiling.fixed_config(W, overrides={"init_velocity_noise": 0})
-    bound = ceiling.first_step_bound(cfg, cells)
+    cfg = fixed.fixed_config(W, overrides={"init_velocity_noise": 0})
+    bound = first_step_bound(cfg, cells)
     beyond = (np.abs(cells["x0"]) > cfg.plant.x_limit) | (np.abs(cells["theta0"]) > cfg.plant.theta_limit)
     assert sorted(c["cell"] for c in bound["lost_cells"]) == np.flatnonzero(beyond).tolist()
-    rk4 = ceiling.first_step_bound(ceiling.fixed_config(W, overrides={"integrator": "rk4"}), cells[:5])
+    rk4 = first_step_bound(fixed.fixed_config(W, overrides={"integrator": "rk4"}), cells[:5])
     assert rk4["computed"] is False and "Euler" in rk4["reason"]
 
 
@@ -195,9 +240,9 @@ def test_command_writes_its_records(small_ceiling):
         assert rec["config"]["run"]["max_trials"] == (1 if protocol == "first" else 5)
         assert rec["config"]["run"]["success_steps"] == 1000
         assert rec["prior_info"]["kind"] == "fixed-w" and rec["prior_info"]["mean"] == best["w"]
-        assert np.all(cells["weights"] == np.asarray(best["w"]))
+        assert np.all(cells["weights"][:, :4] == np.asarray(best["w"]))
         assert summ["n_success"] == int((cells["outcome"] == B.SUCCESS).sum()) and summ["n_cells"] == 25
-        ref = ceiling.evaluate(best["w"], protocol, cells="600-624", max_trials=5, success_steps=1000)
+        ref = fixed.evaluate(best["w"], protocol, cells="600-624", max_trials=5, success_steps=1000)
         assert ref.tobytes() == cells.tobytes()
     assert record["first_step_bound"]["computed"] and record["first_step_bound"]["n_cells"] == 25
 
@@ -232,8 +277,8 @@ def test_given_w_is_evaluated_without_a_search(tmp_path):
     record = json.loads((out / "ceiling.json").read_text())
     assert "search" not in record and not (out / "search.json").exists()
     assert record["best"]["source"] == "--w" and list(record["best"]["protocols"]) == ["first"]
-    assert record["best"]["w"] == list(ceiling.as_weights(W))
-    ref = ceiling.evaluate(W, "first", cells="0-30", success_steps=500)
+    assert record["best"]["w"] == list(weights.as_weights(W))
+    ref = fixed.evaluate(W, "first", cells="0-30", success_steps=500)
     assert record["best"]["protocols"]["first"]["n_success"] == int((ref["outcome"] == B.SUCCESS).sum())
 
 
@@ -247,7 +292,7 @@ def test_prior_from_starts_the_search_at_the_ico_mean(tmp_path):
     record = json.loads((out / "ceiling.json").read_text())
     start = record["search"]["starts"][0]
     assert start["label"] == "ICO mean (--prior-from)"
-    assert start["w"] == list(ceiling.as_weights(P.from_results(ico).mean))
+    assert start["w"] == list(weights.as_weights(P.from_results(ico).mean))
     assert record["settings"]["prior_from"]["path"] == str(ico.resolve())
     assert [e["phase"] for e in record["search"]["trace"]] == ["start"] * 3
 
@@ -330,14 +375,14 @@ def test_fig3a_reference_lines(tmp_path):
 
 def test_bench_shows_a_ceiling_when_there_is_one(small_ceiling, tmp_path):
     out, _ = small_ceiling
-    assert ceiling.bench_ceiling(tmp_path) is None
-    record = ceiling.bench_ceiling(tmp_path, explicit=out)
-    lines = ceiling.reference_lines(record)
+    assert records.bench_ceiling(tmp_path) is None
+    record = records.bench_ceiling(tmp_path, explicit=out)
+    lines = records.reference_lines(record)
     assert set(lines) == {"first trial", "retries"}
     assert lines["first trial"] == record["best"]["protocols"]["first"]["success_rate"]
     (tmp_path / "ceiling").mkdir()
     (tmp_path / "ceiling" / "ceiling.json").write_text((out / "ceiling.json").read_text())
-    assert ceiling.bench_ceiling(tmp_path) == record
+    assert records.bench_ceiling(tmp_path) == record
     agg = bench.aggregate({"ico": [{"seed": 0, "summary": {"n_cells": 25, "n_interior": 25, "success_rate": 0.5,
                                                           "success_rate_interior": 0.5,
                                                           "median_trials_to_success": 3.0,
@@ -353,6 +398,6 @@ def test_bench_shows_a_ceiling_when_there_is_one(small_ceiling, tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text('{"format_version": 1}')
     with pytest.raises(results.ResultsError, match="not a ceiling record"):
-        ceiling.load_ceiling(bad)
+        records.load_ceiling(bad)
     res = run("bench", "--profile", "quick", "--out", str(tmp_path / "b"), "--ceiling", str(bad), "--quiet")
     assert res.returncode == 2 and "not a ceiling record" in res.stderr and not (tmp_path / "b").exists()

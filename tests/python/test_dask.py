@@ -16,11 +16,12 @@ import numpy as np
 import pytest
 
 from harness import _binding as B
-from harness import _worker, cli, cluster, grid, options, results
+from harness import _worker, cli, cluster, grid, results
 from harness import prior as P
 from harness.conditions import condition_prior, run_condition
 from harness.config import build_config
 from harness.errors import WorkerError
+from harness.registry import REGISTRY
 
 from conftest import SMALL
 
@@ -81,7 +82,7 @@ def test_session_checked_every_worker(session):
 def test_condition_same_cells_npz_as_threads(session, ico_dir, tmp_path, condition):
     """run_condition with the Dask session writes the cells.npz of the threaded engine."""
     caps = SMALL if condition == "ico" else RL_CAPS
-    takes_ico = "ico" in options.PRIOR_RULES.get(condition, ())
+    takes_ico = REGISTRY[condition].prior is not None and REGISTRY[condition].prior.takes_ico
     info = condition_prior(condition, ico_dir if takes_ico else None, P.DEFAULT_FRAME, P.DEFAULT_RIDGE)
     common = dict(condition=condition, seed=3, overrides=caps, cell_spec=CELL_SPEC, progress=False, info=info)
     ref, ref_record, _ = run_condition(out=tmp_path / "threads", threads=2, **common)
@@ -211,7 +212,7 @@ def test_worker_without_the_library_is_a_clear_error(tmp_path):
 
 def test_abi_mismatch_names_the_difference():
     expected = {**_worker.abi_of(B), "abi_version": 999}
-    with pytest.raises(WorkerError, match=r"abi_version 7 != client's 999"):
+    with pytest.raises(WorkerError, match=rf"abi_version {B.ABI_VERSION} != client's 999"):
         _worker.check_worker(expected)
     assert _worker.check_worker(_worker.abi_of(B))["library"] == str(B.LIBRARY_PATH)
 
@@ -316,7 +317,7 @@ def test_bench_on_the_cluster_equals_threads(session, tmp_path):
     """Every grid of a bench (one seed, the quick profile's cells, small caps) on the cluster:
     each results directory holds the threaded bench's cells; bench.json records the backend."""
     from harness import bench
-    from harness.options import CONDITIONS
+    from harness.registry import CONDITIONS
     common = dict(profile="quick", seeds=1, seed=1, rl_max_trials=10, sets=["success_steps=1000"], quiet=True)
     assert bench.run_bench(bench.BenchOptions(out=tmp_path / "t", threads=2, **common)) == 0
     assert bench.run_bench(bench.BenchOptions(out=tmp_path / "d", dask=cluster.DaskSpec(scheduler=session.address),

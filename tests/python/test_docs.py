@@ -13,7 +13,9 @@ from harness.config import build_config, parse_sets
 REPO = Path(__file__).resolve().parents[2]
 # Placeholders the documents use, with a value each stands for.
 PLACEHOLDERS = {"NAME": "variant", "SETTING": "integrator=rk4", "$(BENCH_PROFILE)": "quick",
-                "$(BENCH_OUT)": "results/bench", "$(BENCH_FIGURES)": "docs/figures", "$(BENCH_ARGS)": "--resume"}
+                "$(BENCH_OUT)": "results/bench", "$(BENCH_FIGURES)": "docs/figures", "$(BENCH_ARGS)": "--resume",
+                "$(PLANT)": "furuta", "$(PLANT_OUT)": "results/bench-furuta", "$(PLANT_OUT)/ceiling": "results/c",
+                "$(PLANT_FIGURES)": "docs/figures/furuta", "$(PLANT_DATA)": "docs/data/bench-default-furuta.json"}
 
 
 def _after(text: str):

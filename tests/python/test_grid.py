@@ -34,7 +34,7 @@ def test_small_grid_outcomes(small_run):
     assert np.all(cells["total_steps"][~ok] < SMALL["max_trials"] * SMALL["success_steps"])
     assert np.allclose(cells["elapsed_time"], 0.01 * cells["total_steps"])
     # Learned ICO weights are positive, of the magnitude the paper reports, and w_theta dominates.
-    w = cells["weights"][ok]
+    w = cells["weights"][ok][:, :4]
     assert np.all(w > 0) and np.all(w < 1)
     assert np.all(w[:, 2] == w.max(axis=1))
 
@@ -102,7 +102,7 @@ def test_run_cell_matches_grid(small_cfg, small_run):
 
 def test_trajectory_with_learned_prior(small_cfg, small_run):
     cell = small_run[4]
-    cfg = build_config(SMALL, prior=make_prior(cell["weights"], np.eye(4)))
+    cfg = build_config(SMALL, prior=make_prior(cell["weights"][:4], np.eye(4)))
     tr = grid.trajectory(cfg, -0.5, np.radians(-4.0), duration=5.0)
     assert tr.states.shape == (tr.n_steps + 1, 4)
     assert tr.states[0, 0] == pytest.approx(-0.5) and np.degrees(tr.states[0, 2]) == pytest.approx(-4.0)

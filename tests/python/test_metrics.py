@@ -17,7 +17,7 @@ def hand_cells():
         cells["outcome"][i] = B.SUCCESS
         cells["trials"][i] = trials
         cells["total_steps"][i] = steps
-        cells["weights"][i] = [0.1, 0.2, 0.3, 0.4]
+        cells["weights"][i, :4] = [0.1, 0.2, 0.3, 0.4]
     cells["elapsed_time"] = 0.01 * cells["total_steps"]
     return cells
 

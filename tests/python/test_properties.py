@@ -15,10 +15,11 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from harness import _binding as B
-from harness import config, grid, metrics, options, results, store
+from harness import config, grid, metrics, results, store
 from harness.config import (ALIASES, ALL_FIELDS, BOOLS, ENUMS, RunConfig, build_config, canonical, config_from_dict,
                             parse_sets, parse_value)
 from harness.errors import HarnessError
+from harness.registry import CONDITIONS
 
 HARNESS_ERRORS = (HarnessError,)  # ConfigError, ResultsError, UsageError, ... all derive from it
 
@@ -67,7 +68,7 @@ def test_build_config_accepts_and_round_trips_or_rejects(overrides):
         assert_round_trip(cfg)
 
 
-@given(st.sampled_from(ALL_FIELDS + tuple(ALIASES)), field_values, st.sampled_from(options.CONDITIONS))
+@given(st.sampled_from(ALL_FIELDS + tuple(ALIASES)), field_values, st.sampled_from(CONDITIONS))
 def test_single_field_override(given_name, value, condition):
     cfg = total(build_config, {given_name: value}, condition=condition)
     if cfg is None:

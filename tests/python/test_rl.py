@@ -12,9 +12,9 @@ import pytest
 
 from harness import _binding as B
 from harness import grid, results
-from harness import options
 from harness import prior as P
 from harness.config import build_config, make_prior, named_sets, parse_sets
+from harness.registry import CONDITIONS, REGISTRY
 
 REPO = Path(__file__).resolve().parents[2]
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -47,14 +47,14 @@ def hand_cells():
     cells["theta0"] = np.radians(th)
     cells["outcome"] = [B.SUCCESS] * 5 + [B.FAILED]
     rng = np.random.default_rng(3)
-    cells["weights"] = rng.normal(size=(6, 4))
+    cells["weights"][:, :4] = rng.normal(size=(6, 4))
     return cells
 
 
 def test_prior_exact_mean_cov_and_frame():
     cells = hand_cells()
     info = P.compute(cells, P.DEFAULT_FRAME, ridge=1e-3)
-    w = cells["weights"][:4]  # frame bounds are inclusive: x0 = +-1.2 m, theta0 = +-6 deg are in
+    w = cells["weights"][:4, :4]  # frame bounds are inclusive: x0 = +-1.2 m, theta0 = +-6 deg are in
     assert info.n_cells == 4
     np.testing.assert_allclose(info.mean, w.mean(axis=0), rtol=0, atol=1e-15)
     d = w - w.mean(axis=0)
@@ -63,7 +63,7 @@ def test_prior_exact_mean_cov_and_frame():
     # all successful cells
     every = P.compute(cells, None, ridge=0.0)
     assert every.n_cells == 5
-    np.testing.assert_allclose(every.cov, np.cov(cells["weights"][:5], rowvar=False))
+    np.testing.assert_allclose(every.cov, np.cov(cells["weights"][:5, :4], rowvar=False))
     # narrower frame, ridge default
     narrow = P.compute(cells, (0.6, 3.0))
     assert narrow.n_cells == 2 and narrow.ridge == P.DEFAULT_RIDGE
@@ -111,7 +111,7 @@ def test_prior_from_results_records_provenance(ico_dir):
     cells, record = results.load(ico_dir)
     ok = (cells["outcome"] == B.SUCCESS) & (np.abs(cells["x0"]) <= 1.2)
     assert info.n_cells == int(ok.sum()) >= 2
-    np.testing.assert_allclose(info.mean, cells["weights"][ok].mean(axis=0))
+    np.testing.assert_allclose(info.mean, cells["weights"][ok][:, :4].mean(axis=0))
     assert info.source_commit == record["git"]["commit"]
     assert info.ico_phase_simulated_time == pytest.approx(float(cells["elapsed_time"].sum()))
 
@@ -135,14 +135,14 @@ def test_rl_grid_deterministic_records_posterior(ico_dir, configuration):
     for f in B.CELL_DTYPE.names:
         assert np.array_equal(a[f], b[f]), f
     assert np.all(a["outcome"] != B.PENDING) and np.all(a["status"] == 0)
-    assert not np.array_equal(a["weights"][0], info.mean)  # mu_w learned
+    assert not np.array_equal(a["weights"][0][:4], info.mean)  # mu_w learned
     for cov in a["cov"]:
-        assert np.array_equal(cov, cov.T)
-        assert np.all(np.linalg.eigvalsh(cov) > 0)
+        assert np.array_equal(cov, cov.T) and not cov[4:].any()  # 0 after the cart-pole's 4 inputs
+        assert np.all(np.linalg.eigvalsh(cov[:4, :4]) > 0)
         if configuration == "literal":
             assert np.trace(cov) < 0.99 * np.trace(prior_cov)  # no forgetting: Sigma_w shrinks
         else:
-            assert np.array_equal(cov, prior_cov)  # the gradient reading moves mu_w only
+            assert np.array_equal(cov[:4, :4], prior_cov)  # the gradient reading moves mu_w only
     rl = build_config(TINY_RL, condition="rl", prior=P.condition_prior("rl", None).prior())
     c = grid.make_cells(5, [611])
     grid.run_grid(rl, c, progress=False)
@@ -157,12 +157,12 @@ def test_control_learns_nothing_and_equals_zero_rates(ico_dir, condition, config
     those of its condition with the learning rates at 0: the critic rate and the actor's, the
     rate beta of the gradient reading (ICO->RL's default), the scale alpha of the mean (RL
     alone's default) and posterior (literal) ones."""
-    info = P.condition_prior(options.CONTROL_OF[condition], P.from_results(ico_dir))
+    info = P.condition_prior(REGISTRY[condition].control_of, P.from_results(ico_dir))
     prior = info.prior()
     named = LITERAL if configuration == "literal" else {}
     control = build_config({**TINY_RL, **named}, condition=condition, prior=prior)
     assert control.controller.learn == 0 and control.controller.mode == B.MODE_RL
-    base = options.CONTROL_OF[condition]
+    base = REGISTRY[condition].control_of
     reading = build_config({**TINY_RL, **named}, condition=base).flat()["actor.update"]
     actor_rate = "actor.rate" if reading == "gradient" else "actor.scale"  # beta, or alpha of u_ob
     zero = build_config({**TINY_RL, **named, "critic.rate": 0, actor_rate: 0}, condition=base, prior=prior)
@@ -170,8 +170,8 @@ def test_control_learns_nothing_and_equals_zero_rates(ico_dir, condition, config
     cells = {name: grid.make_cells(5, [300, 611, 612, 900]) for name in ("control", "zero", "learning")}
     for name, cfg in (("control", control), ("zero", zero), ("learning", learning)):
         grid.run_grid(cfg, cells[name], threads=2, progress=False)
-    mean = np.array(prior.mean[:B.N_INPUTS], dtype=float)
-    cov = np.array([list(r)[:B.N_INPUTS] for r in prior.cov[:B.N_INPUTS]], dtype=float)
+    mean = np.array(prior.mean, dtype=float)  # zero after the task's 4 inputs, as the cells' weights
+    cov = np.array([list(r) for r in prior.cov], dtype=float)
     for w, c in zip(cells["control"]["weights"], cells["control"]["cov"]):
         assert np.array_equal(w, mean) and np.array_equal(c, cov)
     for f in ("outcome", "status", "trials", "total_steps", "last_trial_steps"):
@@ -373,7 +373,7 @@ def test_bench_quick_writes_comparison(tmp_path):
     conds = ("ico", "ico-rl", "ico-rl-control", "ico-mean-rl", "ico-mean-rl-control", "rl-ico-cov",
              "rl-ico-cov-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
              "search-control")
-    assert options.CONDITIONS == conds
+    assert CONDITIONS == conds
     for cond in conds:
         for seed in (0, 1):
             assert results.exists(out / cond / f"seed-{seed}")
@@ -381,9 +381,8 @@ def test_bench_quick_writes_comparison(tmp_path):
     assert set(summary) == set(conds) and summary["ico"]["paper"]["success_rate"] == 0.68
     text = (out / "summary.md").read_text()
     assert "ICO->RL" in text
-    for control, cond in options.CONTROL_OF.items():
-        labels = options.CONDITION_LABELS
-        assert f"| {labels[cond]} | {labels[control]} |" in text
+    for cond, control in ((c.name, c.control) for c in REGISTRY.values() if c.control):
+        assert f"| {REGISTRY[cond].label} | {REGISTRY[control].label} |" in text
         # the gain over the control, recomputed from the cells
         gain = summary[cond]["gain_over_control"]
         for i, seed in enumerate((0, 1)):
@@ -421,7 +420,7 @@ def test_bench_quick_writes_comparison(tmp_path):
         record = json.loads((out / cond / "seed-0" / "run.json").read_text())
         controller = record["config"]["controller"]
         assert controller["mode"] == "search" and controller["search"]["cov_scale"] == scale
-        assert controller["learn"] is (cond not in options.CONTROL_OF)
+        assert controller["learn"] is REGISTRY[cond].learns
         identity = record["prior_info"]["cov"] == np.eye(4).tolist()
         assert identity is cond.startswith("search"), cond
     icorl = json.loads((out / "ico-rl" / "seed-0" / "run.json").read_text())

@@ -285,10 +285,10 @@ def test_no_learning_control_learns_nothing(condition):
         grid.run_grid(cfg, cells[name], threads=2, progress=False)
         assert np.all(cells[name]["status"] == 0)
     for w, c in zip(cells["control"]["weights"], cells["control"]["cov"]):
-        assert np.array_equal(w, mean) and np.array_equal(c, sigma0)
+        assert np.array_equal(w[:4], mean) and np.array_equal(c[:4, :4], sigma0)
     assert np.any(cells["control"]["trials"] > 2)  # full batches were run
     learned = cells["learning"][cells["learning"]["trials"] > 2]
-    assert len(learned) and not np.array_equal(learned["weights"][0], mean)
+    assert len(learned) and not np.array_equal(learned["weights"][0][:4], mean)
     # tick by tick, through the batch's terminal ticks
     rng = np.random.default_rng(2)
     state = controller(control, mean, [list(r)[:B.N_INPUTS] for r in prior.cov[:B.N_INPUTS]], seed=4)

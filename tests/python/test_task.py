@@ -26,7 +26,8 @@ def oracle(rules, s):
 
 
 def controller(n, rules, late_source=B.LATE_SOURCES["rules"]):
-    """An ICO controller (no learning) of a task with n inputs and these rules."""
+    """An ICO controller (no learning) of a task with n inputs and these rules (checked by icoac_init;
+    no plant: the controller alone)."""
     cfg = build_config({"learn": 0})
     task = cfg.controller.task
     task.n_inputs = n
@@ -37,7 +38,6 @@ def controller(n, rules, late_source=B.LATE_SOURCES["rules"]):
         task.rule_threshold[k], task.rule_reflex[k] = threshold, reflex
     for i in range(B.MAX_INPUTS):
         cfg.controller.policy.input_range[i] = 1.0
-    cfg.check()
     state = B.State()
     B.check_status(B.lib.icoac_init(ctypes.byref(cfg.controller), ctypes.byref(state), None, 1))
     return cfg, state

@@ -1,5 +1,6 @@
-/* icoac_sim: cart-pole plant, benchmark trial loop and grid runner for the icoac controller.
- * Host-only C11; exported as a shared library for the Python harness. */
+/* icoac_sim: plants (the cart-pole and a registry of others), benchmark trial loop and grid
+ * runner for the icoac controller. Host-only C11; exported as a shared library for the Python
+ * harness. */
 #ifndef ICOAC_SIM_H
 #define ICOAC_SIM_H
 
@@ -11,7 +12,7 @@
 extern "C" {
 #endif
 
-#define ICOAC_SIM_ABI_VERSION 2
+#define ICOAC_SIM_ABI_VERSION 3
 
 /* Status of sim functions: values below 100 are icoac_status_t, passed through. */
 typedef enum {
@@ -20,7 +21,8 @@ typedef enum {
     ICOAC_SIM_ERR_BAD_RUN = 101,      /* run parameter out of range */
     ICOAC_SIM_ERR_BAD_ARGUMENT = 102, /* NULL pointer, zero length or bad cell */
     ICOAC_SIM_ERR_THREAD = 103,       /* a worker thread could not be started */
-    ICOAC_SIM_CANCELLED = 104         /* the cancel flag was raised; finished cells are kept */
+    ICOAC_SIM_CANCELLED = 104,        /* the cancel flag was raised; finished cells are kept */
+    ICOAC_SIM_ERR_NONFINITE = 105     /* plant state or input not finite, or made so by a step */
 } icoac_sim_status_t;
 
 typedef enum {
@@ -71,10 +73,12 @@ typedef enum {
     ICOAC_SIM_ERROR = 3    /* the controller reported an error (e.g. ICOAC_ERR_NUMERIC); see status */
 } icoac_sim_outcome_t;
 
-/* One cell: the caller fills x0, theta0, seed; the run fills the rest. */
+/* One cell: the caller fills x0, theta0, seed; the run fills the rest. For a registry plant
+ * (icoac_sim_plant_grid), x0 is the start of the grid's column component and theta0 that of its
+ * row component, in the plant's units. */
 typedef struct {
-    double x0;                  /* m */
-    double theta0;              /* rad */
+    double x0;                  /* m (the cart-pole's x; a plant's column component) */
+    double theta0;              /* rad (the cart-pole's theta; a plant's row component) */
     uint64_t seed;              /* drives initial velocities and exploration */
     int32_t outcome;            /* icoac_sim_outcome_t */
     int32_t status;             /* icoac_status_t / icoac_sim_status_t of the run */
@@ -82,8 +86,8 @@ typedef struct {
     int64_t total_steps;        /* steps over all trials */
     int64_t last_trial_steps;   /* length of the final trial */
     double elapsed_time;        /* s: dt * total_steps */
-    double weights[ICOAC_CARTPOLE_INPUTS];              /* final w (ICO) or mu_w (RL) */
-    double cov[ICOAC_CARTPOLE_INPUTS][ICOAC_CARTPOLE_INPUTS];  /* final Sigma_w (RL) */
+    double weights[ICOAC_MAX_INPUTS];                   /* final w (ICO) or mu_w (RL); task.n_inputs used, 0 after */
+    double cov[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS];     /* final Sigma_w (RL); the leading n x n block */
 } icoac_sim_cell_t;
 
 /* Indices of the progress array given to icoac_sim_run_grid. */
@@ -159,6 +163,138 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t 
                              const icoac_prior_t *prior, double x0, double theta0,
                              double init_velocity_noise, uint64_t seed, int64_t max_steps,
                              double *states, double *forces, int64_t *n_steps);
+
+/* ---- Plant registry (docs/plants.md) -------------------------------------------------------
+ * Every plant is a descriptor: its state, parameters, dynamics, failure test and grid of initial
+ * conditions. The cart-pole above is the registry's first plant, ICOAC_SIM_CART_POLE; its
+ * icoac_sim_plant_t maps onto a model with icoac_sim_model_from_plant. */
+#define ICOAC_SIM_MAX_STATE 6   /* state components of any plant */
+#define ICOAC_SIM_MAX_PARAMS 16 /* parameters of any plant */
+#define ICOAC_SIM_CART_POLE 0   /* registry index of the cart-pole */
+
+/* A named, unit-carrying quantity: a state component or the plant's input. */
+typedef struct {
+    const char *name; /* "x", "theta_dot", "voltage" */
+    const char *unit; /* "m", "rad/s", "V" */
+} icoac_sim_axis_t;
+
+/* One plant parameter: valid values are 0 or normal numbers in [min, max]. */
+typedef struct {
+    const char *name;
+    const char *unit;
+    double value; /* default */
+    double min;
+    double max;
+} icoac_sim_param_t;
+
+/* A swept start coordinate: value i (0 <= i < count) is first + step * i, converted by
+ * * PI / 180 when degrees is 1 (first and step are then in degrees). */
+typedef struct {
+    int32_t component; /* state index */
+    int32_t count;
+    double first;
+    double step;
+    int32_t degrees;
+    int32_t reserved; /* 0 */
+} icoac_sim_sweep_t;
+
+/* One integration step of the plant's ODE: s (n_state values) advanced by dt under input u
+ * with the integrator (icoac_sim_integrator_t); p holds the parameter block. */
+typedef void (*icoac_sim_step_fn)(const double *p, double dt, int32_t integrator, double *s, double u);
+/* ds = ds/dt at state s under input u. */
+typedef void (*icoac_sim_derivatives_fn)(const double *p, const double *s, double u, double *ds);
+/* 1 when s is outside the plant's limits or not finite, else 0. */
+typedef int32_t (*icoac_sim_failed_fn)(const double *p, const double *s);
+/* Total mechanical energy (J) of s. */
+typedef double (*icoac_sim_energy_fn)(const double *p, const double *s);
+
+typedef struct {
+    const char *name;   /* registry key, e.g. "furuta" */
+    const char *title;  /* one line for humans */
+    const char *source; /* where the equations and default parameters come from */
+    icoac_sim_axis_t input;
+    int32_t n_state;    /* <= ICOAC_SIM_MAX_STATE */
+    int32_t n_params;   /* <= ICOAC_SIM_MAX_PARAMS */
+    icoac_sim_axis_t state[ICOAC_SIM_MAX_STATE];
+    const icoac_sim_param_t *params; /* n_params entries */
+    /* Grid of initial conditions: rows sweep one component (a cell's theta0), columns another
+     * (its x0); the other components start at start[], and those with drawn[i] = 1 then get
+     * U(-a, a), a = the run's init_velocity_noise, drawn in index order. */
+    icoac_sim_sweep_t rows;
+    icoac_sim_sweep_t cols;
+    double start[ICOAC_SIM_MAX_STATE];
+    int32_t drawn[ICOAC_SIM_MAX_STATE];
+    /* Controller input i reads state component observed[i] (n_state entries, -1: none). */
+    int32_t observed[ICOAC_SIM_MAX_STATE];
+    icoac_sim_step_fn step;
+    icoac_sim_derivatives_fn derivatives;
+    icoac_sim_failed_fn failed;
+    icoac_sim_energy_fn energy; /* NULL when the plant has none */
+} icoac_sim_plant_desc_t;
+
+/* A registry plant with its parameter block and the engine's integration options. */
+typedef struct {
+    int32_t plant;      /* registry index */
+    int32_t integrator; /* icoac_sim_integrator_t */
+    double dt;          /* s, [1e-6, 1] */
+    double param[ICOAC_SIM_MAX_PARAMS]; /* the descriptor's parameters in its order; the rest 0 */
+} icoac_sim_model_t;
+
+/* Plants in the registry; the descriptor of plant i (NULL when out of range); the index of the
+ * plant named name (-1 when none is). */
+int32_t icoac_sim_plant_count(void);
+const icoac_sim_plant_desc_t *icoac_sim_plant_info(int32_t index);
+int32_t icoac_sim_plant_find(const char *name);
+
+/* Model of plant index with its default parameters, dt 0.01 s and Euler. */
+int32_t icoac_sim_model_default(icoac_sim_model_t *model, int32_t index);
+/* ICOAC_SIM_ERR_BAD_PLANT for an unknown plant, a parameter outside its range, a bad dt or
+ * integrator, or a nonzero unused parameter. */
+int32_t icoac_sim_model_check(const icoac_sim_model_t *model);
+/* The cart-pole model of a cart-pole plant struct (same dynamics, limits and options). */
+int32_t icoac_sim_model_from_plant(const icoac_sim_plant_t *plant, icoac_sim_model_t *model);
+
+/* State arrays hold ICOAC_SIM_MAX_STATE values, of which the plant's n_state are read/written.
+ * Bad input gets a status, the state left as it was: ICOAC_SIM_ERR_BAD_PLANT (model),
+ * ICOAC_SIM_ERR_NONFINITE (state or u not finite, or the step made them so). */
+int32_t icoac_sim_model_step(const icoac_sim_model_t *model, double state[ICOAC_SIM_MAX_STATE], double u);
+int32_t icoac_sim_model_derivatives(const icoac_sim_model_t *model, const double state[ICOAC_SIM_MAX_STATE],
+                                    double u, double ds[ICOAC_SIM_MAX_STATE]);
+/* *failed = 1 when the state is outside the plant's limits or not finite, else 0. */
+int32_t icoac_sim_model_failed(const icoac_sim_model_t *model, const double state[ICOAC_SIM_MAX_STATE],
+                               int32_t *failed);
+/* ICOAC_SIM_ERR_BAD_ARGUMENT when the plant has no energy function. */
+int32_t icoac_sim_model_energy(const icoac_sim_model_t *model, const double state[ICOAC_SIM_MAX_STATE],
+                               double *energy);
+
+/* The plant's grid (rows.count * cols.count cells, row-major): theta0 = the row value, x0 = the
+ * column value; seeds and outcomes as icoac_sim_paper_grid (the cart-pole's is that grid). */
+int32_t icoac_sim_plant_grid(int32_t index, icoac_sim_cell_t *cells, int64_t n_cells, uint64_t seed);
+/* Start state of a trial from cell: start[], the swept components from the cell, the drawn ones
+ * U(-noise, noise) from rng (for the cart-pole, the trial loop's start). The engine seeds that rng
+ * with icoac_rng_seed(&rng, cell seed, ICOAC_SIM_START_STREAM). */
+#define ICOAC_SIM_START_STREAM 2u
+int32_t icoac_sim_model_start(const icoac_sim_model_t *model, const icoac_sim_cell_t *cell, double noise,
+                              icoac_rng_t *rng, double state[ICOAC_SIM_MAX_STATE]);
+
+/* The benchmark on any registry plant: icoac_sim_run_cell, icoac_sim_run_grid and
+ * icoac_sim_trajectory with a model in place of the cart-pole struct (those three are these with
+ * the model of their plant, bit for bit). Trials start by icoac_sim_model_start; the controller's
+ * task reads all the plant's n_state components (task.n_inputs = n_state; the plant observes its
+ * state in order), and a task of another size is refused with ICOAC_SIM_ERR_BAD_PLANT. The trajectory's states hold
+ * (max_steps + 1) rows of the plant's n_state values. */
+int32_t icoac_sim_run_cell_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                                 const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                                 icoac_sim_cell_t *cell, const volatile int32_t *cancel,
+                                 volatile int64_t *progress);
+int32_t icoac_sim_run_grid_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                                 const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                                 icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
+                                 const volatile int32_t *cancel, volatile int64_t *progress);
+int32_t icoac_sim_trajectory_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                                   const icoac_prior_t *prior, double x0, double theta0,
+                                   double init_velocity_noise, uint64_t seed, int64_t max_steps,
+                                   double *states, double *forces, int64_t *n_steps);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,22 @@
+"""Gymnasium for icoac: the simulator's plants as registered envs, an icoac controller as a policy
+on any env with the cart-pole's observation layout, and a continuous-force Gymnasium CartPole-v1.
+
+Importing this package registers ``icoac/CartPole-v0``, ``icoac/Furuta-v0`` and
+``icoac/DoubleCartPole-v0`` (one id per plant of harness.gym.plants);
+``gymnasium.make("harness.gym:icoac/CartPole-v0")`` imports it on the way. Modules: plants (what
+each plant is), env (IcoacPlantEnv), policy (IcoacPolicy), cartpole_v1 (ContinuousCartPole).
+docs/gymnasium.md describes them.
+"""
+import gymnasium
+
+from .cartpole_v1 import ContinuousCartPole, continuous_cartpole
+from .env import IcoacPlantEnv
+from .plants import PLANTS, env_id
+from .policy import Episode, IcoacPolicy
+
+for _spec in PLANTS.values():
+    if env_id(_spec) not in gymnasium.registry:
+        gymnasium.register(id=env_id(_spec), entry_point="harness.gym.env:IcoacPlantEnv",
+                           kwargs={"plant": _spec.name}, max_episode_steps=_spec.max_episode_steps)
+
+__all__ = ["ContinuousCartPole", "Episode", "IcoacPlantEnv", "IcoacPolicy", "continuous_cartpole", "env_id"]

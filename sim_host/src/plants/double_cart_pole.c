@@ -1,0 +1,109 @@
+/* Double inverted pendulum on a cart, force on the cart, with the parameters of Bogdanov,
+ * "Optimal control of a double inverted pendulum on a cart", OGI technical report CSE-04-006,
+ * 2004. Frictionless; both links are uniform rods (centre of mass at half length, inertia
+ * m L^2 / 12 about it); angles are absolute, from upright, positive toward +x. Equations:
+ * Lagrange's equations, derived in docs/plants.md.
+ *
+ * State (x, x_dot, theta1, theta1_dot, theta2, theta2_dot). */
+#include <math.h>
+
+#include "icoac_sim/icoac_sim.h"
+#include "sim_integrate.h"
+
+enum { GRAVITY, CART_MASS, MASS1, MASS2, LENGTH1, LENGTH2, X_LIMIT, ANGLE_LIMIT, N_PARAMS };
+
+/* Inertia terms: T = 1/2 qdot^T M qdot with q = (x, theta1, theta2),
+ * M = [[m, a1 c1, a2 c2], [a1 c1, j1, b c12], [a2 c2, b c12, j2]], V = g (a1 c1 + a2 c2). */
+typedef struct {
+    double m, a1, a2, j1, j2, b;
+} terms_t;
+
+static terms_t terms(const double *p)
+{
+    terms_t t;
+    const double l1 = p[LENGTH1], l2 = p[LENGTH2];
+    t.m = p[CART_MASS] + p[MASS1] + p[MASS2];
+    t.a1 = (0.5 * p[MASS1] + p[MASS2]) * l1;
+    t.a2 = 0.5 * p[MASS2] * l2;
+    t.j1 = (p[MASS1] / 3.0 + p[MASS2]) * l1 * l1;
+    t.j2 = p[MASS2] * l2 * l2 / 3.0;
+    t.b = 0.5 * p[MASS2] * l1 * l2;
+    return t;
+}
+
+static void derivatives(const double *p, const double *s, double force, double *ds)
+{
+    const terms_t t = terms(p);
+    const double s1 = sin(s[2]), c1 = cos(s[2]), s2 = sin(s[4]), c2 = cos(s[4]);
+    const double s12 = sin(s[2] - s[4]), c12 = cos(s[2] - s[4]);
+    /* symmetric mass matrix (m00 m01 m02 / m11 m12 / m22) and right-hand side r */
+    const double m01 = t.a1 * c1, m02 = t.a2 * c2, m12 = t.b * c12;
+    const double r0 = force + t.a1 * s1 * s[3] * s[3] + t.a2 * s2 * s[5] * s[5];
+    const double r1 = p[GRAVITY] * t.a1 * s1 - t.b * s12 * s[5] * s[5];
+    const double r2 = p[GRAVITY] * t.a2 * s2 + t.b * s12 * s[3] * s[3];
+    /* Cramer's rule with the cofactors of the symmetric matrix */
+    const double k00 = t.j1 * t.j2 - m12 * m12, k01 = m02 * m12 - m01 * t.j2, k02 = m01 * m12 - m02 * t.j1;
+    const double k11 = t.m * t.j2 - m02 * m02, k12 = m01 * m02 - t.m * m12, k22 = t.m * t.j1 - m01 * m01;
+    const double det = t.m * k00 + m01 * k01 + m02 * k02;
+    ds[0] = s[1];
+    ds[1] = (k00 * r0 + k01 * r1 + k02 * r2) / det;
+    ds[2] = s[3];
+    ds[3] = (k01 * r0 + k11 * r1 + k12 * r2) / det;
+    ds[4] = s[5];
+    ds[5] = (k02 * r0 + k12 * r1 + k22 * r2) / det;
+}
+
+static void step(const double *p, double dt, int32_t integrator, double *s, double force)
+{
+    sim_integrate(derivatives, 6, p, dt, integrator, s, force);
+}
+
+/* Outside the track or either link's angle limit (strict), or not finite; NaN fails. */
+static int32_t failed(const double *p, const double *s)
+{
+    return !(fabs(s[0]) <= p[X_LIMIT] && fabs(s[2]) <= p[ANGLE_LIMIT] && fabs(s[4]) <= p[ANGLE_LIMIT] &&
+             isfinite(s[1]) && isfinite(s[3]) && isfinite(s[5]));
+}
+
+static double energy(const double *p, const double *s)
+{
+    const terms_t t = terms(p);
+    const double c1 = cos(s[2]), c2 = cos(s[4]), c12 = cos(s[2] - s[4]);
+    const double v = s[1], w1 = s[3], w2 = s[5];
+    const double kinetic = 0.5 * (t.m * v * v + t.j1 * w1 * w1 + t.j2 * w2 * w2) + t.a1 * c1 * v * w1 +
+                           t.a2 * c2 * v * w2 + t.b * c12 * w1 * w2;
+    return kinetic + p[GRAVITY] * (t.a1 * c1 + t.a2 * c2);
+}
+
+static const icoac_sim_param_t params[N_PARAMS] = {
+    {"gravity", "m/s^2", 9.8, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"cart_mass", "kg", 1.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"mass1", "kg", 0.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"mass2", "kg", 0.75, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"length1", "m", 0.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"length2", "m", 0.75, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"x_limit", "m", 2.4, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"angle_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX},
+};
+
+const icoac_sim_plant_desc_t sim_double_cart_pole = {
+    "double_cart_pole",
+    "double inverted pendulum on a cart, force on the cart",
+    "Bogdanov, 'Optimal control of a double inverted pendulum on a cart', OGI School of Science & "
+    "Engineering, OHSU, technical report CSE-04-006, 2004",
+    {"force", "N"},
+    6,
+    N_PARAMS,
+    {{"x", "m"}, {"x_dot", "m/s"}, {"theta1", "rad"}, {"theta1_dot", "rad/s"}, {"theta2", "rad"},
+     {"theta2_dot", "rad/s"}},
+    params,
+    {2, 25, -12.0, 1.0, 1, 0}, /* theta1_0: -12..12 deg */
+    {0, 49, -2.4, 0.1, 0, 0},  /* x0: -2.4..2.4 m */
+    {0.0, 0.0, 0.0, 0.0, 0.0, 0.0},
+    {0, 1, 0, 1, 0, 1},
+    {0, 1, 2, 3, 4, 5},
+    step,
+    derivatives,
+    failed,
+    energy,
+};

@@ -1,0 +1,114 @@
+/* Furuta (rotary inverted) pendulum driven by a DC motor, with the parameters of the Quanser
+ * QUBE-Servo 2 (QUBE-Servo 2 User Manual, system parameters table: motor and rotary pendulum
+ * module; the module's masses and lengths are also listed in the QUBE-Servo 3 User Manual,
+ * Table 2.2). Equations: Lagrange's equations of the two links, derived in docs/plants.md (the
+ * model of Acosta, "Furuta's pendulum: a conservative nonlinear model for theory and practise",
+ * Math. Probl. Eng. 2010, article 742894, and of Cazzolato & Prime, "On the dynamics of the Furuta
+ * pendulum", J. Control Sci. Eng. 2011, here with thin-rod links).
+ *
+ * State (theta, theta_dot, alpha, alpha_dot): arm angle about the motor axis, pendulum angle
+ * from upright (positive when the pendulum leans the way the arm's tip moves for theta_dot > 0).
+ * Input: motor voltage V; the motor's torque is k_t (V - k_t theta_dot) / R_m (inductance
+ * neglected, back-EMF constant = torque constant in SI units). Links are thin uniform rods: the
+ * arm pivots at one end, the pendulum at the arm's tip. */
+#include <math.h>
+
+#include "icoac_sim/icoac_sim.h"
+#include "sim_integrate.h"
+
+enum {
+    GRAVITY, ARM_MASS, ARM_LENGTH, PENDULUM_MASS, PENDULUM_LENGTH, HUB_INERTIA, RESISTANCE,
+    TORQUE_CONSTANT, ARM_DAMPING, PENDULUM_DAMPING, ARM_LIMIT, PENDULUM_LIMIT, N_PARAMS
+};
+
+/* Inertia terms of the Lagrangian: T = 1/2 (a + b sin^2 alpha) theta_dot^2
+ * + c cos alpha theta_dot alpha_dot + 1/2 b alpha_dot^2, V = d cos alpha. */
+typedef struct {
+    double a, b, c, d;
+} terms_t;
+
+static terms_t terms(const double *p)
+{
+    terms_t t;
+    const double lr = p[ARM_LENGTH], lp = p[PENDULUM_LENGTH], mp = p[PENDULUM_MASS];
+    t.a = p[HUB_INERTIA] + (p[ARM_MASS] / 3.0 + mp) * lr * lr;
+    t.b = mp * lp * lp / 3.0;
+    t.c = 0.5 * mp * lr * lp;
+    t.d = 0.5 * mp * p[GRAVITY] * lp;
+    return t;
+}
+
+static void derivatives(const double *p, const double *s, double voltage, double *ds)
+{
+    const terms_t t = terms(p);
+    const double sin_a = sin(s[2]), cos_a = cos(s[2]);
+    const double torque = p[TORQUE_CONSTANT] * (voltage - p[TORQUE_CONSTANT] * s[1]) / p[RESISTANCE];
+    /* mass matrix [[m11, m12], [m12, b]] and right-hand side (r1, r2) */
+    const double m11 = t.a + t.b * sin_a * sin_a;
+    const double m12 = t.c * cos_a;
+    const double r1 = torque - p[ARM_DAMPING] * s[1] - 2.0 * t.b * sin_a * cos_a * s[1] * s[3] +
+                      t.c * sin_a * s[3] * s[3];
+    const double r2 = -p[PENDULUM_DAMPING] * s[3] + t.b * sin_a * cos_a * s[1] * s[1] + t.d * sin_a;
+    const double det = m11 * t.b - m12 * m12;
+    ds[0] = s[1];
+    ds[1] = (t.b * r1 - m12 * r2) / det;
+    ds[2] = s[3];
+    ds[3] = (m11 * r2 - m12 * r1) / det;
+}
+
+static void step(const double *p, double dt, int32_t integrator, double *s, double voltage)
+{
+    sim_integrate(derivatives, 4, p, dt, integrator, s, voltage);
+}
+
+/* Outside the arm or pendulum limit (strict), or not finite; NaN fails. */
+static int32_t failed(const double *p, const double *s)
+{
+    return !(fabs(s[0]) <= p[ARM_LIMIT] && fabs(s[2]) <= p[PENDULUM_LIMIT] && isfinite(s[1]) &&
+             isfinite(s[3]));
+}
+
+static double energy(const double *p, const double *s)
+{
+    const terms_t t = terms(p);
+    const double sin_a = sin(s[2]), cos_a = cos(s[2]);
+    return 0.5 * (t.a + t.b * sin_a * sin_a) * s[1] * s[1] + t.c * cos_a * s[1] * s[3] +
+           0.5 * t.b * s[3] * s[3] + t.d * cos_a;
+}
+
+static const icoac_sim_param_t params[N_PARAMS] = {
+    {"gravity", "m/s^2", 9.81, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"arm_mass", "kg", 0.095, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"arm_length", "m", 0.085, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"pendulum_mass", "kg", 0.024, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"pendulum_length", "m", 0.129, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    /* motor rotor 4.0e-6 + module hub 0.6e-6 */
+    {"hub_inertia", "kg m^2", 4.6e-6, 0.0, ICOAC_SIM_PHYS_MAX},
+    {"resistance", "ohm", 8.4, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"torque_constant", "N m/A", 0.042, 0.0, ICOAC_SIM_PHYS_MAX},
+    {"arm_damping", "N m s/rad", 0.0, 0.0, ICOAC_SIM_PHYS_MAX},
+    {"pendulum_damping", "N m s/rad", 0.0, 0.0, ICOAC_SIM_PHYS_MAX},
+    {"arm_limit", "rad", 0.5 * ICOAC_SIM_PI, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
+    {"pendulum_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX},
+};
+
+const icoac_sim_plant_desc_t sim_furuta = {
+    "furuta",
+    "Furuta pendulum (Quanser QUBE-Servo 2), motor voltage on the arm",
+    "Quanser QUBE-Servo 2 User Manual (system parameters); Acosta, Math. Probl. Eng. 2010, "
+    "article 742894; Cazzolato & Prime, J. Control Sci. Eng. 2011",
+    {"voltage", "V"},
+    4,
+    N_PARAMS,
+    {{"theta", "rad"}, {"theta_dot", "rad/s"}, {"alpha", "rad"}, {"alpha_dot", "rad/s"}},
+    params,
+    {2, 25, -12.0, 1.0, 1, 0},  /* alpha0: -12..12 deg */
+    {0, 49, -90.0, 3.75, 1, 0}, /* theta0: -90..90 deg */
+    {0.0, 0.0, 0.0, 0.0},
+    {0, 1, 0, 1},
+    {0, 1, 2, 3},
+    step,
+    derivatives,
+    failed,
+    energy,
+};

@@ -1,0 +1,186 @@
+"""The benchmark on registry plants (harness --plant): configurations and records by plant, the
+plant's grid in every metric and map, the task settings and their sweep, refusals by name."""
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from harness import _binding as B
+from harness import cli, geometry, grid, metrics, plants, results
+from harness import prior as P
+from harness.config import build_config, config_from_dict
+from harness.tools import plant_sweeps
+
+REPO = Path(__file__).resolve().parents[2]
+TINY_ARGS = ["--max-trials", "30", "--success-steps", "200", "--quiet"]
+CELLS = "600-605"
+
+
+def main(capsys, *args):
+    rc = cli.main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def one_line_error(rc, err):
+    assert rc == 2 and "Traceback" not in err, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("icoac-harness: error: "), err
+    return lines[0]
+
+
+def test_cart_pole_config_unchanged_by_the_plant_argument():
+    for condition in (None, "ico-rl", "rl", "search"):
+        assert build_config(condition=condition).to_dict() == \
+            build_config(condition=condition, plant="cart_pole").to_dict()
+    cfg = build_config()
+    assert cfg.model is None and cfg.plant_name == "cart_pole"
+    m = cfg.engine_model()
+    assert m.plant == 0 and m.param[0] == cfg.plant.gravity and m.dt == cfg.plant.dt
+
+
+def test_furuta_config_has_its_task_and_learner_settings():
+    cfg = build_config(condition="ico-rl", plant="furuta", overrides={"pendulum_damping": 1e-4, "dt": 0.005})
+    d = cfg.to_dict()
+    assert d["plant"]["name"] == "furuta" and d["plant"]["pendulum_damping"] == 1e-4 and d["plant"]["dt"] == 0.005
+    task = plants.task_overrides("furuta", plants.FURUTA_SETTING)
+    assert np.allclose(d["controller"]["policy"]["input_range"][:4], task["policy.input_range"], rtol=1e-6)
+    assert math.isclose(d["controller"]["ico"]["rate"], plants.FURUTA_SETTING["ico.rate"], rel_tol=1e-6)
+    assert d["controller"]["actor"]["noise_std"] == plants.PLANTS["furuta"].learners["ico-rl"]["actor.noise_std"]
+    # the control takes its learner's noise; a user's --set wins over both
+    ctrl = build_config(condition="ico-rl-control", plant="furuta", overrides={"policy.gain": 2})
+    assert ctrl.to_dict()["controller"]["actor"]["noise_std"] == d["controller"]["actor"]["noise_std"]
+    assert ctrl.controller.policy.gain == 2
+    # the record reads back to the same configuration
+    assert config_from_dict(d).to_dict() == d
+
+
+@pytest.mark.parametrize("overrides, words", [
+    ({"x_limit": 3.0}, ["furuta", "x_limit"]),
+    ({"arm_mass": -3.0}, ["arm_mass=-3.0"]),
+    ({"no_such": 1.0}, ["no_such"]),
+])
+def test_bad_plant_parameters_are_named(overrides, words):
+    with pytest.raises(B.ConfigError) as exc:
+        build_config(overrides, plant="furuta")
+    for w in words:
+        assert w in str(exc.value)
+
+
+def test_task_of_another_size_and_unknown_plants_are_refused_by_name(capsys, tmp_path):
+    line = one_line_error(*main(capsys, "grid", "--plant", "double_cart_pole", "--out", tmp_path / "d",
+                                "--set", "task.n_inputs=4", "--set", "task.n_rules=4", *TINY_ARGS)[::2])
+    assert "double_cart_pole" in line and "task.n_inputs=4" in line and "6 state components" in line
+    line = one_line_error(*main(capsys, "grid", "--plant", "nope", "--out", tmp_path / "n", *TINY_ARGS)[::2])
+    assert "nope" in line and "furuta" in line
+    assert not (tmp_path / "d").exists() and not (tmp_path / "n").exists()
+
+
+def test_plant_grid_geometry():
+    fur = geometry.of("furuta")
+    info = B.plant_info("furuta")
+    cells = grid.plant_grid("furuta", 0)
+    assert cells.size == fur.cells == info["rows"]["count"] * info["cols"]["count"]
+    rows, cols = fur.grid_index(cells)
+    k = np.arange(cells.size)
+    assert np.array_equal(rows, k // fur.cols) and np.array_equal(cols, k % fur.cols)
+    assert fur.on_grid(cells).all() and not geometry.on_grid(cells).all()
+    assert fur.interior_mask(cells).sum() == fur.n_interior == (fur.rows - 2) * (fur.cols - 2)
+    assert (fur.col_unit, fur.row_unit) == ("deg", "deg")
+    assert geometry.CART_POLE.central_frame() == (1.2, 6.0)  # the cart-pole's default prior frame
+    assert fur.central_frame() == (45.0, 6.0)
+    # the summary's interior follows the plant's grid
+    cells["outcome"] = B.FAILED
+    assert metrics.summary(cells, fur)["n_interior"] == fur.n_interior
+
+
+def test_prior_frame_of_the_plant():
+    fur = geometry.of("furuta")
+    cells = grid.plant_grid("furuta", 0)
+    cells["outcome"] = B.SUCCESS
+    cells["weights"][:, :4] = np.arange(cells.size)[:, None] * np.array([1.0, 2.0, 3.0, 4.0]) / cells.size
+    info = P.compute(cells, P.CENTRAL, grid=fur)
+    col_deg, row_deg = np.degrees(cells["x0"]), np.degrees(cells["theta0"])
+    inside = (np.abs(col_deg) <= 45.0 + 1e-9) & (np.abs(row_deg) <= 6.0 + 1e-9)
+    assert info.n_cells == int(inside.sum()) and info.frame == (45.0, 6.0)
+    assert np.allclose(info.mean, cells["weights"][inside][:, :4].mean(axis=0))
+
+
+def test_grid_command_records_and_resumes_by_plant(capsys, tmp_path):
+    out = tmp_path / "fur"
+    rc, _, err = main(capsys, "grid", "--plant", "furuta", "--out", out, "--cells", CELLS, *TINY_ARGS)
+    assert rc == 0, err
+    cells, record = results.load(out)
+    assert record["config"]["plant"]["name"] == "furuta" and results.record_plant(record) == "furuta"
+    assert geometry.of("furuta").on_grid(cells).all()
+    expected = grid.make_cells(0, grid.parse_cell_indices(CELLS), plant="furuta")
+    assert np.array_equal(cells["x0"], expected["x0"]) and np.array_equal(cells["theta0"], expected["theta0"])
+    # the engine through the harness is the C engine on the model
+    cfg = config_from_dict(record["config"])
+    again = grid.make_cells(0, grid.parse_cell_indices(CELLS), plant="furuta")
+    grid.run_grid(cfg, again, threads=1, progress=False)
+    assert again.tobytes() == cells.tobytes()
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    line = one_line_error(*main(capsys, "grid", "--out", out, "--cells", CELLS, *TINY_ARGS)[::2])
+    assert "plant name 'furuta' != 'cart_pole'" in line
+    line = one_line_error(*main(capsys, "grid", "--plant", "furuta", "--out", out, "--cells", CELLS,
+                                "--set", "gravity=9.7", *TINY_ARGS)[::2])
+    assert "plant gravity 9.81 != 9.7" in line
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
+    rc, _, err = main(capsys, "grid", "--out", out, "--resume", "--quiet")
+    assert rc == 0, err
+
+
+def test_ceiling_of_a_plant_records_it(capsys, tmp_path):
+    w = "3.37,2.08,20.8,11.1"
+    rc, _, err = main(capsys, "ceiling", "--plant", "furuta", "--out", tmp_path / "c", "--w", w, "--cells", CELLS,
+                      "--protocol", "first", "--success-steps", "300", "--quiet")
+    assert rc == 0, err
+    record = json.loads((tmp_path / "c" / "ceiling.json").read_text())
+    assert record["settings"]["plant"] == "furuta"
+    assert "G = 1 V" in (tmp_path / "c" / "ceiling.md").read_text()
+
+
+def test_sweep_ranking_and_the_furuta_choice():
+    rows = [{"key": "a", "seed": "0", "success_rate": "0.300", "median_trials": "900"},
+            {"key": "b", "seed": "0", "success_rate": "0.295", "median_trials": "100"},
+            {"key": "c", "seed": "0", "success_rate": "0.10", "median_trials": ""}]
+    assert [r["key"] for r in plant_sweeps.ranked(rows)] == ["b", "a", "c"]  # within one point: fewer trials
+    # the settings in harness/plants.py are the choice its sweep's summary records
+    text = (REPO / "docs" / "sweeps-furuta.md").read_text()
+    choice = re.search(r"## Choice\s+`([^`]+)`", text).group(1)
+    assert plant_sweeps.setting_of(choice) == plants.FURUTA_SETTING
+    for learner, settings in plants.PLANTS["furuta"].learners.items():
+        if learner in plant_sweeps.LEARNER_SPACE:
+            picked = re.search(rf"## Learner {learner}: .*?Choice: `([^`]+)`", text, re.S).group(1)
+            assert json.loads(picked) == settings
+
+
+def test_figures_and_sweep_take_the_recorded_plant(capsys, tmp_path):
+    out = tmp_path / "fur"
+    assert main(capsys, "grid", "--plant", "furuta", "--out", out, "--cells", CELLS, *TINY_ARGS)[0] == 0
+    line = one_line_error(*main(capsys, "figures", "--results", out, "--out", tmp_path / "f", "--plant",
+                                "cart_pole")[::2])
+    assert "furuta" in line and not (tmp_path / "f").exists()
+    line = one_line_error(*main(capsys, "sweep", "--prior-from", out, "--out", tmp_path / "s", "--plant",
+                                "cart_pole", "--param", "actor.noise_std=1")[::2])
+    assert "furuta" in line and not (tmp_path / "s").exists()
+    rc, printed, err = main(capsys, "figures", "--results", out, "--out", tmp_path / "f", "--plant", "furuta")
+    assert rc == 0, err
+    assert sorted(Path(p).name for p in printed.split()) == ["fig1b_success_map.png", "fig1cf_weights.png"]
+
+
+def test_sweep_stage_writes_its_rows_and_resumes(tmp_path, monkeypatch):
+    monkeypatch.setattr(plant_sweeps, "MAX_TRIALS", 20)
+    monkeypatch.setattr(plant_sweeps, "SUCCESS_STEPS", 100)
+    path = tmp_path / "stage.csv"
+    setting = plant_sweeps.samples("furuta")[0]
+    rows = plant_sweeps.run_stage("furuta", path, [setting], [0, 1], [600, 601])
+    assert [r["seed"] for r in plant_sweeps.read_rows(path)] == ["0", "1"] and len(rows) == 2
+    assert plant_sweeps.setting_of(rows[0]["key"]) == setting
+    before = path.read_bytes()
+    plant_sweeps.run_stage("furuta", path, [setting], [0, 1], [600, 601])  # nothing left to run
+    assert path.read_bytes() == before
