@@ -94,13 +94,15 @@ TASK_SPACES: dict[str, tuple[tuple[tuple[str, tuple[float, ...]], ...], Any]] = 
                 ("zone_deg", (11.5, 10.0, 8.0, 6.0)),
                 ("ico.rate", (1e-4, 1e-3, 1e-2)),
                 ("policy.gain", (1.0, 3.0, 10.0))), furuta_task),
-    "double_cart_pole": ((("cart_velocity_range", (1.0, 2.0, 3.5, 6.0)),
-                          ("link_velocity_range", (0.5, 1.0, 2.0, 4.0)),
-                          ("zone_deg", (10.0, 8.0, 6.0, 4.0)),
+    # a first, narrower space put its best at its edges (rate 0.01, gain 30 N, both velocity ranges
+    # and the zone at their largest): this one extends each beyond it
+    "double_cart_pole": ((("cart_velocity_range", (1.0, 2.0, 3.5, 6.0, 10.0)),
+                          ("link_velocity_range", (0.5, 1.0, 2.0, 4.0, 8.0)),
+                          ("zone_deg", (11.0, 10.0, 8.0, 6.0, 4.0)),
                           ("upper_reflex", (1.0, -1.0)),
                           ("cart_reflex", (1.0, -1.0)),
-                          ("ico.rate", (1e-4, 1e-3, 1e-2)),
-                          ("policy.gain", (3.0, 10.0, 30.0))), double_task),
+                          ("ico.rate", (1e-4, 1e-3, 1e-2, 1e-1)),
+                          ("policy.gain", (3.0, 10.0, 30.0, 100.0))), double_task),
 }
 
 

@@ -1,7 +1,7 @@
 /* The benchmark on registry plants (icoac_sim_run_cell_model, icoac_sim_run_grid_model,
  * icoac_sim_trajectory_model): the cart-pole's model runs bit for bit as its plant struct, a
- * Furuta pendulum grid runs its own dynamics and failure test, and what the controller build
- * cannot observe is refused. */
+ * Furuta pendulum grid runs its own dynamics and failure test, the 6-state double pendulum runs
+ * with a task of 6 inputs, and a task of another size is refused. */
 #include "test_common.h"
 
 #include "test_sim_common.h"
@@ -134,8 +134,52 @@ static void test_furuta_trajectory(void **unused)
     }
 }
 
-/* Refused: a plant whose state the controller build does not observe (the 6-state double
- * pendulum), a model outside its ranges, NULL; the cells are left as they were. */
+/* The double pendulum with a task of its 6 inputs (the cart-pole's rules on x and theta1): the
+ * trajectory is the model's steps under the recorded forces, and a grid's cells end with weights
+ * on all six inputs (the engine feeds the controller every state component). */
+static void test_double_pendulum_six_inputs(void **unused)
+{
+    const icoac_sim_model_t model = model_of(icoac_sim_plant_find("double_cart_pole"));
+    const icoac_sim_run_t run = test_small_run(20, 200);
+    icoac_config_t cfg = test_default_config();
+    icoac_sim_cell_t cells[2];
+    double states[31 * 6], forces[30];
+    int64_t steps = -1;
+    int64_t k;
+    int i;
+    (void)unused;
+    cfg.task.n_inputs = 6;
+    for (i = 4; i < 6; ++i) {
+        cfg.policy.input_range[i] = ICOAC_R(1.0);
+        cfg.critic.range[i] = ICOAC_R(1.0);
+        cfg.critic.units[i] = 1;
+    }
+    assert_int_equal(icoac_config_check(&cfg), ICOAC_OK);
+    assert_int_equal(icoac_sim_trajectory_model(&cfg, &model, NULL, 0.2, 0.1, 0.0, 3u, 30, states, forces, &steps),
+                     ICOAC_SIM_OK);
+    assert_true(steps >= 1 && steps <= 30);
+    assert_true(states[0] == 0.2 && states[2] == 0.1 && states[4] == 0.0);
+    for (k = 0; k < steps; ++k) {
+        double s[ICOAC_SIM_MAX_STATE] = {0.0};
+        memcpy(s, states + 6 * k, 6 * sizeof s[0]);
+        assert_int_equal(icoac_sim_model_step(&model, s, forces[k]), ICOAC_SIM_OK);
+        assert_memory_equal(s, states + 6 * (k + 1), 6 * sizeof s[0]);
+    }
+    memset(cells, 0, sizeof cells);
+    cells[1].x0 = -0.5; /* near upright: the links fall slowly enough for the reflex to teach ICO */
+    cells[1].theta0 = -0.05;
+    cells[0].seed = 1u;
+    cells[1].seed = 2u;
+    assert_int_equal(icoac_sim_run_grid_model(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL), ICOAC_SIM_OK);
+    for (i = 0; i < 2; ++i) {
+        assert_int_equal(cells[i].status, ICOAC_OK);
+        assert_true(cells[i].outcome == ICOAC_SIM_SUCCESS || cells[i].outcome == ICOAC_SIM_FAILED);
+        assert_true(cells[i].weights[4] != 0.0 || cells[i].weights[5] != 0.0); /* theta2 reached ICO */
+    }
+}
+
+/* Refused: a task whose input count is not the plant's (the cart-pole's 4-input task on the
+ * 6-state double pendulum), a model outside its ranges, NULL; the cells are left as they were. */
 static void test_refused(void **unused)
 {
     const icoac_sim_run_t run = test_small_run(2, 10);
@@ -194,6 +238,7 @@ int main(void)
         cmocka_unit_test(test_cart_pole_model_bit_for_bit),
         cmocka_unit_test(test_furuta_grid),
         cmocka_unit_test(test_furuta_trajectory),
+        cmocka_unit_test(test_double_pendulum_six_inputs),
         cmocka_unit_test(test_refused),
         cmocka_unit_test(test_grid_null_run),
     };

@@ -327,23 +327,27 @@ def test_registry_plant_parameters_and_bad_input(env_id, plant):
             env.reset(options=bad)
 
 
-def test_policy_refuses_the_six_state_env():
+def test_policy_refuses_an_env_of_another_size():
     with pytest.raises(ValueError, match="observation must be a Box of 4"):
         hg.IcoacPolicy().run_episode(gymnasium.make("icoac/DoubleCartPole-v0"))
+    with pytest.raises(ValueError, match="observation must be a Box of 6"):
+        hg.IcoacPolicy(plant="double_cart_pole").run_episode(gymnasium.make("icoac/CartPole-v0"))
 
 
-def test_furuta_episodes_equal_the_engine_trial_loop():
-    """IcoacPolicy with the Furuta's task settings on icoac/Furuta-v0 = the engine's cell run on the
-    Furuta model: same trial lengths, same learned weights (no initial velocity noise, so that every
-    trial of the engine starts where the env's reset puts it)."""
-    trials, horizon, cell = 10, 300, 269  # alpha0 = -7 deg, theta0 = 0
-    cfg = build_config({"max_trials": trials, "success_steps": horizon, "init_velocity_noise": 0}, plant="furuta")
-    assert hg.IcoacPolicy(condition="ico", plant="furuta").weights.shape == (B.N_INPUTS,)
+@pytest.mark.parametrize("env_id, plant", NEW_PLANTS.items())
+def test_plant_episodes_equal_the_engine_trial_loop(env_id, plant):
+    """IcoacPolicy with a plant's task settings on its env = the engine's cell run on the plant's
+    model: same trial lengths, same learned weights (no initial velocity noise, so that every trial
+    of the engine starts where the env's reset puts it)."""
+    trials, horizon, cell = 10, 300, 269  # the row component at -7 deg, the column's at 0
+    cfg = build_config({"max_trials": trials, "success_steps": horizon, "init_velocity_noise": 0}, plant=plant)
+    n = len(B.plant_info(plant)["state"])
+    assert hg.IcoacPolicy(condition="ico", plant=plant).weights.shape == (n,)
     cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
-    B.check_status(B.lib.icoac_sim_plant_grid(B.plant_index("furuta"), cells, cells.size, 0))
+    B.check_status(B.lib.icoac_sim_plant_grid(B.plant_index(plant), cells, cells.size, 0))
     seed = int(cells[cell]["seed"])
     engine = run_cell(cfg, cells[cell]["x0"], cells[cell]["theta0"], seed=seed)
-    env = gymnasium.make("icoac/Furuta-v0", max_episode_steps=horizon, init_velocity_noise=0)
+    env = gymnasium.make(env_id, max_episode_steps=horizon, init_velocity_noise=0)
     policy = hg.IcoacPolicy(cfg, seed=int(B.lib.icoac_mix_seed(seed, 1)))
     assert_episodes_are_the_engine_trials(policy, env, cell, trials, engine)
     assert np.any(policy.weights != 0)  # it learned
