@@ -119,8 +119,8 @@ FURUTA_SETTING = {"arm_range": 1.0, "arm_velocity_range": 2.3, "pendulum_velocit
 FURUTA_ICO_RL = {"actor.update": "mean", "actor.likelihood_std": 0.1, "actor.scale": 0.1, "actor.noise_std": 1.0}
 
 # The double pendulum's task setting, chosen by its sweep (docs/sweeps-double_cart_pole.md).
-DOUBLE_SETTING = {"cart_velocity_range": 6.0, "link_velocity_range": 4.0, "zone_deg": 10.0, "upper_reflex": -1.0,
-                  "cart_reflex": -1.0, "ico.rate": 1e-2, "policy.gain": 30.0}
+DOUBLE_SETTING = {"cart_velocity_range": 10.0, "link_velocity_range": 4.0, "zone_deg": 10.0, "upper_reflex": -1.0,
+                  "cart_reflex": -1.0, "ico.rate": 0.1, "policy.gain": 3.0}
 
 PLANTS: dict[str, PlantSpec] = {
     CART_POLE: PlantSpec(CART_POLE, {}, "the C defaults (the paper's task)"),

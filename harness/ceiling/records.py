@@ -90,13 +90,15 @@ def summary_markdown(record: Mapping[str, Any]) -> str:
     pol = record.get("policy", {})
     plant = st.get("plant", CART_POLE)
     unit = B.plant_info(plant)["input"][1]
+    names = "w_x, w_ẋ, w_θ, w_θ̇" if plant == CART_POLE else ", ".join(
+        f"w_{name}" for name, _ in B.plant_info(plant)["state"])
     lines = ["# Linear-policy ceiling (method.md, L5)", "",
              f"Policy F = G·wᵀx̃ + U with G = {pol.get('gain', 'n/a'):g} {unit}, reflex {pol.get('reflex_mode')} "
              f"({pol.get('reflex_force', 'n/a'):g} {unit}), no learning (learn = 0); "
              f"{'' if plant == CART_POLE else f'plant {plant}; '}seed {st['seed']}, "
              f"{st['n_cells']} cells{'' if st['cells'] is None else ' (subset)'}, horizon {st['success_steps']:g} "
              f"steps{'' if not st['set'] else ', --set ' + ', '.join(f'{k}={v}' for k, v in st['set'].items())}.",
-             "", f"Best w = (w_x, w_ẋ, w_θ, w_θ̇) = {format_w(best['w'], 6)} ({best['source']}).", "",
+             "", f"Best w = ({names}) = {format_w(best['w'], 6)} ({best['source']}).", "",
              "| protocol | trials per cell | success, all cells | success, interior cells | median trials to success |",
              "|---|---|---|---|---|"]
     for p, s in best["protocols"].items():
