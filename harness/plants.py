@@ -25,6 +25,14 @@ class PlantSpec:
     # a learner's settings on this plant where its cart-pole defaults do not carry over, by the
     # learner's condition name (its control takes them too), from the plant's learner sweep
     learners: dict[str, dict[str, Any]] = field(default_factory=dict)
+    # the ICO cells the ICO prior averages (harness.prior.compute): "successful" (the paper's), or
+    # "finished" where ICO balances too few cells for a prior (why: prior_why)
+    prior_cells: str = "successful"
+    prior_why: str = ""
+
+
+# The cells of an ICO grid an ICO prior may average (PlantSpec.prior_cells).
+PRIOR_CELLS = ("successful", "finished")
 
 
 # The cart-pole's reflex zone along its position, 2.35 of 2.4 m, as a fraction of the input range
@@ -133,7 +141,11 @@ PLANTS: dict[str, PlantSpec] = {
                                   "rl": {"actor.noise_std": 3.0}, "rl-ico-cov": {"actor.noise_std": 3.0}}),
     "double_cart_pole": PlantSpec("double_cart_pole", task_overrides("double_cart_pole", DOUBLE_SETTING),
                                   "its sweep (docs/sweeps-double_cart_pole.md): velocity scaling, reflex zone "
-                                  "and the upper link's reflex sign, ICO rate, gain"),
+                                  "and the upper link's reflex sign, ICO rate, gain",
+                                  prior_cells="finished",
+                                  prior_why="ICO balances at most 1 of its 1225 cells at the default caps (no prior "
+                                            "of 2 or more successful cells in any frame), but it learns weights in "
+                                            "every cell: the ICO prior averages them, balanced or not"),
 }
 # Registry plants the controller build cannot run, and why.
 UNRUNNABLE: dict[str, str] = {}
@@ -149,3 +161,4 @@ def spec(name: str) -> PlantSpec:
         raise B.ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {name} cannot run: {UNRUNNABLE[name]}")
     B.plant_index(name)  # an unknown name: the registry's message
     raise AssertionError(name)
+assert all(p.prior_cells in PRIOR_CELLS and (p.prior_cells == PRIOR_CELLS[0]) != bool(p.prior_why) for p in PLANTS.values())

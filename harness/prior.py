@@ -21,6 +21,7 @@ from .config import make_prior
 from .errors import PriorError
 from .options import FRAME_NAMES, PRIOR_FRAME as DEFAULT_FRAME, PRIOR_RIDGE as DEFAULT_RIDGE
 from .options import PRIOR_STD as DEFAULT_STD
+from .plants import PRIOR_CELLS, spec as plant_spec
 from .registry import COV_RULES, MEAN_RULES, REGISTRY
 
 _TOL = 1e-9
@@ -95,23 +96,28 @@ def parse_frame(text: str | None, x_max: float | None = None, theta_max_deg: flo
 
 
 def compute(cells: np.ndarray, frame: tuple[float, float] | str | None = DEFAULT_FRAME,
-            ridge: float = DEFAULT_RIDGE, grid: geometry.PlantGrid = geometry.CART_POLE) -> PriorInfo:
-    """ICO->RL prior from an ICO cell array of the plant's grid: successful cells inside frame
-    (CENTRAL: the grid's central frame), mean and sample cov + ridge*I."""
+            ridge: float = DEFAULT_RIDGE, grid: geometry.PlantGrid = geometry.CART_POLE,
+            use: str = PRIOR_CELLS[0]) -> PriorInfo:
+    """ICO->RL prior from an ICO cell array of the plant's grid: the cells inside frame (CENTRAL:
+    the grid's central frame) that ICO balanced ("successful", the paper's) or that it finished
+    ("finished": balanced or failed, its weights learned either way; harness.plants says which
+    plant takes it), mean and sample cov + ridge*I."""
     if not (math.isfinite(ridge) and ridge >= 0):
         raise PriorError(f"prior ridge must be finite and >= 0, got {ridge}")
+    if use not in PRIOR_CELLS:
+        raise PriorError(f"prior cells must be one of {', '.join(PRIOR_CELLS)}, got {use!r:.40}")
     if frame == CENTRAL:
         frame = grid.central_frame()
-    sel = metrics.success_mask(cells) & frame_mask(cells, frame, grid)
+    taken = metrics.success_mask(cells) if use == "successful" else np.isin(cells["outcome"], (B.SUCCESS, B.FAILED))
+    sel = taken & frame_mask(cells, frame, grid)
     n = int(np.count_nonzero(sel))
     where = "any cell" if frame is None else (f"|{grid.col_name}0| <= {frame[0]:g} {grid.col_unit}, "
                                               f"|{grid.row_name}0| <= {frame[1]:g} {grid.row_unit}")
+    what = "ICO-successful" if use == "successful" else "ICO-finished"
     if n == 0:
-        raise PriorError(f"no ICO-successful cell in the prior frame ({where}); "
-                         "widen the frame or use --prior-frame all")
+        raise PriorError(f"no {what} cell in the prior frame ({where}); widen the frame or use --prior-frame all")
     if n < 2:
-        raise PriorError(f"only {n} ICO-successful cell in the prior frame ({where}); "
-                         "a sample covariance needs at least 2")
+        raise PriorError(f"only {n} {what} cell in the prior frame ({where}); a sample covariance needs at least 2")
     w = cells["weights"][sel][:, :grid.n_inputs].astype(np.float64)
     mean = w.mean(axis=0)
     cov = np.cov(w, rowvar=False, ddof=1) + ridge * np.eye(grid.n_inputs)
@@ -119,7 +125,8 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | str | None = DEFAULT
     # entries that would be subnormal in the controller's reals are 0 to it on a host that
     # flushes subnormals, so the C prior check rejects them: store them as 0
     cov[np.abs(cov) < np.finfo(B.real_dtype).tiny] = 0.0
-    return PriorInfo(mean=mean, cov=cov, frame=frame, n_cells=n, ridge=float(ridge))
+    return PriorInfo(mean=mean, cov=cov, frame=frame, n_cells=n, ridge=float(ridge),
+                     extra={} if use == PRIOR_CELLS[0] else {"prior_cells": use})
 
 
 # The words of a prior rule (harness.registry) -> the mean (from the ICO prior) and covariance (from
@@ -168,10 +175,12 @@ def from_results(path: str | Path, frame: tuple[float, float] | str | None = DEF
         raise PriorError(f"--prior-from: {str(path)!r} holds condition {record.get('condition')!r}, not ico")
     if not record.get("complete", False):
         raise PriorError(f"--prior-from: {str(path)!r} is incomplete (PENDING cells); finish it with --resume")
-    info = compute(cells, frame, ridge, geometry.of(results.record_plant(record)))
+    plant = results.record_plant(record)
+    info = compute(cells, frame, ridge, geometry.of(plant), plant_spec(plant).prior_cells)
     info.source = str(path.resolve())
     info.source_commit = (record.get("git") or {}).get("commit")
     info.source_seed = record.get("seed")
     info.ico_phase_simulated_time = float(np.sum(cells["elapsed_time"]))
-    info.extra = {"source_cells": int(cells.size), "source_success_rate": record.get("summary", {}).get("success_rate")}
+    info.extra = {**info.extra, "source_cells": int(cells.size),
+                  "source_success_rate": record.get("summary", {}).get("success_rate")}
     return info

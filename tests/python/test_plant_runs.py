@@ -184,3 +184,22 @@ def test_sweep_stage_writes_its_rows_and_resumes(tmp_path, monkeypatch):
     before = path.read_bytes()
     plant_sweeps.run_stage("furuta", path, [setting], [0, 1], [600, 601])  # nothing left to run
     assert path.read_bytes() == before
+
+
+def test_prior_of_finished_cells():
+    """A plant whose ICO prior averages every finished cell (plants.PlantSpec.prior_cells): the
+    failed cells' weights count, pending and error cells do not, and the rule is recorded."""
+    cells = grid.plant_grid("double_cart_pole", 0)[:6]
+    cells["outcome"] = [B.SUCCESS, B.FAILED, B.FAILED, B.PENDING, B.ERROR, B.FAILED]
+    cells["x0"], cells["theta0"] = 0.0, 0.0
+    cells["weights"][:, :6] = np.arange(36.0).reshape(6, 6)
+    grid6 = geometry.of("double_cart_pole")
+    info = P.compute(cells, None, ridge=0.0, grid=grid6, use="finished")
+    assert info.n_cells == 4 and info.to_dict()["prior_cells"] == "finished"
+    np.testing.assert_allclose(info.mean, cells["weights"][[0, 1, 2, 5]][:, :6].mean(axis=0))
+    with pytest.raises(P.PriorError, match="only 1 ICO-successful cell"):
+        P.compute(cells, None, grid=grid6)
+    with pytest.raises(P.PriorError, match="prior cells"):
+        P.compute(cells, None, grid=grid6, use="some")
+    assert plants.PLANTS["double_cart_pole"].prior_cells == "finished"
+    assert plants.PLANTS["furuta"].prior_cells == plants.PLANTS["cart_pole"].prior_cells == "successful"
