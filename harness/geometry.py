@@ -20,6 +20,10 @@ from .options import CART_POLE as CART_POLE_NAME
 TOL = 1e-6  # plant units (m, rad): a cell coordinate must be this close to a grid point
 
 
+def _start_name(component: str) -> str:
+    return f"{component}_0" if component[-1:].isdigit() else f"{component}0"
+
+
 class PlantGrid:
     """The grid of a registry plant: shape, axis values and labels, (row, column) of cells, the
     interior (off the outermost rows and columns) and maps."""
@@ -114,11 +118,18 @@ class PlantGrid:
         return tuple(round(v, 9) for v in (self.col_first - self.col_step / 2, self.col_last + self.col_step / 2,
                                            self.row_first - self.row_step / 2, self.row_last + self.row_step / 2))
 
+    def col_start(self) -> str:
+        """The column component's start by name: x0; a name ending in a digit gets _0 (theta1_0)."""
+        return _start_name(self.col_name)
+
+    def row_start(self) -> str:
+        return _start_name(self.row_name)
+
     def col_label(self) -> str:
-        return f"{self.col_name}0 ({self.col_unit})"
+        return f"{self.col_start()} ({self.col_unit})"
 
     def row_label(self) -> str:
-        return f"{self.row_name}0 ({self.row_unit})"
+        return f"{self.row_start()} ({self.row_unit})"
 
     def central_frame(self) -> tuple[float, float]:
         """Half the grid's half-extent along each axis (display units): the default prior frame

@@ -111,8 +111,8 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | str | None = DEFAULT
     taken = metrics.success_mask(cells) if use == "successful" else np.isin(cells["outcome"], (B.SUCCESS, B.FAILED))
     sel = taken & frame_mask(cells, frame, grid)
     n = int(np.count_nonzero(sel))
-    where = "any cell" if frame is None else (f"|{grid.col_name}0| <= {frame[0]:g} {grid.col_unit}, "
-                                              f"|{grid.row_name}0| <= {frame[1]:g} {grid.row_unit}")
+    where = "any cell" if frame is None else (f"|{grid.col_start()}| <= {frame[0]:g} {grid.col_unit}, "
+                                              f"|{grid.row_start()}| <= {frame[1]:g} {grid.row_unit}")
     what = "ICO-successful" if use == "successful" else "ICO-finished"
     if n == 0:
         raise PriorError(f"no {what} cell in the prior frame ({where}); widen the frame or use --prior-frame all")
