@@ -148,8 +148,7 @@ sweeps-rl-alone: build venv
 
 # The task settings and learner noise of each plant but the cart-pole (harness/plants.py), by
 # their sweeps (harness.tools.plant_sweeps; resumable): the task on spread cells, then the
-# learners on the plant's ICO grid of seed 0 (make bench BENCH_PLANTS=furuta first). The double
-# pendulum's learners keep the cart-pole's settings (its force is in newtons, as the cart-pole's).
+# learners on the plant's ICO grid of seed 0 (make bench BENCH_PLANTS=<plant> first).
 PLANT_SWEEPS = $(VPY) -m harness.tools.plant_sweeps --plant furuta --out results/sweeps-furuta
 DOUBLE_SWEEPS = $(VPY) -m harness.tools.plant_sweeps --plant double_cart_pole --out results/sweeps-double_cart_pole
 sweeps-plants: build venv
@@ -158,6 +157,8 @@ sweeps-plants: build venv
 	$(PLANT_SWEEPS) --report
 	cp results/sweeps-furuta/summary.md docs/sweeps-furuta.md
 	$(DOUBLE_SWEEPS)
+	$(DOUBLE_SWEEPS) --stage learners --prior-from $(BENCH_OUT)-double_cart_pole/ico/seed-0
+	$(DOUBLE_SWEEPS) --report
 	cp results/sweeps-double_cart_pole/summary.md docs/sweeps-double_cart_pole.md
 
 # Microcontroller resource report: cross builds, QEMU runs, table in docs/porting.md.
