@@ -13,9 +13,9 @@ from typing import Any
 import numpy as np
 
 from . import _binding as B
-from . import grid, results, store
+from . import geometry, grid, results, store
 from . import prior as P
-from .config import RunConfig, build_config, plant_inputs
+from .config import RunConfig, build_config
 from .errors import UsageError
 from .options import CART_POLE, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY
 from .registry import CONDITIONS, REGISTRY
@@ -37,10 +37,10 @@ def condition_prior(condition: str, prior_from, frame, ridge: float, std: float 
     if rule is None or not rule.takes_ico:
         if prior_from is not None:
             raise UsageError(f"condition {condition} takes nothing from ICO; drop --prior-from")
-        return None if rule is None else P.condition_prior(condition, None, std, plant_inputs(plant))
+        return None if rule is None else P.condition_prior(condition, None, std, geometry.of(plant).n_inputs)
     if prior_from is None:
         raise UsageError(f"condition {condition} needs --prior-from ICO_RESULTS_DIR")
-    return P.condition_prior(condition, P.from_results(prior_from, frame, ridge), std, plant_inputs(plant))
+    return P.condition_prior(condition, P.from_results(prior_from, frame, ridge), std, geometry.of(plant).n_inputs)
 
 
 def prior_extra(info: P.PriorInfo | None) -> dict | None:

@@ -21,7 +21,7 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from . import _binding as B
-from . import literals, options
+from . import geometry, literals, options
 from .plants import CART_POLE, spec as plant_spec
 from .registry import CONDITIONS, REGISTRY
 from ._binding import ConfigError
@@ -467,9 +467,10 @@ class RunConfig:
             raise ConfigError(status, text, context="controller config")
         if self.model is not None:
             check_model(self.model)
-        if self.n_inputs != plant_inputs(self.plant_name):  # the engine's refusal, said before a run
+        n_state = geometry.of(self.plant_name).n_inputs
+        if self.n_inputs != n_state:  # the engine's refusal, said before a run
             raise ConfigError(B.SIM_ERR_BAD_PLANT, f"task.n_inputs={self.n_inputs}: plant {self.plant_name} has "
-                              f"{plant_inputs(self.plant_name)} state components, one input each",
+                              f"{n_state} state components, one input each",
                               context="plant config")
         checks = ((("plant config", self.plant, B.lib.icoac_sim_plant_check, B.lib.icoac_sim_plant_default),)
                   if self.model is None else ())
@@ -523,10 +524,6 @@ def check_model(model: B.Model) -> None:
                           f"plant {info['name']} has {n} state components; this controller build takes "
                           f"at most {B.MAX_INPUTS} inputs, one per component in order", context="plant config")
 
-
-def plant_inputs(plant: str) -> int:
-    """The controller inputs of a plant's task: one per state component (the engine's rule)."""
-    return len(B.plant_info(plant)["state"])
 
 
 def build_model(name: str, values: Mapping[str, Any]) -> B.Model:

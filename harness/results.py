@@ -136,9 +136,9 @@ def open_file(file: Path, follow: bool = True):
 # The cell layout of the versions whose controller read 4 inputs (simulator ABI 2): read, and
 # widened to today's (the weights and covariance after the fourth input are 0, as the engine now
 # writes them for a 4-input task).
-FOUR_INPUT_CELL_DTYPE = np.dtype([(name, B.CELL_DTYPE.fields[name][0].base, (B.N_INPUTS,) * len(shape))
-                                  if (shape := B.CELL_DTYPE.fields[name][0].shape) else
-                                  (name, B.CELL_DTYPE.fields[name][0]) for name in B.CELL_DTYPE.names], align=True)
+_FOUR_INPUT_SHAPES = {"weights": (B.N_INPUTS,), "cov": (B.N_INPUTS, B.N_INPUTS)}
+FOUR_INPUT_CELL_DTYPE = np.dtype([(name, (np.float64, _FOUR_INPUT_SHAPES[name]) if name in _FOUR_INPUT_SHAPES
+                                   else B.CELL_DTYPE.fields[name][0]) for name in B.CELL_DTYPE.names], align=True)
 
 
 def _widened(old: np.ndarray) -> np.ndarray:
@@ -172,7 +172,7 @@ def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
                     shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
                 else:
                     raise _err(f"{where}: unsupported .npy version {version}")
-                layout = B.CELL_DTYPE if dtype != FOUR_INPUT_CELL_DTYPE else FOUR_INPUT_CELL_DTYPE
+                layout = FOUR_INPUT_CELL_DTYPE if dtype == FOUR_INPUT_CELL_DTYPE else B.CELL_DTYPE
                 if dtype != layout:
                     raise _err(f"{where} has a different cell layout than this library "
                                f"({_dtype_difference(dtype)}); it was written by another version")

@@ -11,9 +11,8 @@ from typing import Any, Sequence
 import numpy as np
 
 from .. import _binding as B
-from .. import grid, results, store
+from .. import geometry, grid, results, store
 from .. import prior as P
-from ..config import plant_inputs
 from ..errors import UsageError
 from ..plants import CART_POLE
 from ..options import (CEILING_CANDIDATES, CEILING_CONFIRM, CEILING_FILE, CEILING_MAX_CANDIDATES, CEILING_MAX_TRIALS,
@@ -72,7 +71,7 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
         indices = grid.parse_cell_indices(opt.cells)
     except B.ConfigError as exc:
         raise UsageError(f"--cells: {exc}") from None
-    n_inputs = plant_inputs(opt.plant)
+    n_inputs = geometry.of(opt.plant).n_inputs
     typical_w = typical_weights(n_inputs)
     probe = fixed_config(typical_w, "retries", max_trials=max_trials, success_steps=opt.success_steps,
                          overrides=overrides, plant=opt.plant)  # C checks of everything

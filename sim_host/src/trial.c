@@ -21,29 +21,29 @@
 
 /* The plant state as the controller's reals. A value outside the real type's range would be
  * an undefined conversion: it is passed as NaN, which the controller rejects.
- * With SSE2 and float reals the four values go out in one 16-byte store. The compiler
+ * With SSE2 and float reals a 4-input task's values go out in one 16-byte store. The compiler
  * vectorizes icoac_step's reads of in->s into one 16-byte load, which cannot be forwarded from
  * four 4-byte stores: it then waits until they retire, and that serializes the ticks of the
  * engine's lanes (measured: two lanes in lockstep ran no faster than one). */
 void sim_to_input(const double *s, int32_t n, uint32_t flags, icoac_input_t *in)
 {
-    int32_t i;
+    int32_t i = 0;
 #if defined(__SSE2__) && !(defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE)
     if (n == 4) {
-    const __m128d magnitude = _mm_castsi128_pd(_mm_set1_epi64x(0x7FFFFFFFFFFFFFFFll));
-    const __m128d limit = _mm_set1_pd(SIM_REAL_MAX);
-    const __m128d nan = _mm_set1_pd((double)NAN);
-    const __m128d low = _mm_set_pd(s[1], s[0]);
-    const __m128d high = _mm_set_pd(s[3], s[2]);
-    const __m128d low_ok = _mm_cmple_pd(_mm_and_pd(low, magnitude), limit); /* false for NaN */
-    const __m128d high_ok = _mm_cmple_pd(_mm_and_pd(high, magnitude), limit);
-    const __m128 low_real = _mm_cvtpd_ps(_mm_or_pd(_mm_and_pd(low_ok, low), _mm_andnot_pd(low_ok, nan)));
-    const __m128 high_real = _mm_cvtpd_ps(_mm_or_pd(_mm_and_pd(high_ok, high), _mm_andnot_pd(high_ok, nan)));
-    _mm_storeu_ps(in->s, _mm_movelh_ps(low_real, high_real));
-    n = 0;
+        const __m128d magnitude = _mm_castsi128_pd(_mm_set1_epi64x(0x7FFFFFFFFFFFFFFFll));
+        const __m128d limit = _mm_set1_pd(SIM_REAL_MAX);
+        const __m128d nan = _mm_set1_pd((double)NAN);
+        const __m128d low = _mm_set_pd(s[1], s[0]);
+        const __m128d high = _mm_set_pd(s[3], s[2]);
+        const __m128d low_ok = _mm_cmple_pd(_mm_and_pd(low, magnitude), limit); /* false for NaN */
+        const __m128d high_ok = _mm_cmple_pd(_mm_and_pd(high, magnitude), limit);
+        const __m128 low_real = _mm_cvtpd_ps(_mm_or_pd(_mm_and_pd(low_ok, low), _mm_andnot_pd(low_ok, nan)));
+        const __m128 high_real = _mm_cvtpd_ps(_mm_or_pd(_mm_and_pd(high_ok, high), _mm_andnot_pd(high_ok, nan)));
+        _mm_storeu_ps(in->s, _mm_movelh_ps(low_real, high_real));
+        i = 4;
     }
 #endif
-    for (i = 0; i < n; ++i) {
+    for (; i < n; ++i) {
         in->s[i] = fabs(s[i]) <= SIM_REAL_MAX ? (icoac_real_t)s[i] : (icoac_real_t)NAN;
     }
     in->flags = flags;
