@@ -25,9 +25,13 @@ BENCH_PLANTS ?= cart_pole
 FUZZ_TIME ?= 600
 FUZZ_JOBS ?= 2
 FUZZ_FLAGS ?=
+# The C sources a fuzzing run tests (their git tree ids, "-modified" for uncommitted changes): the
+# ledger adds up only runs of the same sources.
+FUZZ_SOURCES = $(shell git ls-tree -d HEAD firmware sim_host tests/fuzz 2>/dev/null | git hash-object --stdin | \
+  cut -c1-12)$(shell git diff --quiet HEAD -- firmware sim_host tests/fuzz 2>/dev/null || echo -modified)
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim fuzz_model
 
-.PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz bench \
+.PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz fuzz-ledger bench \
   bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
@@ -92,8 +96,14 @@ test: test-asan test-c test-python test-fuzz
 # Long fuzzing: FUZZ_TIME s per target, FUZZ_JOBS at a time, from tests/fuzz/corpus/<target>;
 # new inputs, logs and crash reproducers go to build/fuzz/work/<target>/.
 fuzz: build-fuzz
-	@printf '%s\n' $(FUZZ_TARGETS) | xargs -P $(FUZZ_JOBS) -I '{}' sh tests/fuzz/run_fuzzer.sh fuzz $(FUZZ_TIME) \
-	  build/fuzz/tests/fuzz/'{}' tests/fuzz/corpus/'{}' build/fuzz/work/'{}' $(FUZZ_FLAGS)
+	@printf '%s\n' $(FUZZ_TARGETS) | ICOAC_FUZZ_SOURCES=$(FUZZ_SOURCES) xargs -P $(FUZZ_JOBS) -I '{}' \
+	  sh tests/fuzz/run_fuzzer.sh fuzz $(FUZZ_TIME) build/fuzz/tests/fuzz/'{}' tests/fuzz/corpus/'{}' \
+	  build/fuzz/work/'{}' $(FUZZ_FLAGS)
+	@$(PYTHON) tests/fuzz/ledger.py build/fuzz/work $(FUZZ_SOURCES)
+
+# What every long fuzzing run of the current sources adds up to, per target.
+fuzz-ledger:
+	@$(PYTHON) tests/fuzz/ledger.py build/fuzz/work $(FUZZ_SOURCES)
 
 bench-speed: build
 	./build/release/sim_host/icoac_bench

@@ -4,7 +4,9 @@
 #       run EXE once on every file in CORPUS.
 #   run_fuzzer.sh fuzz SECONDS EXE CORPUS WORK [--fresh] [libFuzzer options...]
 #       fuzz for SECONDS from CORPUS, which is only read: new inputs go to WORK/corpus
-#       (--fresh empties it first), the log to WORK/fuzz.log.
+#       (--fresh empties it first), the log to WORK/fuzz.log, and one line per run to
+#       WORK/ledger.tsv (the executions, coverage and exit status, with ICOAC_FUZZ_SOURCES, the
+#       id of the C sources fuzzed), so runs resumed from the corpus add up (tests/fuzz/ledger.py).
 # Crash and contract-violation reproducers go to WORK/artifacts/. The exit status is non-zero
 # on a crash, a sanitizer report, a contract violation, a timeout or an out-of-memory.
 set -eu
@@ -51,6 +53,15 @@ fuzz)
     # shellcheck disable=SC2086
     "$exe" $limits -max_total_time="$seconds" -print_final_stats=1 "$@" "$work/corpus" "$corpus" \
         >"$log" 2>&1 || status=$?
+    ledger=$work/ledger.tsv
+    [ -f "$ledger" ] || printf 'utc\tsources\tseconds\texecutions\tcov\tft\tcorpus\tstatus\n' >"$ledger"
+    executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+    last=$(grep -E '^#[0-9]+ +(DONE|pulse|NEW|REDUCE|INITED)' "$log" | tail -n 1)
+    [ -n "$executions" ] || executions=$(echo "$last" | sed -n 's/^#\([0-9]*\).*/\1/p')
+    cov=$(echo "$last" | sed -n 's/.* cov: \([0-9]*\).*/\1/p')
+    ft=$(echo "$last" | sed -n 's/.* ft: \([0-9]*\).*/\1/p')
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$(date -u +%Y-%m-%dT%H:%M:%SZ)" "${ICOAC_FUZZ_SOURCES:-unknown}" \
+        "$seconds" "${executions:-0}" "${cov:-0}" "${ft:-0}" "$(ls "$work/corpus" | wc -l)" "$status" >>"$ledger"
     if [ "$status" -eq 0 ]; then
         echo "$name: no failure in ${seconds} s (log $log)"
         grep -E '^#[0-9]+ +DONE|^stat::' "$log" || true
