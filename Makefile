@@ -25,10 +25,11 @@ BENCH_PLANTS ?= cart_pole
 FUZZ_TIME ?= 600
 FUZZ_JOBS ?= 2
 FUZZ_FLAGS ?=
-# The C sources a fuzzing run tests (their git tree ids, "-modified" for uncommitted changes): the
-# ledger adds up only runs of the same sources.
-FUZZ_SOURCES = $(shell git ls-tree -d HEAD firmware sim_host tests/fuzz 2>/dev/null | git hash-object --stdin | \
-  cut -c1-12)$(shell git diff --quiet HEAD -- firmware sim_host tests/fuzz 2>/dev/null || echo -modified)
+# The C sources a fuzzing run tests (the id of their git trees, "-modified" for uncommitted
+# changes): the ledger adds up only runs of the same sources.
+FUZZ_C_SOURCES = firmware sim_host $(wildcard tests/fuzz/*.c tests/fuzz/*.h)
+FUZZ_SOURCES = $(shell git ls-tree HEAD $(FUZZ_C_SOURCES) 2>/dev/null | git hash-object --stdin | \
+  cut -c1-12)$(shell git diff --quiet HEAD -- $(FUZZ_C_SOURCES) 2>/dev/null || echo -modified)
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim fuzz_model
 
 .PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz fuzz-ledger bench \
