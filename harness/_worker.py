@@ -105,7 +105,23 @@ def abi_of(B) -> dict[str, Any]:
             "sizeof_config": int(B.lib.icoac_sizeof_config()),
             "sizeof_prior": int(B.lib.icoac_sizeof_prior()), "sizeof_plant": int(B.lib.icoac_sim_sizeof_plant()),
             "sizeof_run": int(B.lib.icoac_sim_sizeof_run()), "sizeof_cell": int(B.CELL_DTYPE.itemsize),
+            "plants": [B.plant_info(i)["name"] for i in range(int(B.lib.icoac_sim_plant_count()))],
             "harness_version": __version__}
+
+
+def config_bytes(cfg) -> tuple:
+    """A RunConfig as the bytes of its C structs (controller, plant, run, prior or None, model or
+    None), which a worker turns back into the same configuration (config_from_bytes)."""
+    return (bytes(cfg.controller), bytes(cfg.plant), bytes(cfg.run),
+            None if cfg.prior is None else bytes(cfg.prior), None if cfg.model is None else bytes(cfg.model))
+
+
+def config_from_bytes(B, cfg_bytes: tuple):
+    from .config import RunConfig
+    controller, plant, run, prior, model = cfg_bytes
+    return RunConfig(controller=B.Config.from_buffer_copy(controller), plant=B.Plant.from_buffer_copy(plant),
+                     run=B.Run.from_buffer_copy(run), prior=None if prior is None else B.Prior.from_buffer_copy(prior),
+                     model=None if model is None else B.Model.from_buffer_copy(model))
 
 
 def check_worker(expected: Mapping[str, Any], dask_worker=None) -> dict[str, Any]:
@@ -124,21 +140,18 @@ def check_worker(expected: Mapping[str, Any], dask_worker=None) -> dict[str, Any
 def run_chunk(run_id: str, chunk: int, cfg_bytes: tuple, cells: np.ndarray, expected: Mapping[str, Any]) -> dict:
     """Run one chunk: ``cells`` (a small CELL_DTYPE array, some or all PENDING) through
     grid.run_grid on one C thread, with the configuration rebuilt bitwise from the client's struct
-    bytes (controller, plant, run, prior or None). Returns {"chunk", "cells", "wall_time",
+    bytes (config_bytes). Returns {"chunk", "cells", "wall_time",
     "worker"}; cells left PENDING were cancelled (cancel_run)."""
     B = _binding()
     check_worker(expected)
     from . import grid
-    from .config import RunConfig
 
     cells = np.array(cells, dtype=B.CELL_DTYPE, copy=True, order="C")
     stop = _cancel_event(run_id)
     if stop.is_set():
         grid.reset_pending(cells)
         return {"chunk": chunk, "cells": cells, "wall_time": 0.0, "worker": worker_name()}
-    controller, plant, run, prior = cfg_bytes
-    cfg = RunConfig(controller=B.Config.from_buffer_copy(controller), plant=B.Plant.from_buffer_copy(plant),
-                    run=B.Run.from_buffer_copy(run), prior=None if prior is None else B.Prior.from_buffer_copy(prior))
+    cfg = config_from_bytes(B, cfg_bytes)
     report = _progress_reporter(B, run_id, chunk)
     res = grid.run_grid(cfg, cells, threads=1, progress=False, cancel_event=stop, on_progress=report)
     return {"chunk": chunk, "cells": cells, "wall_time": res.wall_time, "worker": worker_name()}

@@ -236,8 +236,7 @@ class _Run:
         self.client = session.client
         self.cells = cells
         self.run_id = uuid.uuid4().hex[:16]
-        self.cfg_bytes = (bytes(cfg.controller), bytes(cfg.plant), bytes(cfg.run),
-                          None if cfg.prior is None else bytes(cfg.prior))
+        self.cfg_bytes = _worker.config_bytes(cfg)
         self.chunk_size = size
         self.chunks: dict[int, np.ndarray] = {}      # chunk id -> cell indices
         self.futures: dict[int, Any] = {}            # chunk id -> future not yet merged

@@ -85,8 +85,6 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     extra = prior_extra(info)
     prior = info.prior() if info is not None else None
     cfg = None if resume and not explicit else build_config(overrides, condition=condition, prior=prior, plant=plant)
-    if dask is not None and cfg is not None and cfg.model is not None:
-        raise UsageError(f"--plant {plant}: the Dask backend runs the cart-pole only; run it on local threads")
     with store.ResultsStore(out, start_over=start_over) as st:
         have = st.present()
         if resume and not have:

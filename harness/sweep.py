@@ -22,7 +22,6 @@ import numpy as np
 from . import _binding as B
 from . import geometry, grid, metrics, results, store
 from . import prior as P
-from .plants import CART_POLE
 from ._binding import ConfigError
 from .config import build_config, canonical, command_overrides, given_twice, named_sets, parse_sets, parse_value
 from .errors import SweepError, UsageError
@@ -218,9 +217,6 @@ def run_sweep(opt: SweepOptions) -> int:
     ico_cells, ico_record = results.load(ico_dir, what="--prior-from")
     plant = results.record_plant(ico_record)  # the sweep runs on the plant of its ICO grid
     plant_grid = geometry.of(plant)
-    if plant != CART_POLE and opt.dask is not None:
-        raise UsageError(f"the ICO grid of --prior-from is of the {plant}: the Dask backend runs the cart-pole "
-                         "only; run the sweep on local threads")
     priors: dict = {}
 
     # ICO outcome on the sweep cells (matched by grid position).

@@ -96,6 +96,20 @@ def test_condition_same_cells_npz_as_threads(session, ico_dir, tmp_path, conditi
     assert record["summary"] == ref_record["summary"]
 
 
+@pytest.mark.parametrize("plant,condition", [("furuta", "ico"), ("double_cart_pole", "search")])
+def test_other_plants_same_cells_npz_as_threads(session, tmp_path, plant, condition):
+    """A chunk carries the plant's model: a grid of another plant on the cluster is the threaded one."""
+    info = condition_prior(condition, None, P.DEFAULT_FRAME, P.DEFAULT_RIDGE, plant=plant)
+    common = dict(condition=condition, seed=2, overrides={"max_trials": 40, "success_steps": 300}, cell_spec="600-611",
+                  progress=False, plant=plant, info=info)
+    ref, ref_record, _ = run_condition(out=tmp_path / "threads", threads=2, **common)
+    got, record, cancelled = run_condition(out=tmp_path / "dask", threads=0, dask=session, **common)
+    assert not cancelled and record["complete"] and results.record_plant(record) == plant
+    assert (ref["outcome"] != B.PENDING).all()
+    assert_same(got, ref, plant)
+    assert record["summary"] == ref_record["summary"]
+
+
 def test_chunk_sizes_and_scheduler_address_give_the_same_cells(session):
     cfg = build_config(ICO_CAPS)
     ref = threaded(cfg, 4, CELLS)
@@ -230,7 +244,7 @@ def test_c_error_on_a_worker_comes_back_as_the_same_exception(session):
     cfg.controller.mode = 99
     with pytest.raises(B.ConfigError) as want:
         cfg.check()
-    cfg_bytes = (bytes(cfg.controller), bytes(cfg.plant), bytes(cfg.run), None)
+    cfg_bytes = _worker.config_bytes(cfg)
     fut = session.client.submit(_worker.run_chunk, "test-error", 0, cfg_bytes, grid.make_cells(0, [611]),
                                 _worker.abi_of(B), pure=False, retries=1)
     exc = fut.exception(timeout=30)
