@@ -47,10 +47,8 @@ QUICK_COLS = (4, 19, 22, 24, 26, 44)
 QUICK_CELLS = sorted(int(geometry.cell_index(r, c)) for r in QUICK_ROWS for c in QUICK_COLS)
 
 PROFILES: dict[str, dict[str, Any]] = {
-    # ICO at the paper's caps (1e5 trials, 1e5 steps), RL conditions with a reduced trial cap.
-    # Measured on 2 cores at 5971575 (docs/results.md): per seed, ICO full grid 80-86 s, ICO->RL
-    # 59-68 s at the 1000-trial cap (most of it in cells that never succeed), its control 43-63 s,
-    # RL alone 10 s, its control 4 s: 5 seeds take ~18 min, inside the 30 min budget.
+    # ICO at the paper's caps (1e5 trials, 1e5 steps), the learners' conditions with a 1000-trial
+    # cap. Each bench records its wall time per stage in bench.json (docs/results.md quotes it).
     "default": {"seeds": 5, "ico": {}, "rl": {"max_trials": 1000}, "cells": None},
     "paper": {"seeds": 5, "ico": {}, "rl": {}, "cells": None},
     "quick": {"seeds": 2, "ico": {"max_trials": 6000, "success_steps": 2000},

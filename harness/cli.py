@@ -230,7 +230,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     b = sub.add_parser("bench", help="benchmark stages: grids, figures, summary")
     b.add_argument("--profile", choices=O.PROFILE_NAMES, default=O.PROFILE_NAMES[0],
-                   help="default: ICO at paper caps + RL conditions capped (< 30 min on 2 cores); "
+                   help="default: ICO at the paper's caps, the learners capped at 1000 trials; "
                         "paper: 5 seeds, all at 1e5/1e5; quick: smoke test")
     b.add_argument("--out", required=True, help="bench directory (one results directory per condition and seed)")
     b.add_argument("--figures", default=None, help="figure directory")
