@@ -102,15 +102,16 @@ TASK_SPACES: dict[str, tuple[tuple[tuple[str, tuple[float, ...]], ...], Any]] = 
                 ("zone_deg", (11.5, 10.0, 8.0, 6.0)),
                 ("ico.rate", (1e-4, 1e-3, 1e-2)),
                 ("policy.gain", (1.0, 3.0, 10.0))), furuta_task),
-    # a first, narrower space put its best at its edges (rate 0.01, gain 30 N, both velocity ranges
-    # and the zone at their largest): this one extends each beyond it
-    "double_cart_pole": ((("cart_velocity_range", (1.0, 2.0, 3.5, 6.0, 10.0)),
+    # Each space put its best at its edges, and the next extends those dimensions beyond it: the
+    # first (rate 0.01, gain 30 N, both velocity ranges and the zone at their largest), the second
+    # (cart velocity range 10 m/s, rate 0.1, gain 3 N).
+    "double_cart_pole": ((("cart_velocity_range", (1.0, 2.0, 3.5, 6.0, 10.0, 17.0, 30.0)),
                           ("link_velocity_range", (0.5, 1.0, 2.0, 4.0, 8.0)),
                           ("zone_deg", (11.0, 10.0, 8.0, 6.0, 4.0)),
                           ("upper_reflex", (1.0, -1.0)),
                           ("cart_reflex", (1.0, -1.0)),
-                          ("ico.rate", (1e-4, 1e-3, 1e-2, 1e-1)),
-                          ("policy.gain", (3.0, 10.0, 30.0, 100.0))), double_task),
+                          ("ico.rate", (1e-4, 1e-3, 1e-2, 1e-1, 0.3, 1.0)),
+                          ("policy.gain", (0.3, 1.0, 3.0, 10.0, 30.0, 100.0))), double_task),
 }
 
 
@@ -127,8 +128,8 @@ FURUTA_SETTING = {"arm_range": 1.0, "arm_velocity_range": 2.3, "pendulum_velocit
 FURUTA_ICO_RL = {"actor.update": "mean", "actor.likelihood_std": 0.1, "actor.scale": 0.1, "actor.noise_std": 1.0}
 
 # The double pendulum's task setting, chosen by its sweep (docs/sweeps-double_cart_pole.md).
-DOUBLE_SETTING = {"cart_velocity_range": 10.0, "link_velocity_range": 4.0, "zone_deg": 10.0, "upper_reflex": -1.0,
-                  "cart_reflex": -1.0, "ico.rate": 0.1, "policy.gain": 3.0}
+DOUBLE_SETTING = {"cart_velocity_range": 30.0, "link_velocity_range": 4.0, "zone_deg": 10.0, "upper_reflex": -1.0,
+                  "cart_reflex": -1.0, "ico.rate": 1.0, "policy.gain": 10.0}
 
 # ICO->RL's reading and noise on the double pendulum, by its learner sweep.
 DOUBLE_ICO_RL = {**FURUTA_ICO_RL, "actor.noise_std": 3.0}
