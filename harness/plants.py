@@ -131,8 +131,6 @@ FURUTA_ICO_RL = {"actor.update": "mean", "actor.likelihood_std": 0.1, "actor.sca
 DOUBLE_SETTING = {"cart_velocity_range": 30.0, "link_velocity_range": 4.0, "zone_deg": 10.0, "upper_reflex": -1.0,
                   "cart_reflex": -1.0, "ico.rate": 1.0, "policy.gain": 10.0}
 
-# ICO->RL's reading and noise on the double pendulum, by its learner sweep.
-DOUBLE_ICO_RL = {**FURUTA_ICO_RL, "actor.noise_std": 3.0}
 
 PLANTS: dict[str, PlantSpec] = {
     CART_POLE: PlantSpec(CART_POLE, {}, "the C defaults (the paper's task)"),
@@ -146,11 +144,9 @@ PLANTS: dict[str, PlantSpec] = {
     "double_cart_pole": PlantSpec("double_cart_pole", task_overrides("double_cart_pole", DOUBLE_SETTING),
                                   "its sweep (docs/sweeps-double_cart_pole.md): velocity scaling, reflex zone "
                                   "and the upper link's reflex sign, ICO rate, gain",
-                                  # the learner sweeps (docs/sweeps-double_cart_pole.md): ICO->RL
-                                  # balances 1.8 % of the ICO-failed cells with the mean reading at
-                                  # 3 N, nothing otherwise; every RL alone setting balances none, so it
-                                  # keeps its defaults
-                                  learners={"ico-rl": DOUBLE_ICO_RL, "ico-mean-rl": DOUBLE_ICO_RL},
+                                  # the learner sweeps (docs/sweeps-double_cart_pole.md): no setting of
+                                  # either actor-critic learner balances a cell, so both keep their
+                                  # defaults
                                   prior_cells="finished",
                                   prior_why="ICO balances at most 1 of its 1225 cells at the default caps (no prior "
                                             "of 2 or more successful cells in any frame), but it learns weights in "
