@@ -198,7 +198,10 @@ def report(plant: str, out: Path) -> Path:
                   "|---|---|---|---|---|---|"]
         lines += [f"| {i} | {r['reading']} | {r['key']} | {100 * r['ico_failed']:.1f} % | {100 * r['spread']:.1f} % | "
                   f"{_trials(r['median_trials'])} |" for i, r in enumerate(table, 1)]
-        lines += ["", f"Choice: `{table[0]['key']}`.", ""]
+        if table[0]["ico_failed"] > 0 or table[0]["spread"] > 0:
+            lines += ["", f"Choice: `{table[0]['key']}`.", ""]
+        else:
+            lines += ["", "No setting balances a cell: the learner keeps its defaults.", ""]
     path = out / "summary.md"
     store.write_text(path, "\n".join(lines) + "\n")
     return path
