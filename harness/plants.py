@@ -131,7 +131,6 @@ FURUTA_ICO_RL = {"actor.update": "mean", "actor.likelihood_std": 0.1, "actor.sca
 DOUBLE_SETTING = {"cart_velocity_range": 30.0, "link_velocity_range": 4.0, "zone_deg": 10.0, "upper_reflex": -1.0,
                   "cart_reflex": -1.0, "ico.rate": 1.0, "policy.gain": 10.0}
 
-
 PLANTS: dict[str, PlantSpec] = {
     CART_POLE: PlantSpec(CART_POLE, {}, "the C defaults (the paper's task)"),
     "furuta": PlantSpec("furuta", task_overrides("furuta", FURUTA_SETTING),

@@ -1,0 +1,56 @@
+"""The fuzzing ledger: tests/fuzz/run_fuzzer.sh appends one line per run, parsed from libFuzzer's
+output, and tests/fuzz/ledger.py adds up the runs of one source id per target. A stand-in for
+the fuzz executable prints what libFuzzer prints at the end of a run."""
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+RUN = REPO / "tests" / "fuzz" / "run_fuzzer.sh"
+LEDGER = REPO / "tests" / "fuzz" / "ledger.py"
+
+
+def fake_fuzzer(path: Path, executions: int, cov: int, ft: int, status: int) -> Path:
+    path.write_text("#!/bin/sh\n"
+                    f"printf '#2\\tINITED cov: 5 ft: 6 corp: 1/1b exec/s: 0 rss: 30Mb\\n'\n"
+                    f"printf '#{executions}\\tDONE   cov: {cov} ft: {ft} corp: 3/9b exec/s: 9 rss: 31Mb\\n'\n"
+                    f"printf 'stat::number_of_executed_units: {executions}\\n'\n"
+                    f"exit {status}\n")
+    path.chmod(0o755)
+    return path
+
+
+def fuzz(exe: Path, work: Path, sources: str) -> subprocess.CompletedProcess:
+    corpus = work.parent / "seed"
+    corpus.mkdir(parents=True, exist_ok=True)
+    return subprocess.run(["sh", str(RUN), "fuzz", "7", str(exe), str(corpus), str(work)], capture_output=True,
+                          text=True, env={"PATH": "/usr/bin:/bin", "ICOAC_FUZZ_SOURCES": sources})
+
+
+def ledger(root: Path, sources: str) -> dict[str, list[str]]:
+    out = subprocess.run([sys.executable, str(LEDGER), str(root), sources], capture_output=True, text=True,
+                         check=True).stdout
+    return {cols[1].strip(): [c.strip() for c in cols[2:-1]]
+            for cols in (line.split("|") for line in out.splitlines()) if len(cols) > 3 and cols[1].strip()
+            not in ("target", "---")}
+
+
+def test_runs_add_up_per_source_id(tmp_path):
+    work = tmp_path / "work"
+    a, b = work / "fuzz_a", work / "fuzz_b"
+    assert fuzz(fake_fuzzer(tmp_path / "a1", 1200, 40, 90, 0), a, "src1").returncode == 0
+    assert fuzz(fake_fuzzer(tmp_path / "a2", 3400, 44, 99, 0), a, "src1").returncode == 0
+    assert fuzz(fake_fuzzer(tmp_path / "a3", 5000000, 50, 120, 0), a, "src2").returncode == 0
+    failed = fuzz(fake_fuzzer(tmp_path / "b1", 77, 3, 4, 1), b, "src1")
+    assert failed.returncode == 1 and "FAILED" in failed.stdout
+    lines = (a / "ledger.tsv").read_text().splitlines()
+    assert lines[0].split("\t") == ["utc", "sources", "seconds", "executions", "cov", "ft", "corpus", "status"]
+    assert [line.split("\t")[1:6] for line in lines[1:]] == [["src1", "7", "1200", "40", "90"],
+                                                             ["src1", "7", "3400", "44", "99"],
+                                                             ["src2", "7", "5000000", "50", "120"]]
+    rows = ledger(work, "src1")
+    # runs, hours, executions, goal, coverage and features of the last run, corpus, findings
+    assert rows["fuzz_a"][:6] == ["2", "0.00", "4,600", "0%", "44", "99"] and rows["fuzz_a"][7] == "0"
+    assert rows["fuzz_b"][2] == "77" and rows["fuzz_b"][7] == "1"
+    assert ledger(work, "src2")["fuzz_a"][2:4] == ["5,000,000", "50%"]
+    assert ledger(work, "src3") == {}
