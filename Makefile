@@ -111,7 +111,8 @@ bench-speed: build
 
 # BENCH_ARGS: more bench options, e.g. BENCH_ARGS=--resume to continue a stopped run.
 # Per plant (bench-plant), the linear-policy ceiling first (about 40 s; a rerun replays its
-# cached search), then the bench, which shows it in summary.md and Fig. 3a.
+# cached search), its retries capped as the profile's learners, then the bench, which shows it in
+# summary.md and Fig. 3a.
 bench: build venv bench-speed
 	@plants="$(BENCH_PLANTS)"; \
 	if [ "$$plants" = all ]; then plants=$$($(VPY) -c 'from harness.plants import PLANTS; print(" ".join(PLANTS))'); fi; \
@@ -122,7 +123,7 @@ PLANT_OUT = $(if $(filter cart_pole,$(PLANT)),$(BENCH_OUT),$(BENCH_OUT)-$(PLANT)
 PLANT_FIGURES = $(if $(filter cart_pole,$(PLANT)),$(BENCH_FIGURES),$(BENCH_FIGURES)/$(PLANT))
 PLANT_DATA = $(if $(filter cart_pole,$(PLANT)),$(BENCH_DATA),$(basename $(BENCH_DATA))-$(PLANT).json)
 bench-plant:
-	$(VPY) -m harness ceiling --plant $(PLANT) --out $(PLANT_OUT)/ceiling --quiet
+	$(VPY) -m harness ceiling --plant $(PLANT) --profile $(BENCH_PROFILE) --out $(PLANT_OUT)/ceiling --quiet
 	$(VPY) -m harness bench --plant $(PLANT) --profile $(BENCH_PROFILE) --out $(PLANT_OUT) \
 	  --figures $(PLANT_FIGURES) --data $(PLANT_DATA) $(BENCH_ARGS)
 

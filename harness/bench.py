@@ -57,6 +57,13 @@ PROFILES: dict[str, dict[str, Any]] = {
 assert tuple(PROFILES) == PROFILE_NAMES
 
 
+def learner_caps(profile: str, plant: str = CART_POLE) -> tuple[int, int]:
+    """(trial cap, steps of a successful trial) of a profile's learner grids: the profile's, else the
+    C defaults. The ceiling's retries take them (`ceiling --profile`)."""
+    run = build_config(PROFILES[profile]["rl"], condition="rl", plant=plant).run
+    return int(run.max_trials), int(run.success_steps)
+
+
 def seed_dir(out: Path, condition: str, seed: int) -> Path:
     return Path(out) / condition / f"seed-{seed}"
 

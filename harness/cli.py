@@ -302,8 +302,8 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--protocol", choices=O.CEILING_PROTOCOL_CHOICES, default="both",
                    help="final evaluation: one trial per cell (first), fresh initial velocities up to "
                         "--max-trials (retries), or both (default)")
-    c.add_argument("--max-trials", type=_positive_int, default=O.CEILING_MAX_TRIALS,
-                   help=f"trial cap of the retries protocol (default {O.CEILING_MAX_TRIALS})")
+    c.add_argument("--max-trials", type=_positive_int, default=None,
+                   help=f"trial cap of the retries protocol (default: --profile's, else {O.CEILING_MAX_TRIALS})")
     c.add_argument("--success-steps", type=_positive_int, default=None,
                    help="full horizon: steps of a successful trial (default 1e5)")
     c.add_argument("--cells", default=None, help="subset of the paper grid's cell indices, e.g. 0,5,600-610")
@@ -318,6 +318,9 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--threads", type=_threads, default=0, help=f"C threads in [0, {O.MAX_THREADS}] (0: all cores)")
     c.add_argument("--set", action="append", metavar="NAME=VALUE",
                    help=SET_HELP + "; mode, learn, max_trials and success_steps are set by the command")
+    c.add_argument("--profile", choices=O.PROFILE_NAMES, default=None,
+                   help="take --max-trials and --success-steps, unless given, from this bench profile's learner "
+                        "grids, so that the ceiling's retries get the learners' trial cap")
     c.add_argument("--plant", type=_plant, default=O.CART_POLE, help=PLANT_HELP)
     c.add_argument("--quiet", action="store_true", help="no progress output")
     c.set_defaults(func=cmd_ceiling)
@@ -439,9 +442,17 @@ def cmd_sweep(args) -> int:
 def cmd_ceiling(args) -> int:
     from .ceiling import command as ceiling
 
+    max_trials, success_steps = args.max_trials, args.success_steps
+    if args.profile is not None:
+        from .bench import learner_caps
+
+        cap, horizon = learner_caps(args.profile, args.plant)
+        max_trials = cap if max_trials is None else max_trials
+        success_steps = horizon if success_steps is None else success_steps
     opt = ceiling.CeilingOptions(
         out=Path(args.out), prior_from=Path(args.prior_from) if args.prior_from else None, w=args.w,
-        protocol=args.protocol, max_trials=args.max_trials, success_steps=args.success_steps, cells=args.cells,
+        protocol=args.protocol, max_trials=O.CEILING_MAX_TRIALS if max_trials is None else max_trials,
+        success_steps=success_steps, cells=args.cells,
         candidates=args.candidates, screen_steps=args.screen_steps, confirm=args.confirm, seed=args.seed,
         threads=args.threads, sets=args.set or [], quiet=args.quiet, plant=args.plant)
     return ceiling.run_ceiling(opt, argv=sys.argv[1:])

@@ -282,6 +282,23 @@ def test_given_w_is_evaluated_without_a_search(tmp_path):
     assert record["best"]["protocols"]["first"]["n_success"] == int((ref["outcome"] == B.SUCCESS).sum())
 
 
+@pytest.mark.parametrize("extra, cap, horizon", [
+    ([], 600, 2000),                                           # the quick profile's learner caps
+    (["--max-trials", "9", "--success-steps", "700"], 9, 700),  # given options win
+])
+def test_profile_gives_the_retries_the_learners_caps(tmp_path, extra, cap, horizon):
+    assert bench.learner_caps("quick") == (600, 2000)
+    assert bench.learner_caps("paper") == (100000, 100000)
+    assert bench.learner_caps("default")[0] == options.CEILING_MAX_TRIALS
+    out = tmp_path / "w"
+    res = run("ceiling", "--out", str(out), "--w", "0.3,0.5,0.8,1.2", "--protocol", "retries", "--cells", "0-3",
+              "--profile", "quick", *extra, "--quiet")
+    assert res.returncode == 0, res.stderr
+    record = json.loads((out / "ceiling.json").read_text())
+    assert (record["settings"]["max_trials"], record["settings"]["success_steps"]) == (cap, horizon)
+    assert record["best"]["protocols"]["retries"]["max_trials"] == cap
+
+
 def test_prior_from_starts_the_search_at_the_ico_mean(tmp_path):
     from harness import prior as P
     ico = Path(__file__).resolve().parent / "fixtures" / "abi3_ico"
