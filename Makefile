@@ -21,10 +21,12 @@ BENCH_DATA ?= docs/data/bench-$(BENCH_PROFILE).json
 # cart-pole writes the directories above, another plant P their names with -P (results, data) or
 # /P (figures) added.
 BENCH_PLANTS ?= cart_pole
-# `make fuzz`: seconds per target, targets run at once, extra libFuzzer options.
+# `make fuzz`: seconds per target, targets run at once, extra libFuzzer options, and the ledger
+# (one <target>.tsv each, committed, so that a campaign adds up across checkouts).
 FUZZ_TIME ?= 600
 FUZZ_JOBS ?= 2
 FUZZ_FLAGS ?=
+FUZZ_LEDGER ?= tests/fuzz/ledger
 # The C sources a fuzzing run tests (the id of their git trees, "-modified" for uncommitted
 # changes): the ledger adds up only runs of the same sources.
 FUZZ_C_SOURCES = firmware sim_host $(wildcard tests/fuzz/*.c tests/fuzz/*.h)
@@ -95,16 +97,18 @@ test-fuzz: build-fuzz
 test: test-asan test-c test-python test-fuzz
 
 # Long fuzzing: FUZZ_TIME s per target, FUZZ_JOBS at a time, from tests/fuzz/corpus/<target>;
-# new inputs, logs and crash reproducers go to build/fuzz/work/<target>/.
+# new inputs, logs and crash reproducers go to build/fuzz/work/<target>/, a line per run to
+# $(FUZZ_LEDGER)/<target>.tsv.
 fuzz: build-fuzz
 	@printf '%s\n' $(FUZZ_TARGETS) | ICOAC_FUZZ_SOURCES=$(FUZZ_SOURCES) xargs -P $(FUZZ_JOBS) -I '{}' \
+	  env ICOAC_FUZZ_LEDGER=$(FUZZ_LEDGER)/'{}'.tsv \
 	  sh tests/fuzz/run_fuzzer.sh fuzz $(FUZZ_TIME) build/fuzz/tests/fuzz/'{}' tests/fuzz/corpus/'{}' \
 	  build/fuzz/work/'{}' $(FUZZ_FLAGS)
-	@$(PYTHON) tests/fuzz/ledger.py build/fuzz/work $(FUZZ_SOURCES)
+	@$(PYTHON) tests/fuzz/ledger.py $(FUZZ_LEDGER) $(FUZZ_SOURCES)
 
 # What every long fuzzing run of the current sources adds up to, per target.
 fuzz-ledger:
-	@$(PYTHON) tests/fuzz/ledger.py build/fuzz/work $(FUZZ_SOURCES)
+	@$(PYTHON) tests/fuzz/ledger.py $(FUZZ_LEDGER) $(FUZZ_SOURCES)
 
 bench-speed: build
 	./build/release/sim_host/icoac_bench

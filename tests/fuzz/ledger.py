@@ -1,7 +1,8 @@
 """What the long fuzzing runs (`make fuzz`) add up to: one row per target, from each target's
-WORK/ledger.tsv (tests/fuzz/run_fuzzer.sh), over the runs of the given C sources only.
+ledger LEDGER_DIR/<target>.tsv (tests/fuzz/run_fuzzer.sh), over the runs of the given C sources
+only.
 
-    python3 tests/fuzz/ledger.py WORK_ROOT SOURCES
+    python3 tests/fuzz/ledger.py LEDGER_DIR SOURCES
 
 A run that ended with a non-zero status is a finding (its reproducer is in WORK/artifacts/)."""
 import csv
@@ -16,11 +17,11 @@ def rows(ledger: Path, sources: str) -> list[dict]:
         return [r for r in csv.DictReader(f, delimiter="\t") if r["sources"] == sources]
 
 
-def main(work_root: str, sources: str) -> int:
+def main(ledger_dir: str, sources: str) -> int:
     print(f"fuzzing of sources {sources} (runs of other sources are not counted)\n")
     print("| target | runs | hours | executions | goal 1e7 | coverage (last run) | features | corpus | findings |")
     print("|---|---|---|---|---|---|---|---|---|")
-    for ledger in sorted(Path(work_root).glob("*/ledger.tsv")):
+    for ledger in sorted(Path(ledger_dir).glob("*.tsv")):
         runs = rows(ledger, sources)
         if not runs:
             continue
@@ -28,7 +29,7 @@ def main(work_root: str, sources: str) -> int:
         hours = sum(float(r["seconds"]) for r in runs) / 3600
         findings = sum(r["status"] != "0" for r in runs)
         last = runs[-1]
-        print(f"| {ledger.parent.name} | {len(runs)} | {hours:.2f} | {executions:,} | "
+        print(f"| {ledger.stem} | {len(runs)} | {hours:.2f} | {executions:,} | "
               f"{'met' if executions >= GOAL else f'{executions / GOAL:.0%}'} | {last['cov']} | {last['ft']} | "
               f"{last['corpus']} | {findings} |")
     return 0

@@ -4,9 +4,10 @@
 #       run EXE once on every file in CORPUS.
 #   run_fuzzer.sh fuzz SECONDS EXE CORPUS WORK [--fresh] [libFuzzer options...]
 #       fuzz for SECONDS from CORPUS, which is only read: new inputs go to WORK/corpus
-#       (--fresh empties it first), the log to WORK/fuzz.log, and one line per run to
-#       WORK/ledger.tsv (the executions, coverage and exit status, with ICOAC_FUZZ_SOURCES, the
-#       id of the C sources fuzzed), so runs resumed from the corpus add up (tests/fuzz/ledger.py).
+#       (--fresh empties it first), the log to WORK/fuzz.log, and one line per run to the
+#       ledger, $ICOAC_FUZZ_LEDGER or else WORK/ledger.tsv (the executions, coverage and exit
+#       status, with ICOAC_FUZZ_SOURCES, the id of the C sources fuzzed), so runs resumed from
+#       the corpus add up (tests/fuzz/ledger.py).
 # Crash and contract-violation reproducers go to WORK/artifacts/. The exit status is non-zero
 # on a crash, a sanitizer report, a contract violation, a timeout or an out-of-memory.
 set -eu
@@ -53,7 +54,8 @@ fuzz)
     # shellcheck disable=SC2086
     "$exe" $limits -max_total_time="$seconds" -print_final_stats=1 "$@" "$work/corpus" "$corpus" \
         >"$log" 2>&1 || status=$?
-    ledger=$work/ledger.tsv
+    ledger=${ICOAC_FUZZ_LEDGER:-$work/ledger.tsv}
+    mkdir -p "$(dirname "$ledger")"
     [ -f "$ledger" ] || printf 'utc\tsources\tseconds\texecutions\tcov\tft\tcorpus\tstatus\n' >"$ledger"
     executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
     last=$(grep -E '^#[0-9]+[[:space:]]+(DONE|pulse|NEW|REDUCE|INITED)' "$log" | tail -n 1)

@@ -20,11 +20,13 @@ def fake_fuzzer(path: Path, executions: int, cov: int, ft: int, status: int) -> 
     return path
 
 
-def fuzz(exe: Path, work: Path, sources: str) -> subprocess.CompletedProcess:
+def fuzz(exe: Path, work: Path, sources: str, ledger: Path | None = None) -> subprocess.CompletedProcess:
     corpus = work.parent / "seed"
     corpus.mkdir(parents=True, exist_ok=True)
+    env = {"PATH": "/usr/bin:/bin", "ICOAC_FUZZ_SOURCES": sources,
+           **({} if ledger is None else {"ICOAC_FUZZ_LEDGER": str(ledger)})}
     return subprocess.run(["sh", str(RUN), "fuzz", "7", str(exe), str(corpus), str(work)], capture_output=True,
-                          text=True, env={"PATH": "/usr/bin:/bin", "ICOAC_FUZZ_SOURCES": sources})
+                          text=True, env=env)
 
 
 def ledger(root: Path, sources: str) -> dict[str, list[str]]:
@@ -36,21 +38,29 @@ def ledger(root: Path, sources: str) -> dict[str, list[str]]:
 
 
 def test_runs_add_up_per_source_id(tmp_path):
-    work = tmp_path / "work"
+    work, book = tmp_path / "work", tmp_path / "ledger"
     a, b = work / "fuzz_a", work / "fuzz_b"
-    assert fuzz(fake_fuzzer(tmp_path / "a1", 1200, 40, 90, 0), a, "src1").returncode == 0
-    assert fuzz(fake_fuzzer(tmp_path / "a2", 3400, 44, 99, 0), a, "src1").returncode == 0
-    assert fuzz(fake_fuzzer(tmp_path / "a3", 5000000, 50, 120, 0), a, "src2").returncode == 0
-    failed = fuzz(fake_fuzzer(tmp_path / "b1", 77, 3, 4, 1), b, "src1")
+    assert fuzz(fake_fuzzer(tmp_path / "a1", 1200, 40, 90, 0), a, "src1", book / "fuzz_a.tsv").returncode == 0
+    assert fuzz(fake_fuzzer(tmp_path / "a2", 3400, 44, 99, 0), a, "src1", book / "fuzz_a.tsv").returncode == 0
+    assert fuzz(fake_fuzzer(tmp_path / "a3", 5000000, 50, 120, 0), a, "src2", book / "fuzz_a.tsv").returncode == 0
+    failed = fuzz(fake_fuzzer(tmp_path / "b1", 77, 3, 4, 1), b, "src1", book / "fuzz_b.tsv")
     assert failed.returncode == 1 and "FAILED" in failed.stdout
-    lines = (a / "ledger.tsv").read_text().splitlines()
+    assert not (a / "ledger.tsv").exists()
+    lines = (book / "fuzz_a.tsv").read_text().splitlines()
     assert lines[0].split("\t") == ["utc", "sources", "seconds", "executions", "cov", "ft", "corpus", "status"]
     assert [line.split("\t")[1:6] for line in lines[1:]] == [["src1", "7", "1200", "40", "90"],
                                                              ["src1", "7", "3400", "44", "99"],
                                                              ["src2", "7", "5000000", "50", "120"]]
-    rows = ledger(work, "src1")
+    rows = ledger(book, "src1")
     # runs, hours, executions, goal, coverage and features of the last run, corpus, findings
     assert rows["fuzz_a"][:6] == ["2", "0.00", "4,600", "0%", "44", "99"] and rows["fuzz_a"][7] == "0"
     assert rows["fuzz_b"][2] == "77" and rows["fuzz_b"][7] == "1"
-    assert ledger(work, "src2")["fuzz_a"][2:4] == ["5,000,000", "50%"]
-    assert ledger(work, "src3") == {}
+    assert ledger(book, "src2")["fuzz_a"][2:4] == ["5,000,000", "50%"]
+    assert ledger(book, "src3") == {}
+
+
+def test_without_a_ledger_path_the_line_goes_to_the_work_directory(tmp_path):
+    work = tmp_path / "work" / "fuzz_c"
+    assert fuzz(fake_fuzzer(tmp_path / "c1", 500, 7, 8, 0), work, "src1").returncode == 0
+    lines = (work / "ledger.tsv").read_text().splitlines()
+    assert len(lines) == 2 and lines[1].split("\t")[1:4] == ["src1", "7", "500"]
