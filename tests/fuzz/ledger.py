@@ -13,8 +13,10 @@ GOAL = 10_000_000  # executions per target for a deep fuzzing campaign
 
 
 def rows(ledger: Path, sources: str) -> list[dict]:
+    """The runs of the given sources; lines starting with '#' are comments."""
     with ledger.open(newline="") as f:
-        return [r for r in csv.DictReader(f, delimiter="\t") if r["sources"] == sources]
+        lines = (line for line in f if not line.startswith("#"))
+        return [r for r in csv.DictReader(lines, delimiter="\t") if r["sources"] == sources]
 
 
 def main(ledger_dir: str, sources: str) -> int:

@@ -59,6 +59,17 @@ def test_runs_add_up_per_source_id(tmp_path):
     assert ledger(book, "src3") == {}
 
 
+def test_comment_lines_are_skipped(tmp_path):
+    book = tmp_path / "ledger"
+    book.mkdir()
+    (book / "fuzz_d.tsv").write_text("# transcribed from an earlier checkout\n"
+                                     "utc\tsources\tseconds\texecutions\tcov\tft\tcorpus\tstatus\n"
+                                     "2026-01-01T00:00:00Z\tsrc1\t60\t900\t5\t6\t7\t0\n")
+    assert fuzz(fake_fuzzer(tmp_path / "d1", 100, 8, 9, 0), tmp_path / "work" / "fuzz_d", "src1",
+                book / "fuzz_d.tsv").returncode == 0
+    assert ledger(book, "src1")["fuzz_d"][:3] == ["2", "0.02", "1,000"]
+
+
 def test_without_a_ledger_path_the_line_goes_to_the_work_directory(tmp_path):
     work = tmp_path / "work" / "fuzz_c"
     assert fuzz(fake_fuzzer(tmp_path / "c1", 500, 7, 8, 0), work, "src1").returncode == 0
