@@ -32,35 +32,39 @@ void icoac_priv_actor_sample(icoac_priv_state_t *st)
 }
 
 /* Posterior reading: Sigma' = A Sigma A^T + sigma_L^2 k k^T with A = I - k h^T (Joseph form),
- * evaluated as A Sigma = Sigma - k (Sigma h)^T and (A Sigma) A^T = A Sigma - (A Sigma h) k^T;
- * the upper triangle is mirrored, so Sigma stays exactly symmetric. A Sigma is formed one row at
- * a time (row i of the result needs row i of A Sigma only), so the frame holds vectors, no
- * matrix; with forgetting, Sigma / lambda_f is formed entry by entry where it is read. cov must
- * not be the prior it is computed from (the tick stages into the spare buffer). */
-static inline void posterior_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
-                                  const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
-                                  icoac_real_t cov[N][N], int n)
+ * evaluated as A Sigma = Sigma - k (Sigma h)^T and (A Sigma) A^T = A Sigma - (A Sigma h) k^T.
+ * A Sigma is formed one row at a time (row i of the result needs row i of A Sigma only), so the
+ * frame holds vectors, no matrix; row i writes the upper triangle of row i of cov, which no
+ * later row reads, and the lower triangle is mirrored at the end, so Sigma stays exactly
+ * symmetric. With forgetting, Sigma / lambda_f is formed in cov first and read from there. cov
+ * must not be the state's Sigma (the tick stages into the spare buffer). Returns 1 when the new
+ * off-diagonal entries are finite (each adds v - v, 0 or NaN, to a sum), 0 otherwise; the
+ * caller checks the diagonal through the trace. */
+static inline int posterior_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                 const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N],
+                                 icoac_real_t cov[N][N], int n)
 {
     const icoac_real_t noise_var = likelihood_var(actor);
     const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
-    const int forget = actor->forgetting < ICOAC_R(1.0);
-    const icoac_real_t inflate = forget ? ICOAC_R(1.0) / actor->forgetting : ICOAC_R(1.0);
     icoac_real_t row[N];
     icoac_real_t cov_h[N];
     icoac_real_t gain[N];
     icoac_real_t inv_innovation_var;
+    icoac_real_t off_diagonal = ICOAC_R(0.0);
     int i;
     int j;
 
-    for (i = 0; i < n; ++i) {
-        if (forget) {
+    if (actor->forgetting < ICOAC_R(1.0)) {
+        const icoac_real_t inflate = ICOAC_R(1.0) / actor->forgetting;
+        for (i = 0; i < n; ++i) {
             for (j = 0; j < n; ++j) {
-                row[j] = prior[i][j] * inflate;
+                cov[i][j] = prior[i][j] * inflate;
             }
-            cov_h[i] = icoac_priv_dot_n(row, h, n);
-        } else {
-            cov_h[i] = icoac_priv_dot_n(prior[i], h, n);
         }
+        prior = ICOAC_PRIV_CONST_MAT(cov);
+    }
+    for (i = 0; i < n; ++i) {
+        cov_h[i] = icoac_priv_dot_n(prior[i], h, n);
     }
     inv_innovation_var = ICOAC_R(1.0) / (icoac_priv_dot_n(h, cov_h, n) + noise_var);
     for (i = 0; i < N; ++i) {
@@ -74,15 +78,20 @@ static inline void posterior_step(const icoac_actor_config_t *actor, const icoac
     for (i = 0; i < n; ++i) {
         icoac_real_t a_cov_h;
         for (j = 0; j < n; ++j) {
-            row[j] = prior[i][j] * inflate - gain[i] * cov_h[j]; /* inflate 1 without forgetting: exact */
+            row[j] = prior[i][j] - gain[i] * cov_h[j];
         }
         a_cov_h = icoac_priv_dot_n(row, h, n);
         for (j = i; j < n; ++j) {
-            const icoac_real_t value = row[j] - a_cov_h * gain[j] + noise_var * gain[i] * gain[j];
-            cov[i][j] = value;
-            cov[j][i] = value;
+            cov[i][j] = row[j] - a_cov_h * gain[j] + noise_var * gain[i] * gain[j];
         }
     }
+    for (i = 0; i < n; ++i) {
+        for (j = i + 1; j < n; ++j) {
+            cov[j][i] = cov[i][j];
+            off_diagonal += cov[i][j] - cov[i][j];
+        }
+    }
+    return icoac_priv_finite(off_diagonal);
 }
 
 void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
@@ -91,25 +100,26 @@ void icoac_priv_actor_posterior(const icoac_actor_config_t *actor, const icoac_p
 {
     icoac_real_t staged[N][N];
     int i;
-    posterior_step(actor, st, h, innovation, w, staged, N);
+    (void)posterior_step(actor, st, h, innovation, w, staged, N);
     for (i = 0; i < N; ++i) {
         icoac_priv_copy(cov[i], staged[i]);
     }
 }
 
-/* Mean reading: mu += Sigma0 h innovation / (h^T Sigma0 h + sigma_L^2), Sigma_w unchanged. */
-ICOAC_PRIV_NOINLINE static void mean_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
-                                          const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N])
+/* Mean reading: mu += Sigma0 h innovation / (h^T Sigma0 h + sigma_L^2), Sigma_w unchanged; over
+ * the first n entries. */
+static inline void mean_step(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                             const icoac_real_t h[N], icoac_real_t innovation, icoac_real_t w[N], int n)
 {
     const icoac_real_t (*prior)[N] = icoac_priv_cov_c(st);
     icoac_real_t cov_h[N];
     icoac_real_t step;
     int i;
-    for (i = 0; i < N; ++i) {
-        cov_h[i] = icoac_priv_dot(prior[i], h);
+    for (i = 0; i < n; ++i) {
+        cov_h[i] = icoac_priv_dot_n(prior[i], h, n);
     }
-    step = innovation / (icoac_priv_dot(h, cov_h) + likelihood_var(actor));
-    for (i = 0; i < N; ++i) {
+    step = innovation / (icoac_priv_dot_n(h, cov_h, n) + likelihood_var(actor));
+    for (i = 0; i < n; ++i) {
         w[i] = st->w[i] + cov_h[i] * step;
     }
 }
@@ -179,7 +189,15 @@ ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, cons
     for (i = 0; i < N; ++i) {
         w[i] = st->w[i] + icoac_priv_dot(cov[i], shift);
     }
-    return actor->update == ICOAC_ACTOR_POSTERIOR;
+    if (actor->update != ICOAC_ACTOR_POSTERIOR) {
+        return 0;
+    }
+    for (i = 0; i + 1 < N; ++i) {
+        if (!icoac_priv_all_finite(&cov[i][i + 1], N - 1 - i)) {
+            return -1; /* an off-diagonal entry (the caller checks the diagonal) */
+        }
+    }
+    return 1;
 }
 
 /* The batch's shift after one more observation, and a value that is finite only when the
@@ -201,15 +219,16 @@ ICOAC_PRIV_NOINLINE static icoac_real_t batch_shift(const icoac_actor_config_t *
     return trace + icoac_priv_dot(shift, shift);
 }
 
-int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t *st, const icoac_real_t h[N],
-                          icoac_real_t delta, int observed, int trial_end, icoac_real_t w[N],
-                          icoac_real_t cov[N][N])
+/* icoac_priv_actor_step over the first n entries (a compile-time n in each instance). */
+static inline int actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t *st, const icoac_real_t h[N],
+                             icoac_real_t delta, int observed, int trial_end, icoac_real_t w[N], icoac_real_t cov[N][N],
+                             int n)
 {
     /* u_ob - h^T mu_w, with u_ob = h^T w_act + alpha * delta * eps (Eq. 7-8); acting with mu_w,
      * w_act is mu_w bit for bit and the first term is exactly 0 */
     icoac_real_t innovation = actor->scale * delta * st->noise_prev;
     if (actor->act_with_sample) {
-        innovation += icoac_priv_dot(h, st->w_act) - icoac_priv_dot(h, st->w);
+        innovation += icoac_priv_dot_n(h, st->w_act, n) - icoac_priv_dot_n(h, st->w, n);
     }
     if (actor->batch) {
         icoac_real_t *shift = st->batch.staged_shift;
@@ -228,31 +247,36 @@ int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t 
         return batch_end(actor, st, observed ? h : 0, shift, w, cov);
     }
     if (!observed) {
-        icoac_priv_copy(w, st->w);
+        icoac_priv_copy_n(w, st->w, n);
         return 0;
     }
     switch (actor->update) {
     case ICOAC_ACTOR_MEAN:
-        mean_step(actor, st, h, innovation, w);
+        mean_step(actor, st, h, innovation, w, n);
         return 0;
     case ICOAC_ACTOR_GRADIENT: {
         const icoac_real_t step = actor->rate * delta * st->noise_prev / (actor->noise_std * actor->noise_std);
         int i;
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < n; ++i) {
             w[i] = st->w[i] + step * h[i];
         }
         return 0;
     }
     case ICOAC_ACTOR_POSTERIOR:
-        if ((st->grid.shape & ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) != 0u) {
-            posterior_step(actor, st, h, innovation, w, cov, ICOAC_CARTPOLE_INPUTS);
-        } else {
-            posterior_step(actor, st, h, innovation, w, cov, N);
-        }
-        return 1;
+        return posterior_step(actor, st, h, innovation, w, cov, n) ? 1 : -1;
     default:
         return -2;
     }
+}
+
+int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t *st, const icoac_real_t h[N],
+                          icoac_real_t delta, int observed, int trial_end, icoac_real_t w[N],
+                          icoac_real_t cov[N][N], int n)
+{
+    if (n == ICOAC_CARTPOLE_INPUTS) {
+        return actor_step(actor, st, h, delta, observed, trial_end, w, cov, ICOAC_CARTPOLE_INPUTS);
+    }
+    return actor_step(actor, st, h, delta, observed, trial_end, w, cov, N);
 }
 
 void icoac_priv_actor_commit_batch(const icoac_actor_config_t *actor, icoac_priv_state_t *st,

@@ -39,9 +39,8 @@ static const int32_t cartpole_units[ICOAC_MAX_INPUTS] = {ICOAC_CRITIC_N_X, ICOAC
 static void task_cartpole(icoac_task_config_t *task)
 {
     /* Eq. (4), first match wins: leaning or pushed past the zone on one side pushes back */
-    static const int32_t input[ICOAC_CARTPOLE_RULES] = {ICOAC_IDX_THETA, ICOAC_IDX_X, ICOAC_IDX_THETA, ICOAC_IDX_X};
-    static const int32_t side[ICOAC_CARTPOLE_RULES] = {ICOAC_RULE_ABOVE, ICOAC_RULE_BELOW, ICOAC_RULE_BELOW,
-                                                       ICOAC_RULE_ABOVE};
+    static const int32_t input[ICOAC_CARTPOLE_RULES] = ICOAC_PRIV_CARTPOLE_RULE_INPUTS;
+    static const int32_t side[ICOAC_CARTPOLE_RULES] = ICOAC_PRIV_CARTPOLE_RULE_SIDES;
     static const icoac_real_t threshold[ICOAC_CARTPOLE_RULES] = {CARTPOLE_ZONE_THETA, -CARTPOLE_ZONE_X,
                                                                  -CARTPOLE_ZONE_THETA, CARTPOLE_ZONE_X};
     static const icoac_real_t reflex[ICOAC_CARTPOLE_RULES] = {ICOAC_R(1.0), ICOAC_R(1.0), ICOAC_R(-1.0), ICOAC_R(-1.0)};

@@ -202,6 +202,7 @@ static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, con
             !icoac_priv_nonneg_at_least(ICOAC_R(1.0), product_r)) {
             continue;
         }
+        ICOAC_PRIV_OPAQUE(u); /* the row's weights in a register: one add per unit's address */
         unit_b = product_r * *product;
         while (icoac_priv_nonneg_at_least(unit_b, threshold)) {
             value += u[*cell++] * unit_b;

@@ -14,8 +14,23 @@ static void clear_trial(icoac_priv_state_t *st)
     memset(&st->batch, 0, sizeof st->batch);
 }
 
+/* 1 when the task's rule table is laid out as the cart-pole preset's: 4 inputs, 4 rules on the
+ * preset's inputs and sides (any thresholds and reflexes). */
+static int cartpole_rules(const icoac_task_config_t *task)
+{
+    static const int32_t rule_input[ICOAC_CARTPOLE_RULES] = ICOAC_PRIV_CARTPOLE_RULE_INPUTS;
+    static const int32_t rule_side[ICOAC_CARTPOLE_RULES] = ICOAC_PRIV_CARTPOLE_RULE_SIDES;
+    int same = task->n_inputs == ICOAC_CARTPOLE_INPUTS && task->late_source == ICOAC_LATE_RULES &&
+               task->n_rules == ICOAC_CARTPOLE_RULES;
+    int k;
+    for (k = 0; same && k < ICOAC_CARTPOLE_RULES; ++k) {
+        same = task->rule_input[k] == rule_input[k] && task->rule_side[k] == rule_side[k];
+    }
+    return same;
+}
+
 /* What the tick takes from the configuration in force, derived once: 1 / policy.input_range
- * (0 past the task's inputs), the critic's geometry and the search's floors. */
+ * (0 past the task's inputs), the critic's geometry, the shape tags and the search's floors. */
 static void derive(icoac_priv_state_t *st)
 {
     const int n = icoac_priv_inputs(&st->config);
@@ -24,6 +39,9 @@ static void derive(icoac_priv_state_t *st)
         st->inv_range[i] = i < n ? ICOAC_R(1.0) / st->config.policy.input_range[i] : ICOAC_R(0.0);
     }
     icoac_priv_critic_grid(&st->config, &st->grid);
+    if (cartpole_rules(&st->config.task)) {
+        st->grid.shape |= ICOAC_PRIV_SHAPE_CARTPOLE_RULES;
+    }
     if (st->config.mode == ICOAC_MODE_SEARCH) {
         icoac_priv_search_floors(&st->config.search, &st->search);
     }

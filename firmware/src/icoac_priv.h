@@ -203,6 +203,15 @@ static inline void icoac_priv_copy(icoac_real_t dst[ICOAC_MAX_INPUTS], const ico
     }
 }
 
+/* dst = src over the first n entries (an instance with a compile-time n). */
+static inline void icoac_priv_copy_n(icoac_real_t *dst, const icoac_real_t *src, int n)
+{
+    int i;
+    for (i = 0; i < n && i < ICOAC_MAX_INPUTS; ++i) {
+        dst[i] = src[i];
+    }
+}
+
 /* Fixed pairwise order, the same on every target: (a0 b0 + a1 b1) + (a2 b2 + a3 b3), then each
  * further pair (and a last odd term) added in turn. Zero entries add +-0, which leaves every
  * nonzero sum unchanged. */
@@ -255,6 +264,20 @@ static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_rea
     st->has_prev = 1;
 }
 
+/* The trace over the first n entries (4 <= n <= ICOAC_MAX_INPUTS), in the same order. */
+static inline icoac_real_t icoac_priv_trace_n(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS], int n)
+{
+    icoac_real_t sum = (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
+    int i;
+    for (i = 4; i + 1 < n && i + 1 < ICOAC_MAX_INPUTS; i += 2) {
+        sum += m[i][i] + m[i + 1][i + 1];
+    }
+    if ((n & 1) != 0 && n <= ICOAC_MAX_INPUTS) {
+        sum += m[n - 1][n - 1];
+    }
+    return sum;
+}
+
 /* Stages of a tick. Each tick function stages what it would learn and output, checks that it
  * is finite, and only then commits it; it returns 0 when not, with the state untouched but for
  * its scratch (the spare covariance buffer and the spare kept-unit list, never read before a
@@ -275,9 +298,10 @@ int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
                         const icoac_real_t scaled[ICOAC_MAX_INPUTS], icoac_real_t penalty, int terminal,
                         icoac_output_t *out);
 
-/* Actor-critic tick: critic and actor on the transition into s, then act (icoac_rl.c). */
+/* Actor-critic tick: critic and actor on the transition into s, then act (icoac_rl.c), for a
+ * task of n inputs. */
 int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_MAX_INPUTS],
-                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out);
+                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out, int n);
 
 /* Critic (method.md, critic): V(s) with the units it kept, and the TD update v_k += step * b_k
  * over such units. Two kernels compute the same units:
@@ -502,10 +526,12 @@ static inline void icoac_priv_critic_update(const icoac_critic_config_t *critic,
  * the candidate mu_w in w, Sigma_w in cov (the spare buffer) and the batch's shift in its
  * scratch; h = G x~(t); observed: the transition's tick explored (L3); trial_end: a terminal
  * tick. Returns 1 when cov holds a new Sigma_w, 0 when Sigma_w stays, -1 when the batch sums
- * or its closed form failed, -2 for an unknown actor.update (a corrupted state). icoac_priv_actor_commit_batch follows the tick's checks. */
+ * or its closed form failed, -2 for an unknown actor.update (a corrupted state). n: the task's
+ * inputs; the per-tick readings stage w and cov over the first n entries only (the batch's closed
+ * form over all). icoac_priv_actor_commit_batch follows the tick's checks. */
 int icoac_priv_actor_step(const icoac_actor_config_t *actor, icoac_priv_state_t *st,
                           const icoac_real_t h[ICOAC_MAX_INPUTS], icoac_real_t delta, int observed, int trial_end,
-                          icoac_real_t w[ICOAC_MAX_INPUTS], icoac_real_t cov[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS]);
+                          icoac_real_t w[ICOAC_MAX_INPUTS], icoac_real_t cov[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS], int n);
 void icoac_priv_actor_commit_batch(const icoac_actor_config_t *actor, icoac_priv_state_t *st,
                                    const icoac_real_t h[ICOAC_MAX_INPUTS], int observed, int trial_end);
 /* The posterior reading's step for innovation (in place allowed: w, cov may be st's own). */

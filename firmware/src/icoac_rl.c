@@ -9,28 +9,19 @@ static icoac_real_t clip_td(icoac_real_t delta, icoac_real_t td_clip)
     return delta > td_clip ? td_clip : (delta < -td_clip ? -td_clip : delta);
 }
 
-/* Off-diagonal entries of a symmetric matrix finite (its trace covers the diagonal). */
-static int off_diagonal_finite(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS])
-{
-    int finite = 1;
-    int i;
-    for (i = 0; i + 1 < ICOAC_MAX_INPUTS; ++i) {
-        finite &= icoac_priv_all_finite(&m[i][i + 1], ICOAC_MAX_INPUTS - 1 - i);
-    }
-    return finite;
-}
-
-/* Actor-critic tick: learn from the transition s_t -> s (method.md, one tick), then act on s.
+/* Actor-critic tick: learn from the transition s_t -> s (method.md, one tick), then act on s,
+ * over the first n inputs (ICOAC_MAX_INPUTS, or a task's n as a compile-time constant: the
+ * entries past the task's n are 0 and stay so, so both instances give the same values).
  * V(s), delta, the actor's candidate mu_w and Sigma_w and the force are staged; the critic and
  * the actor are updated, and the caches advanced, only when they are finite. Returns 0, with
  * the state untouched, otherwise. Checked: V(s), delta, |w| (covers every w_i), the trace of
- * Sigma_w (covers its diagonal) and its off-diagonal when it changed, the batch sums, and
- * G z (+ reflex). Not checked, as finite by the configuration's bounds: the noise
+ * Sigma_w (covers its diagonal; the actor step checks its off-diagonal when it changed, and the
+ * batch sums), and G z (+ reflex). Not checked, as finite by the configuration's bounds: the noise
  * (|eps| < 1e8 sigma_u), hence the force G z + eps + reflex; and the critic weights, which move
  * by at most critic_rate * td_clip <= 1e4 per tick. Writes every output field but reflex,
  * penalty, weight_norm and status. */
-int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_MAX_INPUTS],
-                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out)
+static inline int rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_MAX_INPUTS],
+                          const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out, int n)
 {
     icoac_real_t w[ICOAC_MAX_INPUTS];
     icoac_real_t h[ICOAC_MAX_INPUTS];
@@ -67,26 +58,23 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     }
     if (update) {
         for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
-            h[i] = cfg->policy.gain * st->x_prev[i];
+            h[i] = i < n ? cfg->policy.gain * st->x_prev[i] : ICOAC_R(0.0);
         }
-        cov_changed = icoac_priv_actor_step(&cfg->actor, st, h, delta, observed, terminal, w, cov);
+        cov_changed = icoac_priv_actor_step(&cfg->actor, st, h, delta, observed, terminal, w, cov, n);
         if (cov_changed < 0) {
             return cov_changed == -1 ? ICOAC_PRIV_TICK_NUMERIC : ICOAC_PRIV_TICK_CORRUPT;
         }
-        norm = ICOAC_PRIV_SQRT(icoac_priv_dot(w, w));
+        norm = ICOAC_PRIV_SQRT(icoac_priv_dot_n(w, w, n));
         if (cov_changed) {
-            trace = icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov));
-            if (!off_diagonal_finite(ICOAC_PRIV_CONST_MAT(cov))) {
-                return 0;
-            }
+            trace = icoac_priv_trace_n(ICOAC_PRIV_CONST_MAT(cov), n); /* the actor checked the rest */
         } else {
-            trace = icoac_priv_trace(icoac_priv_cov_c(st));
+            trace = icoac_priv_trace_n(icoac_priv_cov_c(st), n);
         }
     } else {
-        trace = icoac_priv_trace(icoac_priv_cov_c(st));
+        trace = icoac_priv_trace_n(icoac_priv_cov_c(st), n);
     }
     if (!terminal) {
-        z = icoac_priv_dot(w_act, scaled);
+        z = icoac_priv_dot_n(w_act, scaled, n);
         policy_force = cfg->policy.gain * z;
     }
     if (!(icoac_priv_finite(value) & icoac_priv_finite(delta) & icoac_priv_finite(norm) & icoac_priv_finite(trace) &
@@ -97,11 +85,11 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     if (update) {
         icoac_priv_critic_update(&cfg->critic, &st->grid, st->v,
                                  &st->active[cfg->critic.quirks ? slot_prev ^ 1 : slot_prev], cfg->critic.rate * delta);
-        icoac_priv_copy(st->w, w);
+        icoac_priv_copy_n(st->w, w, n);
         st->cov_slot = (st->cov_slot & 1) ^ cov_changed;
         st->weight_norm = norm;
         if (!cfg->actor.act_with_sample) {
-            icoac_priv_copy(st->w_act, w);
+            icoac_priv_copy_n(st->w_act, w, n);
         }
         if (cfg->actor.batch) {
             icoac_priv_actor_commit_batch(&cfg->actor, st, h, observed, terminal);
@@ -132,6 +120,16 @@ int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const 
     st->value_prev = (cfg->critic.quirks && !st->has_prev) ? ICOAC_R(0.0) : value;
     st->noise_prev = noise;
     st->trial_ticks++;
-    icoac_priv_cache_tick(st, scaled);
+    icoac_priv_copy_n(st->x_prev, scaled, n);
+    st->has_prev = 1;
     return 1;
+}
+
+int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_MAX_INPUTS],
+                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out, int n)
+{
+    if (n == ICOAC_CARTPOLE_INPUTS) {
+        return rl_tick(cfg, st, s, scaled, terminal, out, ICOAC_CARTPOLE_INPUTS);
+    }
+    return rl_tick(cfg, st, s, scaled, terminal, out, ICOAC_MAX_INPUTS);
 }

@@ -35,13 +35,19 @@ ICOAC_STATIC_ASSERT(ICOAC_STATE_LIST ==
 ICOAC_STATIC_ASSERT(ICOAC_CRITIC_BLOCK_MAX <= ICOAC_PRIV_CELL_MASK, block_fits_its_mask);
 ICOAC_STATIC_ASSERT(ICOAC_CRITIC_UNITS_PER_INPUT_MAX <= ICOAC_CRITIC_BLOCK_MAX, an_input_fits_a_block);
 
-/* Shape tag of the configuration in force (icoac_priv_grid_t.shape), derived by icoac_init /
- * icoac_retune / icoac_reset: the RL tick runs the critic kernels and the posterior step
- * instantiated for the cart-pole's shape when it is set, the general ones otherwise. The
- * cart-pole instances use their compile-time shape, inside every array whatever the state
- * holds, so a corrupted tag stays memory-safe. (The tick's features test the task's three words
- * in the configuration copy instead: icoac_step.c.) */
+/* Shape tags of the configuration in force (icoac_priv_grid_t.shape), derived by icoac_init /
+ * icoac_retune / icoac_reset: the RL tick runs the critic kernels instantiated for the
+ * cart-pole's shape when CARTPOLE_CRITIC is set, the general ones otherwise; the tick's
+ * cart-pole instance reads the rule table with the cart-pole's inputs and sides as constants
+ * when CARTPOLE_RULES is set (thresholds and reflexes from the configuration copy). Those
+ * instances use their compile-time shape, inside every array whatever the state holds, so a
+ * corrupted tag stays memory-safe. (The tick's instance itself is chosen on the task's three
+ * words in the configuration copy: icoac_step.c; the actor's on the task's n.) */
+#define ICOAC_PRIV_SHAPE_CARTPOLE_RULES 1u  /* the rule table of the cart-pole preset: inputs and sides */
 #define ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC 2u /* RL with 4 inputs and the 3 x 3 x 6 x 3 grid (rows 9, cells 18) */
+/* The cart-pole preset's rules (Eq. 4, first match wins): the input and side of each. */
+#define ICOAC_PRIV_CARTPOLE_RULE_INPUTS {ICOAC_IDX_THETA, ICOAC_IDX_X, ICOAC_IDX_THETA, ICOAC_IDX_X}
+#define ICOAC_PRIV_CARTPOLE_RULE_SIDES {ICOAC_RULE_ABOVE, ICOAC_RULE_BELOW, ICOAC_RULE_BELOW, ICOAC_RULE_ABOVE}
 #define ICOAC_PRIV_CARTPOLE_ROWS (ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT)
 #define ICOAC_PRIV_CARTPOLE_CELLS (ICOAC_CRITIC_N_THETA * ICOAC_CRITIC_N_THETA_DOT)
 ICOAC_STATIC_ASSERT(ICOAC_PRIV_CARTPOLE_ROWS + ICOAC_PRIV_CARTPOLE_CELLS < ICOAC_PRIV_LIST, cartpole_list_fits);
@@ -51,7 +57,7 @@ ICOAC_STATIC_ASSERT(ICOAC_PRIV_CARTPOLE_ROWS + ICOAC_PRIV_CARTPOLE_CELLS < ICOAC
 typedef struct {
     uint8_t n;     /* task.n_inputs */
     uint8_t split; /* first cell input, < n */
-    uint8_t shape; /* ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC or 0 */
+    uint8_t shape; /* ICOAC_PRIV_SHAPE_* bits */
     uint8_t unused;
 } icoac_priv_grid_t;
 

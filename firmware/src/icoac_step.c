@@ -55,10 +55,12 @@ ICOAC_PRIV_NOINLINE static icoac_status_t not_in_trial(icoac_priv_state_t *st, i
 
 /* A tick on an initialised state in a trial, for a task of n inputs whose late signal is the
  * first `rules` rules of its table (sensor: 0, the input's flag instead). One implementation,
- * instantiated for the cart-pole's task (compile-time n and rules: unrolled) and for the
- * configuration's (bounded to the arrays); icoac_step selects one per tick. */
+ * instantiated for the cart-pole's task (compile-time n and rules: unrolled; with
+ * cartpole_rules, the rules' inputs and sides as constants when the state's tag says the table
+ * has the preset's layout) and for the configuration's (bounded to the arrays); icoac_step
+ * selects one per tick. */
 static inline icoac_status_t tick(icoac_priv_state_t *st, const icoac_input_t *in, icoac_output_t *out, int n,
-                                  int rules, int sensor)
+                                  int rules, int sensor, int cartpole_rules)
 {
     const icoac_config_t *cfg = &st->config;
     const icoac_real_t *const inputs = in->s; /* entries n and up are not read */
@@ -74,7 +76,9 @@ static inline icoac_status_t tick(icoac_priv_state_t *st, const icoac_input_t *i
     terminal = (in->flags & ICOAC_INPUT_TERMINAL) != 0u;
     icoac_priv_scale_inputs(&cfg->policy, st, n, inputs, scaled);
     if (!sensor) {
-        zone = icoac_priv_zone(&cfg->task, rules, n, inputs);
+        zone = cartpole_rules && (st->grid.shape & ICOAC_PRIV_SHAPE_CARTPOLE_RULES) != 0u
+                   ? icoac_priv_zone_cartpole(&cfg->task, inputs)
+                   : icoac_priv_zone(&cfg->task, rules, n, inputs);
     } else {
         zone = sensor_zone(in);
         if (!icoac_priv_finite(zone.reflex)) {
@@ -85,7 +89,7 @@ static inline icoac_status_t tick(icoac_priv_state_t *st, const icoac_input_t *i
     out->reflex = zone.reflex;
     out->penalty = zone.penalty;
     if (cfg->mode == ICOAC_MODE_RL) {
-        ok = icoac_priv_rl_tick(cfg, st, inputs, scaled, terminal, out);
+        ok = icoac_priv_rl_tick(cfg, st, inputs, scaled, terminal, out, n);
     } else if (cfg->mode == ICOAC_MODE_SEARCH) {
         ok = icoac_priv_search_tick(cfg, st, scaled, terminal, out);
     } else if (cfg->mode == ICOAC_MODE_ICO) {
@@ -114,7 +118,7 @@ ICOAC_PRIV_NOINLINE static icoac_status_t tick_general(icoac_priv_state_t *st, c
 {
     const icoac_task_config_t *task = &st->config.task;
     const int sensor = task->late_source != ICOAC_LATE_RULES;
-    return tick(st, in, out, icoac_priv_inputs(&st->config), sensor ? 0 : icoac_priv_rules(task), sensor);
+    return tick(st, in, out, icoac_priv_inputs(&st->config), sensor ? 0 : icoac_priv_rules(task), sensor, 0);
 }
 
 icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
@@ -134,7 +138,7 @@ icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_o
      * instance reads exactly the inputs and rules the copy names, whatever else the state holds */
     if (st->config.task.n_inputs == ICOAC_CARTPOLE_INPUTS && st->config.task.late_source == ICOAC_LATE_RULES &&
         st->config.task.n_rules == ICOAC_CARTPOLE_RULES) {
-        return tick(st, in, out, ICOAC_CARTPOLE_INPUTS, ICOAC_CARTPOLE_RULES, 0);
+        return tick(st, in, out, ICOAC_CARTPOLE_INPUTS, ICOAC_CARTPOLE_RULES, 0, 1);
     }
     return tick_general(st, in, out);
 }

@@ -70,8 +70,9 @@
  *           mode differs from the one in force, else OK. On an error the state is bytewise
  *           unchanged. On OK icoac_get_config returns the new configuration (every field
  *           bitwise), 1 / policy.input_range and (search) the floors search.floor *
- *           (prior variance * search.cov_scale) are re-derived, and every other byte of the
- *           state is unchanged: w, |w|, cov, v, w_act, the batch sums, the search's record and
+ *           (prior variance * search.cov_scale) are re-derived, the shape tag's rule-layout
+ *           bit says whether the new rule table is the cart-pole preset's (4 inputs, its 4 rules'
+ *           inputs and sides), and every other byte of the state is unchanged: w, |w|, cov, v, w_act, the batch sums, the search's record and
  *           factor, the trial's caches, the RNG, the counters and the header word. The
  *           configuration in force is then the new one for every later check.
  *   end     icoac_get_posterior returns w and cov; icoac_get_config the configuration in force.
@@ -160,6 +161,24 @@ static icoac_real_t trace4(const icoac_real_t m[N][N])
 static int inputs_of(const icoac_config_t *cfg)
 {
     return (uint32_t)cfg->task.n_inputs <= (uint32_t)N ? (int)cfg->task.n_inputs : N;
+}
+
+/* The task's rule table has the cart-pole preset's layout: 4 inputs, 4 rules on the preset's
+ * inputs and sides (theta above, x below, theta below, x above); any thresholds and reflexes. */
+static int cartpole_rule_layout(const icoac_task_config_t *t)
+{
+    static const int32_t input[4] = {ICOAC_IDX_THETA, ICOAC_IDX_X, ICOAC_IDX_THETA, ICOAC_IDX_X};
+    static const int32_t side[4] = {ICOAC_RULE_ABOVE, ICOAC_RULE_BELOW, ICOAC_RULE_BELOW, ICOAC_RULE_ABOVE};
+    int k;
+    if (t->n_inputs != 4 || t->late_source != ICOAC_LATE_RULES || t->n_rules != 4) {
+        return 0;
+    }
+    for (k = 0; k < 4; ++k) {
+        if (t->rule_input[k] != input[k] || t->rule_side[k] != side[k]) {
+            return 0;
+        }
+    }
+    return 1;
 }
 
 static icoac_counters_t counters_of(const icoac_state_t *state)
@@ -770,6 +789,12 @@ static int check_retune(const icoac_config_t *in_force, icoac_state_t *state, co
     memcpy(&ex->config, &st->config, sizeof ex->config);
     memcpy(ex->inv_range, st->inv_range, sizeof ex->inv_range);
     memcpy(ex->search.floor, st->search.floor, sizeof ex->search.floor);
+    FZ_CHECK((st->grid.shape & ICOAC_PRIV_SHAPE_CARTPOLE_RULES) ==
+                 (cartpole_rule_layout(&next->task) ? ICOAC_PRIV_SHAPE_CARTPOLE_RULES : 0u),
+             "op %d: icoac_retune: rule-layout tag %u for a table of the preset's layout: %d", op,
+             (unsigned)(st->grid.shape & ICOAC_PRIV_SHAPE_CARTPOLE_RULES), cartpole_rule_layout(&next->task));
+    ex->grid.shape = (uint8_t)((ex->grid.shape & ~ICOAC_PRIV_SHAPE_CARTPOLE_RULES) |
+                               (st->grid.shape & ICOAC_PRIV_SHAPE_CARTPOLE_RULES));
     FZ_CHECK(memcmp(&ex->grid, &st->grid, sizeof ex->grid) == 0, "op %d: icoac_retune changed the critic geometry", op);
     FZ_CHECK(memcmp(&expect, state, sizeof expect) == 0,
              "op %d: icoac_retune changed more than the configuration and what it derives", op);

@@ -74,6 +74,53 @@ def test_random_rule_tables_first_match_wins(seed):
     assert len(matched) >= min(len(rules), 2)
 
 
+# The cart-pole preset's layout (theta above, x below, theta below, x above), which the controller's
+# cart-pole instance reads as constants, and two 4-rule tables of 4 inputs that differ from it in
+# one input or one side (read from the table).
+PRESET_LAYOUT = [(2, ABOVE), (0, BELOW), (2, BELOW), (0, ABOVE)]
+OTHER_LAYOUTS = {"side": [(2, ABOVE), (0, BELOW), (2, ABOVE), (0, ABOVE)],
+                 "input": [(2, ABOVE), (1, BELOW), (2, BELOW), (0, ABOVE)]}
+
+
+def random_rules(rng, layout):
+    return [(index, side, float(REAL(round(rng.uniform(-1, 1), 2))), rng.choice([-1.0, -0.5, 0.25, 1.0]))
+            for index, side in layout]
+
+
+def check_against_oracle(state, rules, rng, ticks=400):
+    thresholds = [r[2] for r in rules]
+    for _ in range(ticks):
+        s = [rng.choice([rng.uniform(-1.5, 1.5), rng.choice(thresholds)]) for _ in range(4)]
+        status, out = tick(state, s)
+        penalty, reflex = oracle(rules, s)
+        assert status == B.OK and (out.penalty, out.reflex) == (penalty, float(REAL(reflex))), (rules, s)
+
+
+@pytest.mark.parametrize("layout", ["preset", "side", "input"])
+def test_four_rule_tables_of_four_inputs(layout):
+    # any thresholds and reflexes on the preset's layout, and the layouts next to it
+    rng = random.Random(layout)
+    rules = random_rules(rng, PRESET_LAYOUT if layout == "preset" else OTHER_LAYOUTS[layout])
+    _, state = controller(4, rules)
+    check_against_oracle(state, rules, rng)
+
+
+@pytest.mark.parametrize("layout", ["side", "input"])
+def test_retune_between_rule_layouts(layout):
+    # icoac_retune re-derives which layout the tick reads: to another layout and back
+    rng = random.Random(f"retune-{layout}")
+    preset = random_rules(rng, PRESET_LAYOUT)
+    other = random_rules(rng, OTHER_LAYOUTS[layout])
+    cfg, state = controller(4, preset)
+    for rules in (other, preset):
+        task = cfg.controller.task
+        for k, (index, side, threshold, reflex) in enumerate(rules):
+            task.rule_input[k], task.rule_side[k] = index, side
+            task.rule_threshold[k], task.rule_reflex[k] = threshold, reflex
+        B.check_status(B.lib.icoac_retune(ctypes.byref(state), ctypes.byref(cfg.controller)))
+        check_against_oracle(state, rules, rng, ticks=200)
+
+
 def test_first_match_precedence():
     # two rules on one input that both match above 0.5: the first one's reflex
     _, state = controller(2, [(1, ABOVE, 0.1, 0.25), (1, ABOVE, 0.5, -1.0), (0, BELOW, -0.2, 1.0)])
