@@ -213,23 +213,9 @@ static inline void icoac_priv_copy_n(icoac_real_t *dst, const icoac_real_t *src,
 }
 
 /* Fixed pairwise order, the same on every target: (a0 b0 + a1 b1) + (a2 b2 + a3 b3), then each
- * further pair (and a last odd term) added in turn. Zero entries add +-0, which leaves every
- * nonzero sum unchanged. */
-static inline icoac_real_t icoac_priv_dot(const icoac_real_t a[ICOAC_MAX_INPUTS], const icoac_real_t b[ICOAC_MAX_INPUTS])
-{
-    icoac_real_t sum = (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
-    int i;
-    for (i = 4; i + 1 < ICOAC_MAX_INPUTS; i += 2) {
-        sum += a[i] * b[i] + a[i + 1] * b[i + 1];
-    }
-    if ((ICOAC_MAX_INPUTS & 1) != 0) {
-        sum += a[ICOAC_MAX_INPUTS - 1] * b[ICOAC_MAX_INPUTS - 1];
-    }
-    return sum;
-}
-
-/* The same order over the first n entries (4 <= n <= ICOAC_MAX_INPUTS): the dot product of the
- * instances with a compile-time n; with n = ICOAC_MAX_INPUTS it is icoac_priv_dot. */
+ * further pair (and a last odd term) added in turn, over the first n entries (4 <= n <=
+ * ICOAC_MAX_INPUTS; a compile-time n in the instances). Zero entries add +-0, which leaves every
+ * nonzero sum unchanged, so a task's n gives the sum over all entries. */
 static inline icoac_real_t icoac_priv_dot_n(const icoac_real_t *a, const icoac_real_t *b, int n)
 {
     icoac_real_t sum = (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
@@ -243,18 +229,10 @@ static inline icoac_real_t icoac_priv_dot_n(const icoac_real_t *a, const icoac_r
     return sum;
 }
 
-/* The trace, in the dot product's order. */
-static inline icoac_real_t icoac_priv_trace(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS])
+/* The same over every entry. */
+static inline icoac_real_t icoac_priv_dot(const icoac_real_t a[ICOAC_MAX_INPUTS], const icoac_real_t b[ICOAC_MAX_INPUTS])
 {
-    icoac_real_t sum = (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
-    int i;
-    for (i = 4; i + 1 < ICOAC_MAX_INPUTS; i += 2) {
-        sum += m[i][i] + m[i + 1][i + 1];
-    }
-    if ((ICOAC_MAX_INPUTS & 1) != 0) {
-        sum += m[ICOAC_MAX_INPUTS - 1][ICOAC_MAX_INPUTS - 1];
-    }
-    return sum;
+    return icoac_priv_dot_n(a, b, ICOAC_MAX_INPUTS);
 }
 
 /* The tick's per-trial cache: this tick's scaled observation is the next one's previous. */
@@ -264,7 +242,7 @@ static inline void icoac_priv_cache_tick(icoac_priv_state_t *st, const icoac_rea
     st->has_prev = 1;
 }
 
-/* The trace over the first n entries (4 <= n <= ICOAC_MAX_INPUTS), in the same order. */
+/* The trace over the first n entries (4 <= n <= ICOAC_MAX_INPUTS), in the dot product's order. */
 static inline icoac_real_t icoac_priv_trace_n(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS], int n)
 {
     icoac_real_t sum = (m[0][0] + m[1][1]) + (m[2][2] + m[3][3]);
@@ -276,6 +254,12 @@ static inline icoac_real_t icoac_priv_trace_n(const icoac_real_t m[ICOAC_MAX_INP
         sum += m[n - 1][n - 1];
     }
     return sum;
+}
+
+/* The trace over every entry. */
+static inline icoac_real_t icoac_priv_trace(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS])
+{
+    return icoac_priv_trace_n(m, ICOAC_MAX_INPUTS);
 }
 
 /* Stages of a tick. Each tick function stages what it would learn and output, checks that it
