@@ -639,6 +639,13 @@ def state_seeds(fmt):
         # the shape tag cleared: the general kernels on the cart-pole's configuration
         "task-shape-general": (raw_state(1, [patch("grid.shape", 0, 0)], fmt=fmt) + ticks(ZERO, 4)
                                + STATE_EXERCISE),
+        # the rule-layout tag against the table: set on a table of another layout (the tick reads
+        # the preset's inputs and sides, the table's thresholds), cleared on the preset (the loop)
+        "task-rules-tag-other-table": (raw_state(0, [patch("grid.shape", 1, 0)], fmt=fmt,
+                                                 init_fields={"task.rule_side[2]": 1, "task.rule_input[3]": 1})
+                                       + ticks(ZERO, 4) + STATE_EXERCISE),
+        "task-rules-tag-cleared": (raw_state(0, [patch("grid.shape", 0, 0)], fmt=fmt) + ticks(ZERO, 4)
+                                   + STATE_EXERCISE),
         "task-sensor-copy": (raw_config(0, {"task.late_source": 1}, fmt=fmt) + ticks(ZERO, 2)
                              + bytes([0x80]) + real(1.0) + bytes([0x80]) + real("nan") + STATE_EXERCISE),
         "rl-actor-update-9-batch": (raw_config(1, {"actor.update": 9}, fmt=fmt, init_fields={"actor.batch": 1})
