@@ -22,8 +22,11 @@ BENCH_DATA ?= docs/data/bench-$(BENCH_PROFILE).json
 # /P (figures) added.
 BENCH_PLANTS ?= cart_pole
 # `make fuzz`: seconds per target, targets run at once, extra libFuzzer options, and the ledger
-# (one <target>.tsv each, committed, so that a campaign adds up across checkouts).
+# (one <target>.tsv each, committed, so that a campaign adds up across checkouts);
+# `make fuzz-campaign`: hours of wall time and the longest run, in seconds.
 FUZZ_TIME ?= 600
+FUZZ_HOURS ?= 2
+FUZZ_CHUNK ?= 1800
 FUZZ_JOBS ?= 2
 FUZZ_FLAGS ?=
 FUZZ_LEDGER ?= tests/fuzz/ledger
@@ -34,7 +37,7 @@ FUZZ_SOURCES = $(shell git ls-tree HEAD $(FUZZ_C_SOURCES) 2>/dev/null | git hash
   cut -c1-12)$(shell git diff --quiet HEAD -- $(FUZZ_C_SOURCES) 2>/dev/null || echo -modified)
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim fuzz_model
 
-.PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz fuzz-ledger bench \
+.PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz fuzz-campaign fuzz-ledger bench \
   bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
@@ -105,6 +108,13 @@ fuzz: build-fuzz
 	  sh tests/fuzz/run_fuzzer.sh fuzz $(FUZZ_TIME) build/fuzz/tests/fuzz/'{}' tests/fuzz/corpus/'{}' \
 	  build/fuzz/work/'{}' $(FUZZ_FLAGS)
 	@$(PYTHON) tests/fuzz/ledger.py $(FUZZ_LEDGER) $(FUZZ_SOURCES)
+
+# Fuzz the targets short of 1e7 executions of the current sources, FUZZ_JOBS at a time, in runs of
+# at most FUZZ_CHUNK s, for FUZZ_HOURS (tests/fuzz/campaign.py); each run adds its ledger line.
+fuzz-campaign: build-fuzz
+	@$(PYTHON) tests/fuzz/campaign.py --sources $(FUZZ_SOURCES) --ledger $(FUZZ_LEDGER) --build build/fuzz/tests/fuzz \
+	  --corpus tests/fuzz/corpus --work build/fuzz/work --hours $(FUZZ_HOURS) --jobs $(FUZZ_JOBS) \
+	  --chunk $(FUZZ_CHUNK) $(FUZZ_TARGETS)
 
 # What every long fuzzing run of the current sources adds up to, per target.
 fuzz-ledger:
