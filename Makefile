@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Quick start: `make bench` (grid benchmark + figures) and `make test` (every test).
 # Both install what they need: Debian packages via apt-get, Python packages into .venv.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Python harness of the icoac controller: ctypes binding of libicoac_sim, grid runs, results, figures.
 
 Layers (no import cycle; `python -m harness.tools.imports` prints the graph): errors, options, registry,

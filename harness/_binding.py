@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ctypes binding of libicoac_sim (sim_host/include/icoac_sim/icoac_sim.h, firmware/include/icoac/*.h).
 
 C is the single source of every number this module exposes: at import it reads the library's

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What a Dask worker runs for harness.cluster: check that it can load the C library with the
 client's ABI, and run one chunk of cells through grid.run_grid (threads=1), the same engine entry
 as the local threaded path.

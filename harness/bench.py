@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The paper's comparison (Fig. 2b, 3): ICO grids per seed, priors, ICO->RL, RL, ICO->search and
 search grids with their no-learning controls (method.md, L1), summary, figures.
 

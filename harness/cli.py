@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Command line: `python -m harness grid|figures|bench|sweep|ceiling ...`.
 
 This module only parses arguments and reports; the work is done by harness.conditions (one

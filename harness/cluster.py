@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The Dask backend: grids run on a dask.distributed cluster, an existing one (``--scheduler
 ADDRESS``) or a LocalCluster of worker processes on this machine (``--workers N``).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Orchestration of one learning condition: its prior (condition_prior) and a validated,
 checkpointed, resumable grid run into a results directory (run_condition). The command line
 (harness.cli), the benchmark stages (harness.bench) and the sweep call these; none of them

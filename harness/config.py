@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Configurations: C defaults plus overrides by field name, validated by the C check functions.
 
 Names. The canonical name of a controller field is its member designator in icoac_config_t,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Exception types of the harness (no dependencies, so the command line can catch them before the
 shared library is loaded).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The paper's figures (Fig. 1b, 1c-f, 1g) as byte-stable PNGs (matplotlib Agg, fixed style)."""
 from __future__ import annotations
 

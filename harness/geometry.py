@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Grids of initial conditions, defined once per plant by its C descriptor (icoac_sim_plant_grid):
 row i starts the row component at rows.first + i * rows.step, column j the column component at
 cols.first + j * cols.step (in degrees when the sweep says so), row-major. A cell stores the

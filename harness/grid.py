@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Run grids of cells through icoac_sim_run_grid_model (any registry plant) with progress, Ctrl-C cancellation and checkpoints."""
 from __future__ import annotations
 

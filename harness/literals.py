@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Numbers written as text - options of the command line, ``--set`` and ``--param`` values, ``--cells``
 indices, ``--w`` weights - read by one grammar (pure Python, no dependencies).
 

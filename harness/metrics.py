@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Benchmark metrics (method.md, benchmark protocol) from a cell array."""
 from __future__ import annotations
 

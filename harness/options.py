@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Harness-side names, limits and defaults, each defined once (pure Python: the command line
 builds its parser from them without loading the shared library). Everything the C library
 defines - enum values, statuses, sizes, grid geometry - comes from the binding instead; the

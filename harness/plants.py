@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The plants a benchmark runs, each defined once: the C registry's plant (dynamics, parameters,
 failure test and grid: sim_host/src/plants/, docs/plants.md) and the controller settings of its
 task for this controller build (the input scaling, the reflex zone and the critic grid), applied

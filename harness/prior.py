@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Priors of the RL conditions (method.md, A15-A17) from the final weights of an ICO grid.
 
 ICO->RL: mean and 4x4 sample covariance (ddof 1) of the final ICO weights of the ICO-successful cells

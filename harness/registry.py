@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The learning conditions, each defined once: its mode, its prior rule, its controller overrides,
 its label and its no-learning control. Every other table of conditions (the command line's
 choices, the configurations, the priors, the bench's stages and tables) is derived from REGISTRY.

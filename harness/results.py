@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Results directories: cells.npz (structured cell array) + run.json (provenance, config, summary)."""
 from __future__ import annotations
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The results store: every file the harness writes into an output directory - cells.npz and
 run.json of a results directory, and the JSON, CSV and Markdown files of bench, sweep and
 ceiling - is written here, and every "the recorded settings must match" check of a resumed

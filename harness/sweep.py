@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`sweep`: full-factorial (or one-at-a-time) sweep of RL parameters on a cell subset, resumable.
 
 DIR/sweep.csv holds one row per finished setting; DIR/sweep.md is regenerated from it; DIR/sweep.json

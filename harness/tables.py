@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Markdown tables of a bench summary (the aggregate of harness.bench, as stored in summary.json
 and docs/data/*.json): the prior taken apart, success within k trials, and the distributions of
 trials and simulated time to success. Pure formatting: bench.py writes them into summary.md and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Generic bare-metal arm-none-eabi layer. Include it from a per-core file that sets
 # ICOAC_CPU_FLAGS first (cortex-m4f.cmake, cortex-m0plus.cmake).
 set(CMAKE_SYSTEM_NAME Generic)

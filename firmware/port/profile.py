@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Where a tick's instructions go on a microcontroller target, function by function.
 
 Builds a cross preset, runs the port example under QEMU with one instruction per translation

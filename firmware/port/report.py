@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Resource report of the microcontroller targets.
 
 Builds the cortex-m4f and cortex-m0plus presets, runs the port example under QEMU with

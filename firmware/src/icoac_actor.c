@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Actor (method.md: the Bayesian actor, L2): the posterior, mean and gradient readings of one
  * observation, per tick or summed over a trial (batch, A14), and the per-trial sample of w.
  * Vectors and matrices run over all ICOAC_MAX_INPUTS entries: those past the task's n are 0 and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Configuration: defaults (the cart-pole task) and checks of every group, the prior check,
  * status names. */
 #include "icoac_priv.h"

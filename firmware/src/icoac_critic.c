@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Normalized Gaussian critic on a grid of critic.units[i] units along each input i (method.md,
  * critic), evaluated separably: a_k = prod_i f_i(k_i) and sum_k a_k = prod_i sum_j f_i(j), so the
  * normalized activation is b_k = prod_i g_i(k_i) with per-input normalized factors g.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Dense critic kernel, the host build's (icoac_priv.h): the units of icoac_critic.c's sparse
  * kernel, found by a mask instead of a sorted list. Unit k = row * cells + cell is kept when
  * b_k = row_product * cell_product >= the floor, the sparse kernel's test on the same product.

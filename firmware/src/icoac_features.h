@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Features of a tick (method.md: input scaling, late signal, force; A2): the task's inputs and
  * their scaling, the late signal (penalty and reflex) of the rule table, and the reflex force. Private; static inline, as they run on every tick
  * of every mode. */

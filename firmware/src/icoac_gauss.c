@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Gaussian helpers shared by the actor and the search: Cholesky factor, SPD inverse, and a
  * draw through the factor. */
 #include "icoac_priv.h"

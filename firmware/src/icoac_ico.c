@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* ICO rule (Eq. 2-3) in both timings of A4 (method.md), staged: the new weights, their norm and the
  * force are stored only when finite. */
 #include "icoac_features.h"

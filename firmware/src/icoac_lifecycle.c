@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Lifecycle of a controller state: init, live retuning, reset per trial (with the check of a
  * state's content), and the accessors. */
 #include "icoac_priv.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Private declarations of the icoac library: numeric helpers and the stages of a tick.
  * Not installed, not part of the API; every name carries the prefix icoac_priv_. */
 #ifndef ICOAC_PRIV_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The actor-critic tick (method.md: critic, actor, one tick): the critic's TD error on the
  * transition into s drives the critic and the Bayesian actor, then the actor acts on s with
  * exploration noise. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Episodic search over N(mu_w, Sigma_w) (method.md, L4): each trial acts with one sample of w, like
  * the ICO policy and without exploration noise; each failed trial's length is its return; every
  * search.batch trials the elite moves mu_w and Sigma_w (cross-entropy step with a floor). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Private layout of icoac_state_t; tests and the library include it, callers do not. */
 #ifndef ICOAC_STATE_H
 #define ICOAC_STATE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The tick dispatcher (method.md, one tick): input check, features, then the mode's tick. */
 #include "icoac_features.h"
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The first-step bound (``first_step_bound``): the first explicit Euler step moves x and theta by
 dt times the initial velocities only (x1 = x0 + dt x_dot0, theta1 = theta0 + dt theta_dot0); the
 force changes only the velocities, which stay finite. So a cell on a failure threshold

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`python -m harness ceiling`: validate everything, then the first-step bound, the search for the
 best w (or a given --w), its full-horizon evaluations and the summary (harness.ceiling)."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Fixed-w evaluation. A controller in mode ICO with ``learn = 0`` and a prior whose mean is w (and
 covariance I, which ICO mode does not read) acts with exactly w in every cell and every trial;
 nothing is updated, so a grid run of condition ``ico`` with ``learn = 0`` evaluates w. Two

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The LQR starting points of the search: the discrete-time LQR gains of the plant linearised at the
 upright state (A, B by central differences of the C plant step ``icoac_sim_model_step``; Q =
 diag(1 / input_range^2), R = 1 / F^2 for F = 1, 3, 10, 30 N), converted to weights by

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What `ceiling` writes into OUT and what is read back. Layout of OUT: ``search.json`` (settings and every screening result, rewritten atomically at
 most every 2 s and on exit: a rerun of the same command takes the screens from it and replays
 the deterministic search), ``evals/<hash of w>_<protocol>_h<steps>/`` (a results directory per

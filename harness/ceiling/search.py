@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The search for the best single w (``search``), all of it with the first protocol:
 
 1. Starting points: the typical ICO weights - the mean final weight of the successful cells in

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A weight vector w (one weight per task input; the cart-pole's w_x, w_xdot, w_theta, w_thetadot) as
 the controller acts with it: rounded to its real type, checked as the C prior check would, parsed
 from text, named and printed."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Gymnasium for icoac: the simulator's plants as registered envs, an icoac controller as a policy
 on any env with the cart-pole's observation layout, and a continuous-force Gymnasium CartPole-v1.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ContinuousCartPole: Gymnasium's own CartPole-v1 driven by a continuous force.
 
 CartPole-v1 pushes with +force_mag (action 1) or -force_mag (action 0), force_mag read at every

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """IcoacPlantEnv: a plant of harness.gym.plants as a gymnasium.Env, stepped by the C simulator.
 
 One env step is one control period: the input (a force, or the Furuta's voltage) is held for the

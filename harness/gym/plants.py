@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The plants the Gymnasium envs serve, each described once: its state (names, units), its action,
 its parameters and the C functions that step it, test failure and draw start states.
 

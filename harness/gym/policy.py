@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """IcoacPolicy: an icoac controller (any mode, learning as it acts) driving a Gymnasium env whose
 observation is four numbers, (x m, x_dot m/s, theta rad, theta_dot rad/s) for the cart-pole or
 another plant's state in the same places (``plant``: its task settings, harness.plants), and whose

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The per-task overhead of the Dask backend (harness.cluster): N chunks of one trivial cell each
 (max_trials 1, success_steps 1: microseconds of C work) on a LocalCluster, against the threaded
 engine on the same cells.

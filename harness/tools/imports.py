@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The import graph of the harness package, from the source (AST only: nothing is imported, the
 shared library is not needed). Every import counts, at module level or inside a function.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The sweeps that chose the learners' defaults (method.md, L2-L4), as one command:
 
     python -m harness.tools.learner_sweeps --prior-from results/bench/ico/seed-0 --out results/sweeps

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The sweep that chose a plant's task settings (harness.plants), as one command:
 
     python -m harness.tools.plant_sweeps --plant furuta --out results/sweeps-furuta

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The tables of docs/results.md, written from the committed bench summaries (docs/data/*.json,
 written by `bench --data`): every block
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Speed benchmark: nanoseconds per closed-loop tick (controller step + plant step) on one
  * core, in the engine and for one cell alone, and grid throughput on all cores. Prints
  * figures; asserts nothing.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Denormal handling of the host engine. Balanced trials decay toward 0 for up to 1000 s and
  * would spend most of their time in subnormal floats, which x86 handles ~100x slower. The
  * engine flushes subnormals to zero (FTZ/DAZ) while it runs and restores the caller's mode.

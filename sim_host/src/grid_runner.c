@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Grid runner: independent cells shared out to worker threads through an atomic counter; each
  * thread advances ICOAC_SIM_LANES of them in lockstep (sim_internal.h). */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Constants and struct layouts exported for bindings (harness/_binding.py reads both tables
  * at import), so that sizes, enum values, statuses, grid geometry and field offsets are defined
  * once, in C. */

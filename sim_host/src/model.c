@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The registry plants as models (parameter block + integration options): defaults, checks,
  * step, derivatives, failure test, energy, grid and trial start, each rejecting bad input with
  * a status. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The paper's grid of initial conditions (method.md, benchmark protocol): 25 angles x 49 positions. */
 #include <string.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Defaults and checks of the run parameters (ranges in icoac_sim.h); the cart-pole's own are in
  * plants/cart_pole.c. */
 #include <math.h>

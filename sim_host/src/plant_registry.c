@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The plant registry: one entry per plant file in src/plants/ (docs/plants.md). The cart-pole
  * stays first (ICOAC_SIM_CART_POLE). */
 #include <string.h>

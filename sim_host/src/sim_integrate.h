@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The engine's integrators for any plant (icoac_sim_integrator_t): a plant file's step calls
  * sim_integrate with its own derivative function, which the compiler then inlines. */
 #ifndef SIM_INTEGRATE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Private helpers shared by the sim_host sources. */
 #ifndef SIM_INTERNAL_H
 #define SIM_INTERNAL_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Status names and layout checks of the sim API. */
 #include "icoac_sim/icoac_sim.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The Fig. 1g trajectory recorder: one trial with learning on, every tick stored. */
 #include <math.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The benchmark trial loop of one cell (method.md, benchmark protocol): trials from a fresh
  * controller until one lasts success_steps or max_trials have failed, as a lane
  * (sim_internal.h) that advances one tick per call, so that a worker thread can interleave

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Bayesian actor (method.md): icoac_priv_actor_posterior against the closed-form Gaussian posterior,
  * long-run symmetry / positive definiteness, forgetting, and the Eq. 7-8 wiring in icoac_step. */
 #include "test_common.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Shared helpers of the cmocka tests. */
 #ifndef ICOAC_TEST_COMMON_H
 #define ICOAC_TEST_COMMON_H

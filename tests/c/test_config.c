@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Configuration, prior and argument checks; the named bad field; status names; layout
  * functions. */
 #include "test_common.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The tick contract (design.md): with an accepted configuration and a finite observation,
  * icoac_step returns ICOAC_OK with a finite output and learned state, or an error status with
  * force 0 and the state unchanged but for its counters. Regression tests of the reproducers

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The no-learning control (method.md L1, cfg.learn = 0): the same acting, exploration noise and
  * random stream as learning, with every update off. */
 #include "test_common.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* NGnet critic (method.md, critic): separable evaluation against the direct n-D formula (long
  * double) on the cart-pole's grid and on other task grids (6 inputs, 1, 3, 5), the activity
  * threshold and the kept-unit list, for both kernels (sparse: microcontrollers, dense: hosts);

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Host engine: determinism of cells and grids, thread-count independence, the lanes of a
  * thread, cancellation and resume, argument checks, cell accounting, trajectory recorder. */
 #define _POSIX_C_SOURCE 199309L /* nanosleep */

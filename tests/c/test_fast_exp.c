@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The optional float exp of the critic (ICOAC_FAST_EXP=1, on for the microcontroller presets):
  * relative error against the double-precision exp over its whole range. */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Step tables through icoac_step: input scaling, reflex/penalty (Eq. 4), force (Eq. 5),
  * and the ICO update (Eq. 2-3) in code and literal timing. */
 #include "test_common.h"

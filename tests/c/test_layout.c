@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The constant and layout tables icoac_sim exports for bindings (sim_host/src/layout.c):
  * non-empty, unique names, every field inside its type, the members of each struct listed
  * without overlap and covering it, and spot checks against this compiler's offsetof. */

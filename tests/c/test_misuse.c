@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Misuse: a configuration edited after icoac_init, live retuning, unknown switches,
  * non-finite fields, repeated terminal ticks and corrupted state bytes. Each reproducer of the
  * misuse report is a test here; run under ASan and UBSan (preset debug-asan), an access outside

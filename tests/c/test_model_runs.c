@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The benchmark on registry plants (icoac_sim_run_cell_model, icoac_sim_run_grid_model,
  * icoac_sim_trajectory_model): the cart-pole's model runs bit for bit as its plant struct, a
  * Furuta pendulum grid runs its own dynamics and failure test, the 6-state double pendulum runs

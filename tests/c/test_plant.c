@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Cart-pole plant against an independent evaluation of its equations (method.md, plant);
  * failure test; parameter checks; the paper grid. */
 #include "test_common.h"

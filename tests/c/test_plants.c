@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The plant registry (sim_host/src/plant_registry.c, model.c, plants/): descriptors consistent,
  * the cart-pole through the interface bit for bit the icoac_sim_plant_t functions, parameter
  * checks, named statuses for non-finite input, grids and trial starts, and energy conservation

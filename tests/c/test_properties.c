@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Properties of icoac_step / icoac_reset: what persists, when nothing is learned,
  * and how non-finite observations are rejected. */
 #include "test_common.h"

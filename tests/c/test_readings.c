@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The actor readings and their switches (method.md, L2, L3, A10, A14) through icoac_step, each
  * against an independent double-precision formula computed here from what the ticks output
  * (the exploration noise eps, the TD error delta) and the observed states:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* PCG32 known answers, uniform range, polar-method normals, SplitMix64 seed mixing. */
 #include "test_common.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Episodic search (ICOAC_MODE_SEARCH, method.md L4) through the public API, each trial a reset, a
  * few ticks and a terminal tick, with the trial's sampled weights read from the state:
  *   - the update after each batch against a reference written here in double: the elite (the

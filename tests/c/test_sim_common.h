@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Helpers of the host simulator's tests (test_engine.c, test_model_runs.c). */
 #ifndef TEST_SIM_COMMON_H
 #define TEST_SIM_COMMON_H

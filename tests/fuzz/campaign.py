@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A deep fuzzing campaign (`make fuzz-campaign`): fuzz the targets still short of the ledger's
 goal, JOBS at a time, in runs of at most CHUNK seconds, until every target meets the goal or the
 time is up. Each run resumes from the inputs the earlier ones found and adds its line to the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Failure report of FZ_CHECK, and the checks' shared helpers. */
 #include "fuzz_check.h"
 

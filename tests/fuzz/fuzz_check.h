@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Contract checks of the fuzz targets: a violated check prints what failed and aborts, so
  * libFuzzer reports it like a crash and saves the input. */
 #ifndef ICOAC_FUZZ_CHECK_H

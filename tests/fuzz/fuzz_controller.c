@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* libFuzzer target of the controller API (icoac.h). One source, three executables:
  * fuzz_controller (float library icoac), fuzz_controller_double (icoac_double) and
  * fuzz_controller_fast_exp (icoac_fast_exp, the microcontroller presets' float math).

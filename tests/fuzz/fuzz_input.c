@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Byte reader, special-value tables and the config / prior sections of the fuzz inputs.
  * tests/fuzz/gen_corpus.py writes inputs in this format: keep the tables in step with it. */
 #include "fuzz_input.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Decoding of fuzz input bytes, shared by the fuzz targets (format: fuzz_controller.c).
  * The reader yields zero bytes once the input is used up, so every input decodes. */
 #ifndef ICOAC_FUZZ_INPUT_H

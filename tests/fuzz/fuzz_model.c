@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* libFuzzer target of the plant registry and model API (icoac_sim.h, "Plant registry"), linked
  * with libicoac_sim.so.
  *

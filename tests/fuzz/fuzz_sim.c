@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* libFuzzer target of the sim API (icoac_sim.h), linked with libicoac_sim.so.
  *
  * Input format, read front to back (a byte past the end reads as 0):

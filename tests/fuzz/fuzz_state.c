@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* libFuzzer target of corrupted controller states: raw bytes in the state's configuration copy,
  * or in the whole state, behind a valid header word, through every entry point of icoac.h.
  * One source, three executables: fuzz_state (float library icoac), fuzz_state_double

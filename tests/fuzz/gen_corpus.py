@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Write the committed seed corpus of the fuzz targets, tests/fuzz/corpus/<target>/.
 
 Inputs follow the formats documented at the top of fuzz_controller.c, fuzz_state.c,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What the long fuzzing runs (`make fuzz`) add up to: one row per target, from each target's
 ledger LEDGER_DIR/<target>.tsv (tests/fuzz/run_fuzzer.sh), over the runs of the given C sources
 only.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # Run one libFuzzer target with the project's options (used by ctest and `make fuzz`).
 #   run_fuzzer.sh replay EXE CORPUS WORK
 #       run EXE once on every file in CORPUS.

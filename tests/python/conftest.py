@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Tests load the real shared library; nothing is built or skipped here."""
 import os
 import signal

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Driving one controller tick by tick through the binding (icoac_init / icoac_reset / icoac_step),
 shared by test_readings.py and test_search.py; the numpy side of those tests is in them."""
 import ctypes

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The linear-policy ceiling (method.md, L5, harness.ceiling): fixed-w evaluation, the search, the
 first-step bound, the command and its files, the bench's reference lines."""
 import json

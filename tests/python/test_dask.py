@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The Dask backend (harness.cluster): a LocalCluster on loopback (2 worker processes, 1 thread
 each) gives the threaded engine's cells, bitwise, for every condition family, also when a worker
 is killed mid-chunk and through cancel and resume; workers that cannot load the library say so.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Every `python -m harness ...` command in README.md, docs/*.md and the Makefile, and every
 `icoac-harness ...` command (the installed package's script), still parses, and its --set /
 --param names and values build a configuration (nothing is run)."""

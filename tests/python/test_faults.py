@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Every harness fault is one line `icoac-harness: error: ...` on stderr, exit status 2, and nothing
 on disk is rewritten. The CLI runs in-process through harness.cli.main."""
 import errno

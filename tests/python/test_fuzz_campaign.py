@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The fuzzing campaign (tests/fuzz/campaign.py): which target runs next and for how long, and a
 whole campaign over stand-in fuzz executables that stops when every target meets its goal."""
 import subprocess

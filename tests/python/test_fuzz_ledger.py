@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The fuzzing ledger: tests/fuzz/run_fuzzer.sh appends one line per run, parsed from libFuzzer's
 output, and tests/fuzz/ledger.py adds up the runs of one source id per target. A stand-in for
 the fuzz executable prints what libFuzzer prints at the end of a run."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The Gymnasium side (harness.gym): the registered cart-pole env against the engine it must
 reproduce, the controller as a policy, Gymnasium's own CartPole-v1 under a continuous force."""
 import ctypes

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Kill tests: a grid run as `python -m harness grid` is killed (SIGKILL) or interrupted (SIGINT) at
 a random moment, resumed with --resume, and must equal an uninterrupted run bitwise, cell by cell.
 

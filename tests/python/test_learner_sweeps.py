@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """RL alone's ranking by the sweeps' criterion (harness.tools.learner_sweeps.ranked_rows): the
 highest ICO-failed success; within one point of the best, the spread cells, then fewer median
 trials; controls and confirmations left out; rows with identical results counted once."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Canonical names and their aliases, ABI-3 records (flat controller dict), and the import graph."""
 import json
 import shutil

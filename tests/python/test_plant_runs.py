@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The benchmark on registry plants (harness --plant): configurations and records by plant, the
 plant's grid in every metric and map, the task settings and their sweep, refusals by name."""
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The registry plants (sim_host/src/plants/) against equations of motion derived here a second,
 independent way, with numpy only: each body is a set of point masses placed by the plant's
 geometry (a thin uniform rod as its two Gauss-Legendre points, exact for the quadratic kinetic

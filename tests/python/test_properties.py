@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Property tests (hypothesis): configuration building, `--set` parsing, cell lists and results
 loading accept an input and round-trip it, or reject it with the harness's own error type - never
 another exception. Profile (examples, derandomized) in conftest.py."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The actor readings (method.md, L2), the per-trial batch (A14), the exploration schedule (L3) and the
 critic quirks (A10) through the binding: every actor step against an independent numpy formula,
 from the observed states and what the ticks output (exploration noise eps, TD error delta):

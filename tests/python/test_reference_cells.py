@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The cart-pole preset reproduces the committed reference cells bit for bit (tests/tools/compare_cells.py:
 a spread subset of cells of every condition with small caps; the reference records its commit)."""
 import pytest

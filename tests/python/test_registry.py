@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The condition registry (harness.registry): every condition defined once, its control generated
 from it, and the configurations and priors derived from it the same as before the registry."""
 import json

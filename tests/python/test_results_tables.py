@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """docs/results.md's tables are the committed summaries (docs/data/*.json) formatted by
 harness.tools.results_tables: the page must agree with them, and a changed number must be caught."""
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """RL / ICO->RL: priors, RL grids, the Bayesian actor step against numpy, sweep and bench CLI."""
 import csv
 import ctypes

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The episodic search (mode search, method.md, L4; conditions ico-search and search) through the binding:
 the update after each batch of trials against a numpy reference of the same step (with its
 fallback: when Sigma' is not positive definite, the floor is added to the whole diagonal), a step

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The results store (harness.store): writes that follow no planted link, one run per output
 directory (the lock, a stale one taken over), resume only of cells written by this ABI with the
 list of builds kept, write errors that name their file. Each fault is one line

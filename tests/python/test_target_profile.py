@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """firmware/port/profile.py's trace reader: per timed tick loop of the port example, the library's
 instructions per function (C runtime calls counted for their caller's side), stub loops skipped."""
 import importlib.util

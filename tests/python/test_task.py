@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The task description's late signal (method.md, the task description) against a Python oracle:
 random rule tables on random input counts (first match wins: penalty -1 and the rule's reflex;
 no match 0, 0), the sensor source (ICOAC_INPUT_LATE and in.reflex), and the cart-pole preset's

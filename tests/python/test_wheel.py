@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The harness as a package (pyproject.toml, scikit-build-core): a wheel built from a clean copy of
 the checkout (its tracked and new, not ignored, files: no build/, no .venv), installed into a fresh
 venv, gives a working `icoac-harness` that runs a grid on the library inside the package - not

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Writes firmware/port/common/recorded_inputs.h: fixed-seed closed-loop observation
  * sequences of the host controller (float icoac) on the host cart-pole plant (icoac_sim).
  *

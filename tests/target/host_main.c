@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Host reference for the target example: same replay code, same inputs, host icoac. */
 #include <stdio.h>
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Checks of the microcontroller target, run by ctest (tests/target/CMakeLists.txt).
 
   build   <preset>                         configure + build a cross preset (cmake --preset)

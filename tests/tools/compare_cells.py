@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Bit-for-bit comparison of grid cells against committed reference cells.
 
 Runs a spread subset of the paper grid's cells (CELLS, failing and successful ones) for every

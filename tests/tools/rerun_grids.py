@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Bit-for-bit check of finished grids against the current library: a spread subset of the cells
 of each condition's grid of a bench directory (seed 0) rerun from that grid's own run.json
 (configuration and prior), every result field compared (weights and covariance included).

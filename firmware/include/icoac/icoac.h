@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* icoac: ICO-learning / Bayesian actor-critic controller, one 100 Hz tick per call.
  *
  * Allocation-free C99. The caller owns a configuration (may live in flash), a state struct

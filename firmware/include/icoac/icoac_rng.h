@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* icoac: PCG32 random numbers and a Gaussian transform, state owned by the caller. */
 #ifndef ICOAC_RNG_H
 #define ICOAC_RNG_H

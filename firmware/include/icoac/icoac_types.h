@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* icoac: real-number type, sizes and status codes shared by every header. */
 #ifndef ICOAC_TYPES_H
 #define ICOAC_TYPES_H

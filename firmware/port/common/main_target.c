@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* icoac port example: replays the recorded closed-loop ICO, RL and search sequences through
  * icoac_step, measures instructions (SysTick under QEMU -icount shift=0) and peak stack
  * (painting), and prints every tick's outputs over semihosting.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Replay of recorded closed-loop observation sequences through icoac_step.
  *
  * Shared by the target example (main_target.c) and the host reference build

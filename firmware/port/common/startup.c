@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Minimal Cortex-M startup: vector table, .data copy, .bss clear, FPU enable (M4F). */
 #include <stdint.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* icoac_sim: plants (the cart-pole and a registry of others), benchmark trial loop and grid
  * runner for the icoac controller. Host-only C11; exported as a shared library for the Python
  * harness. */

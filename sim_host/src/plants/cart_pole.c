@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Frictionless cart-pole (Barto, Sutton & Anderson 1983, with g = +9.8; method.md, plant): the
  * registry's first plant, and the icoac_sim_plant_t entry points of the trial loop. */
 #include <math.h>

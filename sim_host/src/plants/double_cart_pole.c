@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Double inverted pendulum on a cart, force on the cart, with the parameters of Bogdanov,
  * "Optimal control of a double inverted pendulum on a cart", OGI technical report CSE-04-006,
  * 2004. Frictionless; both links are uniform rods (centre of mass at half length, inertia

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Furuta (rotary inverted) pendulum driven by a DC motor, with the parameters of the Quanser
  * QUBE-Servo 2 (QUBE-Servo 2 User Manual, system parameters table: motor and rotary pendulum
  * module; the module's masses and lengths are also listed in the QUBE-Servo 3 User Manual,
