@@ -327,6 +327,9 @@ icoac_status_t icoac_get_counters(const icoac_state_t *state, icoac_counters_t *
 /* The configuration in force (icoac_init's or the last icoac_retune's). */
 icoac_status_t icoac_get_config(const icoac_state_t *state, icoac_config_t *cfg);
 
+/* Release version of the library, "MAJOR.MINOR.PATCH" (icoac_version.h: the same at compile time). */
+const char *icoac_version(void);
+
 /* Layout checks for bindings (field offsets: icoac_sim's layout table on the host). */
 uint32_t icoac_abi_version(void);
 uint32_t icoac_sizeof_real(void);

@@ -21,6 +21,14 @@ typedef float icoac_real_t;
 #define ICOAC_R(x) (x##f)
 #endif
 
+/* The build options of a CMake build or installed package (icoac_build_config.h, generated):
+ * it fixes the build maxima below to the library's. */
+#if defined(__has_include)
+#if __has_include("icoac/icoac_build_config.h")
+#include "icoac/icoac_build_config.h"
+#endif
+#endif
+
 /* Build maxima of the task description (CMake cache variables of the same names, or -D; they
  * change the layout of every public struct, so a library and its callers must agree on them).
  * The defaults fit the shipped plants: the cart-pole (4 inputs, 4 rules, 3 x 3 x 6 x 3 = 162
