@@ -11,4 +11,23 @@ grid; imported by bench and sweep, and by conditions inside a function).
 Gymnasium: gym (the simulator's plants as envs, the controller as a policy; after config) is
 imported by no other module.
 """
-__version__ = "0.1.0"
+
+def _version() -> str:
+    """The project's one version, project(icoac VERSION x.y.z) of the top-level CMakeLists.txt: in a
+    wheel, harness/_version.py written from it by the build (pyproject.toml); in a checkout, read
+    from the file."""
+    try:
+        from ._version import __version__ as version
+        return version
+    except ImportError:
+        import re
+        from pathlib import Path
+        try:
+            text = (Path(__file__).resolve().parent.parent / "CMakeLists.txt").read_text(encoding="utf-8")
+        except OSError:  # neither a wheel nor a checkout
+            return "unknown"
+        match = re.search(r"^project\(icoac VERSION ([0-9]+\.[0-9]+\.[0-9]+)", text, re.MULTILINE)
+        return match.group(1) if match else "unknown"
+
+
+__version__ = _version()

@@ -704,6 +704,15 @@ def get_counters(state: State) -> Counters:
     return counters
 
 
+def library_version() -> str:
+    """The release version the loaded C library was built as (icoac_version)."""
+    if not hasattr(lib, "icoac_version"):
+        raise _stale("no icoac_version")
+    lib.icoac_version.argtypes = []
+    lib.icoac_version.restype = ctypes.c_char_p
+    return lib.icoac_version().decode("ascii")
+
+
 def abi_info() -> dict:
     """ABI description recorded with every result."""
     return {

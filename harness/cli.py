@@ -165,8 +165,28 @@ def _add_seeds(parser, default_count: str) -> None:
                         help=f"number of seeds: --seed .. --seed + N - 1, below 2^64 ({default_count})")
 
 
+class _VersionAction(argparse.Action):
+    """--version: the harness version (no library needed), then the C library's, if it loads."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from . import __version__
+        lines = [f"{PROG} {__version__}"]
+        try:
+            from . import _binding as B
+            lines.append(f"icoac library {B.library_version()} (ABI {int(B.lib.icoac_abi_version())}): {B.LIBRARY_PATH}")
+        except HarnessError as exc:
+            lines.append(f"icoac library not loaded: {_one_line(str(exc))}")
+        print("\n".join(lines))
+        parser.exit(0)
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog=PROG, description="icoac grid benchmarks, results and figures")
+    p.add_argument("--version", action=_VersionAction,
+                   help="print the harness version and, if the C library loads, its version and ABI, then exit")
     sub = p.add_subparsers(dest="command", metavar="{grid,figures,bench,sweep,ceiling}", parser_class=_Parser)
     sub.required = True
     cells_, every = O.DEFAULT_CHECKPOINT_CELLS, O.DEFAULT_CHECKPOINT_EVERY
