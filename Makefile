@@ -38,7 +38,7 @@ FUZZ_SOURCES = $(shell git ls-tree HEAD $(FUZZ_C_SOURCES) 2>/dev/null | git hash
   cut -c1-12)$(shell git diff --quiet HEAD -- $(FUZZ_C_SOURCES) 2>/dev/null || echo -modified)
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim fuzz_model
 
-.PHONY: all deps venv build build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz fuzz-campaign fuzz-ledger bench \
+.PHONY: all deps venv build dist build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz fuzz-campaign fuzz-ledger bench \
   bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
@@ -73,6 +73,11 @@ $(VENV)/.installed: pyproject.toml | deps
 build: deps
 	cmake --preset release >/dev/null
 	cmake --build --preset release
+
+# The library-only release archive build/release/dist/icoac-<version>.tar.gz (docs/porting.md).
+dist: deps
+	cmake --preset release >/dev/null
+	cmake --build --preset release --target icoac_dist
 
 build-asan: deps
 	cmake --preset debug-asan >/dev/null

@@ -20,7 +20,10 @@ file(COPY ${ICOAC_SOURCE_DIR}/CMakeLists.txt ${ICOAC_SOURCE_DIR}/LICENSE ${ICOAC
 file(COPY ${ICOAC_SOURCE_DIR}/docs/porting.md ${ICOAC_SOURCE_DIR}/docs/changelog.md DESTINATION ${stage}/${name}/docs)
 
 set(archive ${ICOAC_DIST_DIR}/${name}.tar.gz)
-execute_process(COMMAND ${CMAKE_COMMAND} -E tar cfz ${archive} --format=gnutar "--mtime=1970-01-01 00:00:00 UTC" ${name}
+# Files in sorted order with a fixed time: the same sources give the same tar (the gzip header
+# still holds the time of compression, so pin the SHA256 of the archive you publish).
+file(GLOB_RECURSE files RELATIVE ${stage} ${stage}/${name}/*)
+execute_process(COMMAND ${CMAKE_COMMAND} -E tar cfz ${archive} --format=gnutar "--mtime=1970-01-01 00:00:00 UTC" ${files}
                 WORKING_DIRECTORY ${stage} COMMAND_ERROR_IS_FATAL ANY)
 file(REMOVE_RECURSE ${stage})
 file(SIZE ${archive} size)

@@ -27,6 +27,8 @@ int main(void)
         }
         printf("tick %d force %.3f\n", k, (double)out.force);
     }
-    printf("icoac %s (header %s, ABI %u)\n", icoac_version(), ICOAC_VERSION_STRING, (unsigned)icoac_abi_version());
+    printf("icoac %s (header %s, ABI %u), maxima %d inputs %d rules %d critic units, state %u bytes\n", icoac_version(),
+           ICOAC_VERSION_STRING, (unsigned)icoac_abi_version(), ICOAC_MAX_INPUTS, ICOAC_MAX_RULES, ICOAC_MAX_CRITIC_UNITS,
+           (unsigned)sizeof state);
     return strcmp(icoac_version(), ICOAC_VERSION_STRING) == 0 ? 0 : 3;
 }
