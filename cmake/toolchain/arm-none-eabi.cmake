@@ -18,15 +18,12 @@ set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 
 # The CPU flags select the instruction set, the float ABI and the matching multilib (libc, libm):
 # they are compile and link options of every target (directory properties of the project that
-# loads this file), so that a CMAKE_C_FLAGS given on the command line cannot drop them, as it
-# would drop CMAKE_C_FLAGS_INIT. The section flags are ordinary defaults, left to CMAKE_C_FLAGS.
+# loads this file, try_compile's too), so that a CMAKE_C_FLAGS given on the command line cannot
+# drop them, as it would drop CMAKE_C_FLAGS_INIT, which only seeds the cache. (project() reads
+# this file twice; CMake de-duplicates the options.) The section flags are ordinary defaults.
 separate_arguments(ICOAC_CPU_OPTIONS UNIX_COMMAND "${ICOAC_CPU_FLAGS}")
-list(GET ICOAC_CPU_OPTIONS 0 ICOAC_CPU_OPTION_FIRST)
-get_directory_property(ICOAC_DIRECTORY_COMPILE_OPTIONS COMPILE_OPTIONS)
-if(NOT ICOAC_CPU_OPTION_FIRST IN_LIST ICOAC_DIRECTORY_COMPILE_OPTIONS) # project() reads this file twice
-  add_compile_options(${ICOAC_CPU_OPTIONS})
-  add_link_options(${ICOAC_CPU_OPTIONS})
-endif()
+add_compile_options(${ICOAC_CPU_OPTIONS})
+add_link_options(${ICOAC_CPU_OPTIONS})
 set(CMAKE_C_FLAGS_INIT "-ffunction-sections -fdata-sections")
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-Wl,--gc-sections")
 
