@@ -210,13 +210,15 @@ def symbol_addresses(nm, elf):
 
 
 def runtime_graph(funcs, words, table_reader):
-    """{address: (name, own frame bytes, [callee address, ...], problems)} from the disassembly."""
+    """{address: (name, own frame bytes, [callee address, ...], problems, tails)} from the
+    disassembly; tails: the callees that a branch reaches at their entry (GCC's sibling calls,
+    made after the epilogue), a subset of the callees."""
     starts = sorted(funcs)
     graph = {}
     for idx, addr in enumerate(starts):
         name, insns = funcs[addr]
         end = starts[idx + 1] if idx + 1 < len(starts) else None
-        frame, callees, problems = 0, set(), []
+        frame, callees, problems, tails = 0, set(), [], set()
 
         def owner(target):
             pos = [s for s in starts if s <= target]
@@ -240,6 +242,8 @@ def runtime_graph(funcs, words, table_reader):
                     t = int(target.group(1), 16)
                     if not (addr <= t and (end is None or t < end)):
                         callees.add(owner(t))  # tail call, or a branch into another routine
+                        if t in funcs and mnem in ("b", "b.n", "b.w"):
+                            tails.add(t)
                 elif mnem.startswith("bx") and ops != "lr":
                     problems.append("indirect branch: %s %s" % (mnem, ops))
                 continue
@@ -270,13 +274,61 @@ def runtime_graph(funcs, words, table_reader):
         body = [ins for ins in insns if ins[1] != "nop"]  # alignment padding at the end
         if body:
             last_mnem, last_ops = body[-1][1], body[-1][2]
+            far_jump = re.match(r"^([0-9a-f]+) <", last_ops)  # Thumb-1: bl inside the function
             ends = (last_mnem in ("b", "b.n", "b.w") or (last_mnem == "bx") or
-                    (last_mnem.startswith(("pop", "ldmia", "ldr")) and "pc" in last_ops))
+                    (last_mnem.startswith(("pop", "ldmia", "ldr")) and "pc" in last_ops) or
+                    (last_mnem == "bl" and far_jump and addr <= int(far_jump.group(1), 16) < (end or 0)))
             if not ends and end is not None:
                 callees.add(end)  # falls through into the next routine
         callees.discard(None)
-        graph[addr] = (name, frame, sorted(callees), problems)
+        graph[addr] = (name, frame, sorted(callees), problems, tails)
     return graph
+
+
+def function_addresses(readelf, elf):
+    """{node: address} of every function of elf, by the .ci's node names: "name" for a global,
+    "<file>:name" (file: the source's base name) for a static one (the symbols after a FILE
+    symbol are its object's)."""
+    out = subprocess.run([readelf, "-sW", elf], check=True, stdout=subprocess.PIPE, text=True).stdout
+    nodes, source = {}, None
+    for line in out.splitlines():
+        f = line.split()
+        if len(f) < 8 or not f[0].endswith(":"):
+            continue
+        if f[3] == "FILE":
+            source = f[7]
+        elif f[3] == "FUNC":
+            key = f[7] if f[4] != "LOCAL" else "%s:%s" % (source, f[7])
+            nodes[key] = int(f[1], 16) & ~1
+    return nodes
+
+
+def tail_edges(frames, edges, graph, nodes, syms):
+    """{(caller node, callee node)} of the library's calls that are tail calls only (every call
+    instruction from the caller to the callee a branch to its entry after the epilogue). Fails
+    when the disassembly has a call the .ci has not."""
+    tails = set()
+    for node in frames:
+        key = node if ":" not in node else "%s:%s" % (os.path.basename(node.rsplit(":", 1)[0]), node.rsplit(":", 1)[1])
+        if key not in nodes:
+            raise AnalysisError("%s is not in the link" % node)
+        _, _, callees, _, tail_addrs = graph[nodes[key]]
+        by_addr = {}
+        for callee in edges.get(node, []):
+            ckey = callee if ":" not in callee else "%s:%s" % (
+                os.path.basename(callee.rsplit(":", 1)[0]), callee.rsplit(":", 1)[1])
+            addr = nodes.get(ckey, syms.get(callee))
+            if addr is None:
+                raise AnalysisError("callee %s of %s is not in the link" % (callee, node))
+            by_addr[addr] = callee
+        missing = [graph[a][0] for a in callees if a not in by_addr]
+        if missing:
+            raise AnalysisError("%s calls %s, which -fcallgraph-info does not list" % (node, ", ".join(missing)))
+        nested = set(callees) - set(tail_addrs)
+        for addr, callee in by_addr.items():
+            if addr in tail_addrs and addr not in nested:
+                tails.add((node, callee))
+    return tails
 
 
 def runtime_bounds(graph, roots):
@@ -286,7 +338,7 @@ def runtime_bounds(graph, roots):
     def visit(addr):
         if addr in memo:
             return memo[addr]
-        name, frame, callees, problems = graph[addr]
+        name, frame, callees, problems, _ = graph[addr]
         if problems:
             raise AnalysisError("%s: %s" % (name, "; ".join(problems)))
         if addr in active:
@@ -318,7 +370,7 @@ def check_method(graph, frames):
     GCC's: the check of the method the runtime routines are bounded by."""
     names = [f[2] for f in frames.values()]
     seen = {}
-    for name, frame, _, problems in graph.values():
+    for name, frame, _, problems, _ in graph.values():
         seen.setdefault(name, []).append((frame, problems))
     checked = 0
     for frame, qual, name in frames.values():
@@ -333,9 +385,10 @@ def check_method(graph, frames):
     return checked
 
 
-def target_runtime(build, externals, frames):
-    """{symbol: (bound, path)} of the runtime routines the library calls, from a whole link of
-    the library with the preset's compiler and flags."""
+def target_runtime(build, externals, frames, edges):
+    """({symbol: (bound, path)} of the runtime routines the library calls, {(caller, callee)}
+    of the library's tail calls), from a whole link of the library with the preset's compiler
+    and flags."""
     cache = cmake_cache(build)
     cc = cache["ICOAC_ARM_GCC"]  # cmake/toolchain/arm-none-eabi.cmake
     prefix = cc[:-3] if cc.endswith("gcc") else cc
@@ -352,8 +405,9 @@ def target_runtime(build, externals, frames):
     missing = [e for e in externals if e not in syms]
     if missing:
         raise AnalysisError("runtime routines not in the link: %s" % ", ".join(missing))
+    tails = tail_edges(frames, edges, graph, function_addresses(prefix + "readelf", elf), syms)
     bounds = runtime_bounds(graph, sorted({syms[e] for e in externals}))
-    return {e: bounds[syms[e]] for e in externals}
+    return {e: bounds[syms[e]] for e in externals}, tails
 
 
 def host_runtime(externals):
@@ -365,9 +419,11 @@ def host_runtime(externals):
 
 # --- the bound ---------------------------------------------------------------------------------
 
-def bounds(frames, edges, runtime, accept_bounded):
+def bounds(frames, edges, runtime, accept_bounded, tails=frozenset()):
     """{node: (bound bytes, [function names along the deepest path])}. A frame must be static,
-    or "dynamic,bounded" (GCC: then the figure is a reliable maximum) when accept_bounded."""
+    or "dynamic,bounded" (GCC: then the figure is a reliable maximum) when accept_bounded. A
+    callee in tails ((caller, callee) pairs: tail calls only) runs after the caller's frame is
+    released."""
     memo, active = {}, []
 
     def visit(node):
@@ -384,13 +440,17 @@ def bounds(frames, edges, runtime, accept_bounded):
         if qual != "static" and not (accept_bounded and qual == "dynamic,bounded"):
             raise AnalysisError("%s: %s frame (%d bytes)" % (name, qual, frame))
         active.append(node)
-        best = (0, [])
+        best = (frame, ["%s (%d)" % (name, frame)])
         for callee in edges.get(node, []):
             b = visit(callee)
+            if (node, callee) in tails:
+                b = (b[0], ["%s (%d, tail call to:)" % (name, frame)] + b[1])
+            else:
+                b = (frame + b[0], ["%s (%d)" % (name, frame)] + b[1])
             if b[0] > best[0]:
                 best = b
         active.pop()
-        memo[node] = (frame + best[0], ["%s (%d)" % (name, frame)] + best[1])
+        memo[node] = best
         return memo[node]
 
     for node in frames:  # every function, reachable from the API or not
@@ -404,13 +464,14 @@ def analyse(config, build=None):
     obj_dir = os.path.join(build, "firmware", "CMakeFiles", lib + ".dir")
     frames, edges = read_callgraph(obj_dir)
     externals = sorted({c for cs in edges.values() for c in cs if c not in frames and c != "__indirect_call"})
+    tails = set()
     if config.startswith("cortex"):
-        runtime = target_runtime(build, externals, frames)
+        runtime, tails = target_runtime(build, externals, frames, edges)
         runtime = {e: (b, [p[0].replace(")", ", runtime)")] + p[1:]) for e, (b, p) in runtime.items()}
     else:
         runtime = host_runtime(externals)
     # x86-64 pushes the stack arguments of a call (icoac's 9-argument kernels): "dynamic,bounded"
-    all_bounds = bounds(frames, edges, runtime, accept_bounded=not config.startswith("cortex"))
+    all_bounds = bounds(frames, edges, runtime, accept_bounded=not config.startswith("cortex"), tails=tails)
     result = {}
     for fn in public_functions():
         if fn not in all_bounds:
