@@ -217,7 +217,8 @@ def runtime_graph(funcs, words, table_reader):
     graph = {}
     for idx, addr in enumerate(starts):
         name, insns = funcs[addr]
-        end = starts[idx + 1] if idx + 1 < len(starts) else None
+        # one past the routine: the next one's start, or past the last instruction of the last one
+        end = starts[idx + 1] if idx + 1 < len(starts) else (insns[-1][0] + 4 if insns else addr)
         frame, callees, problems, tails = 0, set(), [], set()
 
         def owner(target):
@@ -232,7 +233,7 @@ def runtime_graph(funcs, words, table_reader):
             if mnem in ("bl", "blx"):
                 if target:
                     t = int(target.group(1), 16)
-                    if not (addr <= t and (end is None or t < end)):
+                    if not (addr <= t and t < end):
                         callees.add(owner(t))
                 else:
                     problems.append("indirect call: %s %s" % (mnem, ops))
@@ -240,7 +241,7 @@ def runtime_graph(funcs, words, table_reader):
             if base in ("b", "b.n", "b.w", "cbz", "cbnz", "bx") or mnem in ("cbz", "cbnz"):
                 if target:
                     t = int(target.group(1), 16)
-                    if not (addr <= t and (end is None or t < end)):
+                    if not (addr <= t and t < end):
                         callees.add(owner(t))  # tail call, or a branch into another routine
                         if t in funcs and mnem in ("b", "b.n", "b.w"):
                             tails.add(t)
@@ -249,7 +250,7 @@ def runtime_graph(funcs, words, table_reader):
                 continue
             if mnem == "mov" and ops.startswith("pc,"):
                 table = jump_table(insns, i, words, table_reader)
-                if table is None or any(not (addr <= t & ~1 and (end is None or t & ~1 < end)) for t in table):
+                if table is None or any(not (addr <= t & ~1 and t & ~1 < end) for t in table):
                     problems.append("indirect branch: %s %s" % (mnem, ops))
                 continue  # a switch inside the routine
             if re.match(r"^ldr(\.w)?$", mnem) and ops.startswith("pc,") and "[sp]" not in ops:
@@ -277,8 +278,8 @@ def runtime_graph(funcs, words, table_reader):
             far_jump = re.match(r"^([0-9a-f]+) <", last_ops)  # Thumb-1: bl inside the function
             ends = (last_mnem in ("b", "b.n", "b.w") or (last_mnem == "bx") or
                     (last_mnem.startswith(("pop", "ldmia", "ldr")) and "pc" in last_ops) or
-                    (last_mnem == "bl" and far_jump and addr <= int(far_jump.group(1), 16) < (end or 0)))
-            if not ends and end is not None:
+                    (last_mnem == "bl" and far_jump and addr <= int(far_jump.group(1), 16) < end))
+            if not ends and end in funcs:
                 callees.add(end)  # falls through into the next routine
         callees.discard(None)
         graph[addr] = (name, frame, sorted(callees), problems, tails)
