@@ -393,8 +393,8 @@ def target_runtime(build, externals, frames, edges):
     cache = cmake_cache(build)
     cc = cache["ICOAC_ARM_GCC"]  # cmake/toolchain/arm-none-eabi.cmake
     prefix = cc[:-3] if cc.endswith("gcc") else cc
-    elf = os.path.join(build, "firmware", "icoac_stack_link.elf")
-    lib = os.path.join(build, "firmware", "libicoac.a")
+    elf = os.path.join(build, "icoac_stack_link.elf")
+    lib = find_in(build, "libicoac.a", False)
     # the library whole, newlib-nano and libm as the port example; icoac_step as the entry
     subprocess.run([cc] + cache.get("CMAKE_C_FLAGS", "").split() +
                    ["-nostartfiles", "--specs=nano.specs", "-Wl,--whole-archive", lib,
@@ -459,10 +459,19 @@ def bounds(frames, edges, runtime, accept_bounded, tails=frozenset()):
     return memo
 
 
+def find_in(build, name, want_dir):
+    """The one path named name under build (CMake's object directory of a target, a library)."""
+    found = [os.path.join(d, name) for d, dirs, files in os.walk(build) if name in (dirs if want_dir else files)]
+    if len(found) != 1:
+        raise AnalysisError("%s: %d of %s under %s (build the library first)" % (
+            "directory" if want_dir else "file", len(found), name, build))
+    return found[0]
+
+
 def analyse(config, build=None):
     build_rel, lib = CONFIGS[config]
     build = build or os.path.join(ROOT, build_rel)
-    obj_dir = os.path.join(build, "firmware", "CMakeFiles", lib + ".dir")
+    obj_dir = find_in(build, lib + ".dir", True)
     frames, edges = read_callgraph(obj_dir)
     externals = sorted({c for cs in edges.values() for c in cs if c not in frames and c != "__indirect_call"})
     tails = set()
