@@ -125,8 +125,8 @@ static inline void mean_step(const icoac_actor_config_t *actor, const icoac_priv
     }
 }
 
-/* sum += h h^T / sigma_L^2 */
-static void add_info(const icoac_actor_config_t *actor, const icoac_real_t h[N], icoac_real_t sum[N][N])
+/* sum += h h^T / sigma_L^2 (out of line: its frame is not nested in its callers') */
+ICOAC_PRIV_NOINLINE static void add_info(const icoac_actor_config_t *actor, const icoac_real_t h[N], icoac_real_t sum[N][N])
 {
     const icoac_real_t inv_var = ICOAC_R(1.0) / likelihood_var(actor);
     int i;
@@ -144,26 +144,20 @@ static void add_info(const icoac_actor_config_t *actor, const icoac_real_t h[N],
 ICOAC_PRIV_NOINLINE static void batch_prior(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
                                             icoac_real_t cov[N][N])
 {
-    int i;
-    int j;
-    for (i = 0; i < N; ++i) {
-        for (j = 0; j < N; ++j) {
-            cov[i][j] = icoac_priv_cov_c(st)[i][j];
-        }
-    }
+    /* one loop over the N * N entries, not unrolled into a frame of spilled values */
+    icoac_real_t *const entry = &cov[0][0];
+    int k;
+    memcpy(cov, icoac_priv_cov_c(st), sizeof st->cov_buffer[0]);
     if (actor->update == ICOAC_ACTOR_POSTERIOR && actor->forgetting < ICOAC_R(1.0)) {
         const icoac_real_t inflate = ICOAC_R(1.0) / actor->forgetting;
-        for (i = 0; i < N; ++i) {
-            for (j = 0; j < N; ++j) {
-                cov[i][j] *= inflate;
-            }
+        for (k = 0; k < N * N; ++k) {
+            entry[k] *= inflate;
         }
     }
 }
 
-/* precision (Sigma^-1 in place) += the trial's information and h_last's (or NULL) */
-ICOAC_PRIV_NOINLINE static void batch_precision(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
-                                                const icoac_real_t *h_last, icoac_real_t precision[N][N])
+/* precision (Sigma^-1 in place) += the trial's information */
+ICOAC_PRIV_NOINLINE static void batch_precision(const icoac_priv_state_t *st, icoac_real_t precision[N][N])
 {
     int i;
     int j;
@@ -171,9 +165,6 @@ ICOAC_PRIV_NOINLINE static void batch_precision(const icoac_actor_config_t *acto
         for (j = 0; j < N; ++j) {
             precision[i][j] += st->batch.info[i][j];
         }
-    }
-    if (h_last != 0) {
-        add_info(actor, h_last, precision);
     }
 }
 
@@ -223,7 +214,10 @@ ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, cons
     if (!icoac_priv_spd_inverse(cov, n)) {
         return -1;
     }
-    batch_precision(actor, st, h_last, cov);
+    batch_precision(st, cov);
+    if (h_last != 0) {
+        add_info(actor, h_last, cov); /* and this tick's observation */
+    }
     if (!icoac_priv_spd_inverse(cov, n)) {
         return -1;
     }
