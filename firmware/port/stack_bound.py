@@ -5,8 +5,13 @@
 The bound of a function is its own frame plus the largest bound of its callees, over GCC's call
 graph of the built library: frames from `-fstack-usage` (.su), calls from `-fcallgraph-info=su`
 (.ci, VCG). A static call graph covers every mode, reading, batch and error path. The script
-fails on a cycle (recursion), an indirect call, a frame that is not "static" (dynamic or
-bounded), and a callee outside the library whose frame it cannot bound.
+fails on a cycle (recursion), an indirect call, a frame that is not "static" (the host accepts
+"dynamic,bounded", a reliable maximum in GCC's words: x86-64 pushes a call's stack arguments),
+and a callee outside the library whose frame it cannot bound.
+
+Tail calls (Cortex-M): a callee that the disassembly of the link below reaches only by a branch
+to its entry (GCC's sibling call, after the caller's epilogue) adds its bound in place of the
+caller's frame. Every call of the disassembly must be in the .ci.
 
 Callees outside the library (libm, libc, libgcc):
 - Cortex-M presets: the library is linked whole (--whole-archive, the preset's flags,
@@ -118,14 +123,6 @@ def read_callgraph(obj_dir):
 
 
 # --- runtime routines from a Cortex-M disassembly ----------------------------------------------
-
-SP_DECREMENT = [
-    (re.compile(r"^(push|stmdb|stmfd)(\.w)?$"), "list"),
-    (re.compile(r"^(vpush|vstmdb)$"), "vlist"),
-    (re.compile(r"^sub(s|w|\.w)?$"), "sub"),
-]
-TERMINATORS = re.compile(r"^(b(\.n|\.w)?|bx|pop(\.w)?|ldmia(\.w)?|ldr(\.w)?)$")
-
 
 def reg_count(reglist):
     """Registers of "{r4, r5, lr}" or "{s16-s21}" / "{d8-d9}", and the bytes of each."""
@@ -263,7 +260,9 @@ def runtime_graph(funcs, words, table_reader):
                 frame += reg_count(ops[ops.index("{"):])
             elif re.search(r"\[sp, #-(\d+)\]!", ops):
                 frame += int(re.search(r"\[sp, #-(\d+)\]!", ops).group(1))
-            elif operands and operands[0] == "sp" and not mnem.startswith(("cmp", "str", "ldr")):
+            elif mnem.startswith(("tbb", "tbh")):
+                problems.append("table branch: %s %s" % (mnem, ops))
+            elif operands and operands[0] == "sp" and not mnem.startswith(("cmp", "str")):
                 imm = re.match(r"^#(-?\d+)$", operands[-1])
                 if re.match(r"^sub(s|w|\.w)?$", mnem) and imm and operands[1:2] in (["sp"], [operands[-1]]):
                     frame += int(imm.group(1))
@@ -376,10 +375,9 @@ def check_method(graph, frames):
     checked = 0
     for frame, qual, name in frames.values():
         if names.count(name) == 1 and len(seen.get(name, [])) == 1:
-            got, problems = seen[name][0]
-            if got != frame or problems:
-                raise AnalysisError("disassembly method: %s has %d B (%s), -fstack-usage %d B"
-                                    % (name, got, "; ".join(problems) or "no problem", frame))
+            got = seen[name][0][0]  # (a GCC switch's table branch is no problem here)
+            if got != frame:
+                raise AnalysisError("disassembly method: %s has %d B, -fstack-usage %d B" % (name, got, frame))
             checked += 1
     if checked < len(frames) // 2:
         raise AnalysisError("disassembly method checked on %d library functions only" % checked)
