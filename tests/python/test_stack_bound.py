@@ -96,9 +96,8 @@ def test_runtime_frames_are_the_sum_of_every_stack_decrement():
     assert bounds[0x1000][0] == 84 + 20 + 8 + 0
 
 
-@pytest.mark.parametrize("insn", [("blx", "r3"), ("bx", "r2"), ("mov", "sp, r7"), ("add", "sp, r3"), ("tbb", "[pc, r3]"),
-                                  ("ldr", "sp, [r0]"),
-                                  ("mov", "pc, r3")])
+@pytest.mark.parametrize("insn", [("blx", "r3"), ("bx", "r2"), ("mov", "sp, r7"), ("add", "sp, r3"),
+                                  ("tbb", "[pc, r3]"), ("ldr", "sp, [r0]"), ("mov", "pc, r3")])
 def test_an_indirect_branch_or_unbounded_stack_write_fails(insn):
     graph = sb.runtime_graph(funcs(r0=[("push", "{lr}"), insn, ("pop", "{pc}")]), {}, lambda a, n: [0] * n)
     with pytest.raises(sb.AnalysisError):
