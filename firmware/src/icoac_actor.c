@@ -126,7 +126,8 @@ static inline void mean_step(const icoac_actor_config_t *actor, const icoac_priv
 }
 
 /* sum += h h^T / sigma_L^2 (out of line: its frame is not nested in its callers') */
-ICOAC_PRIV_NOINLINE static void add_info(const icoac_actor_config_t *actor, const icoac_real_t h[N], icoac_real_t sum[N][N])
+ICOAC_PRIV_NOINLINE static void add_info(const icoac_actor_config_t *actor, const icoac_real_t h[N],
+                                         icoac_real_t sum[N][N])
 {
     const icoac_real_t inv_var = ICOAC_R(1.0) / likelihood_var(actor);
     int i;
