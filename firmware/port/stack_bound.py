@@ -523,9 +523,11 @@ def main(argv):
     if args.json:
         print(json.dumps({fn: b for fn, (b, _) in result.items()}, indent=1))
         return
-    method = ("runtime routines: prologues of a whole link's disassembly" if args.config.startswith("cortex")
-              else "glibc routines: %d B each, assumed" % HOST_RUNTIME_FRAME)
-    print("static stack bound, %s (%s)" % (args.config, method))
+    method = ("runtime routines and tail calls from the disassembly of a whole link (assumed: no loop in a "
+              "runtime routine decrements sp)" if args.config.startswith("cortex")
+              else "glibc routines %d B each: assumed, not measured" % HOST_RUNTIME_FRAME)
+    print("static stack bound, %s: GCC's frames (.su) and calls (.ci); %s; interrupts not included"
+          % (args.config, method))
     print("  runtime: " + ", ".join("%s %d" % kv for kv in sorted(runtime.items())))
     width = max(len(fn) for fn in result)
     for fn, (b, path) in result.items():
