@@ -5,7 +5,7 @@
 Builds a cross preset, runs the port example under QEMU with one instruction per translation
 block and every executed instruction logged with its function (-singlestep -d exec), and counts
 the instructions of each function inside each timed tick loop of the example (ico, rl,
-rl_literal, search), per tick. The counts are exact, not sampled. A C runtime function (memset,
+rl_literal, rl_batch, search), per tick. The counts are exact, not sampled. A C runtime function (memset,
 sqrtf, expf, a soft-float helper, ...) is counted as the library's when the library called it.
 The library's total per tick is what report.py measures with the SysTick, give or take the
 example's loop and the few instructions of each call.
@@ -26,7 +26,7 @@ sys.path.insert(0, os.path.join(ROOT, "tests", "target"))
 import target_check  # noqa: E402
 
 # The example's timed tick loops, in the order main_target.c runs them (each after its stub run).
-LOOPS = ("ico", "rl", "rl_literal", "search")
+LOOPS = ("ico", "rl", "rl_literal", "rl_batch", "search")
 # The example's own functions inside a timed loop (replay.c, main_target.c): not the library's.
 EXAMPLE = {"replay_run", "step_stub", "reset_stub", "port_tick_start", "port_tick_done", "port_ticks_begin",
            "port_ticks_end", "port_read_sp", "timer_now", "timer_elapsed", "stack_paint", "stack_keep_low",
@@ -84,7 +84,7 @@ def profile(preset):
             loops = list(loops_of(trace, library_functions(preset)))
         if qemu.wait(timeout=600) != 0:
             sys.exit(f"qemu exited with status {qemu.returncode}")
-    # ico, rl and rl_literal run once; the search's phases each run its loop again: add them up
+    # ico, rl, rl_literal and rl_batch run once; the search's phases each run its loop again: add them up
     out = {}
     for i, (counts, ticks) in enumerate(loops):
         name = LOOPS[min(i, len(LOOPS) - 1)]

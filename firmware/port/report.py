@@ -5,7 +5,8 @@
 Builds the cortex-m4f and cortex-m0plus presets, runs the port example under QEMU with
 -icount shift=0 (1 instruction = 1 ns of virtual time) and tabulates flash/RAM
 (arm-none-eabi-size), struct sizes, peak stack and instructions per tick (and, for the search
-learner, per update and per trial start).
+learner, per update and per trial start); and the stack table: the static bound of each public
+function (stack_bound.py) beside its painted peak.
 
   python3 firmware/port/report.py                      # print the table
   python3 firmware/port/report.py --update docs/porting.md   # rewrite the table between markers
@@ -19,9 +20,17 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "tests", "target"))
 import target_check  # noqa: E402
+import stack_bound  # noqa: E402  (firmware/port, on target_check's path)
 
 BEGIN, END = "<!-- target-report:begin -->", "<!-- target-report:end -->"
+STACK_BEGIN, STACK_END = "<!-- stack-report:begin -->", "<!-- stack-report:end -->"
 GOALS = {"cortex-m4f": 3000, "cortex-m0plus": 100000}
+DOC = os.path.join(ROOT, "docs", "porting.md")
+PRESETS = ("cortex-m4f", "cortex-m0plus")
+BUDGETS = {p: stack_bound.read_budget(DOC, p) for p in PRESETS}
+# the public functions of the stack table: the painted ones first (main_target.c, "M calls")
+STACK_FUNCTIONS = ("icoac_step", "icoac_init", "icoac_reset", "icoac_retune", "icoac_config_check",
+                   "icoac_get_posterior", "icoac_prior_check", "icoac_rng_normal")
 
 
 def search_batch():
@@ -91,7 +100,7 @@ def measure(preset):
     insn_per_count = int(cal["insns"]) / int(cal["systick"])
     meas = target_check.measurements(out)
     ticks = {}
-    for mode in ("ico", "rl", "rl_literal"):
+    for mode in ("ico", "rl", "rl_literal", "rl_batch"):
         kv = meas[mode]
         net = (kv["systick_total"] - kv["systick_base"]) * insn_per_count / kv["ticks"]
         worst = (kv["systick_max"] - kv["systick_base_max"]) * insn_per_count
@@ -116,8 +125,11 @@ def measure(preset):
         "elf": size_of(target_check.elf(preset)),
         "frame": step_frame(preset),
         "config": int(z["config"]), "state": int(z["state"]),
-        "ico": ticks["ico"], "rl": ticks["rl"], "rl_literal": ticks["rl_literal"], "search": search, "board": target_check.BOARDS[preset],
-        "recorded": sum(kv["ticks"] for kv in meas.values()),
+        "ico": ticks["ico"], "rl": ticks["rl"], "rl_literal": ticks["rl_literal"], "rl_batch": ticks["rl_batch"],
+        "search": search, "board": target_check.BOARDS[preset],
+        "painted": dict(target_check.painted_peaks(meas)), "calls": meas["calls"],
+        "static": {fn: b for fn, (b, _) in stack_bound.analyse(preset)[0].items()},
+        "recorded": sum(meas[m]["ticks"] for m in ("ico", "rl", "search")),  # the sequences in flash
         "insn_per_count": insn_per_count,
     }
 
@@ -144,17 +156,18 @@ def table(results):
     row("`sizeof(icoac_state_t)`", "", lambda r, k: "%d B" % r["state"])
     row("state + config", "<= 4096 B", lambda r, k: "%d B %s" % (r["config"] + r["state"],
         "ok" if r["config"] + r["state"] <= 4096 else "**over**"))
-    row("peak stack of a tick, ICO (painted)", "<= 512 B",
-        lambda r, k: "%d B %s" % (r["ico"][1], "ok" if r["ico"][1] <= 512 else "**over**"))
-    row("peak stack of a tick, RL (painted)", "<= 512 B",
-        lambda r, k: "%d B %s" % (r["rl"][1], "ok" if r["rl"][1] <= 512 else "**over**"))
-    row("peak stack of a tick, RL literal reading (painted)", "<= 512 B",
-        lambda r, k: "%d B %s" % (r["rl_literal"][1], "ok" if r["rl_literal"][1] <= 512 else "**over**"))
-    row("peak stack of a search tick (painted; update ticks excluded)", "<= 512 B",
-        lambda r, k: "%d B %s" % (r["search"]["stack"], "ok" if r["search"]["stack"] <= 512 else "**over**"))
-    row("peak stack of a search update tick (painted)", "<= 512 B",
-        lambda r, k: "%d B %s" % (r["search"]["stack_update"],
-                                  "ok" if r["search"]["stack_update"] <= 512 else "**over**"))
+    stack_goal = "; ".join("%s <= %d B" % ({"cortex-m4f": "M4F", "cortex-m0plus": "M0+"}[k], BUDGETS[k]) for k in p)
+
+    def stack_row(name, fn):
+        row(name, stack_goal, lambda r, k: "%d B %s" % (fn(r), "ok" if fn(r) <= BUDGETS[k] else "**over**"))
+
+    stack_row("peak stack of a tick, ICO (painted)", lambda r: r["ico"][1])
+    stack_row("peak stack of a tick, RL (painted)", lambda r: r["rl"][1])
+    stack_row("peak stack of a tick, RL literal reading (painted)", lambda r: r["rl_literal"][1])
+    stack_row("peak stack of a tick, RL batch (`actor.batch = 1`, posterior; painted)", lambda r: r["rl_batch"][1])
+    stack_row("peak stack of a search tick (painted; update ticks excluded)", lambda r: r["search"]["stack"])
+    stack_row("peak stack of a search update tick (painted)", lambda r: r["search"]["stack_update"])
+    stack_row("static stack bound, every public function (`stack_bound.py`)", lambda r: max(r["static"].values()))
     row("`icoac_step` own frame (`-fstack-usage`)", "",
         lambda r, k: "%d B" % r["frame"])
     row("instructions per ICO tick (mean of 400)", "", lambda r, k: "%.0f" % r["ico"][0])
@@ -162,6 +175,8 @@ def table(results):
         lambda r, k: "%.0f %s" % (r["rl"][0], "ok" if r["rl"][0] <= GOALS[k] else "**over goal**"))
     row("instructions per RL tick, literal reading (posterior actor; mean of 400)", "M4F <= 3,000; M0+ <= 100,000",
         lambda r, k: "%.0f %s" % (r["rl_literal"][0], "ok" if r["rl_literal"][0] <= GOALS[k] else "**over goal**"))
+    row("instructions per RL tick, batch (`actor.batch = 1`, posterior; mean of 400)", "",
+        lambda r, k: "%.0f" % r["rl_batch"][0])
     sr = first["search"]
     row("instructions per search tick (mean of the %d that do not close a batch)"
         % (sr["ticks"] - sr["updates"]), "", lambda r, k: "%.0f" % r["search"]["tick"])
@@ -177,16 +192,40 @@ def table(results):
     return "\n".join("| " + " | ".join(r) + " |" for r in rows) + "\n"
 
 
+def stack_table(results):
+    """Static bound vs painted peak per public function and core."""
+    p = list(results)
+    rows = [("public function",) + tuple("%s static / painted" % k for k in p), ("---",) * (len(p) + 1)]
+    for fn in STACK_FUNCTIONS:
+        cells = []
+        for k in p:
+            r = results[k]
+            painted = r["painted"].get(fn)
+            if fn == "icoac_step":
+                painted = max(v for name, v in r["painted"].items() if not name.startswith("icoac_"))
+            cells.append("%d B / %s" % (r["static"][fn], "%d B" % painted if painted is not None else "-"))
+        rows.append(("`%s`" % fn,) + tuple(cells))
+    rows.append(("every public function (largest)",) + tuple(
+        "%d B (`%s`)" % max((b, fn) for fn, b in results[k]["static"].items()) for k in p))
+    rows.append(("budget (table above)",) + tuple("%d B" % BUDGETS[k] for k in p))
+    return "\n".join("| " + " | ".join(r) + " |" for r in rows) + "\n"
+
+
+def replace_between(doc, begin, end, text):
+    a, b = doc.index(begin) + len(begin), doc.index(end)
+    return doc[:a] + "\n" + text + doc[b:]
+
+
 def main(argv):
-    results = {p: measure(p) for p in ("cortex-m4f", "cortex-m0plus")}
-    text = table(results)
+    results = {p: measure(p) for p in PRESETS}
+    text, stack = table(results), stack_table(results)
     if len(argv) > 2 and argv[1] == "--update":
         path = argv[2]
-        doc = open(path).read()
-        a, b = doc.index(BEGIN) + len(BEGIN), doc.index(END)
-        open(path, "w").write(doc[:a] + "\n" + text + doc[b:])
+        doc = replace_between(open(path).read(), BEGIN, END, text)
+        open(path, "w").write(replace_between(doc, STACK_BEGIN, STACK_END, stack))
         print("updated", path)
     print(text)
+    print(stack)
 
 
 if __name__ == "__main__":

@@ -125,8 +125,9 @@ static inline void mean_step(const icoac_actor_config_t *actor, const icoac_priv
     }
 }
 
-/* sum += h h^T / sigma_L^2 */
-static void add_info(const icoac_actor_config_t *actor, const icoac_real_t h[N], icoac_real_t sum[N][N])
+/* sum += h h^T / sigma_L^2 (out of line: its frame is not nested in its callers') */
+ICOAC_PRIV_NOINLINE static void add_info(const icoac_actor_config_t *actor, const icoac_real_t h[N],
+                                         icoac_real_t sum[N][N])
 {
     const icoac_real_t inv_var = ICOAC_R(1.0) / likelihood_var(actor);
     int i;
@@ -138,55 +139,42 @@ static void add_info(const icoac_actor_config_t *actor, const icoac_real_t h[N],
     }
 }
 
-/* The batch's closed form at a trial's end: with precision P = Sigma^-1 + sum h h^T / sigma_L^2,
- * mu' = mu + P^-1 sum h innovation / sigma_L^2, Sigma' = P^-1 (posterior; the mean reading keeps
- * Sigma); the gradient reading moves mu by beta / sigma_u^2 * sum delta eps h. The sums are the
- * state's plus this tick's observation (h_last, or NULL) and shift, staged by the caller. */
-ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
-                                          const icoac_real_t *h_last, const icoac_real_t shift[N],
-                                          icoac_real_t w[N], icoac_real_t cov[N][N])
+/* The steps of the batch's closed form, each out of line: no value of one is live across the
+ * factorizations, so batch_end's frame holds pointers only. */
+/* cov = Sigma (/ lambda_f on the posterior reading with forgetting) */
+ICOAC_PRIV_NOINLINE static void batch_prior(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                            icoac_real_t cov[N][N])
 {
-    icoac_real_t precision[N][N];
-    int i;
-    int j;
-    if (actor->update != ICOAC_ACTOR_POSTERIOR && actor->update != ICOAC_ACTOR_MEAN &&
-        actor->update != ICOAC_ACTOR_GRADIENT) {
-        return -2;
-    }
-    if (actor->update == ICOAC_ACTOR_GRADIENT) {
-        const icoac_real_t step = actor->rate / (actor->noise_std * actor->noise_std);
-        for (i = 0; i < N; ++i) {
-            w[i] = st->w[i] + step * shift[i];
-        }
-        return 0;
-    }
-    for (i = 0; i < N; ++i) {
-        for (j = 0; j < N; ++j) {
-            cov[i][j] = icoac_priv_cov_c(st)[i][j];
-        }
-    }
+    /* one loop over the N * N entries, not unrolled into a frame of spilled values */
+    icoac_real_t *const entry = &cov[0][0];
+    int k;
+    memcpy(cov, icoac_priv_cov_c(st), sizeof st->cov_buffer[0]);
     if (actor->update == ICOAC_ACTOR_POSTERIOR && actor->forgetting < ICOAC_R(1.0)) {
         const icoac_real_t inflate = ICOAC_R(1.0) / actor->forgetting;
-        for (i = 0; i < N; ++i) {
-            for (j = 0; j < N; ++j) {
-                cov[i][j] *= inflate;
-            }
+        for (k = 0; k < N * N; ++k) {
+            entry[k] *= inflate;
         }
     }
-    if (!icoac_priv_spd_inverse(ICOAC_PRIV_CONST_MAT(cov), precision, icoac_priv_inputs(&st->config))) {
-        return -1;
-    }
+}
+
+/* precision (Sigma^-1 in place) += the trial's information */
+ICOAC_PRIV_NOINLINE static void batch_precision(const icoac_priv_state_t *st, icoac_real_t precision[N][N])
+{
+    int i;
+    int j;
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
             precision[i][j] += st->batch.info[i][j];
         }
     }
-    if (h_last != 0) {
-        add_info(actor, h_last, precision);
-    }
-    if (!icoac_priv_spd_inverse(ICOAC_PRIV_CONST_MAT(precision), cov, icoac_priv_inputs(&st->config))) {
-        return -1;
-    }
+}
+
+/* w = mu + P^-1 shift; the posterior reading's return of batch_end, or 0 */
+ICOAC_PRIV_NOINLINE static int batch_mean(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                          const icoac_real_t shift[N], icoac_real_t w[N],
+                                          const icoac_real_t cov[N][N])
+{
+    int i;
     for (i = 0; i < N; ++i) {
         w[i] = st->w[i] + icoac_priv_dot(cov[i], shift);
     }
@@ -199,6 +187,42 @@ ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, cons
         }
     }
     return 1;
+}
+
+/* The batch's closed form at a trial's end: with precision P = Sigma^-1 + sum h h^T / sigma_L^2,
+ * mu' = mu + P^-1 sum h innovation / sigma_L^2, Sigma' = P^-1 (posterior; the mean reading keeps
+ * Sigma); the gradient reading moves mu by beta / sigma_u^2 * sum delta eps h. The sums are the
+ * state's plus this tick's observation (h_last, or NULL) and shift, staged by the caller. P is
+ * formed and inverted in cov (in place: no matrix in a frame). */
+ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, const icoac_priv_state_t *st,
+                                          const icoac_real_t *h_last, const icoac_real_t shift[N],
+                                          icoac_real_t w[N], icoac_real_t cov[N][N])
+{
+    const int n = icoac_priv_inputs(&st->config);
+    int i;
+    if (actor->update != ICOAC_ACTOR_POSTERIOR && actor->update != ICOAC_ACTOR_MEAN &&
+        actor->update != ICOAC_ACTOR_GRADIENT) {
+        return -2;
+    }
+    if (actor->update == ICOAC_ACTOR_GRADIENT) {
+        const icoac_real_t step = actor->rate / (actor->noise_std * actor->noise_std);
+        for (i = 0; i < N; ++i) {
+            w[i] = st->w[i] + step * shift[i];
+        }
+        return 0;
+    }
+    batch_prior(actor, st, cov);
+    if (!icoac_priv_spd_inverse(cov, n)) {
+        return -1;
+    }
+    batch_precision(st, cov);
+    if (h_last != 0) {
+        add_info(actor, h_last, cov); /* and this tick's observation */
+    }
+    if (!icoac_priv_spd_inverse(cov, n)) {
+        return -1;
+    }
+    return batch_mean(actor, st, shift, w, ICOAC_PRIV_CONST_MAT(cov));
 }
 
 /* The batch's shift after one more observation, and a value that is finite only when the

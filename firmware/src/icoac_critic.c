@@ -271,14 +271,27 @@ ICOAC_PRIV_NOINLINE static icoac_real_t value_general(const icoac_critic_config_
     return sparse_value(critic, v, s, list, shape.n, shape.units, shape.split, shape.rows, shape.cells);
 }
 
+/* The cart-pole's instance. Inline in the dispatch below where the call of the general instance
+ * is a tail call (the dispatch's frame is released first); out of line on ARMv6-M (Cortex-M0/M0+),
+ * whose calls into another section are never tail calls, so that the general instance's frame
+ * is not nested under this one's. */
+#if defined(__ARM_ARCH_6M__)
+ICOAC_PRIV_NOINLINE
+#endif
+static icoac_real_t value_cartpole(const icoac_critic_config_t *critic, const icoac_real_t *v,
+                                   const icoac_real_t s[ICOAC_MAX_INPUTS], icoac_priv_critic_list_t *list)
+{
+    static const int cartpole_units[ICOAC_CARTPOLE_INPUTS] = ICOAC_PRIV_CARTPOLE_UNITS;
+    return sparse_value(critic, v, s, list, ICOAC_CARTPOLE_INPUTS, cartpole_units, 2, ICOAC_PRIV_CARTPOLE_ROWS,
+                        ICOAC_PRIV_CARTPOLE_CELLS);
+}
+
 icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
                                             const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
                                             icoac_priv_critic_list_t *list)
 {
-    static const int cartpole_units[ICOAC_CARTPOLE_INPUTS] = ICOAC_PRIV_CARTPOLE_UNITS;
     if ((grid->shape & ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) != 0u) {
-        return sparse_value(critic, v, s, list, ICOAC_CARTPOLE_INPUTS, cartpole_units, 2, ICOAC_PRIV_CARTPOLE_ROWS,
-                            ICOAC_PRIV_CARTPOLE_CELLS);
+        return value_cartpole(critic, v, s, list);
     }
     return value_general(critic, grid, v, s, list);
 }

@@ -10,9 +10,13 @@ int icoac_priv_cholesky(const icoac_real_t m[N][N], icoac_real_t lower[N][N], in
     int i;
     int j;
     int k;
+    /* the entries the factor leaves 0; column j reads m's column j on and writes it, so lower
+     * may be m itself */
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
-            lower[i][j] = ICOAC_R(0.0);
+            if (j > i || i >= n) {
+                lower[i][j] = ICOAC_R(0.0);
+            }
         }
     }
     for (j = 0; j < n; ++j) {
@@ -35,48 +39,50 @@ int icoac_priv_cholesky(const icoac_real_t m[N][N], icoac_real_t lower[N][N], in
     return 1;
 }
 
-int icoac_priv_spd_inverse(const icoac_real_t m[N][N], icoac_real_t inverse[N][N], int n)
+/* m = m^-1 from its Cholesky factor, which m holds in its lower triangle; returns 1. Out of
+ * line: its frame and the factorization's come one after the other. */
+ICOAC_PRIV_NOINLINE static int inverse_from_factor(icoac_real_t m[N][N], int n)
 {
-    icoac_real_t lower[N][N];
     icoac_real_t column[N];
+    icoac_real_t diagonal[N]; /* of the inverse: m's holds the factor's until the last column */
     int i;
     int j;
     int k;
-    if (!icoac_priv_cholesky(m, lower, n)) {
-        return 0;
-    }
-    for (i = 0; i < N; ++i) {
-        for (j = 0; j < N; ++j) {
-            inverse[i][j] = ICOAC_R(0.0);
-        }
-    }
+    /* the inverse's upper triangle is written above the factor */
     for (k = 0; k < n; ++k) {
         /* L y = e_k, then L^T x = y: x is column k of the inverse */
         for (i = 0; i < n; ++i) {
             icoac_real_t sum = i == k ? ICOAC_R(1.0) : ICOAC_R(0.0);
             for (j = 0; j < i; ++j) {
-                sum -= lower[i][j] * column[j];
+                sum -= m[i][j] * column[j];
             }
-            column[i] = sum / lower[i][i];
+            column[i] = sum / m[i][i];
         }
         for (i = n - 1; i >= 0; --i) {
             icoac_real_t sum = column[i];
             for (j = i + 1; j < n; ++j) {
-                sum -= lower[j][i] * column[j];
+                sum -= m[j][i] * column[j];
             }
-            column[i] = sum / lower[i][i];
+            column[i] = sum / m[i][i];
         }
-        for (i = 0; i < n; ++i) {
-            inverse[i][k] = column[i];
+        for (i = 0; i < k; ++i) {
+            m[i][k] = column[i];
         }
+        diagonal[k] = column[k];
     }
     /* exactly symmetric */
     for (i = 0; i < n; ++i) {
+        m[i][i] = diagonal[i];
         for (j = i + 1; j < n; ++j) {
-            inverse[j][i] = inverse[i][j];
+            m[j][i] = m[i][j];
         }
     }
     return 1;
+}
+
+int icoac_priv_spd_inverse(icoac_real_t m[N][N], int n)
+{
+    return icoac_priv_cholesky(ICOAC_PRIV_CONST_MAT(m), m, n) && inverse_from_factor(m, n);
 }
 
 void icoac_priv_sample_lower(icoac_rng_t *rng, const icoac_real_t mean[N], const icoac_real_t lower[N][N],

@@ -83,8 +83,10 @@ static int state_ok(const icoac_priv_state_t *st)
     return 1;
 }
 
-icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const icoac_prior_t *prior,
-                          uint64_t seed)
+/* icoac_init but its icoac_reset: out of line, so that its frame (the staged prior) is released
+ * before the reset's. */
+ICOAC_PRIV_NOINLINE static icoac_status_t init_state(const icoac_config_t *cfg, icoac_state_t *state,
+                                                     const icoac_prior_t *prior, uint64_t seed)
 {
     icoac_priv_state_t *st = icoac_priv_state(state);
     icoac_status_t status;
@@ -128,7 +130,14 @@ icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const
     st->weight_norm = ICOAC_PRIV_SQRT(icoac_priv_dot(st->w, st->w));
     icoac_rng_seed(&st->rng, seed, 0x1C0ACu);
     st->magic = ICOAC_PRIV_STATE_MAGIC;
-    return icoac_reset(state);
+    return ICOAC_OK;
+}
+
+icoac_status_t icoac_init(const icoac_config_t *cfg, icoac_state_t *state, const icoac_prior_t *prior,
+                          uint64_t seed)
+{
+    const icoac_status_t status = init_state(cfg, state, prior, seed);
+    return status != ICOAC_OK ? status : icoac_reset(state);
 }
 
 icoac_status_t icoac_retune(icoac_state_t *state, const icoac_config_t *cfg)

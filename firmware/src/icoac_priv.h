@@ -541,12 +541,13 @@ void icoac_priv_search_floors(const icoac_search_config_t *search, icoac_priv_se
 
 /* Gaussian helpers (icoac_gauss.c), on the leading n x n block (n in [1, ICOAC_MAX_INPUTS]);
  * the entries of the outputs past n are 0. */
-/* m = L L^T; returns 0 when m is not positive definite. */
+/* m = L L^T (lower may be m: factored in place); returns 0 when m is not positive definite,
+ * lower then unspecified. */
 int icoac_priv_cholesky(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS],
                         icoac_real_t lower[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS], int n);
-/* inverse = m^-1 (exactly symmetric) through the Cholesky factor; 0 when m is not PD. */
-int icoac_priv_spd_inverse(const icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS],
-                           icoac_real_t inverse[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS], int n);
+/* m = m^-1 in place (exactly symmetric) through the Cholesky factor; 0 when m is not PD, m
+ * then unspecified. */
+int icoac_priv_spd_inverse(icoac_real_t m[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS], int n);
 /* sample = mean + L z, z n standard normals drawn from rng. */
 void icoac_priv_sample_lower(icoac_rng_t *rng, const icoac_real_t mean[ICOAC_MAX_INPUTS],
                              const icoac_real_t lower[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS],

@@ -30,10 +30,9 @@ static int scaled_prior(const icoac_search_config_t *search, const icoac_real_t 
 
 int icoac_priv_search_prior_ok(const icoac_search_config_t *search, const icoac_real_t cov[N][N], int n)
 {
-    icoac_real_t sigma0[N][N];
+    icoac_real_t sigma0[N][N]; /* factored in place */
     icoac_real_t floor[N];
-    icoac_real_t lower[N][N];
-    return scaled_prior(search, cov, sigma0, floor, lower, n);
+    return scaled_prior(search, cov, sigma0, floor, sigma0, n);
 }
 
 void icoac_priv_search_init(const icoac_search_config_t *search, icoac_priv_state_t *st)

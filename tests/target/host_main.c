@@ -16,6 +16,7 @@ int main(void)
     replay_controller_t ctrl;
     if (replay_run(&ctrl, ICOAC_MODE_ICO, icoac_step, 1) == 0u ||
         replay_run(&ctrl, ICOAC_MODE_RL, icoac_step, 1) == 0u ||
+        replay_run(&ctrl, REPLAY_RL_BATCH, icoac_step, 1) == 0u ||
         replay_run(&ctrl, ICOAC_MODE_SEARCH, icoac_step, 1) == 0u) {
         return 1;
     }

@@ -248,6 +248,80 @@ static int measure(replay_controller_t *ctrl, int32_t mode, const char *name, ui
     return n == 0u;
 }
 
+/* For one call: paint every word below sp (the caller's own stack pointer) and, after the call,
+ * the bytes below sp it wrote. Macros, so that no frame of their own lies below sp. */
+#define PAINT_BELOW(sp)                                                                            \
+    do {                                                                                           \
+        volatile uint32_t *p_ = __stack_bottom;                                                    \
+        while ((uintptr_t)p_ < (sp)) {                                                             \
+            *p_++ = STACK_PAINT;                                                                   \
+        }                                                                                          \
+    } while (0)
+#define WRITTEN_BELOW(sp, bytes)                                                                   \
+    do {                                                                                           \
+        const volatile uint32_t *p_ = __stack_bottom;                                              \
+        while (*p_ == STACK_PAINT && (uintptr_t)p_ < (sp)) {                                       \
+            ++p_;                                                                                  \
+        }                                                                                          \
+        (bytes) = (uint32_t)((sp) - (uintptr_t)p_);                                                \
+    } while (0)
+
+static void keep_max(uint32_t *peak, uint32_t v)
+{
+    if (v > *peak) {
+        *peak = v;
+    }
+}
+
+/* The public calls but icoac_step (the tick loops measure it), painted one at a time, in the
+ * configuration of each replay (icoac_init without and with a prior). Line "M calls <fn>=<peak
+ * bytes below the caller's sp> ...", the largest over the configurations. */
+static int measure_calls(replay_controller_t *ctrl)
+{
+    static const int32_t modes[] = {ICOAC_MODE_ICO, ICOAC_MODE_RL, REPLAY_RL_LITERAL, REPLAY_RL_BATCH,
+                                    ICOAC_MODE_SEARCH};
+    static icoac_prior_t prior; /* out of the frame: the caller's data, not the call's stack */
+    uint32_t check = 0u, init = 0u, init_prior = 0u, reset = 0u, retune = 0u, posterior = 0u, bytes;
+    const uintptr_t sp = port_read_sp();
+    int bad = 0;
+    uint32_t m;
+    for (m = 0u; m < sizeof modes / sizeof modes[0]; ++m) {
+        replay_config(&ctrl->cfg, modes[m]);
+        PAINT_BELOW(sp);
+        bad |= icoac_config_check(&ctrl->cfg) != ICOAC_OK;
+        WRITTEN_BELOW(sp, bytes);
+        keep_max(&check, bytes);
+        PAINT_BELOW(sp);
+        bad |= icoac_init(&ctrl->cfg, &ctrl->state, NULL, 1u) != ICOAC_OK;
+        WRITTEN_BELOW(sp, bytes);
+        keep_max(&init, bytes);
+        PAINT_BELOW(sp);
+        bad |= icoac_get_posterior(&ctrl->state, &prior) != ICOAC_OK;
+        WRITTEN_BELOW(sp, bytes);
+        keep_max(&posterior, bytes);
+        PAINT_BELOW(sp);
+        bad |= icoac_init(&ctrl->cfg, &ctrl->state, &prior, 2u) != ICOAC_OK;
+        WRITTEN_BELOW(sp, bytes);
+        keep_max(&init_prior, bytes);
+        PAINT_BELOW(sp);
+        bad |= icoac_reset(&ctrl->state) != ICOAC_OK;
+        WRITTEN_BELOW(sp, bytes);
+        keep_max(&reset, bytes);
+        PAINT_BELOW(sp);
+        bad |= icoac_retune(&ctrl->state, &ctrl->cfg) != ICOAC_OK;
+        WRITTEN_BELOW(sp, bytes);
+        keep_max(&retune, bytes);
+    }
+    port_puts("M calls");
+    put_kv("icoac_config_check", check);
+    put_kv("icoac_init", init > init_prior ? init : init_prior);
+    put_kv("icoac_reset", reset);
+    put_kv("icoac_retune", retune);
+    put_kv("icoac_get_posterior", posterior);
+    port_puts("\n");
+    return bad;
+}
+
 int main(void)
 {
     /* In main's frame, above the tick loop's: the painted stack measures the tick alone. */
@@ -272,11 +346,13 @@ int main(void)
     count_insns = (200000u + (c2 - c1) / 2u) / (c2 - c1); /* instructions per count, rounded */
     if (measure(&ctrl, ICOAC_MODE_ICO, "ico", count_insns) || measure(&ctrl, ICOAC_MODE_RL, "rl", count_insns) ||
         measure(&ctrl, REPLAY_RL_LITERAL, "rl_literal", count_insns) ||
-        measure(&ctrl, ICOAC_MODE_SEARCH, "search", count_insns)) {
+        measure(&ctrl, REPLAY_RL_BATCH, "rl_batch", count_insns) ||
+        measure(&ctrl, ICOAC_MODE_SEARCH, "search", count_insns) || measure_calls(&ctrl)) {
         return 1;
     }
     if (replay_run(&ctrl, ICOAC_MODE_ICO, icoac_step, 1) == 0u ||
         replay_run(&ctrl, ICOAC_MODE_RL, icoac_step, 1) == 0u ||
+        replay_run(&ctrl, REPLAY_RL_BATCH, icoac_step, 1) == 0u ||
         replay_run(&ctrl, ICOAC_MODE_SEARCH, icoac_step, 1) == 0u) {
         return 1;
     }

@@ -121,6 +121,21 @@ static void print_posterior(const icoac_state_t *state)
     }
 }
 
+void replay_config(icoac_config_t *cfg, int32_t mode)
+{
+    icoac_config_default(cfg);
+    cfg->mode = mode == REPLAY_RL_LITERAL || mode == REPLAY_RL_BATCH ? ICOAC_MODE_RL : mode;
+    if (mode == REPLAY_RL_LITERAL) {
+        cfg->actor.update = ICOAC_ACTOR_POSTERIOR;
+        cfg->actor.explore_ticks = 0;
+        cfg->actor.batch = 0;
+    } else if (mode == REPLAY_RL_BATCH) {
+        cfg->actor.update = ICOAC_ACTOR_POSTERIOR;
+        cfg->actor.batch = 1;
+    }
+    cfg->search.batch = REPLAY_SEARCH_BATCH; /* as gen_inputs.c; search mode only */
+}
+
 uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step, int verbose)
 {
     const replay_tick_t *seq;
@@ -138,25 +153,18 @@ uint32_t replay_run(replay_controller_t *ctrl, int32_t mode, replay_step_fn step
         n = REPLAY_SEARCH_N;
         seed = REPLAY_SEARCH_SEED;
         section = "S search\n";
-    } else if (mode == ICOAC_MODE_RL || mode == REPLAY_RL_LITERAL) {
+    } else if (mode == ICOAC_MODE_RL || mode == REPLAY_RL_LITERAL || mode == REPLAY_RL_BATCH) {
         seq = replay_rl;
         n = REPLAY_RL_N;
         seed = REPLAY_RL_SEED;
-        section = mode == REPLAY_RL_LITERAL ? "S rl_literal\n" : "S rl\n";
+        section = mode == REPLAY_RL_LITERAL ? "S rl_literal\n" : (mode == REPLAY_RL_BATCH ? "S rl_batch\n" : "S rl\n");
     } else {
         seq = replay_ico;
         n = REPLAY_ICO_N;
         seed = REPLAY_ICO_SEED;
         section = "S ico\n";
     }
-    icoac_config_default(&ctrl->cfg);
-    ctrl->cfg.mode = mode == REPLAY_RL_LITERAL ? ICOAC_MODE_RL : mode;
-    if (mode == REPLAY_RL_LITERAL) {
-        ctrl->cfg.actor.update = ICOAC_ACTOR_POSTERIOR;
-        ctrl->cfg.actor.explore_ticks = 0;
-        ctrl->cfg.actor.batch = 0;
-    }
-    ctrl->cfg.search.batch = REPLAY_SEARCH_BATCH; /* as gen_inputs.c; search mode only */
+    replay_config(&ctrl->cfg, mode);
     if (icoac_config_check(&ctrl->cfg) != ICOAC_OK ||
         icoac_init(&ctrl->cfg, &ctrl->state, NULL, seed) != ICOAC_OK) {
         port_puts("E init\n");

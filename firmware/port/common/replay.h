@@ -47,8 +47,15 @@ typedef struct {
 /* Not a controller mode: the RL sequence with the paper's literal actor reading (posterior
  * update, exploration always on, per tick), whatever the defaults are. */
 #define REPLAY_RL_LITERAL 0x100
+/* Not a controller mode either: the RL sequence with the batch granularity (actor.batch = 1,
+ * posterior reading): the closed form at each trial's end, the deepest path of a tick. */
+#define REPLAY_RL_BATCH 0x101
 
-/* Run sequence mode (ICOAC_MODE_ICO / ICOAC_MODE_RL / ICOAC_MODE_SEARCH / REPLAY_RL_LITERAL)
+/* The configuration replay_run uses for mode (ICOAC_MODE_*, REPLAY_RL_LITERAL, REPLAY_RL_BATCH). */
+void replay_config(icoac_config_t *cfg, int32_t mode);
+
+/* Run sequence mode (ICOAC_MODE_ICO / ICOAC_MODE_RL / ICOAC_MODE_SEARCH / REPLAY_RL_LITERAL /
+ * REPLAY_RL_BATCH)
  * with step on ctrl (re-initialised; default configuration but search.batch =
  * REPLAY_SEARCH_BATCH); print each tick and then the posterior when verbose. Returns the
  * number of ticks, or 0 on an init error. */
