@@ -84,7 +84,7 @@ static long double distance2(const grid_t *g, const icoac_real_t *s_in, int i, i
  * double, so far-out states do not turn into 0/0; the shifts cancel in the ratio. */
 static void direct_b(const grid_t *g, const icoac_real_t *s_in, double *b)
 {
-    static long double logs[1024];
+    static long double logs[KMAX];
     long double top = -1e300L, total = 0;
     const int units = units_of(g);
     int k, i;
@@ -218,7 +218,7 @@ static void test_grid_centres(void)
 static void test_separable_equals_direct(void)
 {
     test_rng_t rng = {0xC0FFEEu};
-    static double bl[KMAX], bd[1024];
+    static double bl[KMAX], bd[KMAX];
     int gi, n, k;
     for (gi = 0; gi < N_GRIDS; ++gi) {
         const grid_t *g = &grids[gi];
@@ -262,7 +262,7 @@ static void check_value(const grid_t *g, icoac_real_t threshold, unsigned seed, 
     const int units = units_of(g);
     icoac_real_t v[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t active;
-    static double bd[1024];
+    static double bd[KMAX];
     int n, k;
     cfg.critic.threshold = threshold;
     for (n = 0; n < STATES / 2; ++n) {
@@ -295,7 +295,7 @@ static void test_value_is_weighted_sum(void)
 static void test_threshold_drops_small_activations(void)
 {
     test_rng_t rng = {8u};
-    static double bl[KMAX], bd[1024];
+    static double bl[KMAX], bd[KMAX];
     int gi, n, k, dropped = 0, kept = 0;
     for (gi = 0; gi < N_GRIDS; ++gi) {
         const grid_t *g = &grids[gi];
@@ -330,8 +330,8 @@ static void test_kept_unit_list(void)
     test_rng_t rng = {12u};
     icoac_real_t v[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t active;
-    static double bd[1024];
-    static int listed[1024];
+    static double bd[KMAX];
+    static int listed[KMAX];
     int gi, n, i, r, total_kept = 0, total_units = 0, all_kept_grids = 0;
     memset(v, 0, sizeof v);
     for (gi = 0; gi < N_GRIDS; ++gi) {
@@ -408,7 +408,7 @@ static void test_dense_matches_sparse(void)
     test_rng_t rng = {0xD15Eu};
     icoac_real_t v_sparse[KMAX], v_dense[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t sparse, dense;
-    static double bd[1024];
+    static double bd[KMAX];
     double max_rel = 0;
     int gi, t, n, k;
     for (gi = 0; gi < N_GRIDS; ++gi) {
