@@ -211,7 +211,8 @@ static void test_grid_centres(void)
     }
 }
 
-/* States per grid and kernel: fewer on an emulated core (QEMU is slow). */
+/* Random states per grid (and kernel, in test_separable_equals_direct): fewer on an emulated core
+ * (QEMU is slow). */
 #define STATES TEST_ITERATIONS(200, 40)
 
 /* Every kernel on every grid equals the n-D definition, with threshold 0 (every unit). */
@@ -301,10 +302,10 @@ static void test_threshold_drops_small_activations(void)
         const grid_t *g = &grids[gi];
         const icoac_config_t cfg = grid_config(g);
         TEST_ASSERT_TRUE(cfg.critic.threshold == (icoac_real_t)0.001); /* the authors' cut-off is the default */
-        for (n = 0; n < 2 * 100; ++n) {
+        for (n = 0; n < STATES; ++n) {
             icoac_real_t s[ICOAC_MAX_INPUTS];
-            random_state(g, &rng, n % 100 >= 75, s);
-            library_b(n / 100, &cfg, s, bl);
+            random_state(g, &rng, n % (STATES / 2) >= STATES * 3 / 8, s);
+            library_b(n / (STATES / 2), &cfg, s, bl);
             direct_b(g, s, bd);
             for (k = 0; k < units_of(g); ++k) {
                 if (near_threshold(bd[k], 0.001)) {
@@ -339,7 +340,7 @@ static void test_kept_unit_list(void)
         icoac_config_t cfg = grid_config(g);
         const icoac_priv_critic_list_t *list = &active.sparse;
         const int units = units_of(g);
-        for (n = 0; n < 200; ++n) {
+        for (n = 0; n < STATES; ++n) {
             random_state(g, &rng, n % 3 == 2, s);
             (void)kernel_value(SPARSE, &cfg, v, s, &active);
             direct_b(g, s, bd);
