@@ -11,7 +11,8 @@ APT_PACKAGES := cmake ninja-build gcc libc6-dev python3 python3-venv git \
   clang libclang-rt-14-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # Unity (the C test framework): empty, CMake fetches v2.6.1 from GitHub; else a local copy of that
-# release (offline builds), given to every host configure as FETCHCONTENT_SOURCE_DIR_UNITY.
+# release (offline builds), given to the configures that build the C tests (release, debug-asan;
+# the fuzz preset builds none) as FETCHCONTENT_SOURCE_DIR_UNITY.
 UNITY_DIR ?=
 CMAKE_UNITY = $(if $(UNITY_DIR),-DFETCHCONTENT_SOURCE_DIR_UNITY=$(abspath $(UNITY_DIR)))
 BENCH_PROFILE ?= default
@@ -95,7 +96,7 @@ test-python: build venv
 	$(VPY) -m pytest -q tests/python $(PYTEST_ARGS)
 
 build-fuzz: deps
-	cmake --preset fuzz $(CMAKE_UNITY) >/dev/null
+	cmake --preset fuzz >/dev/null
 	cmake --build --preset fuzz
 
 # Each fuzz target over its committed corpus, then a short fuzzing run (tests/fuzz).
