@@ -6,10 +6,15 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 VPY := $(VENV)/bin/python
-APT_PACKAGES := cmake ninja-build gcc libc6-dev libcmocka-dev python3 python3-venv git \
+APT_PACKAGES := cmake ninja-build gcc libc6-dev python3 python3-venv git \
   gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm binutils-arm-none-eabi \
   clang libclang-rt-14-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+# Unity (the C test framework): empty, CMake fetches v2.6.1 from GitHub; else a local copy of that
+# release (offline builds), given to the configures that build the C tests (release, debug-asan;
+# the fuzz preset builds none) as FETCHCONTENT_SOURCE_DIR_UNITY.
+UNITY_DIR ?=
+CMAKE_UNITY = $(if $(UNITY_DIR),-DFETCHCONTENT_SOURCE_DIR_UNITY=$(abspath $(UNITY_DIR)))
 BENCH_PROFILE ?= default
 # The default profile writes results/bench and docs/figures; any other profile its own directories
 # (results/paper, docs/figures/paper), so the profiles never overwrite each other.
@@ -71,7 +76,7 @@ $(VENV)/.installed: pyproject.toml | deps
 	@touch $@
 
 build: deps
-	cmake --preset release >/dev/null
+	cmake --preset release $(CMAKE_UNITY) >/dev/null
 	cmake --build --preset release
 
 # The library-only release archive build/release/dist/icoac-<version>.tar.gz (docs/porting.md).
@@ -80,7 +85,7 @@ dist: deps
 	cmake --build --preset release --target icoac_dist
 
 build-asan: deps
-	cmake --preset debug-asan >/dev/null
+	cmake --preset debug-asan $(CMAKE_UNITY) >/dev/null
 	cmake --build --preset debug-asan
 
 test-asan: build-asan

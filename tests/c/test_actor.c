@@ -99,7 +99,7 @@ static icoac_state_t rl_state(icoac_config_t *cfg)
     *cfg = test_default_config();
     cfg->mode = ICOAC_MODE_RL;
     test_literal_reading(cfg);
-    assert_int_equal(icoac_init(cfg, &state, NULL, 1u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(cfg, &state, NULL, 1u));
     return state;
 }
 
@@ -141,17 +141,16 @@ static void compare_with_closed_form(const icoac_config_t *cfg, test_rng_t *rng,
         assert_close(mean_of(&state)[i], post.mean[i], tol * (1.0 + fabs(innovation)));
         for (j = 0; j < N; ++j) {
             assert_close(cov_of(&state)[i][j], post.cov[i][j], tol);
-            assert_true(cov_of(&state)[i][j] == cov_of(&state)[j][i]);
+            TEST_ASSERT_TRUE(cov_of(&state)[i][j] == cov_of(&state)[j][i]);
         }
     }
 }
 
-static void test_update_matches_closed_form(void **unused)
+static void test_update_matches_closed_form(void)
 {
     icoac_config_t cfg;
     test_rng_t rng = {0xACu};
     int n;
-    (void)unused;
     (void)rl_state(&cfg);
     for (n = 0; n < 400; ++n) {
         /* 0: sigma_L = sigma_u */
@@ -163,7 +162,7 @@ static void test_update_matches_closed_form(void **unused)
     }
 }
 
-static void test_zero_innovation_keeps_mean(void **unused)
+static void test_zero_innovation_keeps_mean(void)
 {
     icoac_config_t cfg;
     icoac_state_t state = rl_state(&cfg);
@@ -172,18 +171,17 @@ static void test_zero_innovation_keeps_mean(void **unused)
     icoac_real_t h[M] = {(icoac_real_t)3.0, (icoac_real_t)-7.0, (icoac_real_t)10.0, (icoac_real_t)0.5};
     icoac_real_t mean_before[M] = {0};
     double trace_before;
-    (void)unused;
     random_gauss(&rng, 1.0, &prior);
     load_state(&state, &prior);
     memcpy(mean_before, mean_of(&state), sizeof mean_before);
     trace_before = (double)icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov_of(&state)));
     actor_update_in_place(&cfg, &state, h, (icoac_real_t)0.0);
-    assert_memory_equal(mean_of(&state), mean_before, sizeof mean_before);
+    TEST_ASSERT_EQUAL_MEMORY(mean_before, mean_of(&state), sizeof mean_before);
     /* the covariance still shrinks */
-    assert_true((double)icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov_of(&state))) < trace_before);
+    TEST_ASSERT_TRUE((double)icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov_of(&state))) < trace_before);
 }
 
-static void test_forgetting_inflates_first(void **unused)
+static void test_forgetting_inflates_first(void)
 {
     icoac_config_t cfg;
     icoac_state_t state = rl_state(&cfg);
@@ -193,7 +191,6 @@ static void test_forgetting_inflates_first(void **unused)
     double hd[N];
     const double lambda = 0.9;
     int i, j;
-    (void)unused;
     cfg.actor.forgetting = (icoac_real_t)lambda;
     random_gauss(&rng, 0.5, &prior);
     load_state(&state, &prior);
@@ -220,7 +217,7 @@ static void test_forgetting_inflates_first(void **unused)
     memset(h, 0, sizeof h);
     actor_update_in_place(&cfg, &state, h, (icoac_real_t)0.3);
     for (i = 0; i < N; ++i) {
-        assert_true(mean_of(&state)[i] == (icoac_real_t)prior.mean[i]);
+        TEST_ASSERT_TRUE(mean_of(&state)[i] == (icoac_real_t)prior.mean[i]);
         for (j = 0; j < N; ++j) {
             assert_close(cov_of(&state)[i][j], prior.cov[i][j] / lambda,
                          4.0 * REAL_EPS * (1.0 + fabs(prior.cov[i][j])));
@@ -231,11 +228,10 @@ static void test_forgetting_inflates_first(void **unused)
 /* The RL tick stages the update: it reads (mu_w, Sigma_w) from the state and writes the
  * candidate to a local w and the spare covariance buffer, leaving the state's own posterior
  * as it was. The staged result is bitwise the in-place one, with and without forgetting. */
-static void test_update_staged_into_spare(void **unused)
+static void test_update_staged_into_spare(void)
 {
     test_rng_t rng = {0x57A6Eu};
     int n, i;
-    (void)unused;
     for (n = 0; n < 200; ++n) {
         icoac_config_t cfg;
         icoac_state_t state = rl_state(&cfg);
@@ -258,13 +254,13 @@ static void test_update_staged_into_spare(void **unused)
         icoac_priv_actor_posterior(&cfg.actor, st, h, innovation, w, st->cov_buffer[spare]);
         actor_update_in_place(&cfg, &in_place, h, innovation);
         /* the state's posterior and slot are untouched ... */
-        assert_int_equal(st->cov_slot, icoac_priv_state_c(&before)->cov_slot);
-        assert_memory_equal(st->w, icoac_priv_state_c(&before)->w, sizeof st->w);
-        assert_memory_equal(icoac_priv_cov_c(st), icoac_priv_cov_c(icoac_priv_state_c(&before)),
-                            sizeof(icoac_real_t) * N * N);
+        TEST_ASSERT_EQUAL_INT(icoac_priv_state_c(&before)->cov_slot, st->cov_slot);
+        TEST_ASSERT_EQUAL_MEMORY(icoac_priv_state_c(&before)->w, st->w, sizeof st->w);
+        TEST_ASSERT_EQUAL_MEMORY(icoac_priv_cov_c(icoac_priv_state_c(&before)), icoac_priv_cov_c(st),
+                                 sizeof(icoac_real_t) * N * N);
         /* ... and the staged candidate is the in-place result */
-        assert_memory_equal(w, mean_of(&in_place), sizeof w);
-        assert_memory_equal(st->cov_buffer[spare], cov_of(&in_place), sizeof(icoac_real_t) * N * N);
+        TEST_ASSERT_EQUAL_MEMORY(mean_of(&in_place), w, sizeof w);
+        TEST_ASSERT_EQUAL_MEMORY(cov_of(&in_place), st->cov_buffer[spare], sizeof(icoac_real_t) * N * N);
     }
 }
 
@@ -295,24 +291,24 @@ static void run_long(double forgetting, int n_updates)
         for (i = 0; i < N; ++i) {
             for (j = 0; j < N; ++j) {
                 if (cov_of(&state)[i][j] != cov_of(&state)[j][i]) {
-                    print_error("update %d: cov not symmetric at (%d, %d)\n", n, i, j);
-                    fail();
+                    TEST_PRINTF("update %d: cov not symmetric at (%d, %d)", n, i, j);
+                    TEST_FAIL();
                 }
                 info[i][j] = forgetting * info[i][j] + (double)h[i] * (double)h[j] / test_likelihood_var(&cfg.actor);
             }
         }
         if (!icoac_priv_cholesky(ICOAC_PRIV_CONST_MAT(cov_of(&state)), lower, ICOAC_CARTPOLE_INPUTS)) {
-            print_error("update %d: cov not positive definite\n", n);
-            fail();
+            TEST_PRINTF("update %d: cov not positive definite", n);
+            TEST_FAIL();
         }
         if (forgetting == 1.0) {
             /* without forgetting Sigma never grows (up to rounding) */
-            assert_true((double)icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov_of(&state))) <=
-                        prev_trace * (1.0 + 64.0 * REAL_EPS));
+            TEST_ASSERT_TRUE((double)icoac_priv_trace(ICOAC_PRIV_CONST_MAT(cov_of(&state))) <=
+                             prev_trace * (1.0 + 64.0 * REAL_EPS));
         }
     }
     for (i = 0; i < N; ++i) {
-        assert_true(isfinite(mean_of(&state)[i]));
+        TEST_ASSERT_TRUE(isfinite(mean_of(&state)[i]));
     }
     /* Sigma * info should be I: check the trace and the largest off-diagonal. */
     {
@@ -336,27 +332,24 @@ static void run_long(double forgetting, int n_updates)
     }
 }
 
-static void test_long_run_symmetric_pd(void **unused)
+static void test_long_run_symmetric_pd(void)
 {
-    (void)unused;
-    run_long(1.0, 1000000);
+    run_long(1.0, TEST_ITERATIONS(1000000, 20000)); /* fewer updates on an emulated core (QEMU is slow) */
 }
 
-static void test_long_run_with_forgetting(void **unused)
+static void test_long_run_with_forgetting(void)
 {
-    (void)unused;
-    run_long(0.999, 100000);
+    run_long(0.999, TEST_ITERATIONS(100000, 10000)); /* fewer updates on an emulated core (QEMU is slow) */
 }
 
 /* Eq. 7-8 through icoac_step with the posterior reading: u_ob - h^T mu = alpha * delta * eps,
  * h = G x~(s_t), likelihood variance sigma_L^2; likelihood_std 0 (the default) takes sigma_L =
  * sigma_u (the literal reading), for sigma_u = 1 and for another sigma_u, and an explicit
  * sigma_L != sigma_u is used as given. */
-static void test_step_wiring(void **unused)
+static void test_step_wiring(void)
 {
     static const double cases[][2] = {{1.0, 0.0}, {0.5, 0.0}, {2.0, 0.0}, {0.5, 2.0}}; /* sigma_u, likelihood_std */
     size_t c;
-    (void)unused;
     for (c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
@@ -373,10 +366,10 @@ static void test_step_wiring(void **unused)
         test_literal_reading(&cfg);
         cfg.actor.noise_std = (icoac_real_t)cases[c][0];
         cfg.actor.likelihood_std = (icoac_real_t)cases[c][1];
-        assert_int_equal(icoac_config_check(&cfg), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&cfg));
         r = cases[c][1] != 0.0 ? cases[c][1] * cases[c][1] : cases[c][0] * cases[c][0];
         p.cov[0][2] = p.cov[2][0] = (icoac_real_t)0.1;
-        assert_int_equal(icoac_init(&cfg, &state, &p, 2024u), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, &p, 2024u));
         for (i = 0; i < N; ++i) {
             prior.mean[i] = (double)p.mean[i];
             for (j = 0; j < N; ++j) {
@@ -385,19 +378,19 @@ static void test_step_wiring(void **unused)
             hd[i] = 10.0 * test_scale(i, (double)s1.s[i], 1);
             z += prior.mean[i] * test_scale(i, (double)s1.s[i], 1);
         }
-        assert_int_equal(icoac_step(&state, &s1, &out), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &s1, &out));
         eps = (double)out.noise;
-        assert_true(eps != 0.0);
+        TEST_ASSERT_TRUE(eps != 0.0);
         assert_close(out.z, z, 1e-5);
         assert_close(out.force, 10.0 * z + eps, 1e-4); /* no reflex at s1 */
         slot = icoac_priv_state_c(&state)->cov_slot;
-        assert_int_equal(icoac_step(&state, &s2, &out), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &s2, &out));
         assert_close(out.td_error, -1.0, 0.0);
         /* the learning tick committed the staged covariance by flipping the slot */
-        assert_int_equal(icoac_priv_state_c(&state)->cov_slot, slot ^ 1);
-        assert_int_equal(icoac_get_posterior(&state, &posterior), ICOAC_OK);
-        assert_memory_equal(posterior.cov, cov_of(&state), sizeof posterior.cov);
-        assert_memory_equal(posterior.mean, mean_of(&state), sizeof posterior.mean);
+        TEST_ASSERT_EQUAL_INT(slot ^ 1, icoac_priv_state_c(&state)->cov_slot);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(&state, &posterior));
+        TEST_ASSERT_EQUAL_MEMORY(cov_of(&state), posterior.cov, sizeof posterior.cov);
+        TEST_ASSERT_EQUAL_MEMORY(mean_of(&state), posterior.mean, sizeof posterior.mean);
         closed_form(&prior, hd, 0.5 * -1.0 * eps, r, &post);
         for (i = 0; i < N; ++i) {
             assert_close(mean_of(&state)[i], post.mean[i], REAL_IS_FLOAT ? 1e-5 : 1e-12);
@@ -412,14 +405,14 @@ static void test_step_wiring(void **unused)
         for (i = 0; i < N; ++i) {
             diff += fabs(other.cov[i][i] - post.cov[i][i]);
         }
-        assert_true(r == 1.0 ? diff == 0.0 : diff > 1e-3);
+        TEST_ASSERT_TRUE(r == 1.0 ? diff == 0.0 : diff > 1e-3);
     }
 }
 
 
 /* act_with_sample: at each reset the acting weights are mu + L n, L L^T = Sigma, n ~ N(0, I)
  * drawn from the controller's generator (method.md, Bayesian actor: acting with a sample). */
-static void test_posterior_sample_per_trial(void **unused)
+static void test_posterior_sample_per_trial(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
@@ -427,7 +420,6 @@ static void test_posterior_sample_per_trial(void **unused)
     icoac_prior_t p = test_prior(0.1, -0.2, 0.3, 0.05, 0.0);
     double cov[N][N], lower[N][N];
     int i, j, k, trial;
-    (void)unused;
     cfg.mode = ICOAC_MODE_RL;
     cfg.actor.act_with_sample = 1;
     /* a full SPD covariance */
@@ -452,12 +444,12 @@ static void test_posterior_sample_per_trial(void **unused)
             lower[i][j] = i == j ? sqrt(sum) : sum / lower[j][j];
         }
     }
-    assert_int_equal(icoac_init(&cfg, &state, &p, 31u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, &p, 31u));
     /* the sample drawn by icoac_init is reproducible from the seed */
     {
         icoac_state_t fresh;
-        assert_int_equal(icoac_init(&cfg, &fresh, &p, 31u), ICOAC_OK);
-        assert_memory_equal(icoac_priv_state_c(&fresh)->w_act, st->w_act, sizeof st->w_act);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &fresh, &p, 31u));
+        TEST_ASSERT_EQUAL_MEMORY(st->w_act, icoac_priv_state_c(&fresh)->w_act, sizeof st->w_act);
     }
     /* direct check: draw the normals from a copy of the generator, then reset */
     for (trial = 0; trial < 5; ++trial) {
@@ -466,7 +458,7 @@ static void test_posterior_sample_per_trial(void **unused)
         for (i = 0; i < N; ++i) {
             n[i] = (double)icoac_rng_normal(&copy);
         }
-        assert_int_equal(icoac_reset(&state), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
         for (i = 0; i < N; ++i) {
             double expect = (double)mean_of(&state)[i];
             for (j = 0; j <= i; ++j) {
@@ -474,21 +466,23 @@ static void test_posterior_sample_per_trial(void **unused)
             }
             assert_close(st->w_act[i], expect, REAL_IS_FLOAT ? 1e-6 : 1e-13);
         }
-        assert_true(memcmp(st->w_act, st->w, sizeof st->w) != 0);
+        TEST_ASSERT_TRUE(memcmp(st->w_act, st->w, sizeof st->w) != 0);
     }
 }
 
+void setUp(void) {}
+void tearDown(void) {}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_update_matches_closed_form),
-        cmocka_unit_test(test_zero_innovation_keeps_mean),
-        cmocka_unit_test(test_forgetting_inflates_first),
-        cmocka_unit_test(test_update_staged_into_spare),
-        cmocka_unit_test(test_long_run_symmetric_pd),
-        cmocka_unit_test(test_long_run_with_forgetting),
-        cmocka_unit_test(test_step_wiring),
-        cmocka_unit_test(test_posterior_sample_per_trial),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_update_matches_closed_form);
+    RUN_TEST(test_zero_innovation_keeps_mean);
+    RUN_TEST(test_forgetting_inflates_first);
+    RUN_TEST(test_update_staged_into_spare);
+    RUN_TEST(test_long_run_symmetric_pd);
+    RUN_TEST(test_long_run_with_forgetting);
+    RUN_TEST(test_step_wiring);
+    RUN_TEST(test_posterior_sample_per_trial);
+    return UNITY_END();
 }

@@ -1,18 +1,33 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Shared helpers of the cmocka tests. */
+/* Shared helpers of the Unity tests, on the host and on the Cortex-M targets. */
 #ifndef ICOAC_TEST_COMMON_H
 #define ICOAC_TEST_COMMON_H
 
-#include <setjmp.h>
-#include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 
-#include <cmocka.h>
+#include "unity.h"
+
+/* Failure context is printed with TEST_PRINTF (Unity's own printf, no stdio on the targets). */
+#ifndef UNITY_INCLUDE_PRINT_FORMATTED
+#error "build Unity with UNITY_INCLUDE_PRINT_FORMATTED (cmake/modules/IcoacUnity.cmake)"
+#endif
 
 #include <math.h>
-#include <stdio.h>
 #include <string.h>
+
+/* 1 in a build for an emulated core (tests/target), 0 on the host. */
+#ifndef ICOAC_TEST_ON_TARGET
+#define ICOAC_TEST_ON_TARGET 0
+#endif
+
+/* A loop count of a long test: `host` on the host, `target` on an emulated core, where the test
+ * says why it runs fewer (QEMU runs a Cortex-M about 100 times slower than the host). */
+#if ICOAC_TEST_ON_TARGET
+#define TEST_ITERATIONS(host, target) (target)
+#else
+#define TEST_ITERATIONS(host, target) (host)
+#endif
 
 #include "icoac/icoac.h"
 
@@ -24,19 +39,14 @@
 /* Machine epsilon of icoac_real_t. */
 #define REAL_EPS (REAL_IS_FLOAT ? 1.1920928955078125e-7 : 2.220446049250313e-16)
 
-static inline void assert_close_at(double actual, double expected, double tol, const char *expr,
-                                   const char *file, int line)
-{
-    if (!(fabs(actual - expected) <= tol)) {
-        print_error("%s = %.17g, expected %.17g (|diff| %.3g > tol %.3g)\n", expr, actual, expected,
-                    fabs(actual - expected), tol);
-        _fail(file, line);
-    }
-}
-
-/* |actual - expected| <= tol, NaN fails. */
-#define assert_close(actual, expected, tol) \
-    assert_close_at((double)(actual), (double)(expected), (double)(tol), #actual, __FILE__, __LINE__)
+/* |actual - expected| <= tol, a non-finite actual fails; the message names the expression. */
+#define assert_close(actual, expected, tol)                                                        \
+    do {                                                                                           \
+        const double assert_close_actual_ = (double)(actual);                                      \
+        TEST_ASSERT_TRUE_MESSAGE(isfinite(assert_close_actual_), #actual " is not finite");        \
+        TEST_ASSERT_DOUBLE_WITHIN_MESSAGE((double)(tol), (double)(expected), assert_close_actual_, \
+                                          #actual);                                                \
+    } while (0)
 
 /* Deterministic test-side random numbers (xorshift64*), independent of the library RNG. */
 typedef struct {
@@ -80,7 +90,7 @@ static inline icoac_prior_t test_random_prior(test_rng_t *rng, double mean_half_
             p.cov[i][j] = p.cov[j][i] = (icoac_real_t)(scale * sum);
         }
     }
-    assert_int_equal(icoac_prior_check(&p, ICOAC_CARTPOLE_INPUTS), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_prior_check(&p, ICOAC_CARTPOLE_INPUTS));
     return p;
 }
 
@@ -90,8 +100,8 @@ static inline icoac_prior_t test_random_prior(test_rng_t *rng, double mean_half_
 static inline void test_assert_config_in_force(const icoac_config_t *cfg, const icoac_state_t *state)
 {
     icoac_config_t in_force;
-    assert_int_equal(icoac_get_config(state, &in_force), ICOAC_OK);
-    assert_memory_equal(&in_force, cfg, sizeof in_force);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_config(state, &in_force));
+    TEST_ASSERT_EQUAL_MEMORY(cfg, &in_force, sizeof in_force);
 }
 
 static inline icoac_config_t test_default_config(void)
@@ -99,7 +109,7 @@ static inline icoac_config_t test_default_config(void)
     icoac_config_t cfg;
     memset(&cfg, 0, sizeof cfg);
     icoac_config_default(&cfg);
-    assert_int_equal(icoac_config_check(&cfg), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&cfg));
     return cfg;
 }
 

@@ -8,7 +8,7 @@
 #define NAN_R ((icoac_real_t)NAN)
 #define INF_R ((icoac_real_t)INFINITY)
 
-static void test_defaults_match_spec(void **unused)
+static void test_defaults_match_spec(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_config_t filled;
@@ -18,11 +18,10 @@ static void test_defaults_match_spec(void **unused)
     icoac_actor_config_t actor;
     icoac_search_config_t search;
     const double tol = 4.0 * REAL_EPS;
-    (void)unused;
-    assert_int_equal(cfg.mode, ICOAC_MODE_ICO);
-    assert_int_equal(cfg.policy.reflex_mode, ICOAC_REFLEX_UNIT);
-    assert_int_equal(cfg.ico.timing, ICOAC_ICO_TIMING_CODE);
-    assert_int_equal(cfg.policy.clip_inputs, 1);
+    TEST_ASSERT_EQUAL_INT(ICOAC_MODE_ICO, cfg.mode);
+    TEST_ASSERT_EQUAL_INT(ICOAC_REFLEX_UNIT, cfg.policy.reflex_mode);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ICO_TIMING_CODE, cfg.ico.timing);
+    TEST_ASSERT_EQUAL_INT(1, cfg.policy.clip_inputs);
     assert_close(cfg.policy.input_range[0], 2.4, tol * 2.4);
     assert_close(cfg.policy.input_range[1], 3.5, tol * 3.5);
     assert_close(cfg.policy.input_range[2], 0.2094384, tol);
@@ -30,29 +29,29 @@ static void test_defaults_match_spec(void **unused)
     assert_close(cfg.policy.gain, 10.0, 0.0);
     assert_close(cfg.policy.reflex_force, 1.0, 0.0);
     /* the cart-pole task: Eq. (4)'s zone as four rules, first match wins */
-    assert_int_equal(cfg.task.n_inputs, 4);
-    assert_int_equal(cfg.task.late_source, ICOAC_LATE_RULES);
-    assert_int_equal(cfg.task.n_rules, 4);
-    assert_int_equal(cfg.task.rule_input[0], ICOAC_IDX_THETA);
-    assert_int_equal(cfg.task.rule_side[0], ICOAC_RULE_ABOVE);
+    TEST_ASSERT_EQUAL_INT(4, cfg.task.n_inputs);
+    TEST_ASSERT_EQUAL_INT(ICOAC_LATE_RULES, cfg.task.late_source);
+    TEST_ASSERT_EQUAL_INT(4, cfg.task.n_rules);
+    TEST_ASSERT_EQUAL_INT(ICOAC_IDX_THETA, cfg.task.rule_input[0]);
+    TEST_ASSERT_EQUAL_INT(ICOAC_RULE_ABOVE, cfg.task.rule_side[0]);
     assert_close(cfg.task.rule_threshold[0], DEG(11.5), tol);
     assert_close(cfg.task.rule_reflex[0], 1.0, 0.0);
-    assert_int_equal(cfg.task.rule_input[1], ICOAC_IDX_X);
-    assert_int_equal(cfg.task.rule_side[1], ICOAC_RULE_BELOW);
+    TEST_ASSERT_EQUAL_INT(ICOAC_IDX_X, cfg.task.rule_input[1]);
+    TEST_ASSERT_EQUAL_INT(ICOAC_RULE_BELOW, cfg.task.rule_side[1]);
     assert_close(cfg.task.rule_threshold[1], -2.35, tol * 2.35);
     assert_close(cfg.task.rule_reflex[1], 1.0, 0.0);
-    assert_int_equal(cfg.task.rule_input[2], ICOAC_IDX_THETA);
-    assert_int_equal(cfg.task.rule_side[2], ICOAC_RULE_BELOW);
+    TEST_ASSERT_EQUAL_INT(ICOAC_IDX_THETA, cfg.task.rule_input[2]);
+    TEST_ASSERT_EQUAL_INT(ICOAC_RULE_BELOW, cfg.task.rule_side[2]);
     assert_close(cfg.task.rule_threshold[2], -DEG(11.5), tol);
     assert_close(cfg.task.rule_reflex[2], -1.0, 0.0);
-    assert_int_equal(cfg.task.rule_input[3], ICOAC_IDX_X);
-    assert_int_equal(cfg.task.rule_side[3], ICOAC_RULE_ABOVE);
+    TEST_ASSERT_EQUAL_INT(ICOAC_IDX_X, cfg.task.rule_input[3]);
+    TEST_ASSERT_EQUAL_INT(ICOAC_RULE_ABOVE, cfg.task.rule_side[3]);
     assert_close(cfg.task.rule_threshold[3], 2.35, tol * 2.35);
     assert_close(cfg.task.rule_reflex[3], -1.0, 0.0);
-    assert_int_equal(cfg.critic.units[0], 3);
-    assert_int_equal(cfg.critic.units[1], 3);
-    assert_int_equal(cfg.critic.units[2], 6);
-    assert_int_equal(cfg.critic.units[3], 3);
+    TEST_ASSERT_EQUAL_INT(3, cfg.critic.units[0]);
+    TEST_ASSERT_EQUAL_INT(3, cfg.critic.units[1]);
+    TEST_ASSERT_EQUAL_INT(6, cfg.critic.units[2]);
+    TEST_ASSERT_EQUAL_INT(3, cfg.critic.units[3]);
     assert_close(cfg.ico.rate, 1e-4, tol * 1e-4);
     assert_close(cfg.critic.rate, 0.6, tol);
     assert_close(cfg.critic.discount, 0.95, tol);
@@ -65,18 +64,18 @@ static void test_defaults_match_spec(void **unused)
     assert_close(cfg.actor.noise_std, 3.0, 0.0); /* chosen by the learner sweeps (literal: 1) */
     assert_close(cfg.actor.scale, 0.5, 0.0);
     assert_close(cfg.actor.forgetting, 1.0, 0.0);
-    assert_int_equal(cfg.actor.reflex, 1);
-    assert_int_equal(cfg.actor.act_with_sample, 0);
+    TEST_ASSERT_EQUAL_INT(1, cfg.actor.reflex);
+    TEST_ASSERT_EQUAL_INT(0, cfg.actor.act_with_sample);
     /* L2-L4, A10 (method.md): the literal critic, per-tick updates and sigma_L = sigma_u (0); the actor
      * reading and its exploration schedule, and the search group, chosen by the learner sweeps */
-    assert_int_equal(cfg.learn, 1);
-    assert_int_equal(cfg.critic.quirks, 0);
-    assert_int_equal(cfg.actor.update, ICOAC_ACTOR_GRADIENT);
+    TEST_ASSERT_EQUAL_INT(1, cfg.learn);
+    TEST_ASSERT_EQUAL_INT(0, cfg.critic.quirks);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ACTOR_GRADIENT, cfg.actor.update);
     assert_close(cfg.actor.rate, 0.001, tol * 0.001);
-    assert_true(cfg.actor.likelihood_std == 0); /* 0: sigma_L = sigma_u (literal) */
-    assert_int_equal(cfg.actor.batch, 0);
-    assert_int_equal(cfg.actor.explore_ticks, 1000);
-    assert_int_equal(cfg.search.batch, 8);
+    TEST_ASSERT_TRUE(cfg.actor.likelihood_std == 0); /* 0: sigma_L = sigma_u (literal) */
+    TEST_ASSERT_EQUAL_INT(0, cfg.actor.batch);
+    TEST_ASSERT_EQUAL_INT(1000, cfg.actor.explore_ticks);
+    TEST_ASSERT_EQUAL_INT(8, cfg.search.batch);
     assert_close(cfg.search.elite_fraction, 0.25, 0.0);
     assert_close(cfg.search.step, 0.5, 0.0);
     assert_close(cfg.search.floor, 1.0, 0.0);
@@ -94,19 +93,19 @@ static void test_defaults_match_spec(void **unused)
     icoac_critic_config_default(&critic);
     icoac_actor_config_default(&actor);
     icoac_search_config_default(&search);
-    assert_int_equal(filled.mode, ICOAC_MODE_ICO);
-    assert_memory_equal(&policy, &filled.policy, sizeof policy);
-    assert_memory_equal(&ico, &filled.ico, sizeof ico);
-    assert_memory_equal(&critic, &filled.critic, sizeof critic);
-    assert_memory_equal(&actor, &filled.actor, sizeof actor);
-    assert_memory_equal(&search, &filled.search, sizeof search);
+    TEST_ASSERT_EQUAL_INT(ICOAC_MODE_ICO, filled.mode);
+    TEST_ASSERT_EQUAL_MEMORY(&filled.policy, &policy, sizeof policy);
+    TEST_ASSERT_EQUAL_MEMORY(&filled.ico, &ico, sizeof ico);
+    TEST_ASSERT_EQUAL_MEMORY(&filled.critic, &critic, sizeof critic);
+    TEST_ASSERT_EQUAL_MEMORY(&filled.actor, &actor, sizeof actor);
+    TEST_ASSERT_EQUAL_MEMORY(&filled.search, &search, sizeof search);
     /* and the default over a 0xA5 fill equals the default over zeros, field by field */
-    assert_true(memcmp(filled.policy.input_range, cfg.policy.input_range, sizeof cfg.policy.input_range) == 0);
-    assert_true(filled.policy.gain == cfg.policy.gain && filled.task.rule_threshold[3] == cfg.task.rule_threshold[3]);
-    assert_true(memcmp(&filled.task, &cfg.task, sizeof cfg.task) == 0);
-    assert_true(filled.critic.threshold == cfg.critic.threshold && filled.actor.reflex == cfg.actor.reflex);
-    assert_true(filled.actor.likelihood_std == cfg.actor.likelihood_std && filled.search.floor == cfg.search.floor);
-    assert_true(filled.search.batch == cfg.search.batch && filled.actor.explore_ticks == cfg.actor.explore_ticks);
+    TEST_ASSERT_TRUE(memcmp(filled.policy.input_range, cfg.policy.input_range, sizeof cfg.policy.input_range) == 0);
+    TEST_ASSERT_TRUE(filled.policy.gain == cfg.policy.gain && filled.task.rule_threshold[3] == cfg.task.rule_threshold[3]);
+    TEST_ASSERT_TRUE(memcmp(&filled.task, &cfg.task, sizeof cfg.task) == 0);
+    TEST_ASSERT_TRUE(filled.critic.threshold == cfg.critic.threshold && filled.actor.reflex == cfg.actor.reflex);
+    TEST_ASSERT_TRUE(filled.actor.likelihood_std == cfg.actor.likelihood_std && filled.search.floor == cfg.search.floor);
+    TEST_ASSERT_TRUE(filled.search.batch == cfg.search.batch && filled.actor.explore_ticks == cfg.actor.explore_ticks);
     /* must not crash */
     icoac_config_default(NULL);
     icoac_policy_config_default(NULL);
@@ -514,12 +513,11 @@ static int starts_with(const char *s, const char *prefix)
     return s != NULL && strncmp(s, prefix, strlen(prefix)) == 0;
 }
 
-static void test_bad_configs_rejected_state_untouched(void **unused)
+static void test_bad_configs_rejected_state_untouched(void)
 {
     size_t n;
     int seen[ICOAC_ERR_BAD_TASK + 1] = {0};
     int s;
-    (void)unused;
     for (n = 0; n < N_CONFIG_CASES; ++n) {
         const config_case_t *c = &config_cases[n];
         icoac_config_t cfg = test_default_config();
@@ -528,42 +526,31 @@ static void test_bad_configs_rejected_state_untouched(void **unused)
         icoac_status_t got;
         c->mutate(&cfg);
         got = icoac_config_check(&cfg);
-        if (got != c->expected) {
-            print_error("case %s: icoac_config_check -> %d, expected %d\n", c->name, (int)got,
-                        (int)c->expected);
-        }
-        assert_int_equal(got, c->expected);
+        TEST_ASSERT_EQUAL_INT_MESSAGE(c->expected, got, c->name); /* icoac_config_check */
         memset(&state, 0xA5, sizeof state);
         memset(&sentinel, 0xA5, sizeof sentinel);
         got = icoac_init(&cfg, &state, NULL, 7u);
-        if (got != c->expected) {
-            print_error("case %s: icoac_init -> %d, expected %d\n", c->name, (int)got, (int)c->expected);
-        }
-        assert_int_equal(got, c->expected);
+        TEST_ASSERT_EQUAL_INT_MESSAGE(c->expected, got, c->name); /* icoac_init */
         if (c->expected != ICOAC_OK) {
-            if (memcmp(&state, &sentinel, sizeof state) != 0) {
-                print_error("case %s: icoac_init touched the state\n", c->name);
-                fail();
-            }
+            TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&sentinel, &state, sizeof state, c->name); /* state untouched */
         } else {
-            assert_int_equal(icoac_priv_state_c(&state)->magic, ICOAC_PRIV_STATE_MAGIC);
+            TEST_ASSERT_EQUAL_UINT32(ICOAC_PRIV_STATE_MAGIC, icoac_priv_state_c(&state)->magic);
         }
         seen[c->expected] = 1;
     }
     /* Every named configuration status is exercised. */
     for (s = ICOAC_ERR_BAD_MODE; s <= ICOAC_ERR_BAD_ACTOR; ++s) {
-        assert_true(seen[s]);
+        TEST_ASSERT_TRUE(seen[s]);
     }
-    assert_true(seen[ICOAC_ERR_BAD_SEARCH]);
-    assert_true(seen[ICOAC_ERR_BAD_TASK]);
+    TEST_ASSERT_TRUE(seen[ICOAC_ERR_BAD_SEARCH]);
+    TEST_ASSERT_TRUE(seen[ICOAC_ERR_BAD_TASK]);
 }
 
 /* icoac_config_check_field names the first bad field of every case, agrees with
  * icoac_config_check, and writes NULL when the configuration is OK. */
-static void test_config_cases_name_their_field(void **unused)
+static void test_config_cases_name_their_field(void)
 {
     size_t n;
-    (void)unused;
     for (n = 0; n < N_CONFIG_CASES; ++n) {
         const config_case_t *c = &config_cases[n];
         icoac_config_t cfg = test_default_config();
@@ -571,32 +558,26 @@ static void test_config_cases_name_their_field(void **unused)
         icoac_status_t got;
         c->mutate(&cfg);
         got = icoac_config_check_field(&cfg, &field);
-        assert_int_equal(got, c->expected);
-        assert_int_equal(got, icoac_config_check(&cfg));
-        assert_int_equal(icoac_config_check_field(&cfg, NULL), got); /* field may be NULL */
+        TEST_ASSERT_EQUAL_INT(c->expected, got);
+        TEST_ASSERT_EQUAL_INT(icoac_config_check(&cfg), got);
+        TEST_ASSERT_EQUAL_INT(got, icoac_config_check_field(&cfg, NULL)); /* field may be NULL */
         if (c->field == NULL) {
-            if (field != NULL) {
-                print_error("case %s: field %s, expected NULL\n", c->name, field);
-            }
-            assert_null(field);
+            TEST_ASSERT_NULL_MESSAGE(field, c->name);
         } else {
-            if (field == NULL || strcmp(field, c->field) != 0) {
-                print_error("case %s: field %s, expected %s\n", c->name, field ? field : "NULL", c->field);
-                fail();
-            }
+            TEST_ASSERT_EQUAL_STRING_MESSAGE(c->field, field, c->name);
             /* a static string: the same pointer each time, unchanged by the configuration */
             {
                 const char *again = NULL;
-                assert_int_equal(icoac_config_check_field(&cfg, &again), got);
-                assert_ptr_equal(again, field);
+                TEST_ASSERT_EQUAL_INT(got, icoac_config_check_field(&cfg, &again));
+                TEST_ASSERT_EQUAL_PTR(field, again);
             }
         }
     }
     {
         const char *field = "not written";
-        assert_int_equal(icoac_config_check_field(NULL, &field), ICOAC_ERR_NULL);
-        assert_null(field);
-        assert_int_equal(icoac_config_check_field(NULL, NULL), ICOAC_ERR_NULL);
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_config_check_field(NULL, &field));
+        TEST_ASSERT_NULL(field);
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_config_check_field(NULL, NULL));
     }
 }
 
@@ -730,41 +711,39 @@ static int validated(const config_field_t *f, int32_t mode)
 
 /* The table above lists every member of icoac_config_t: with `mode` it covers each byte that
  * is not padding, in struct order, without overlap (a new field the table misses fails here). */
-static void test_field_table_covers_config(void **unused)
+static void test_field_table_covers_config(void)
 {
     size_t end = sizeof(int32_t); /* mode, at offset 0 */
     size_t covered = sizeof(int32_t);
     int i;
-    (void)unused;
-    assert_int_equal(offsetof(icoac_config_t, mode), 0);
+    TEST_ASSERT_EQUAL_size_t(0, offsetof(icoac_config_t, mode));
     for (i = 0; i < N_CONFIG_FIELDS; ++i) {
         const config_field_t *f = &config_fields[i];
-        assert_int_equal(f->size, f->is_int ? sizeof(int32_t) : sizeof(icoac_real_t));
+        TEST_ASSERT_EQUAL_size_t(f->is_int ? sizeof(int32_t) : sizeof(icoac_real_t), f->size);
         if (f->offset < end) {
-            print_error("%s at %u overlaps the field before (end %u)\n", f->name, (unsigned)f->offset, (unsigned)end);
-            fail();
+            TEST_PRINTF("%s at %u overlaps the field before (end %u)", f->name, (unsigned)f->offset, (unsigned)end);
+            TEST_FAIL();
         }
         /* a gap is alignment padding only: shorter than the member's alignment */
         if (f->offset - end >= f->size) {
-            print_error("%u bytes before %s are not listed\n", (unsigned)(f->offset - end), f->name);
-            fail();
+            TEST_PRINTF("%u bytes before %s are not listed", (unsigned)(f->offset - end), f->name);
+            TEST_FAIL();
         }
         end = f->offset + f->size;
         covered += f->size;
     }
-    assert_true(sizeof(icoac_config_t) - end < sizeof(icoac_real_t));
+    TEST_ASSERT_TRUE(sizeof(icoac_config_t) - end < sizeof(icoac_real_t));
     if (REAL_IS_FLOAT) {
-        assert_int_equal(covered, sizeof(icoac_config_t)); /* no padding with float reals */
+        TEST_ASSERT_EQUAL_size_t(sizeof(icoac_config_t), covered); /* no padding with float reals */
     }
 }
 
 /* One bad field at a time: named with its group's status where the mode uses the group,
  * ignored (OK, and a working controller) where it does not. */
-static void test_each_field_named_or_ignored(void **unused)
+static void test_each_field_named_or_ignored(void)
 {
     int32_t mode;
     int i;
-    (void)unused;
     for (mode = ICOAC_MODE_ICO; mode < N_MODES; ++mode) {
         for (i = 0; i < N_CONFIG_FIELDS; ++i) {
             const config_field_t *f = &config_fields[i];
@@ -776,23 +755,23 @@ static void test_each_field_named_or_ignored(void **unused)
             got = icoac_config_check_field(&cfg, &field);
             if (validated(f, mode)) {
                 if (got != f->status || field == NULL || strcmp(field, f->name) != 0) {
-                    print_error("mode %d, bad %s: status %d field %s\n", (int)mode, f->name, (int)got,
+                    TEST_PRINTF("mode %d, bad %s: status %d field %s", (int)mode, f->name, (int)got,
                                 field ? field : "NULL");
-                    fail();
+                    TEST_FAIL();
                 }
             } else {
                 icoac_state_t state;
                 icoac_output_t out;
                 icoac_input_t in = test_input(0.1, -0.2, 0.05, 0.3, 0);
                 if (got != ICOAC_OK || field != NULL) {
-                    print_error("mode %d ignores %s, but: status %d field %s\n", (int)mode, f->name, (int)got,
+                    TEST_PRINTF("mode %d ignores %s, but: status %d field %s", (int)mode, f->name, (int)got,
                                 field ? field : "NULL");
-                    fail();
+                    TEST_FAIL();
                 }
-                assert_int_equal(icoac_init(&cfg, &state, NULL, 3u), ICOAC_OK);
-                assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-                assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-                assert_true(isfinite((double)out.force));
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 3u));
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+                TEST_ASSERT_TRUE(isfinite((double)out.force));
             }
         }
     }
@@ -800,11 +779,10 @@ static void test_each_field_named_or_ignored(void **unused)
 
 /* Spoiling the fields from the last to the first, each check names the one just spoiled: the
  * check walks the mode, the policy, then the mode's groups, in struct order. */
-static void test_check_order_is_struct_order(void **unused)
+static void test_check_order_is_struct_order(void)
 {
     int32_t mode;
     int i;
-    (void)unused;
     for (mode = ICOAC_MODE_ICO; mode < N_MODES; ++mode) {
         icoac_config_t cfg = test_default_config();
         const char *field = NULL;
@@ -815,16 +793,16 @@ static void test_check_order_is_struct_order(void **unused)
                 continue;
             }
             spoil(&cfg, f);
-            assert_int_equal(icoac_config_check_field(&cfg, &field), f->status);
-            assert_non_null(field);
-            assert_string_equal(field, f->name);
+            TEST_ASSERT_EQUAL_INT(f->status, icoac_config_check_field(&cfg, &field));
+            TEST_ASSERT_NOT_NULL(field);
+            TEST_ASSERT_EQUAL_STRING(f->name, field);
         }
         cfg.mode = N_MODES;
-        assert_int_equal(icoac_config_check_field(&cfg, &field), ICOAC_ERR_BAD_MODE);
-        assert_string_equal(field, "mode");
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_MODE, icoac_config_check_field(&cfg, &field));
+        TEST_ASSERT_EQUAL_STRING("mode", field);
         cfg.mode = -1;
-        assert_int_equal(icoac_config_check_field(&cfg, &field), ICOAC_ERR_BAD_MODE);
-        assert_string_equal(field, "mode");
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_MODE, icoac_config_check_field(&cfg, &field));
+        TEST_ASSERT_EQUAL_STRING("mode", field);
     }
 }
 
@@ -832,10 +810,9 @@ static void test_check_order_is_struct_order(void **unused)
  * with a spoilt critic, actor and search, RL with a spoilt ico and search group (new with
  * the one-file-per-stage restructuring), search with a spoilt ico, critic and actor. The
  * controller behaves exactly as with valid unused groups. */
-static void test_unused_groups_ignored(void **unused)
+static void test_unused_groups_ignored(void)
 {
     int32_t mode;
-    (void)unused;
     for (mode = ICOAC_MODE_ICO; mode < N_MODES; ++mode) {
         icoac_config_t cfg = test_default_config();
         icoac_config_t clean;
@@ -850,10 +827,10 @@ static void test_unused_groups_ignored(void **unused)
                 spoil(&cfg, &config_fields[i]);
             }
         }
-        assert_int_equal(icoac_config_check_field(&cfg, &field), ICOAC_OK);
-        assert_null(field);
-        assert_int_equal(icoac_init(&cfg, &state, NULL, 21u), ICOAC_OK);
-        assert_int_equal(icoac_init(&clean, &twin, NULL, 21u), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check_field(&cfg, &field));
+        TEST_ASSERT_NULL(field);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 21u));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&clean, &twin, NULL, 21u));
         for (k = 0; k < 300; ++k) {
             icoac_output_t out, out_twin;
             icoac_input_t in = test_input(test_uniform(&rng, -2.5, 2.5), test_uniform(&rng, -3, 3),
@@ -861,17 +838,17 @@ static void test_unused_groups_ignored(void **unused)
                                           k % 40 == 39 ? ICOAC_INPUT_TERMINAL : 0u);
             memset(&out, 0, sizeof out);
             memset(&out_twin, 0, sizeof out_twin);
-            assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-            assert_int_equal(icoac_step(&twin, &in, &out_twin), ICOAC_OK);
-            assert_memory_equal(&out, &out_twin, sizeof out);
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&twin, &in, &out_twin));
+            TEST_ASSERT_EQUAL_MEMORY(&out_twin, &out, sizeof out);
             if (k % 40 == 39) {
-                assert_int_equal(icoac_reset(&state), ICOAC_OK);
-                assert_int_equal(icoac_reset(&twin), ICOAC_OK);
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&twin));
             }
         }
         /* the same state but for the unused groups of the configuration it keeps */
         icoac_priv_state(&state)->config = clean;
-        assert_memory_equal(&state, &twin, sizeof state);
+        TEST_ASSERT_EQUAL_MEMORY(&twin, &state, sizeof state);
     }
     /* the case table's rejections of a mode's own group, in every other mode */
     {
@@ -900,15 +877,15 @@ static void test_unused_groups_ignored(void **unused)
                 c->mutate(&cfg);
                 cfg.mode = other;
                 if (icoac_config_check_field(&cfg, &field) != ICOAC_OK || field != NULL) {
-                    print_error("case %s in mode %d: not ignored (field %s)\n", c->name, (int)other,
+                    TEST_PRINTF("case %s in mode %d: not ignored (field %s)", c->name, (int)other,
                                 field ? field : "NULL");
-                    fail();
+                    TEST_FAIL();
                 }
-                assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 1u));
                 ++tried;
             }
         }
-        assert_true(tried > 100);
+        TEST_ASSERT_TRUE(tried > 100);
     }
 }
 
@@ -919,24 +896,20 @@ static void expect_bad_prior(const icoac_prior_t *prior, const char *name)
     icoac_state_t sentinel;
     icoac_status_t got;
     int mode;
-    assert_int_equal(icoac_prior_check(prior, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_BAD_PRIOR);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_PRIOR, icoac_prior_check(prior, ICOAC_CARTPOLE_INPUTS));
     for (mode = ICOAC_MODE_ICO; mode < N_MODES; ++mode) {
         cfg.mode = mode;
         memset(&state, 0x5A, sizeof state);
         memset(&sentinel, 0x5A, sizeof sentinel);
         got = icoac_init(&cfg, &state, prior, 1u);
-        if (got != ICOAC_ERR_BAD_PRIOR) {
-            print_error("prior %s: icoac_init -> %d\n", name, (int)got);
-        }
-        assert_int_equal(got, ICOAC_ERR_BAD_PRIOR);
-        assert_memory_equal(&state, &sentinel, sizeof state);
+        TEST_ASSERT_EQUAL_INT_MESSAGE(ICOAC_ERR_BAD_PRIOR, got, name);
+        TEST_ASSERT_EQUAL_MEMORY(&sentinel, &state, sizeof state);
     }
 }
 
-static void test_bad_priors(void **unused)
+static void test_bad_priors(void)
 {
     icoac_prior_t p;
-    (void)unused;
     /* Non-symmetric (but with a PD symmetric part). */
     p = test_prior(0, 0, 0, 0, 1.0);
     p.cov[0][1] = (icoac_real_t)0.1;
@@ -967,41 +940,40 @@ static void test_bad_priors(void **unused)
     expect_bad_prior(&p, "Inf cov");
 }
 
-static void test_init_prior_copied(void **unused)
+static void test_init_prior_copied(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
     icoac_prior_t p = test_prior(0.1, -0.2, 0.3, -0.4, 2.0);
     icoac_prior_t post;
     int i, j;
-    (void)unused;
     p.cov[0][3] = p.cov[3][0] = (icoac_real_t)0.5;
-    assert_int_equal(icoac_prior_check(&p, ICOAC_CARTPOLE_INPUTS), ICOAC_OK);
-    assert_int_equal(icoac_init(&cfg, &state, &p, 3u), ICOAC_OK);
-    assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_OK);
-    assert_memory_equal(post.mean, p.mean, sizeof p.mean);
-    assert_memory_equal(post.cov, p.cov, sizeof p.cov);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_prior_check(&p, ICOAC_CARTPOLE_INPUTS));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, &p, 3u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(&state, &post));
+    TEST_ASSERT_EQUAL_MEMORY(p.mean, post.mean, sizeof p.mean);
+    TEST_ASSERT_EQUAL_MEMORY(p.cov, post.cov, sizeof p.cov);
     /* NULL prior: mean 0, covariance I. */
-    assert_int_equal(icoac_init(&cfg, &state, NULL, 3u), ICOAC_OK);
-    assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 3u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(&state, &post));
     for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
-        assert_true(post.mean[i] == 0);
+        TEST_ASSERT_TRUE(post.mean[i] == 0);
         for (j = 0; j < ICOAC_CARTPOLE_INPUTS; ++j) {
-            assert_true(post.cov[i][j] == (i == j ? 1 : 0));
+            TEST_ASSERT_TRUE(post.cov[i][j] == (i == j ? 1 : 0));
         }
     }
     {
         const icoac_priv_state_t *st = icoac_priv_state_c(&state);
         for (i = 0; i < ICOAC_CARTPOLE_CRITIC_UNITS; ++i) {
-            assert_true(st->v[i] == 0);
+            TEST_ASSERT_TRUE(st->v[i] == 0);
         }
-        assert_true(st->penalty_prev == 0);
-        assert_int_equal(st->cov_slot, 0);
-        assert_memory_equal(icoac_priv_cov_c(st), post.cov, sizeof post.cov);
+        TEST_ASSERT_TRUE(st->penalty_prev == 0);
+        TEST_ASSERT_EQUAL_INT(0, st->cov_slot);
+        TEST_ASSERT_EQUAL_MEMORY(post.cov, icoac_priv_cov_c(st), sizeof post.cov);
     }
 }
 
-static void test_null_pointers(void **unused)
+static void test_null_pointers(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
@@ -1009,37 +981,36 @@ static void test_null_pointers(void **unused)
     icoac_output_t out;
     icoac_prior_t post;
     icoac_counters_t counters;
-    (void)unused;
-    assert_int_equal(icoac_config_check(NULL), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_prior_check(NULL, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_init(NULL, &state, NULL, 0u), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_init(&cfg, NULL, NULL, 0u), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_init(&cfg, &state, NULL, 0u), ICOAC_OK);
-    assert_int_equal(icoac_reset(NULL), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_retune(NULL, &cfg), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_retune(&state, NULL), ICOAC_ERR_NULL);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_config_check(NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_prior_check(NULL, ICOAC_CARTPOLE_INPUTS));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_init(NULL, &state, NULL, 0u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_init(&cfg, NULL, NULL, 0u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 0u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_reset(NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_retune(NULL, &cfg));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_retune(&state, NULL));
     memset(&out, 0x7F, sizeof out);
-    assert_int_equal(icoac_step(NULL, &in, &out), ICOAC_ERR_NULL);
-    assert_int_equal(out.status, ICOAC_ERR_NULL);
-    assert_true(out.force == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_step(NULL, &in, &out));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, out.status);
+    TEST_ASSERT_TRUE(out.force == 0);
     memset(&out, 0x7F, sizeof out);
-    assert_int_equal(icoac_step(&state, NULL, &out), ICOAC_ERR_NULL);
-    assert_int_equal(out.status, ICOAC_ERR_NULL);
-    assert_true(out.force == 0);
-    assert_int_equal(icoac_step(&state, &in, NULL), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_get_posterior(NULL, &post), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_get_posterior(&state, NULL), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_get_counters(NULL, &counters), ICOAC_ERR_NULL);
-    assert_int_equal(icoac_get_counters(&state, NULL), ICOAC_ERR_NULL);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_step(&state, NULL, &out));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, out.status);
+    TEST_ASSERT_TRUE(out.force == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_step(&state, &in, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_get_posterior(NULL, &post));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_get_posterior(&state, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_get_counters(NULL, &counters));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NULL, icoac_get_counters(&state, NULL));
     /* None of the rejected calls counted a tick. */
     memset(&counters, 0xA5, sizeof counters);
-    assert_int_equal(icoac_get_counters(&state, &counters), ICOAC_OK);
-    assert_int_equal(counters.ticks, 0);
-    assert_int_equal(counters.nonfinite, 0);
-    assert_int_equal(counters.numeric_faults, 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_counters(&state, &counters));
+    TEST_ASSERT_EQUAL_UINT32(0, counters.ticks);
+    TEST_ASSERT_EQUAL_UINT32(0, counters.nonfinite);
+    TEST_ASSERT_EQUAL_UINT32(0, counters.numeric_faults);
 }
 
-static void test_not_initialised(void **unused)
+static void test_not_initialised(void)
 {
     icoac_state_t state;
     icoac_state_t copy;
@@ -1047,26 +1018,25 @@ static void test_not_initialised(void **unused)
     icoac_output_t out;
     icoac_prior_t post;
     icoac_counters_t counters;
-    (void)unused;
     memset(&state, 0, sizeof state);
     memset(&out, 0x7F, sizeof out);
     copy = state;
-    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_ERR_NOT_INITIALISED);
-    assert_int_equal(out.status, ICOAC_ERR_NOT_INITIALISED);
-    assert_true(out.force == 0);
-    assert_int_equal(icoac_reset(&state), ICOAC_ERR_NOT_INITIALISED);
-    assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_ERR_NOT_INITIALISED);
-    assert_int_equal(icoac_get_counters(&state, &counters), ICOAC_ERR_NOT_INITIALISED);
-    assert_memory_equal(&state, &copy, sizeof state);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NOT_INITIALISED, icoac_step(&state, &in, &out));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NOT_INITIALISED, out.status);
+    TEST_ASSERT_TRUE(out.force == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NOT_INITIALISED, icoac_reset(&state));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NOT_INITIALISED, icoac_get_posterior(&state, &post));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NOT_INITIALISED, icoac_get_counters(&state, &counters));
+    TEST_ASSERT_EQUAL_MEMORY(&copy, &state, sizeof state);
     /* Garbage is not mistaken for an initialised state. */
     memset(&state, 0xA5, sizeof state);
     copy = state;
-    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_ERR_NOT_INITIALISED);
-    assert_int_equal(icoac_get_counters(&state, &counters), ICOAC_ERR_NOT_INITIALISED);
-    assert_memory_equal(&state, &copy, sizeof state);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NOT_INITIALISED, icoac_step(&state, &in, &out));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NOT_INITIALISED, icoac_get_counters(&state, &counters));
+    TEST_ASSERT_EQUAL_MEMORY(&copy, &state, sizeof state);
 }
 
-static void test_status_strings(void **unused)
+static void test_status_strings(void)
 {
     static const icoac_status_t all[] = {
         ICOAC_OK, ICOAC_ERR_NULL, ICOAC_ERR_NOT_INITIALISED, ICOAC_ERR_NONFINITE_INPUT, ICOAC_ERR_NUMERIC,
@@ -1077,65 +1047,65 @@ static void test_status_strings(void **unused)
     const char *unknown;
     size_t i, j;
     int raw;
-    (void)unused;
     unknown = icoac_status_str((icoac_status_t)999);
-    assert_non_null(unknown);
+    TEST_ASSERT_NOT_NULL(unknown);
     for (i = 0; i < n; ++i) {
         const char *s = icoac_status_str(all[i]);
-        assert_non_null(s);
-        assert_true(strlen(s) > 0);
+        TEST_ASSERT_NOT_NULL(s);
+        TEST_ASSERT_TRUE(strlen(s) > 0);
         /* Named statuses have their own text, distinct from each other and from "unknown". */
-        assert_string_not_equal(s, unknown);
+        TEST_ASSERT_TRUE_MESSAGE(strcmp(s, unknown) != 0, s);
         for (j = 0; j < i; ++j) {
-            assert_string_not_equal(s, icoac_status_str(all[j]));
+            TEST_ASSERT_TRUE_MESSAGE(strcmp(s, icoac_status_str(all[j])) != 0, s);
         }
     }
     for (raw = -5; raw < 200; ++raw) {
-        assert_non_null(icoac_status_str((icoac_status_t)raw));
+        TEST_ASSERT_NOT_NULL(icoac_status_str((icoac_status_t)raw));
     }
 }
 
-static void test_sizeof_functions(void **unused)
+static void test_sizeof_functions(void)
 {
-    (void)unused;
-    assert_int_equal(icoac_abi_version(), ICOAC_ABI_VERSION);
-    assert_int_equal(ICOAC_ABI_VERSION, 8);
-    assert_int_equal(ICOAC_ERR_BAD_TASK, 19);
-    assert_int_equal(ICOAC_ERR_BAD_SEARCH, 18);
-    assert_int_equal(ICOAC_MODE_SEARCH, 2);
-    assert_int_equal(ICOAC_ACTOR_POSTERIOR, 0);
-    assert_int_equal(ICOAC_ACTOR_MEAN, 1);
-    assert_int_equal(ICOAC_ACTOR_GRADIENT, 2);
-    assert_int_equal(icoac_sizeof_real(), sizeof(icoac_real_t));
-    assert_int_equal(icoac_sizeof_real(), REAL_IS_FLOAT ? 4 : 8);
-    assert_int_equal(icoac_sizeof_config(), sizeof(icoac_config_t));
-    assert_int_equal(icoac_sizeof_state(), sizeof(icoac_state_t));
-    assert_int_equal(icoac_sizeof_input(), sizeof(icoac_input_t));
-    assert_int_equal(icoac_sizeof_output(), sizeof(icoac_output_t));
-    assert_int_equal(icoac_sizeof_prior(), sizeof(icoac_prior_t));
+    TEST_ASSERT_EQUAL_UINT32(ICOAC_ABI_VERSION, icoac_abi_version());
+    TEST_ASSERT_EQUAL_INT(8, ICOAC_ABI_VERSION);
+    TEST_ASSERT_EQUAL_INT(19, ICOAC_ERR_BAD_TASK);
+    TEST_ASSERT_EQUAL_INT(18, ICOAC_ERR_BAD_SEARCH);
+    TEST_ASSERT_EQUAL_INT(2, ICOAC_MODE_SEARCH);
+    TEST_ASSERT_EQUAL_INT(0, ICOAC_ACTOR_POSTERIOR);
+    TEST_ASSERT_EQUAL_INT(1, ICOAC_ACTOR_MEAN);
+    TEST_ASSERT_EQUAL_INT(2, ICOAC_ACTOR_GRADIENT);
+    TEST_ASSERT_EQUAL_size_t(sizeof(icoac_real_t), icoac_sizeof_real());
+    TEST_ASSERT_EQUAL_UINT32(REAL_IS_FLOAT ? 4 : 8, icoac_sizeof_real());
+    TEST_ASSERT_EQUAL_size_t(sizeof(icoac_config_t), icoac_sizeof_config());
+    TEST_ASSERT_EQUAL_size_t(sizeof(icoac_state_t), icoac_sizeof_state());
+    TEST_ASSERT_EQUAL_size_t(sizeof(icoac_input_t), icoac_sizeof_input());
+    TEST_ASSERT_EQUAL_size_t(sizeof(icoac_output_t), icoac_sizeof_output());
+    TEST_ASSERT_EQUAL_size_t(sizeof(icoac_prior_t), icoac_sizeof_prior());
     /* The caller's storage is the documented size, 8-byte aligned, and holds the private layout. */
-    assert_int_equal(sizeof(icoac_state_t), ICOAC_STATE_SIZE);
-    assert_true(_Alignof(icoac_state_t) >= 8);
-    assert_true(sizeof(icoac_priv_state_t) <= sizeof(icoac_state_t));
-    assert_true(_Alignof(icoac_priv_state_t) <= _Alignof(icoac_state_t));
+    TEST_ASSERT_EQUAL_size_t(ICOAC_STATE_SIZE, sizeof(icoac_state_t));
+    TEST_ASSERT_TRUE(_Alignof(icoac_state_t) >= 8);
+    TEST_ASSERT_TRUE(sizeof(icoac_priv_state_t) <= sizeof(icoac_state_t));
+    TEST_ASSERT_TRUE(_Alignof(icoac_priv_state_t) <= _Alignof(icoac_state_t));
 }
+
+void setUp(void) {}
+void tearDown(void) {}
 
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_defaults_match_spec),
-        cmocka_unit_test(test_bad_configs_rejected_state_untouched),
-        cmocka_unit_test(test_config_cases_name_their_field),
-        cmocka_unit_test(test_field_table_covers_config),
-        cmocka_unit_test(test_each_field_named_or_ignored),
-        cmocka_unit_test(test_check_order_is_struct_order),
-        cmocka_unit_test(test_unused_groups_ignored),
-        cmocka_unit_test(test_bad_priors),
-        cmocka_unit_test(test_init_prior_copied),
-        cmocka_unit_test(test_null_pointers),
-        cmocka_unit_test(test_not_initialised),
-        cmocka_unit_test(test_status_strings),
-        cmocka_unit_test(test_sizeof_functions),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_defaults_match_spec);
+    RUN_TEST(test_bad_configs_rejected_state_untouched);
+    RUN_TEST(test_config_cases_name_their_field);
+    RUN_TEST(test_field_table_covers_config);
+    RUN_TEST(test_each_field_named_or_ignored);
+    RUN_TEST(test_check_order_is_struct_order);
+    RUN_TEST(test_unused_groups_ignored);
+    RUN_TEST(test_bad_priors);
+    RUN_TEST(test_init_prior_copied);
+    RUN_TEST(test_null_pointers);
+    RUN_TEST(test_not_initialised);
+    RUN_TEST(test_status_strings);
+    RUN_TEST(test_sizeof_functions);
+    return UNITY_END();
 }

@@ -69,13 +69,13 @@ static void assert_rejected_state(const icoac_state_t *state, const icoac_state_
     const icoac_priv_state_t *s = priv(state);
     const int active_spare = e->active_slot ^ 1;
     const int cov_spare = e->cov_slot ^ 1;
-    assert_true(active_spare == 0 || active_spare == 1);
-    assert_true(cov_spare == 0 || cov_spare == 1);
+    TEST_ASSERT_TRUE(active_spare == 0 || active_spare == 1);
+    TEST_ASSERT_TRUE(cov_spare == 0 || cov_spare == 1);
     e->counters = s->counters;
     memcpy(&e->active[active_spare], &s->active[active_spare], sizeof e->active[active_spare]);
     memcpy(e->cov_buffer[cov_spare], s->cov_buffer[cov_spare], sizeof e->cov_buffer[cov_spare]);
     memcpy(e->batch.staged_shift, s->batch.staged_shift, sizeof e->batch.staged_shift);
-    assert_memory_equal(state, &expect, sizeof expect);
+    TEST_ASSERT_EQUAL_MEMORY(&expect, state, sizeof expect);
 }
 
 /* One tick under the contract; returns the status. */
@@ -87,30 +87,30 @@ static icoac_status_t checked_step(const icoac_config_t *cfg, icoac_state_t *sta
     test_assert_config_in_force(cfg, state);
     memset(&out, 0x7F, sizeof out);
     status = icoac_step(state, in, &out);
-    assert_int_equal(status, out.status);
-    assert_int_equal(priv(state)->counters.ticks, priv(&before)->counters.ticks + 1u);
+    TEST_ASSERT_EQUAL_INT(out.status, status);
+    TEST_ASSERT_EQUAL_UINT32(priv(&before)->counters.ticks + 1u, priv(state)->counters.ticks);
     if (status == ICOAC_OK) {
-        assert_true(output_finite(&out));
-        assert_true(state_finite(state));
-        assert_true(out.weight_norm == priv(state)->weight_norm);
-        assert_int_equal(priv(state)->counters.numeric_faults, priv(&before)->counters.numeric_faults);
+        TEST_ASSERT_TRUE(output_finite(&out));
+        TEST_ASSERT_TRUE(state_finite(state));
+        TEST_ASSERT_TRUE(out.weight_norm == priv(state)->weight_norm);
+        TEST_ASSERT_EQUAL_UINT32(priv(&before)->counters.numeric_faults, priv(state)->counters.numeric_faults);
         /* a terminal tick ends the trial until icoac_reset */
-        assert_int_equal(priv(state)->magic, (in->flags & ICOAC_INPUT_TERMINAL) != 0u ? ICOAC_PRIV_STATE_ENDED
-                                                                                       : ICOAC_PRIV_STATE_MAGIC);
+        TEST_ASSERT_EQUAL_UINT32((in->flags & ICOAC_INPUT_TERMINAL) != 0u ? ICOAC_PRIV_STATE_ENDED : ICOAC_PRIV_STATE_MAGIC,
+                                 priv(state)->magic);
         return status;
     }
     if (status == ICOAC_ERR_TRIAL_ENDED) {
         icoac_state_t expect = before;
-        assert_int_equal(priv(&before)->magic, ICOAC_PRIV_STATE_ENDED);
-        assert_true(output_cleared(&out, priv(state)->weight_norm));
+        TEST_ASSERT_EQUAL_UINT32(ICOAC_PRIV_STATE_ENDED, priv(&before)->magic);
+        TEST_ASSERT_TRUE(output_cleared(&out, priv(state)->weight_norm));
         icoac_priv_state(&expect)->counters = priv(state)->counters;
-        assert_memory_equal(state, &expect, sizeof expect);
+        TEST_ASSERT_EQUAL_MEMORY(&expect, state, sizeof expect);
         return status;
     }
-    assert_int_equal(status, ICOAC_ERR_NUMERIC);
-    assert_true(output_cleared(&out, priv(state)->weight_norm));
-    assert_int_equal(priv(state)->counters.numeric_faults, priv(&before)->counters.numeric_faults + 1u);
-    assert_int_equal(priv(state)->counters.nonfinite, priv(&before)->counters.nonfinite);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NUMERIC, status);
+    TEST_ASSERT_TRUE(output_cleared(&out, priv(state)->weight_norm));
+    TEST_ASSERT_EQUAL_UINT32(priv(&before)->counters.numeric_faults + 1u, priv(state)->counters.numeric_faults);
+    TEST_ASSERT_EQUAL_UINT32(priv(&before)->counters.nonfinite, priv(state)->counters.nonfinite);
     assert_rejected_state(state, &before);
     return status;
 }
@@ -130,33 +130,32 @@ static void check_scan(const icoac_config_t *cfg, const icoac_real_t *v, const i
     icoac_priv_critic_grid(cfg, &grid);
     memset(list, 0, sizeof list);
     value = icoac_priv_critic_value_sparse(&cfg->critic, &grid, v, s, &list[0]);
-    assert_true(isnan((double)value) || value == ICOAC_R(0.0)); /* as the dense kernel's, below */
-    assert_true(list[0].cells <= list[0].stride && list[0].stride <= ICOAC_CRITIC_BLOCK_MAX);
+    TEST_ASSERT_TRUE(isnan((double)value) || value == ICOAC_R(0.0)); /* as the dense kernel's, below */
+    TEST_ASSERT_TRUE(list[0].cells <= list[0].stride && list[0].stride <= ICOAC_CRITIC_BLOCK_MAX);
     for (i = 0; i < list[0].rows; ++i) {
-        assert_true(list[0].index[i] <= list[0].cells);
+        TEST_ASSERT_TRUE(list[0].index[i] <= list[0].cells);
     }
     for (i = 0; i < list[0].cells; ++i) {
-        assert_true(list[0].index[list[0].rows + i] < list[0].stride);
+        TEST_ASSERT_TRUE(list[0].index[list[0].rows + i] < list[0].stride);
     }
-    assert_true(list[1].index[0] == 0 && list[1].cells == 0);
+    TEST_ASSERT_TRUE(list[1].index[0] == 0 && list[1].cells == 0);
     memset(products, 0, sizeof products);
     value = icoac_priv_critic_value_dense(&cfg->critic, &grid, v, s, &products[0]);
     /* factors computed from NaN are NaN of either sign (IEEE 754 leaves it open): a positive one
      * counts as kept (V NaN, which the tick rejects), a negative one as dropped (V 0) */
-    assert_true(isnan((double)value) || value == ICOAC_R(0.0));
-    assert_true(products[0].cell_begin <= products[0].cell_end);
-    assert_true(products[0].cell_end <= products[0].stride);
-    assert_true(products[1].cell_begin == 0 && products[1].cell_end == 0);
+    TEST_ASSERT_TRUE(isnan((double)value) || value == ICOAC_R(0.0));
+    TEST_ASSERT_TRUE(products[0].cell_begin <= products[0].cell_end);
+    TEST_ASSERT_TRUE(products[0].cell_end <= products[0].stride);
+    TEST_ASSERT_TRUE(products[1].cell_begin == 0 && products[1].cell_end == 0);
 }
 
-static void test_critic_scan_bounded_for_nan(void **unused)
+static void test_critic_scan_bounded_for_nan(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_real_t v[ICOAC_PRIV_CRITIC_WEIGHTS];
     icoac_real_t s[ICOAC_MAX_INPUTS] = {ICOAC_R(0.3), ICOAC_R(-0.2), ICOAC_R(0.05), ICOAC_R(0.1)};
     icoac_real_t all_nan[ICOAC_MAX_INPUTS];
     int i;
-    (void)unused;
     cfg.mode = ICOAC_MODE_RL; /* the mode with a critic geometry */
     for (i = 0; i < ICOAC_PRIV_CRITIC_WEIGHTS; ++i) {
         v[i] = (icoac_real_t)0.5;
@@ -174,34 +173,32 @@ static void test_critic_scan_bounded_for_nan(void **unused)
 
 /* Reproducer 1, second half: the configuration is now rejected, and an RL tick at s = 0 from
  * the nearest accepted range is finite. */
-static void test_subnormal_critic_range(void **unused)
+static void test_subnormal_critic_range(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
     icoac_input_t in = test_input(0, 0, 0, 0, 0);
     const char *field = NULL;
-    (void)unused;
     cfg.mode = ICOAC_MODE_RL;
     cfg.critic.range[0] = (icoac_real_t)1e-39;
-    assert_int_equal(icoac_config_check_field(&cfg, &field), ICOAC_ERR_BAD_CRITIC);
-    assert_string_equal(field, "critic.range[0]");
-    assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_ERR_BAD_CRITIC);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_CRITIC, icoac_config_check_field(&cfg, &field));
+    TEST_ASSERT_EQUAL_STRING("critic.range[0]", field);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_CRITIC, icoac_init(&cfg, &state, NULL, 1u));
     cfg.critic.range[0] = ICOAC_RANGE_MIN;
-    assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
-    assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 1u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, checked_step(&cfg, &state, &in));
     in.s[0] = (icoac_real_t)1e30; /* far outside the narrow grid: s * n / range overflows */
-    assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, checked_step(&cfg, &state, &in));
     in.s[0] = -FLT_MAX;
-    assert_int_equal(checked_step(&cfg, &state, &in), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, checked_step(&cfg, &state, &in));
 }
 
 /* Reproducer 2: unclipped inputs with a huge finite x gave an OK tick with an infinite force
  * (ICO) or NaN weights (RL). Now: a numeric fault, nothing learned, and the controller goes
  * on from the same state when the input is sane again. */
-static void test_unclipped_huge_input(void **unused)
+static void test_unclipped_huge_input(void)
 {
     int mode;
-    (void)unused;
     for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
@@ -212,16 +209,16 @@ static void test_unclipped_huge_input(void **unused)
         cfg.mode = mode;
         cfg.policy.clip_inputs = 0;
         cfg.policy.input_range[0] = ICOAC_RANGE_MIN;
-        assert_int_equal(icoac_init(&cfg, &state, NULL, 3u), ICOAC_OK);
-        assert_int_equal(checked_step(&cfg, &state, &calm), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 3u));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, checked_step(&cfg, &state, &calm));
         twin = state;
-        assert_int_equal(checked_step(&cfg, &state, &huge), ICOAC_ERR_NUMERIC);
-        assert_int_equal(checked_step(&cfg, &state, &calm), ICOAC_OK);
-        assert_int_equal(checked_step(&cfg, &twin, &calm), ICOAC_OK);
-        assert_memory_equal(priv(&state)->w, priv(&twin)->w, sizeof priv(&state)->w);
-        assert_memory_equal(priv(&state)->v, priv(&twin)->v, sizeof priv(&state)->v);
-        assert_memory_equal(icoac_priv_cov_c(priv(&state)), icoac_priv_cov_c(priv(&twin)),
-                            sizeof(icoac_real_t) * ICOAC_CARTPOLE_INPUTS * ICOAC_CARTPOLE_INPUTS);
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NUMERIC, checked_step(&cfg, &state, &huge));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, checked_step(&cfg, &state, &calm));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, checked_step(&cfg, &twin, &calm));
+        TEST_ASSERT_EQUAL_MEMORY(priv(&twin)->w, priv(&state)->w, sizeof priv(&state)->w);
+        TEST_ASSERT_EQUAL_MEMORY(priv(&twin)->v, priv(&state)->v, sizeof priv(&state)->v);
+        TEST_ASSERT_EQUAL_MEMORY(icoac_priv_cov_c(priv(&twin)), icoac_priv_cov_c(priv(&state)),
+                                 sizeof(icoac_real_t) * ICOAC_CARTPOLE_INPUTS * ICOAC_CARTPOLE_INPUTS);
     }
 }
 
@@ -230,7 +227,7 @@ static void test_unclipped_huge_input(void **unused)
  * differently (a subnormal diagonal becomes 0, a subnormal asymmetry disappears). Now rejected;
  * the largest accepted covariance, inflated by forgetting (posterior reading, the literal one),
  * gives numeric faults. */
-static void test_prior_bounds(void **unused)
+static void test_prior_bounds(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
@@ -238,71 +235,68 @@ static void test_prior_bounds(void **unused)
     icoac_input_t in = test_input(1.0, 0.5, 0.1, 0.2, 0);
     int k;
     int faults = 0;
-    (void)unused;
-    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_BAD_PRIOR);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_PRIOR, icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS));
     prior = test_prior(0, 0, 0, 0, 1.0);
     prior.cov[1][1] = (icoac_real_t)1e-39; /* subnormal in float, tiny in double: below 1e-12 of the rest */
-    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), REAL_IS_FLOAT ? ICOAC_ERR_BAD_PRIOR : ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(REAL_IS_FLOAT ? ICOAC_ERR_BAD_PRIOR : ICOAC_OK, icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS));
     prior = test_prior(0, 0, 0, 0, 1.0);
     prior.cov[3][0] = (icoac_real_t)(REAL_IS_FLOAT ? -1e-39 : -1e-310);
-    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_BAD_PRIOR);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_PRIOR, icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS));
     prior.cov[0][3] = prior.cov[3][0]; /* symmetric now, but still subnormal */
-    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_BAD_PRIOR);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_PRIOR, icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS));
     prior = test_prior(ICOAC_PRIOR_MEAN_MAX, 0, 0, 0, 1.1 * (double)ICOAC_PRIOR_COV_MAX);
-    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), ICOAC_ERR_BAD_PRIOR);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_PRIOR, icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS));
 
     prior = test_prior(ICOAC_PRIOR_MEAN_MAX, 0.1, 0.5, 0.1, (double)ICOAC_PRIOR_COV_MAX);
     cfg.mode = ICOAC_MODE_RL;
     test_literal_reading(&cfg);
     cfg.actor.forgetting = ICOAC_FORGETTING_MIN;
-    assert_int_equal(icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS), ICOAC_OK);
-    assert_int_equal(icoac_init(&cfg, &state, &prior, 5u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_prior_check(&prior, ICOAC_CARTPOLE_INPUTS));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, &prior, 5u));
     for (k = 0; k < (REAL_IS_FLOAT ? 200 : 1200); ++k) {
         faults += checked_step(&cfg, &state, &in) == ICOAC_ERR_NUMERIC;
     }
-    assert_true(faults > 0);
-    assert_int_equal(priv(&state)->counters.numeric_faults, (uint32_t)faults);
+    TEST_ASSERT_TRUE(faults > 0);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)faults, priv(&state)->counters.numeric_faults);
 }
 
 /* Forgetting inflates Sigma_w by 1/lambda per tick (posterior reading, exploring at every
  * tick); at s = 0 no observation informs it, so it overflows after ~128 ticks at lambda = 0.5.
  * Every tick is OK and finite until then, every later one a numeric fault. */
-static void test_forgetting_overflow_is_a_fault(void **unused)
+static void test_forgetting_overflow_is_a_fault(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
     icoac_input_t in = test_input(0, 0, 0, 0, 0);
     int k;
     int first_fault = -1;
-    (void)unused;
     cfg.mode = ICOAC_MODE_RL;
     test_literal_reading(&cfg);
     cfg.actor.forgetting = ICOAC_FORGETTING_MIN;
-    assert_int_equal(icoac_init(&cfg, &state, NULL, 11u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 11u));
     for (k = 0; k < (REAL_IS_FLOAT ? 400 : 2200); ++k) {
         const icoac_status_t status = checked_step(&cfg, &state, &in);
         if (status != ICOAC_OK && first_fault < 0) {
             first_fault = k;
         }
         if (first_fault >= 0) {
-            assert_int_equal(status, ICOAC_ERR_NUMERIC);
+            TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NUMERIC, status);
         }
     }
-    assert_true(first_fault > 100);
-    assert_int_equal(priv(&state)->counters.numeric_faults, (uint32_t)((REAL_IS_FLOAT ? 400 : 2200) - first_fault));
+    TEST_ASSERT_TRUE(first_fault > 100);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)((REAL_IS_FLOAT ? 400 : 2200) - first_fault), priv(&state)->counters.numeric_faults);
 }
 
 /* Random walks over accepted extreme configurations and extreme finite inputs: every tick
  * keeps the contract (checked_step asserts it). RL runs cycle through the three actor readings
  * (sigma_L = sigma_u or the largest sigma_L), per tick or per trial, with or without an
  * exploration schedule. */
-static void test_contract_random_extremes(void **unused)
+static void test_contract_random_extremes(void)
 {
     static const double extremes[] = {0.0, -0.0, 1e-39, -1e-39, 1e-6, 0.5, -1.0, 3.0, 1e6, -1e12, 1e30, -3e38};
     const int n_extremes = (int)(sizeof extremes / sizeof extremes[0]);
     test_rng_t rng = {0xC0FFEEu};
     int run;
-    (void)unused;
     for (run = 0; run < 200; ++run) {
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
@@ -325,8 +319,9 @@ static void test_contract_random_extremes(void **unused)
         cfg.actor.batch = (run / 48) % 2;
         cfg.actor.explore_ticks = run % 11 < 4 ? 0 : (run % 11 < 8 ? 3 : 1000);
         cfg.actor.likelihood_std = run % 13 ? ICOAC_R(0.0) : ICOAC_NOISE_STD_MAX;
-        assert_int_equal(icoac_init(&cfg, &state, NULL, (uint64_t)run), ICOAC_OK);
-        for (k = 0; k < 300; ++k) {
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, (uint64_t)run));
+        /* every configuration, fewer ticks each on an emulated core (QEMU is slow) */
+        for (k = 0; k < TEST_ITERATIONS(300, 30); ++k) {
             icoac_input_t in;
             int i;
             for (i = 0; i < ICOAC_CARTPOLE_INPUTS; ++i) {
@@ -336,42 +331,43 @@ static void test_contract_random_extremes(void **unused)
             in.flags = test_rng_u64(&rng) % 20u == 0u ? ICOAC_INPUT_TERMINAL : 0u;
             (void)checked_step(&cfg, &state, &in);
             if (test_rng_u64(&rng) % 50u == 0u) {
-                assert_int_equal(icoac_reset(&state), ICOAC_OK);
-                assert_true(state_finite(&state));
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
+                TEST_ASSERT_TRUE(state_finite(&state));
             }
         }
     }
 }
 
 /* The finiteness check itself, on every class of value. */
-static void test_all_finite(void **unused)
+static void test_all_finite(void)
 {
     icoac_real_t values[4] = {ICOAC_R(0.0), ICOAC_R(-0.0), ICOAC_R(1.0), ICOAC_R(-3.0e38)};
-    (void)unused;
-    assert_true(icoac_priv_all_finite(values, 4));
+    TEST_ASSERT_TRUE(icoac_priv_all_finite(values, 4));
     values[2] = (icoac_real_t)1e-39; /* subnormal (float) is finite */
-    assert_true(icoac_priv_all_finite(values, 4));
+    TEST_ASSERT_TRUE(icoac_priv_all_finite(values, 4));
     values[1] = (icoac_real_t)INFINITY;
-    assert_false(icoac_priv_all_finite(values, 4));
+    TEST_ASSERT_FALSE(icoac_priv_all_finite(values, 4));
     values[1] = (icoac_real_t)-INFINITY;
-    assert_false(icoac_priv_all_finite(values, 4));
+    TEST_ASSERT_FALSE(icoac_priv_all_finite(values, 4));
     values[1] = (icoac_real_t)NAN;
-    assert_false(icoac_priv_all_finite(values, 4));
+    TEST_ASSERT_FALSE(icoac_priv_all_finite(values, 4));
     values[1] = -(icoac_real_t)NAN;
-    assert_false(icoac_priv_all_finite(values, 4));
-    assert_true(icoac_priv_all_finite(values, 1));
+    TEST_ASSERT_FALSE(icoac_priv_all_finite(values, 4));
+    TEST_ASSERT_TRUE(icoac_priv_all_finite(values, 1));
 }
+
+void setUp(void) {}
+void tearDown(void) {}
 
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_critic_scan_bounded_for_nan),
-        cmocka_unit_test(test_subnormal_critic_range),
-        cmocka_unit_test(test_unclipped_huge_input),
-        cmocka_unit_test(test_prior_bounds),
-        cmocka_unit_test(test_forgetting_overflow_is_a_fault),
-        cmocka_unit_test(test_contract_random_extremes),
-        cmocka_unit_test(test_all_finite),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_critic_scan_bounded_for_nan);
+    RUN_TEST(test_subnormal_critic_range);
+    RUN_TEST(test_unclipped_huge_input);
+    RUN_TEST(test_prior_bounds);
+    RUN_TEST(test_forgetting_overflow_is_a_fault);
+    RUN_TEST(test_contract_random_extremes);
+    RUN_TEST(test_all_finite);
+    return UNITY_END();
 }

@@ -5,6 +5,9 @@
 
 #include "icoac_priv.h"
 
+/* Ticks of each run: fewer on an emulated core (QEMU is slow, and the forces are kept in RAM). */
+#define TICKS TEST_ITERATIONS(20000, 1000)
+
 static icoac_input_t wandering_input(test_rng_t *rng, uint32_t flags)
 {
     return test_input(test_uniform(rng, -2.5, 2.5), test_uniform(rng, -2, 2), test_uniform(rng, -0.22, 0.22),
@@ -17,15 +20,15 @@ static void run(const icoac_config_t *cfg, icoac_state_t *state, const icoac_pri
 {
     test_rng_t rng = {77u};
     int k;
-    assert_int_equal(icoac_init(cfg, state, prior, 3u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(cfg, state, prior, 3u));
     for (k = 0; k < n; ++k) {
         icoac_output_t out;
         const uint32_t flags = k % 97 == 96 ? ICOAC_INPUT_TERMINAL : 0u;
         icoac_input_t in = wandering_input(&rng, flags);
-        assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, &in, &out));
         forces[k] = (double)out.force;
         if (flags != 0u) {
-            assert_int_equal(icoac_reset(state), ICOAC_OK);
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(state));
         }
     }
 }
@@ -33,12 +36,11 @@ static void run(const icoac_config_t *cfg, icoac_state_t *state, const icoac_pri
 /* Nothing learned changes over a long run, in either mode and with either way of acting, and
  * in RL with each actor reading (the default gradient one, the literal posterior one, the
  * mean one per trial). */
-static void test_control_learns_nothing(void **unused)
+static void test_control_learns_nothing(void)
 {
-    static double forces[20000];
+    static double forces[TICKS];
     const icoac_prior_t prior = test_prior(0.1, 0.05, 0.4, 0.1, 0.3);
     int variant;
-    (void)unused;
     for (variant = 0; variant < 6; ++variant) {
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
@@ -56,11 +58,11 @@ static void test_control_learns_nothing(void **unused)
             cfg.actor.batch = 1;
         }
         memset(v0, 0, sizeof v0);
-        run(&cfg, &state, &prior, forces, 20000);
-        assert_int_equal(icoac_get_posterior(&state, &post), ICOAC_OK);
-        assert_memory_equal(post.mean, prior.mean, sizeof post.mean);
-        assert_memory_equal(post.cov, prior.cov, sizeof post.cov);
-        assert_memory_equal(st->v, v0, sizeof v0);
+        run(&cfg, &state, &prior, forces, TICKS);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(&state, &post));
+        TEST_ASSERT_EQUAL_MEMORY(prior.mean, post.mean, sizeof post.mean);
+        TEST_ASSERT_EQUAL_MEMORY(prior.cov, post.cov, sizeof post.cov);
+        TEST_ASSERT_EQUAL_MEMORY(v0, st->v, sizeof v0);
     }
 }
 
@@ -69,12 +71,11 @@ static void test_control_learns_nothing(void **unused)
  * gradient reading; the posterior reading still shrinks Sigma_w there, which does not change
  * how the mean acts), tick by tick, with the same noise and exploration schedule, for each
  * reading. And learning does change the forces. */
-static void test_control_equals_zero_rates(void **unused)
+static void test_control_equals_zero_rates(void)
 {
-    static double control[20000], zero_rates[20000], learning[20000];
+    static double control[TICKS], zero_rates[TICKS], learning[TICKS];
     const icoac_prior_t prior = test_prior(0.1, 0.05, 0.4, 0.1, 0.3);
     int variant;
-    (void)unused;
     for (variant = 0; variant < 4; ++variant) {
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
@@ -85,9 +86,9 @@ static void test_control_equals_zero_rates(void **unused)
         case 2: cfg.actor.update = ICOAC_ACTOR_MEAN; cfg.actor.explore_ticks = 0; break;
         default: cfg.actor.explore_ticks = 40; break; /* shorter than the 97-tick trials */
         }
-        run(&cfg, &state, &prior, learning, 20000);
+        run(&cfg, &state, &prior, learning, TICKS);
         cfg.learn = 0;
-        run(&cfg, &state, &prior, control, 20000);
+        run(&cfg, &state, &prior, control, TICKS);
         cfg.learn = 1;
         cfg.critic.rate = 0;
         if (cfg.actor.update == ICOAC_ACTOR_GRADIENT) {
@@ -95,29 +96,30 @@ static void test_control_equals_zero_rates(void **unused)
         } else {
             cfg.actor.scale = 0;
         }
-        run(&cfg, &state, &prior, zero_rates, 20000);
-        assert_memory_equal(control, zero_rates, sizeof control);
-        assert_true(memcmp(control, learning, sizeof control) != 0);
+        run(&cfg, &state, &prior, zero_rates, TICKS);
+        TEST_ASSERT_EQUAL_MEMORY(zero_rates, control, sizeof control);
+        TEST_ASSERT_TRUE(memcmp(control, learning, sizeof control) != 0);
     }
 }
 
-static void test_learn_is_a_flag(void **unused)
+static void test_learn_is_a_flag(void)
 {
     icoac_config_t cfg = test_default_config();
     const char *field = 0;
-    (void)unused;
-    assert_int_equal(cfg.learn, 1);
+    TEST_ASSERT_EQUAL_INT(1, cfg.learn);
     cfg.learn = 2;
-    assert_int_equal(icoac_config_check_field(&cfg, &field), ICOAC_ERR_BAD_MODE);
-    assert_string_equal(field, "learn");
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_MODE, icoac_config_check_field(&cfg, &field));
+    TEST_ASSERT_EQUAL_STRING("learn", field);
 }
+
+void setUp(void) {}
+void tearDown(void) {}
 
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_control_learns_nothing),
-        cmocka_unit_test(test_control_equals_zero_rates),
-        cmocka_unit_test(test_learn_is_a_flag),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_control_learns_nothing);
+    RUN_TEST(test_control_equals_zero_rates);
+    RUN_TEST(test_learn_is_a_flag);
+    return UNITY_END();
 }

@@ -51,7 +51,7 @@ static icoac_config_t grid_config(const grid_t *g)
         cfg.critic.range[i] = i < g->n ? (icoac_real_t)g->ranges[i] : (icoac_real_t)1.0;
         cfg.critic.units[i] = i < g->n ? g->sizes[i] : 1;
     }
-    assert_int_equal(icoac_config_check(&cfg), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&cfg));
     return cfg;
 }
 
@@ -84,7 +84,7 @@ static long double distance2(const grid_t *g, const icoac_real_t *s_in, int i, i
  * double, so far-out states do not turn into 0/0; the shifts cancel in the ratio. */
 static void direct_b(const grid_t *g, const icoac_real_t *s_in, double *b)
 {
-    static long double logs[1024];
+    static long double logs[KMAX];
     long double top = -1e300L, total = 0;
     const int units = units_of(g);
     int k, i;
@@ -154,7 +154,7 @@ static void library_b(int kernel, const icoac_config_t *cfg, const icoac_real_t 
     icoac_priv_critic_active_t active;
     int k;
     memset(v, 0, sizeof v);
-    assert_true(kernel_value(kernel, cfg, v, s, &active) == 0);
+    TEST_ASSERT_TRUE(kernel_value(kernel, cfg, v, s, &active) == 0);
     kernel_update(kernel, cfg, v, &active, (icoac_real_t)1.0);
     for (k = 0; k < KMAX; ++k) {
         b[k] = (double)v[k];
@@ -177,7 +177,7 @@ static void random_state(const grid_t *g, test_rng_t *rng, int far, icoac_real_t
 }
 
 /* The integer comparison behind the threshold agrees with >= on non-negative reals. */
-static void test_nonneg_at_least(void **unused)
+static void test_nonneg_at_least(void)
 {
     const icoac_real_t special[] = {(icoac_real_t)0.0, (icoac_real_t)1e-45, (icoac_real_t)1e-40,
                                     (icoac_real_t)1e-38, (icoac_real_t)0.001, (icoac_real_t)0.5,
@@ -185,26 +185,24 @@ static void test_nonneg_at_least(void **unused)
     const int n_special = (int)(sizeof special / sizeof special[0]);
     test_rng_t rng = {77u};
     int i, j;
-    (void)unused;
     for (i = 0; i < n_special; ++i) {
         for (j = 0; j < n_special; ++j) {
-            assert_int_equal(icoac_priv_nonneg_at_least(special[i], special[j]), special[i] >= special[j]);
+            TEST_ASSERT_EQUAL_INT(special[i] >= special[j], icoac_priv_nonneg_at_least(special[i], special[j]));
         }
     }
     for (i = 0; i < 100000; ++i) {
         const icoac_real_t a = (icoac_real_t)pow(10.0, test_uniform(&rng, -40, 3));
         const icoac_real_t b = i % 3 == 0 ? a : (icoac_real_t)pow(10.0, test_uniform(&rng, -40, 3));
-        assert_int_equal(icoac_priv_nonneg_at_least(a, b), a >= b);
+        TEST_ASSERT_EQUAL_INT(a >= b, icoac_priv_nonneg_at_least(a, b));
     }
 }
 
-static void test_grid_centres(void **unused)
+static void test_grid_centres(void)
 {
     /* the centres listed in method.md: x {-1.6, 0, 1.6}; theta +-2, +-6, +-10 deg (to 4 digits) */
     const double x_c[3] = {-1.6, 0.0, 1.6};
     const double th_c[6] = {-10, -6, -2, 2, 6, 10};
     int j;
-    (void)unused;
     for (j = 0; j < 3; ++j) {
         assert_close(-2.4 + (2 * j + 1) * 2.4 / 3, x_c[j], 1e-12);
     }
@@ -213,26 +211,29 @@ static void test_grid_centres(void **unused)
     }
 }
 
+/* Random states per grid (and kernel, in test_separable_equals_direct): fewer on an emulated core
+ * (QEMU is slow). */
+#define STATES TEST_ITERATIONS(200, 40)
+
 /* Every kernel on every grid equals the n-D definition, with threshold 0 (every unit). */
-static void test_separable_equals_direct(void **unused)
+static void test_separable_equals_direct(void)
 {
     test_rng_t rng = {0xC0FFEEu};
-    static double bl[KMAX], bd[1024];
+    static double bl[KMAX], bd[KMAX];
     int gi, n, k;
-    (void)unused;
     for (gi = 0; gi < N_GRIDS; ++gi) {
         const grid_t *g = &grids[gi];
         icoac_config_t cfg = grid_config(g);
         const int units = units_of(g);
         cfg.critic.threshold = 0; /* every unit */
-        for (n = 0; n < 2 * 200; ++n) {
-            const int kernel = n / 200;
+        for (n = 0; n < 2 * STATES; ++n) {
+            const int kernel = n / STATES;
             icoac_real_t s[ICOAC_MAX_INPUTS];
             double sum = 0;
-            random_state(g, &rng, n % 200 >= 100, s);
-            if (n % 200 == 0) {
+            random_state(g, &rng, n % STATES >= STATES / 2, s);
+            if (n % STATES == 0) {
                 memset(s, 0, sizeof s); /* between or on centres */
-            } else if (n % 200 == 1) {
+            } else if (n % STATES == 1) {
                 s[0] = (icoac_real_t)(g->ranges[0] * (1.0 - 1.0 / g->sizes[0])); /* on the last centre */
                 s[g->n - 1] = (icoac_real_t)-1e6;
             }
@@ -240,15 +241,15 @@ static void test_separable_equals_direct(void **unused)
             direct_b(g, s, bd);
             for (k = 0; k < units; ++k) {
                 if (!(fabs(bl[k] - bd[k]) <= b_tol())) {
-                    print_error("grid %d kernel %d state %d unit %d: %.10g vs %.10g at (%.17g, %.17g, %.17g, %.17g)\n", gi, kernel, n, k,
+                    TEST_PRINTF("grid %d kernel %d state %d unit %d: %g vs %g at (%g, %g, %g, %g)", gi, kernel, n, k,
                                 bl[k], bd[k], (double)s[0], (double)s[1], (double)s[2], (double)s[3]);
-                    fail();
+                    TEST_FAIL();
                 }
-                assert_true(bl[k] >= 0.0);
+                TEST_ASSERT_TRUE(bl[k] >= 0.0);
                 sum += bl[k];
             }
             for (k = units; k < KMAX; ++k) {
-                assert_true(bl[k] == 0.0); /* nothing past the grid's units */
+                TEST_ASSERT_TRUE(bl[k] == 0.0); /* nothing past the grid's units */
             }
             assert_close(sum, 1.0, REAL_IS_FLOAT ? 1e-5 : 1e-12);
         }
@@ -262,10 +263,10 @@ static void check_value(const grid_t *g, icoac_real_t threshold, unsigned seed, 
     const int units = units_of(g);
     icoac_real_t v[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t active;
-    static double bd[1024];
+    static double bd[KMAX];
     int n, k;
     cfg.critic.threshold = threshold;
-    for (n = 0; n < 100; ++n) {
+    for (n = 0; n < STATES / 2; ++n) {
         double expected = 0, slack = 0;
         for (k = 0; k < KMAX; ++k) {
             v[k] = k < units ? (icoac_real_t)test_uniform(&rng, -1, 1) : (icoac_real_t)NAN; /* past the grid: unread */
@@ -280,10 +281,9 @@ static void check_value(const grid_t *g, icoac_real_t threshold, unsigned seed, 
     }
 }
 
-static void test_value_is_weighted_sum(void **unused)
+static void test_value_is_weighted_sum(void)
 {
     int gi, kernel;
-    (void)unused;
     for (gi = 0; gi < N_GRIDS; ++gi) {
         for (kernel = SPARSE; kernel < KERNELS; ++kernel) {
             check_value(&grids[gi], (icoac_real_t)0.001, 31u, kernel); /* the default */
@@ -293,27 +293,26 @@ static void test_value_is_weighted_sum(void **unused)
     }
 }
 
-static void test_threshold_drops_small_activations(void **unused)
+static void test_threshold_drops_small_activations(void)
 {
     test_rng_t rng = {8u};
-    static double bl[KMAX], bd[1024];
+    static double bl[KMAX], bd[KMAX];
     int gi, n, k, dropped = 0, kept = 0;
-    (void)unused;
     for (gi = 0; gi < N_GRIDS; ++gi) {
         const grid_t *g = &grids[gi];
         const icoac_config_t cfg = grid_config(g);
-        assert_true(cfg.critic.threshold == (icoac_real_t)0.001); /* the authors' cut-off is the default */
-        for (n = 0; n < 2 * 100; ++n) {
+        TEST_ASSERT_TRUE(cfg.critic.threshold == (icoac_real_t)0.001); /* the authors' cut-off is the default */
+        for (n = 0; n < STATES; ++n) {
             icoac_real_t s[ICOAC_MAX_INPUTS];
-            random_state(g, &rng, n % 100 >= 75, s);
-            library_b(n / 100, &cfg, s, bl);
+            random_state(g, &rng, n % (STATES / 2) >= STATES * 3 / 8, s);
+            library_b(n / (STATES / 2), &cfg, s, bl);
             direct_b(g, s, bd);
             for (k = 0; k < units_of(g); ++k) {
                 if (near_threshold(bd[k], 0.001)) {
                     continue;
                 }
                 if (bd[k] < 0.001) {
-                    assert_true(bl[k] == 0.0);
+                    TEST_ASSERT_TRUE(bl[k] == 0.0);
                     ++dropped;
                 } else {
                     assert_close(bl[k], bd[k], b_tol());
@@ -322,53 +321,52 @@ static void test_threshold_drops_small_activations(void **unused)
             }
         }
     }
-    assert_true(dropped > 0 && kept > 0);
+    TEST_ASSERT_TRUE(dropped > 0 && kept > 0);
 }
 
 /* The sparse kernel's kept-unit list: rows in order with their leading cells, cells sorted by
  * product with a zero sentinel, and exactly the units with b_k >= threshold. */
-static void test_kept_unit_list(void **unused)
+static void test_kept_unit_list(void)
 {
     test_rng_t rng = {12u};
     icoac_real_t v[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t active;
-    static double bd[1024];
-    static int listed[1024];
+    static double bd[KMAX];
+    static int listed[KMAX];
     int gi, n, i, r, total_kept = 0, total_units = 0, all_kept_grids = 0;
-    (void)unused;
     memset(v, 0, sizeof v);
     for (gi = 0; gi < N_GRIDS; ++gi) {
         const grid_t *g = &grids[gi];
         icoac_config_t cfg = grid_config(g);
         const icoac_priv_critic_list_t *list = &active.sparse;
         const int units = units_of(g);
-        for (n = 0; n < 200; ++n) {
+        for (n = 0; n < STATES; ++n) {
             random_state(g, &rng, n % 3 == 2, s);
             (void)kernel_value(SPARSE, &cfg, v, s, &active);
             direct_b(g, s, bd);
-            assert_int_equal(list->rows * list->stride, units);
-            assert_true(list->stride <= ICOAC_CRITIC_BLOCK_MAX && list->rows <= ICOAC_CRITIC_BLOCK_MAX);
-            assert_true(list->cells <= list->stride);
-            assert_true(list->rows + list->cells < ICOAC_PRIV_LIST);
-            assert_true(list->product[list->rows + list->cells] == 0);
+            TEST_ASSERT_EQUAL_INT(units, list->rows * list->stride);
+            TEST_ASSERT_TRUE(list->stride <= ICOAC_CRITIC_BLOCK_MAX && list->rows <= ICOAC_CRITIC_BLOCK_MAX);
+            TEST_ASSERT_TRUE(list->cells <= list->stride);
+            TEST_ASSERT_TRUE(list->rows + list->cells < ICOAC_PRIV_LIST);
+            TEST_ASSERT_TRUE(list->product[list->rows + list->cells] == 0);
             for (i = 1; i < list->cells; ++i) {
-                assert_true(list->product[list->rows + i - 1] >= list->product[list->rows + i]);
+                TEST_ASSERT_TRUE(list->product[list->rows + i - 1] >= list->product[list->rows + i]);
             }
             for (i = 0; i < list->cells; ++i) {
-                assert_true(list->index[list->rows + i] < list->stride);
+                TEST_ASSERT_TRUE(list->index[list->rows + i] < list->stride);
             }
             memset(listed, 0, sizeof listed);
             for (r = 0; r < list->rows; ++r) {
-                assert_true(list->index[r] <= list->cells);
+                TEST_ASSERT_TRUE(list->index[r] <= list->cells);
                 for (i = 0; i < list->index[r]; ++i) {
                     const int k = r * list->stride + list->index[list->rows + i];
-                    assert_true(listed[k] == 0);
+                    TEST_ASSERT_TRUE(listed[k] == 0);
                     listed[k] = 1;
                 }
             }
             for (i = 0; i < units; ++i) {
                 if (!near_threshold(bd[i], 0.001)) {
-                    assert_int_equal(listed[i], bd[i] >= 0.001);
+                    TEST_ASSERT_EQUAL_INT(bd[i] >= 0.001, listed[i]);
                 }
                 total_kept += listed[i];
             }
@@ -383,21 +381,21 @@ static void test_kept_unit_list(void **unused)
         for (i = 0; i < units && bd[i] > 1e-30; ++i) {
         }
         if (i == units) {
-            assert_int_equal(list->cells, list->stride);
+            TEST_ASSERT_EQUAL_INT(list->stride, list->cells);
             for (r = 0; r < list->rows; ++r) {
-                assert_int_equal(list->index[r], list->stride);
+                TEST_ASSERT_EQUAL_INT(list->stride, list->index[r]);
             }
             ++all_kept_grids;
         }
     }
-    assert_true(all_kept_grids >= 2); /* the cart-pole's and the double pendulum's at least */
-    assert_true(total_kept > 0 && total_kept < total_units / 2); /* the threshold does prune */
+    TEST_ASSERT_TRUE(all_kept_grids >= 2); /* the cart-pole's and the double pendulum's at least */
+    TEST_ASSERT_TRUE(total_kept > 0 && total_kept < total_units / 2); /* the threshold does prune */
     /* the cart-pole's blocks: (x, x_dot) rows by (theta, theta_dot) cells */
     {
         icoac_config_t cfg = grid_config(&grids[CARTPOLE]);
         (void)kernel_value(SPARSE, &cfg, v, s, &active);
-        assert_int_equal(active.sparse.rows, ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT);
-        assert_int_equal(active.sparse.stride, ICOAC_CRITIC_N_THETA * ICOAC_CRITIC_N_THETA_DOT);
+        TEST_ASSERT_EQUAL_INT(ICOAC_CRITIC_N_X * ICOAC_CRITIC_N_X_DOT, active.sparse.rows);
+        TEST_ASSERT_EQUAL_INT(ICOAC_CRITIC_N_THETA * ICOAC_CRITIC_N_THETA_DOT, active.sparse.stride);
     }
 }
 
@@ -405,16 +403,15 @@ static void test_kept_unit_list(void **unused)
  * the grid), weights and steps, over thresholds 0, the default and 0.05, both keep the same
  * units, so a sequence of updates with the same steps leaves both weight vectors equal bit for
  * bit; V differs only by the rounding of the sum's order (relative to sum |v_k b_k|). */
-static void test_dense_matches_sparse(void **unused)
+static void test_dense_matches_sparse(void)
 {
     const icoac_real_t thresholds[3] = {(icoac_real_t)0.0, (icoac_real_t)0.001, (icoac_real_t)0.05};
     test_rng_t rng = {0xD15Eu};
     icoac_real_t v_sparse[KMAX], v_dense[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t sparse, dense;
-    static double bd[1024];
+    static double bd[KMAX];
     double max_rel = 0;
     int gi, t, n, k;
-    (void)unused;
     for (gi = 0; gi < N_GRIDS; ++gi) {
         const grid_t *g = &grids[gi];
         icoac_config_t cfg = grid_config(g);
@@ -423,7 +420,8 @@ static void test_dense_matches_sparse(void **unused)
             for (k = 0; k < KMAX; ++k) {
                 v_sparse[k] = v_dense[k] = (icoac_real_t)test_uniform(&rng, -2, 2);
             }
-            for (n = 0; n < 1000; ++n) {
+            /* fewer states on an emulated core (QEMU is slow) */
+            for (n = 0; n < TEST_ITERATIONS(1000, 100); ++n) {
                 double magnitude = 0;
                 icoac_real_t value_sparse, value_dense, step;
                 random_state(g, &rng, n % 10 == 9, s);
@@ -440,20 +438,20 @@ static void test_dense_matches_sparse(void **unused)
                 step = (icoac_real_t)test_uniform(&rng, -0.05, 0.05);
                 kernel_update(SPARSE, &cfg, v_sparse, &sparse, step);
                 kernel_update(DENSE, &cfg, v_dense, &dense, step);
-                assert_memory_equal(v_dense, v_sparse, sizeof v_sparse);
+                TEST_ASSERT_EQUAL_MEMORY(v_sparse, v_dense, sizeof v_sparse);
             }
         }
     }
-    assert_true(max_rel > 0); /* the orders do differ: the comparison is not vacuous */
+    TEST_ASSERT_TRUE(max_rel > 0); /* the orders do differ: the comparison is not vacuous */
 }
 
 static void step_ok(const icoac_config_t *cfg, icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
 {
     test_assert_config_in_force(cfg, state);
-    assert_int_equal(icoac_step(state, in, out), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, in, out));
 }
 
-static void test_td_update_through_step(void **unused)
+static void test_td_update_through_step(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
@@ -467,20 +465,19 @@ static void test_td_update_through_step(void **unused)
     const grid_t *g = &grids[CARTPOLE];
     double va = 0, vb = 0, delta;
     int k;
-    (void)unused;
     cfg.mode = ICOAC_MODE_RL;
-    assert_int_equal(icoac_init(&cfg, &state, NULL, 77u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 77u));
 
     /* tick 1: non-terminal s_t, v = 0, nothing to learn yet */
     step_ok(&cfg, &state, &st, &out);
-    assert_true(out.value == 0 && out.td_error == 0);
+    TEST_ASSERT_TRUE(out.value == 0 && out.td_error == 0);
     for (k = 0; k < K; ++k) {
-        assert_true(priv->v[k] == 0);
+        TEST_ASSERT_TRUE(priv->v[k] == 0);
     }
     /* tick 2: terminal: delta = -1 + 0 - V(s_t) = -1, v += eta * delta * b(s_t) */
     step_ok(&cfg, &state, &fail_in, &out);
     assert_close(out.td_error, -1.0, 0.0);
-    assert_true(out.force == 0);
+    TEST_ASSERT_TRUE(out.force == 0);
     direct_b_kept(g, st.s, 0.001, b_t);
     for (k = 0; k < K; ++k) {
         assert_close(priv->v[k], -0.6 * b_t[k], b_tol());
@@ -488,27 +485,27 @@ static void test_td_update_through_step(void **unused)
     }
 
     /* a non-terminal transition s_a -> s_b: delta = gamma V(s_b) - V(s_a) */
-    assert_int_equal(icoac_reset(&state), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
     direct_b_kept(g, sa.s, 0.001, b_a);
     direct_b_kept(g, sb.s, 0.001, b_b);
     for (k = 0; k < K; ++k) {
         va += v1[k] * b_a[k];
         vb += v1[k] * b_b[k];
     }
-    assert_true(va < -0.01); /* close to s_t: clearly negative */
+    TEST_ASSERT_TRUE(va < -0.01); /* close to s_t: clearly negative */
     step_ok(&cfg, &state, &sa, &out);
     assert_close(out.value, va, REAL_IS_FLOAT ? 1e-6 : 1e-12);
     step_ok(&cfg, &state, &sb, &out);
     assert_close(out.value, vb, REAL_IS_FLOAT ? 1e-6 : 1e-12);
     delta = 0.95 * vb - va;
-    assert_true(fabs(delta) < 1.0);
+    TEST_ASSERT_TRUE(fabs(delta) < 1.0);
     assert_close(out.td_error, delta, REAL_IS_FLOAT ? 2e-6 : 1e-12);
     for (k = 0; k < K; ++k) {
         assert_close(priv->v[k], v1[k] + 0.6 * delta * b_a[k], REAL_IS_FLOAT ? 2e-6 : 1e-12);
     }
 }
 
-static void test_td_clip(void **unused)
+static void test_td_clip(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
@@ -518,11 +515,10 @@ static void test_td_clip(void **unused)
     icoac_input_t fail_in = test_input(-2.41, 0.4, -0.1, 0.5, ICOAC_INPUT_TERMINAL);
     double b_t[K];
     int k;
-    (void)unused;
     cfg.mode = ICOAC_MODE_RL;
     cfg.critic.td_clip = (icoac_real_t)0.25;
     cfg.critic.rate = (icoac_real_t)0.5;
-    assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 1u));
     step_ok(&cfg, &state, &st, &out);
     step_ok(&cfg, &state, &fail_in, &out);
     assert_close(out.td_error, -0.25, 0.0);
@@ -532,18 +528,20 @@ static void test_td_clip(void **unused)
     }
 }
 
+void setUp(void) {}
+void tearDown(void) {}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_nonneg_at_least),
-        cmocka_unit_test(test_grid_centres),
-        cmocka_unit_test(test_separable_equals_direct),
-        cmocka_unit_test(test_value_is_weighted_sum),
-        cmocka_unit_test(test_threshold_drops_small_activations),
-        cmocka_unit_test(test_kept_unit_list),
-        cmocka_unit_test(test_dense_matches_sparse),
-        cmocka_unit_test(test_td_update_through_step),
-        cmocka_unit_test(test_td_clip),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_nonneg_at_least);
+    RUN_TEST(test_grid_centres);
+    RUN_TEST(test_separable_equals_direct);
+    RUN_TEST(test_value_is_weighted_sum);
+    RUN_TEST(test_threshold_drops_small_activations);
+    RUN_TEST(test_kept_unit_list);
+    RUN_TEST(test_dense_matches_sparse);
+    RUN_TEST(test_td_update_through_step);
+    RUN_TEST(test_td_clip);
+    return UNITY_END();
 }

@@ -14,14 +14,14 @@ static void init_with_w(const icoac_config_t *cfg, icoac_state_t *state, double 
                         double w3)
 {
     icoac_prior_t p = test_prior(w0, w1, w2, w3, 1.0);
-    assert_int_equal(icoac_init(cfg, state, &p, 11u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(cfg, state, &p, 11u));
 }
 
 static void get_w(const icoac_state_t *state, double w[4])
 {
     icoac_prior_t post;
     int i;
-    assert_int_equal(icoac_get_posterior(state, &post), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(state, &post));
     for (i = 0; i < 4; ++i) {
         w[i] = (double)post.mean[i];
     }
@@ -58,10 +58,10 @@ static void run_scaling(int clip)
         w[scale_rows[r].component] = 1.0;
         init_with_w(&cfg, &state, w[0], w[1], w[2], w[3]);
         in = test_input(s[0], s[1], s[2], s[3], 0);
-        assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
         expected = test_scale(scale_rows[r].component, (double)in.s[scale_rows[r].component], clip);
         if (clip) {
-            assert_true(fabs(expected) <= 1.0);
+            TEST_ASSERT_TRUE(fabs(expected) <= 1.0);
         }
         assert_close(out.z, expected, tol_of(expected));
         /* F = G z + U (1 N). */
@@ -69,24 +69,21 @@ static void run_scaling(int clip)
     }
 }
 
-static void test_scaling_clipped(void **unused)
+static void test_scaling_clipped(void)
 {
-    (void)unused;
     run_scaling(1);
 }
 
-static void test_scaling_unclipped(void **unused)
+static void test_scaling_unclipped(void)
 {
-    (void)unused;
     run_scaling(0);
 }
 
-static void test_feature_is_dot_product(void **unused)
+static void test_feature_is_dot_product(void)
 {
     const double w[4] = {0.5, -0.25, 2.0, 1.0};
     test_rng_t rng = {0x1234567u};
     int k, i;
-    (void)unused;
     for (k = 0; k < 200; ++k) {
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
@@ -97,7 +94,7 @@ static void test_feature_is_dot_product(void **unused)
         cfg.policy.clip_inputs = (int32_t)(k & 1);
         cfg.ico.rate = 0;
         init_with_w(&cfg, &state, w[0], w[1], w[2], w[3]);
-        assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
         for (i = 0; i < 4; ++i) {
             z += w[i] * test_scale(i, (double)in.s[i], cfg.policy.clip_inputs);
         }
@@ -150,11 +147,11 @@ static void run_zone_table(int reflex_mode, double reflex_force, const double w[
         cfg.policy.reflex_mode = reflex_mode;
         cfg.policy.reflex_force = (icoac_real_t)reflex_force;
         init_with_w(&cfg, &state, w[0], w[1], w[2], w[3]);
-        assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
         if (out.reflex != row->reflex || out.penalty != row->penalty) {
-            print_error("row %s: U = %g r = %g, expected U = %g r = %g\n", row->name, (double)out.reflex,
+            TEST_PRINTF("row %s: U = %g r = %g, expected U = %g r = %g", row->name, (double)out.reflex,
                         (double)out.penalty, row->reflex, row->penalty);
-            fail();
+            TEST_FAIL();
         }
         for (i = 0; i < 4; ++i) {
             z += w[i] * test_scale(i, (double)in.s[i], 1);
@@ -162,75 +159,71 @@ static void run_zone_table(int reflex_mode, double reflex_force, const double w[
         force = reflex_mode == ICOAC_REFLEX_GAIN ? 10.0 * (z + row->reflex) : 10.0 * z + reflex_force * row->reflex;
         assert_close(out.z, z, tol_of(4.0));
         assert_close(out.force, force, tol_of(40.0));
-        assert_int_equal(out.status, ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, out.status);
     }
 }
 
-static void test_zone_table_unit_reflex(void **unused)
+static void test_zone_table_unit_reflex(void)
 {
     const double w0[4] = {0, 0, 0, 0};
     const double w1[4] = {0.075, 0.049, 0.318, 0.085};
-    (void)unused;
     run_zone_table(ICOAC_REFLEX_UNIT, 1.0, w0);
     run_zone_table(ICOAC_REFLEX_UNIT, 1.0, w1);
     run_zone_table(ICOAC_REFLEX_UNIT, 2.5, w1);
 }
 
-static void test_zone_table_gain_reflex(void **unused)
+static void test_zone_table_gain_reflex(void)
 {
     const double w0[4] = {0, 0, 0, 0};
     const double w1[4] = {0.075, 0.049, 0.318, 0.085};
-    (void)unused;
     run_zone_table(ICOAC_REFLEX_GAIN, 1.0, w0);
     run_zone_table(ICOAC_REFLEX_GAIN, 1.0, w1);
     /* reflex_force is not used in gain mode */
     run_zone_table(ICOAC_REFLEX_GAIN, 2.5, w1);
 }
 
-static void test_zone_edges_are_strict(void **unused)
+static void test_zone_edges_are_strict(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
     icoac_output_t out;
     icoac_input_t in;
-    (void)unused;
     /* exactly on the thresholds (as stored in the configuration): not in the zone */
     const double edges[4][2] = {{0, 1}, {0, -1}, {1, 0}, {-1, 0}};
     int e;
     for (e = 0; e < 4; ++e) {
-        assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 1u));
         in = test_input(0, 0, 0, 0, 0);
         in.s[0] = (icoac_real_t)edges[e][0] * cfg.task.rule_threshold[3]; /* x above 2.35 m */
         in.s[2] = (icoac_real_t)edges[e][1] * cfg.task.rule_threshold[0]; /* theta above 11.5 deg */
-        assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-        assert_true(out.reflex == 0 && out.penalty == 0);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+        TEST_ASSERT_TRUE(out.reflex == 0 && out.penalty == 0);
     }
 }
 
 /* The private feature helpers of the tick (icoac_features.h) on the same tables. */
-static void test_feature_helpers(void **unused)
+static void test_feature_helpers(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
     size_t r;
     int clip, i;
-    (void)unused;
     for (r = 0; r < sizeof zone_rows / sizeof zone_rows[0]; ++r) {
         const icoac_real_t s[ICOAC_MAX_INPUTS] = {(icoac_real_t)zone_rows[r].x, ICOAC_R(0.3),
                                                   (icoac_real_t)zone_rows[r].theta, ICOAC_R(-0.4)};
         const icoac_priv_zone_t zone =
             icoac_priv_zone(&cfg.task, icoac_priv_rules(&cfg.task), ICOAC_CARTPOLE_INPUTS, s);
-        assert_true(zone.reflex == zone_rows[r].reflex && zone.penalty == zone_rows[r].penalty);
+        TEST_ASSERT_TRUE(zone.reflex == zone_rows[r].reflex && zone.penalty == zone_rows[r].penalty);
     }
     cfg.policy.reflex_force = (icoac_real_t)2.5;
     cfg.policy.reflex_mode = ICOAC_REFLEX_UNIT;
-    assert_true(icoac_priv_reflex_force(&cfg.policy, ICOAC_R(-1.0)) == (icoac_real_t)-2.5);
+    TEST_ASSERT_TRUE(icoac_priv_reflex_force(&cfg.policy, ICOAC_R(-1.0)) == (icoac_real_t)-2.5);
     cfg.policy.reflex_mode = ICOAC_REFLEX_GAIN;
-    assert_true(icoac_priv_reflex_force(&cfg.policy, ICOAC_R(1.0)) == cfg.policy.gain);
-    assert_true(icoac_priv_reflex_force(&cfg.policy, ICOAC_R(0.0)) == 0);
+    TEST_ASSERT_TRUE(icoac_priv_reflex_force(&cfg.policy, ICOAC_R(1.0)) == cfg.policy.gain);
+    TEST_ASSERT_TRUE(icoac_priv_reflex_force(&cfg.policy, ICOAC_R(0.0)) == 0);
     for (clip = 0; clip <= 1; ++clip) {
         cfg.policy.clip_inputs = clip;
-        assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 1u));
         for (r = 0; r < sizeof scale_rows / sizeof scale_rows[0]; ++r) {
             icoac_real_t s[ICOAC_MAX_INPUTS] = {ICOAC_R(0.0)};
             icoac_real_t scaled[ICOAC_MAX_INPUTS];
@@ -246,7 +239,7 @@ static void test_feature_helpers(void **unused)
 
 /* ---- ICO update, code timing ---- */
 
-static void test_ico_code_timing(void **unused)
+static void test_ico_code_timing(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
@@ -255,22 +248,21 @@ static void test_ico_code_timing(void **unused)
     const double w0[4] = {0.01, 0.02, 0.03, 0.04};
     double w[4], xs[4], expect_w[4], z;
     int i;
-    (void)unused;
     init_with_w(&cfg, &state, w0[0], w0[1], w0[2], w0[3]);
 
     /* tick 1: outside the zone, r = 0 -> 0: no learning */
     in = test_input(0.5, 0.2, 0.05, -0.3, 0);
-    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-    assert_true(out.q == 0 && out.penalty == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+    TEST_ASSERT_TRUE(out.q == 0 && out.penalty == 0);
     get_w(&state, w);
     for (i = 0; i < 4; ++i) {
-        assert_true(w[i] == (double)(icoac_real_t)w0[i]);
+        TEST_ASSERT_TRUE(w[i] == (double)(icoac_real_t)w0[i]);
     }
 
     /* tick 2: enters the zone (theta > 11.5 deg), r 0 -> -1: q = 1, w += mu |x~| */
     in = test_input(-1.0, 4.0, 0.205, -1.0, 0);
-    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-    assert_true(out.q == 1 && out.penalty == -1 && out.reflex == 1);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+    TEST_ASSERT_TRUE(out.q == 1 && out.penalty == -1 && out.reflex == 1);
     z = 0;
     for (i = 0; i < 4; ++i) {
         xs[i] = test_scale(i, (double)in.s[i], 1);
@@ -284,7 +276,7 @@ static void test_ico_code_timing(void **unused)
     get_w(&state, w);
     for (i = 0; i < 4; ++i) {
         assert_close(w[i], expect_w[i], 4.0 * REAL_EPS * 0.05);
-        assert_true(w[i] > w0[i]);
+        TEST_ASSERT_TRUE(w[i] > w0[i]);
     }
     assert_close(out.weight_norm,
                  sqrt(expect_w[0] * expect_w[0] + expect_w[1] * expect_w[1] + expect_w[2] * expect_w[2] +
@@ -293,8 +285,8 @@ static void test_ico_code_timing(void **unused)
 
     /* tick 3: still in the zone (other side, other state): no more learning, acts with the new w */
     in = test_input(2.37, -0.5, -0.1, 0.7, 0);
-    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-    assert_true(out.q == 0 && out.penalty == -1 && out.reflex == -1);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+    TEST_ASSERT_TRUE(out.q == 0 && out.penalty == -1 && out.reflex == -1);
     z = 0;
     for (i = 0; i < 4; ++i) {
         z += expect_w[i] * test_scale(i, (double)in.s[i], 1);
@@ -303,23 +295,23 @@ static void test_ico_code_timing(void **unused)
     {
         double w3[4];
         get_w(&state, w3);
-        assert_memory_equal(w3, w, sizeof w);
+        TEST_ASSERT_EQUAL_MEMORY(w, w3, sizeof w);
     }
 
     /* tick 4: leaves the zone, r -1 -> 0: q = 0 */
     in = test_input(0.0, 0.0, 0.0, 0.0, 0);
-    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-    assert_true(out.q == 0 && out.penalty == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+    TEST_ASSERT_TRUE(out.q == 0 && out.penalty == 0);
     {
         double w4[4];
         get_w(&state, w4);
-        assert_memory_equal(w4, w, sizeof w);
+        TEST_ASSERT_EQUAL_MEMORY(w, w4, sizeof w);
     }
 
     /* tick 5: enters again (x < -2.35): learns again with this tick's x~ */
     in = test_input(-2.36, 0.35, -0.02, 0.1, 0);
-    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-    assert_true(out.q == 1 && out.reflex == 1);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+    TEST_ASSERT_TRUE(out.q == 1 && out.reflex == 1);
     {
         double w5[4];
         get_w(&state, w5);
@@ -330,7 +322,7 @@ static void test_ico_code_timing(void **unused)
 }
 
 /* Code timing never observes terminal (failure) states. */
-static void test_ico_code_timing_ignores_terminal(void **unused)
+static void test_ico_code_timing_ignores_terminal(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
@@ -338,28 +330,27 @@ static void test_ico_code_timing_ignores_terminal(void **unused)
     icoac_input_t in;
     double w[4];
     int i;
-    (void)unused;
     init_with_w(&cfg, &state, 0.1, 0.1, 0.1, 0.1);
     in = test_input(0.1, 0.1, 0.1, 0.1, 0);
-    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
     in = test_input(0.1, 0.1, 0.25, 0.1, ICOAC_INPUT_TERMINAL);
-    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-    assert_true(out.q == 0);
-    assert_true(out.force == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+    TEST_ASSERT_TRUE(out.q == 0);
+    TEST_ASSERT_TRUE(out.force == 0);
     get_w(&state, w);
     for (i = 0; i < 4; ++i) {
-        assert_true(w[i] == (double)(icoac_real_t)0.1);
+        TEST_ASSERT_TRUE(w[i] == (double)(icoac_real_t)0.1);
     }
     /* r_prev is still 0: the next in-zone observation learns */
-    assert_int_equal(icoac_reset(&state), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
     in = test_input(0.1, 0.1, 0.205, 0.1, 0);
-    assert_int_equal(icoac_step(&state, &in, &out), ICOAC_OK);
-    assert_true(out.q == 1);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+    TEST_ASSERT_TRUE(out.q == 1);
 }
 
 /* ---- ICO update, literal timing ---- */
 
-static void test_ico_literal_timing(void **unused)
+static void test_ico_literal_timing(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
@@ -368,18 +359,17 @@ static void test_ico_literal_timing(void **unused)
     const double w0[4] = {0.01, 0.02, 0.03, 0.04};
     double w[4], expect_w[4], z;
     int i;
-    (void)unused;
     cfg.ico.timing = ICOAC_ICO_TIMING_LITERAL;
     init_with_w(&cfg, &state, w0[0], w0[1], w0[2], w0[3]);
 
     a = test_input(0.5, -0.2, 0.15, 1.5, 0); /* outside the zone */
-    assert_int_equal(icoac_step(&state, &a, &out), ICOAC_OK);
-    assert_true(out.q == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &a, &out));
+    TEST_ASSERT_TRUE(out.q == 0);
 
     /* observes the zone: update with the previous tick's x~(a), then act with the new w */
     b = test_input(0.6, -0.1, 0.203, 1.4, 0);
-    assert_int_equal(icoac_step(&state, &b, &out), ICOAC_OK);
-    assert_true(out.q == 1 && out.penalty == -1);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &b, &out));
+    TEST_ASSERT_TRUE(out.q == 1 && out.penalty == -1);
     z = 0;
     for (i = 0; i < 4; ++i) {
         expect_w[i] = w0[i] + 1e-4 * fabs(test_scale(i, (double)a.s[i], 1));
@@ -394,16 +384,16 @@ static void test_ico_literal_timing(void **unused)
 
     /* staying in the zone: no more learning */
     c = test_input(0.7, -0.1, 0.207, 1.3, 0);
-    assert_int_equal(icoac_step(&state, &c, &out), ICOAC_OK);
-    assert_true(out.q == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &c, &out));
+    TEST_ASSERT_TRUE(out.q == 0);
     {
         double w2[4];
         get_w(&state, w2);
-        assert_memory_equal(w2, w, sizeof w);
+        TEST_ASSERT_EQUAL_MEMORY(w, w2, sizeof w);
     }
 }
 
-static void test_ico_literal_timing_terminal(void **unused)
+static void test_ico_literal_timing_terminal(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t state;
@@ -411,33 +401,31 @@ static void test_ico_literal_timing_terminal(void **unused)
     icoac_input_t a, f;
     double w[4];
     int i;
-    (void)unused;
     cfg.ico.timing = ICOAC_ICO_TIMING_LITERAL;
     init_with_w(&cfg, &state, 0, 0, 0, 0);
     a = test_input(-0.3, 0.8, -0.19, -1.7, 0);
-    assert_int_equal(icoac_step(&state, &a, &out), ICOAC_OK);
-    assert_true(out.q == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &a, &out));
+    TEST_ASSERT_TRUE(out.q == 0);
     /* jump straight to a failure state (theta < -12 deg), flagged terminal: learned from, no action */
     f = test_input(-0.29, 0.8, -0.215, -1.7, ICOAC_INPUT_TERMINAL);
-    assert_int_equal(icoac_step(&state, &f, &out), ICOAC_OK);
-    assert_true(out.q == 1);
-    assert_true(out.force == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &f, &out));
+    TEST_ASSERT_TRUE(out.q == 1);
+    TEST_ASSERT_TRUE(out.force == 0);
     get_w(&state, w);
     for (i = 0; i < 4; ++i) {
         assert_close(w[i], 1e-4 * fabs(test_scale(i, (double)a.s[i], 1)), 4.0 * REAL_EPS * 1e-4);
     }
     /* after a reset the first tick has no previous observation: no update even if r changes */
-    assert_int_equal(icoac_reset(&state), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
     a = test_input(0.0, 0.0, 0.0, 0.0, 0);
-    assert_int_equal(icoac_step(&state, &a, &out), ICOAC_OK);
-    assert_true(out.q == 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &a, &out));
+    TEST_ASSERT_TRUE(out.q == 0);
 }
 
 /* Code timing with a failure jump gives no learning, literal timing does (method.md, A4). */
-static void test_jump_over_zone(void **unused)
+static void test_jump_over_zone(void)
 {
     int timing;
-    (void)unused;
     for (timing = 0; timing <= 1; ++timing) {
         icoac_config_t cfg = test_default_config();
         icoac_state_t state;
@@ -445,29 +433,31 @@ static void test_jump_over_zone(void **unused)
         icoac_input_t a = test_input(0.0, 0.0, DEG(11.0), 1.0, 0);
         icoac_input_t f = test_input(0.0, 0.0, DEG(12.5), 1.0, ICOAC_INPUT_TERMINAL);
         cfg.ico.timing = timing;
-        assert_int_equal(icoac_init(&cfg, &state, NULL, 1u), ICOAC_OK);
-        assert_int_equal(icoac_step(&state, &a, &out), ICOAC_OK);
-        assert_int_equal(icoac_step(&state, &f, &out), ICOAC_OK);
-        assert_true(out.q == (timing == ICOAC_ICO_TIMING_LITERAL ? 1 : 0));
-        assert_true((out.weight_norm > 0) == (timing == ICOAC_ICO_TIMING_LITERAL));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 1u));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &a, &out));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &f, &out));
+        TEST_ASSERT_TRUE(out.q == (timing == ICOAC_ICO_TIMING_LITERAL ? 1 : 0));
+        TEST_ASSERT_TRUE((out.weight_norm > 0) == (timing == ICOAC_ICO_TIMING_LITERAL));
     }
 }
 
+void setUp(void) {}
+void tearDown(void) {}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_scaling_clipped),
-        cmocka_unit_test(test_scaling_unclipped),
-        cmocka_unit_test(test_feature_is_dot_product),
-        cmocka_unit_test(test_zone_table_unit_reflex),
-        cmocka_unit_test(test_zone_table_gain_reflex),
-        cmocka_unit_test(test_zone_edges_are_strict),
-        cmocka_unit_test(test_feature_helpers),
-        cmocka_unit_test(test_ico_code_timing),
-        cmocka_unit_test(test_ico_code_timing_ignores_terminal),
-        cmocka_unit_test(test_ico_literal_timing),
-        cmocka_unit_test(test_ico_literal_timing_terminal),
-        cmocka_unit_test(test_jump_over_zone),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_scaling_clipped);
+    RUN_TEST(test_scaling_unclipped);
+    RUN_TEST(test_feature_is_dot_product);
+    RUN_TEST(test_zone_table_unit_reflex);
+    RUN_TEST(test_zone_table_gain_reflex);
+    RUN_TEST(test_zone_edges_are_strict);
+    RUN_TEST(test_feature_helpers);
+    RUN_TEST(test_ico_code_timing);
+    RUN_TEST(test_ico_code_timing_ignores_terminal);
+    RUN_TEST(test_ico_literal_timing);
+    RUN_TEST(test_ico_literal_timing_terminal);
+    RUN_TEST(test_jump_over_zone);
+    return UNITY_END();
 }

@@ -47,8 +47,8 @@ static const icoac_sim_field_t *find_field(const char *type, const char *field)
             return &fields[i];
         }
     }
-    print_error("field %s.%s not in the layout table\n", type, field);
-    fail();
+    TEST_PRINTF("field %s.%s not in the layout table", type, field);
+    TEST_FAIL();
     return NULL;
 }
 
@@ -62,71 +62,70 @@ static double constant(const char *name)
             return constants[i].value;
         }
     }
-    print_error("constant %s not in the table\n", name);
-    fail();
+    TEST_PRINTF("constant %s not in the table", name);
+    TEST_FAIL();
     return 0.0;
 }
 
-static void test_constants_table(void **unused)
+static void test_constants_table(void)
 {
     int32_t n = -1;
     const icoac_sim_constant_t *constants = icoac_sim_constants(&n);
     int32_t i, j;
-    (void)unused;
-    assert_non_null(constants);
-    assert_true(n > 0);
-    assert_ptr_equal(icoac_sim_constants(NULL), constants); /* count may be NULL */
+    TEST_ASSERT_NOT_NULL(constants);
+    TEST_ASSERT_TRUE(n > 0);
+    TEST_ASSERT_EQUAL_PTR(constants, icoac_sim_constants(NULL)); /* count may be NULL */
     for (i = 0; i < n; ++i) {
-        assert_non_null(constants[i].name);
-        assert_true(strlen(constants[i].name) > 0);
-        assert_true(isfinite(constants[i].value));
+        TEST_ASSERT_NOT_NULL(constants[i].name);
+        TEST_ASSERT_TRUE(strlen(constants[i].name) > 0);
+        TEST_ASSERT_TRUE(isfinite(constants[i].value));
         for (j = 0; j < i; ++j) {
             if (strcmp(constants[i].name, constants[j].name) == 0) {
-                print_error("constant %s listed twice\n", constants[i].name);
-                fail();
+                TEST_PRINTF("constant %s listed twice", constants[i].name);
+                TEST_FAIL();
             }
         }
     }
     /* spot checks against the headers */
-    assert_true(constant("ICOAC_ABI_VERSION") == ICOAC_ABI_VERSION);
-    assert_true(constant("ICOAC_ABI_VERSION") == 8);
-    assert_true(constant("ICOAC_SIM_ABI_VERSION") == ICOAC_SIM_ABI_VERSION);
-    assert_true(constant("ICOAC_SIM_ABI_VERSION") == 3);
-    assert_true(constant("ICOAC_CARTPOLE_INPUTS") == ICOAC_CARTPOLE_INPUTS);
-    assert_true(constant("ICOAC_CARTPOLE_CRITIC_UNITS") == ICOAC_CARTPOLE_CRITIC_UNITS);
-    assert_true(constant("ICOAC_STATE_SIZE") == ICOAC_STATE_SIZE);
-    assert_true(constant("ICOAC_STATE_SIZE") == (double)icoac_sizeof_state());
-    assert_true(constant("ICOAC_INPUT_TERMINAL") == ICOAC_INPUT_TERMINAL);
-    assert_true(constant("ICOAC_FORCE_MAX") == (double)ICOAC_FORCE_MAX);
-    assert_true(constant("ICOAC_MODE_ICO") == ICOAC_MODE_ICO);
-    assert_true(constant("ICOAC_MODE_RL") == ICOAC_MODE_RL);
-    assert_true(constant("ICOAC_MODE_SEARCH") == ICOAC_MODE_SEARCH);
-    assert_true(constant("ICOAC_MODE_SEARCH") == 2);
-    assert_true(constant("ICOAC_ACTOR_POSTERIOR") == ICOAC_ACTOR_POSTERIOR);
-    assert_true(constant("ICOAC_ACTOR_MEAN") == ICOAC_ACTOR_MEAN);
-    assert_true(constant("ICOAC_ACTOR_GRADIENT") == ICOAC_ACTOR_GRADIENT);
-    assert_true(constant("ICOAC_SEARCH_BATCH_MAX") == ICOAC_SEARCH_BATCH_MAX);
-    assert_true(constant("ICOAC_EXPLORE_TICKS_MAX") == ICOAC_EXPLORE_TICKS_MAX);
-    assert_true(constant("ICOAC_ERR_BAD_SEARCH") == ICOAC_ERR_BAD_SEARCH);
-    assert_true(constant("ICOAC_ERR_BAD_SEARCH") == 18);
-    assert_true(constant("ICOAC_REFLEX_GAIN") == ICOAC_REFLEX_GAIN);
-    assert_true(constant("ICOAC_ICO_TIMING_LITERAL") == ICOAC_ICO_TIMING_LITERAL);
-    assert_true(constant("ICOAC_ERR_NUMERIC") == ICOAC_ERR_NUMERIC);
-    assert_true(constant("ICOAC_ERR_BAD_PRIOR") == ICOAC_ERR_BAD_PRIOR);
-    assert_true(constant("ICOAC_SIM_CANCELLED") == ICOAC_SIM_CANCELLED);
-    assert_true(constant("ICOAC_SIM_ERROR") == ICOAC_SIM_ERROR);
-    assert_true(constant("ICOAC_SIM_PROGRESS_LEN") == ICOAC_SIM_PROGRESS_LEN);
-    assert_true(constant("ICOAC_SIM_GRID_CELLS") == ICOAC_SIM_GRID_CELLS);
-    assert_true(constant("ICOAC_SIM_GRID_CELLS") == 1225);
-    assert_true(constant("ICOAC_SIM_GRID_X_FIRST") == ICOAC_SIM_GRID_X_FIRST);
-    assert_true(constant("ICOAC_SIM_GRID_X_STEP") == ICOAC_SIM_GRID_X_STEP);
-    assert_true(constant("ICOAC_SIM_GRID_THETA_FIRST_DEG") == ICOAC_SIM_GRID_THETA_FIRST_DEG);
-    assert_true(constant("ICOAC_SIM_PI") == ICOAC_SIM_PI);
-    assert_true(constant("ICOAC_SIM_MAX_STATE") == ICOAC_SIM_MAX_STATE);
-    assert_true(constant("ICOAC_SIM_MAX_PARAMS") == ICOAC_SIM_MAX_PARAMS);
-    assert_true(constant("ICOAC_SIM_CART_POLE") == ICOAC_SIM_CART_POLE);
-    assert_true(constant("ICOAC_SIM_START_STREAM") == ICOAC_SIM_START_STREAM);
-    assert_true(constant("ICOAC_SIM_ERR_NONFINITE") == ICOAC_SIM_ERR_NONFINITE);
+    TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == ICOAC_ABI_VERSION);
+    TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == 8);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == ICOAC_SIM_ABI_VERSION);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == 3);
+    TEST_ASSERT_TRUE(constant("ICOAC_CARTPOLE_INPUTS") == ICOAC_CARTPOLE_INPUTS);
+    TEST_ASSERT_TRUE(constant("ICOAC_CARTPOLE_CRITIC_UNITS") == ICOAC_CARTPOLE_CRITIC_UNITS);
+    TEST_ASSERT_TRUE(constant("ICOAC_STATE_SIZE") == ICOAC_STATE_SIZE);
+    TEST_ASSERT_TRUE(constant("ICOAC_STATE_SIZE") == (double)icoac_sizeof_state());
+    TEST_ASSERT_TRUE(constant("ICOAC_INPUT_TERMINAL") == ICOAC_INPUT_TERMINAL);
+    TEST_ASSERT_TRUE(constant("ICOAC_FORCE_MAX") == (double)ICOAC_FORCE_MAX);
+    TEST_ASSERT_TRUE(constant("ICOAC_MODE_ICO") == ICOAC_MODE_ICO);
+    TEST_ASSERT_TRUE(constant("ICOAC_MODE_RL") == ICOAC_MODE_RL);
+    TEST_ASSERT_TRUE(constant("ICOAC_MODE_SEARCH") == ICOAC_MODE_SEARCH);
+    TEST_ASSERT_TRUE(constant("ICOAC_MODE_SEARCH") == 2);
+    TEST_ASSERT_TRUE(constant("ICOAC_ACTOR_POSTERIOR") == ICOAC_ACTOR_POSTERIOR);
+    TEST_ASSERT_TRUE(constant("ICOAC_ACTOR_MEAN") == ICOAC_ACTOR_MEAN);
+    TEST_ASSERT_TRUE(constant("ICOAC_ACTOR_GRADIENT") == ICOAC_ACTOR_GRADIENT);
+    TEST_ASSERT_TRUE(constant("ICOAC_SEARCH_BATCH_MAX") == ICOAC_SEARCH_BATCH_MAX);
+    TEST_ASSERT_TRUE(constant("ICOAC_EXPLORE_TICKS_MAX") == ICOAC_EXPLORE_TICKS_MAX);
+    TEST_ASSERT_TRUE(constant("ICOAC_ERR_BAD_SEARCH") == ICOAC_ERR_BAD_SEARCH);
+    TEST_ASSERT_TRUE(constant("ICOAC_ERR_BAD_SEARCH") == 18);
+    TEST_ASSERT_TRUE(constant("ICOAC_REFLEX_GAIN") == ICOAC_REFLEX_GAIN);
+    TEST_ASSERT_TRUE(constant("ICOAC_ICO_TIMING_LITERAL") == ICOAC_ICO_TIMING_LITERAL);
+    TEST_ASSERT_TRUE(constant("ICOAC_ERR_NUMERIC") == ICOAC_ERR_NUMERIC);
+    TEST_ASSERT_TRUE(constant("ICOAC_ERR_BAD_PRIOR") == ICOAC_ERR_BAD_PRIOR);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_CANCELLED") == ICOAC_SIM_CANCELLED);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_ERROR") == ICOAC_SIM_ERROR);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_PROGRESS_LEN") == ICOAC_SIM_PROGRESS_LEN);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_GRID_CELLS") == ICOAC_SIM_GRID_CELLS);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_GRID_CELLS") == 1225);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_GRID_X_FIRST") == ICOAC_SIM_GRID_X_FIRST);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_GRID_X_STEP") == ICOAC_SIM_GRID_X_STEP);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_GRID_THETA_FIRST_DEG") == ICOAC_SIM_GRID_THETA_FIRST_DEG);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_PI") == ICOAC_SIM_PI);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_MAX_STATE") == ICOAC_SIM_MAX_STATE);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_MAX_PARAMS") == ICOAC_SIM_MAX_PARAMS);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_CART_POLE") == ICOAC_SIM_CART_POLE);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_START_STREAM") == ICOAC_SIM_START_STREAM);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_ERR_NONFINITE") == ICOAC_SIM_ERR_NONFINITE);
 }
 
 /* Byte coverage of one type by its listed members. */
@@ -137,7 +136,7 @@ static void check_type_layout(const icoac_sim_field_t *fields, int32_t n, const 
     int listed = 0;
     int32_t i;
     size_t b;
-    assert_non_null(covered);
+    TEST_ASSERT_NOT_NULL(covered);
     for (i = 0; i < n; ++i) {
         if (strcmp(fields[i].type, type->name) != 0) {
             continue;
@@ -145,56 +144,55 @@ static void check_type_layout(const icoac_sim_field_t *fields, int32_t n, const 
         ++listed;
         for (b = fields[i].offset; b < (size_t)fields[i].offset + fields[i].size; ++b) {
             if (covered[b]) {
-                print_error("%s.%s overlaps another member at byte %u\n", type->name, fields[i].field, (unsigned)b);
-                fail();
+                TEST_PRINTF("%s.%s overlaps another member at byte %u", type->name, fields[i].field, (unsigned)b);
+                TEST_FAIL();
             }
             covered[b] = 1;
             ++bytes;
         }
     }
-    assert_true(listed > 0);
+    TEST_ASSERT_TRUE(listed > 0);
     /* These structs have no padding with float reals (icoac_sim links the float library), so
      * the members listed must cover every byte: no member is missing from the table. */
     if (REAL_IS_FLOAT && bytes != type->size) {
-        print_error("%s: the listed members cover %u of %u bytes\n", type->name, (unsigned)bytes,
+        TEST_PRINTF("%s: the listed members cover %u of %u bytes", type->name, (unsigned)bytes,
                     (unsigned)type->size);
-        fail();
+        TEST_FAIL();
     }
     free(covered);
 }
 
-static void test_fields_table(void **unused)
+static void test_fields_table(void)
 {
     int32_t n = -1;
     const icoac_sim_field_t *fields = icoac_sim_fields(&n);
     int32_t i, j;
     size_t t;
-    (void)unused;
-    assert_non_null(fields);
-    assert_true(n > 0);
-    assert_ptr_equal(icoac_sim_fields(NULL), fields);
+    TEST_ASSERT_NOT_NULL(fields);
+    TEST_ASSERT_TRUE(n > 0);
+    TEST_ASSERT_EQUAL_PTR(fields, icoac_sim_fields(NULL));
     for (i = 0; i < n; ++i) {
         const type_size_t *type;
-        assert_non_null(fields[i].type);
-        assert_non_null(fields[i].field);
-        assert_true(strlen(fields[i].field) > 0);
+        TEST_ASSERT_NOT_NULL(fields[i].type);
+        TEST_ASSERT_NOT_NULL(fields[i].field);
+        TEST_ASSERT_TRUE(strlen(fields[i].field) > 0);
         type = find_type(fields[i].type);
         if (type == NULL) {
-            print_error("field %s of unknown type %s\n", fields[i].field, fields[i].type);
-            fail();
+            TEST_PRINTF("field %s of unknown type %s", fields[i].field, fields[i].type);
+            TEST_FAIL();
         }
         /* inside its type */
-        assert_true(fields[i].size > 0);
+        TEST_ASSERT_TRUE(fields[i].size > 0);
         if ((size_t)fields[i].offset + fields[i].size > type->size) {
-            print_error("%s.%s: offset %u + size %u > sizeof %u\n", fields[i].type, fields[i].field,
+            TEST_PRINTF("%s.%s: offset %u + size %u > sizeof %u", fields[i].type, fields[i].field,
                         (unsigned)fields[i].offset, (unsigned)fields[i].size, (unsigned)type->size);
-            fail();
+            TEST_FAIL();
         }
         /* unique (type, field) */
         for (j = 0; j < i; ++j) {
             if (strcmp(fields[i].type, fields[j].type) == 0 && strcmp(fields[i].field, fields[j].field) == 0) {
-                print_error("field %s.%s listed twice\n", fields[i].type, fields[i].field);
-                fail();
+                TEST_PRINTF("field %s.%s listed twice", fields[i].type, fields[i].field);
+                TEST_FAIL();
             }
         }
     }
@@ -206,13 +204,12 @@ static void test_fields_table(void **unused)
 #define SPOT(type, member)                                                                    \
     do {                                                                                      \
         const icoac_sim_field_t *f_ = find_field(#type, #member);                             \
-        assert_int_equal(f_->offset, offsetof(type, member));                                 \
-        assert_int_equal(f_->size, sizeof(((type *)0)->member));                              \
+        TEST_ASSERT_EQUAL_size_t(offsetof(type, member), f_->offset);                                 \
+        TEST_ASSERT_EQUAL_size_t(sizeof(((type *)0)->member), f_->size);                              \
     } while (0)
 
-static void test_fields_spot_checks(void **unused)
+static void test_fields_spot_checks(void)
 {
-    (void)unused;
     SPOT(icoac_config_t, mode);
     SPOT(icoac_config_t, policy.input_range);
     SPOT(icoac_config_t, policy.gain);
@@ -252,27 +249,29 @@ static void test_fields_spot_checks(void **unused)
     SPOT(icoac_sim_plant_desc_t, energy);
     SPOT(icoac_sim_model_t, param);
     /* the nested layout, as the table names it */
-    assert_int_equal(find_field("icoac_config_t", "critic.range")->size, ICOAC_MAX_INPUTS * sizeof(icoac_real_t));
-    assert_int_equal(find_field("icoac_config_t", "task.rule_input")->size, ICOAC_MAX_RULES * sizeof(int32_t));
-    assert_int_equal(find_field("icoac_config_t", "task.n_inputs")->offset, offsetof(icoac_config_t, task));
-    assert_int_equal(find_field("icoac_config_t", "mode")->offset, 0);
-    assert_int_equal(find_field("icoac_config_t", "policy.input_range")->offset, offsetof(icoac_config_t, policy));
-    assert_true(find_field("icoac_config_t", "ico.rate")->offset >= offsetof(icoac_config_t, ico));
-    assert_true(find_field("icoac_config_t", "actor.act_with_sample")->offset <
-                offsetof(icoac_config_t, actor) + sizeof(icoac_actor_config_t));
-    assert_int_equal(find_field("icoac_config_t", "search.batch")->offset, offsetof(icoac_config_t, search));
+    TEST_ASSERT_EQUAL_size_t(ICOAC_MAX_INPUTS * sizeof(icoac_real_t), find_field("icoac_config_t", "critic.range")->size);
+    TEST_ASSERT_EQUAL_size_t(ICOAC_MAX_RULES * sizeof(int32_t), find_field("icoac_config_t", "task.rule_input")->size);
+    TEST_ASSERT_EQUAL_size_t(offsetof(icoac_config_t, task), find_field("icoac_config_t", "task.n_inputs")->offset);
+    TEST_ASSERT_EQUAL_UINT32(0, find_field("icoac_config_t", "mode")->offset);
+    TEST_ASSERT_EQUAL_size_t(offsetof(icoac_config_t, policy), find_field("icoac_config_t", "policy.input_range")->offset);
+    TEST_ASSERT_TRUE(find_field("icoac_config_t", "ico.rate")->offset >= offsetof(icoac_config_t, ico));
+    TEST_ASSERT_TRUE(find_field("icoac_config_t", "actor.act_with_sample")->offset <
+                     offsetof(icoac_config_t, actor) + sizeof(icoac_actor_config_t));
+    TEST_ASSERT_EQUAL_size_t(offsetof(icoac_config_t, search), find_field("icoac_config_t", "search.batch")->offset);
     /* the search group is the last: its last member ends the struct (no tail padding with float) */
-    assert_true(find_field("icoac_config_t", "search.cov_scale")->offset + sizeof(icoac_real_t) +
+    TEST_ASSERT_TRUE(find_field("icoac_config_t", "search.cov_scale")->offset + sizeof(icoac_real_t) +
                     (REAL_IS_FLOAT ? 0 : sizeof(icoac_real_t) - 1) >=
                 sizeof(icoac_config_t));
 }
 
+void setUp(void) {}
+void tearDown(void) {}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_constants_table),
-        cmocka_unit_test(test_fields_table),
-        cmocka_unit_test(test_fields_spot_checks),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_constants_table);
+    RUN_TEST(test_fields_table);
+    RUN_TEST(test_fields_spot_checks);
+    return UNITY_END();
 }

@@ -3,9 +3,11 @@
  * non-finite fields, repeated terminal ticks and corrupted state bytes. Each reproducer of the
  * misuse report is a test here; run under ASan and UBSan (preset debug-asan), an access outside
  * the state or an undefined conversion fails it. */
-#include <stdlib.h>
-
 #include "test_common.h"
+
+#if !ICOAC_TEST_ON_TARGET
+#include <stdlib.h>
+#endif
 
 #include "icoac_priv.h"
 
@@ -36,17 +38,40 @@ static void assert_unchanged_but_scratch(const icoac_state_t *state, const icoac
     memcpy(&e->active[active_spare], &s->active[active_spare], sizeof e->active[active_spare]);
     memcpy(e->cov_buffer[cov_spare], s->cov_buffer[cov_spare], sizeof e->cov_buffer[cov_spare]);
     memcpy(e->batch.staged_shift, s->batch.staged_shift, sizeof e->batch.staged_shift);
-    assert_memory_equal(state, &expect, sizeof expect);
+    TEST_ASSERT_EQUAL_MEMORY(&expect, state, sizeof expect);
 }
 
+#if ICOAC_TEST_ON_TARGET
+/* No heap on a bare-metal core (firmware/port links none): the states (at most two at once in a
+ * test) come from a static pair, in turn. */
+static icoac_state_t *new_state(void)
+{
+    static icoac_state_t pair[2];
+    static unsigned next;
+    icoac_state_t *state = &pair[next++ % 2u];
+    memset(state, 0, sizeof *state);
+    return state;
+}
+
+static void free_state(icoac_state_t *state)
+{
+    (void)state;
+}
+#else
 /* A state in its own heap block of exactly its size, so that ASan sees a one-byte overrun. */
 static icoac_state_t *new_state(void)
 {
     icoac_state_t *state = malloc(sizeof *state);
-    assert_non_null(state);
+    TEST_ASSERT_NOT_NULL(state);
     memset(state, 0, sizeof *state);
     return state;
 }
+
+static void free_state(icoac_state_t *state)
+{
+    free(state);
+}
+#endif
 
 static icoac_input_t calm(test_rng_t *rng, uint32_t flags)
 {
@@ -60,13 +85,13 @@ static void trial(icoac_state_t *state, test_rng_t *rng, int ticks)
     icoac_output_t out;
     icoac_input_t in;
     int k;
-    assert_int_equal(icoac_reset(state), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(state));
     for (k = 0; k < ticks; ++k) {
         in = calm(rng, 0u);
-        assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, &in, &out));
     }
     in = calm(rng, ICOAC_INPUT_TERMINAL);
-    assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, &in, &out));
 }
 
 /* Reproducer: search mode, init, then search.batch = 1000 and 40 trials. Before, the tick used
@@ -74,7 +99,7 @@ static void trial(icoac_state_t *state, test_rng_t *rng, int ticks)
  * the state. Now the caller's edit changes nothing (the state runs on its own copy, bit for bit
  * as a twin that was never edited), and the same value forced into the state's copy is clamped
  * where it is used, then refused by icoac_reset. */
-static void test_search_batch_edited_after_init(void **unused)
+static void test_search_batch_edited_after_init(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_state_t *state = new_state();
@@ -83,37 +108,36 @@ static void test_search_batch_edited_after_init(void **unused)
     icoac_output_t out;
     icoac_input_t in;
     int t, k;
-    (void)unused;
     cfg.mode = ICOAC_MODE_SEARCH;
-    assert_int_equal(icoac_init(&cfg, state, NULL, 3u), ICOAC_OK);
-    assert_int_equal(icoac_init(&cfg, twin, NULL, 3u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, state, NULL, 3u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, twin, NULL, 3u));
     cfg.search.batch = 1000;
     for (t = 0; t < 40; ++t) {
         trial(state, &rng, 20);
         trial(twin, &rng_twin, 20);
     }
-    assert_memory_equal(state, twin, sizeof *state);
+    TEST_ASSERT_EQUAL_MEMORY(twin, state, sizeof *state);
     /* the same value inside the state (corrupted memory), with a full record: clamped */
     priv_mut(state)->config.search.batch = 1000;
     for (t = 0; t < 40; ++t) {
         priv_mut(state)->magic = ICOAC_PRIV_STATE_MAGIC; /* a new trial without the checks of a reset */
         for (k = 0; k < 20; ++k) {
             in = calm(&rng, 0u);
-            assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, &in, &out));
         }
         in = calm(&rng, ICOAC_INPUT_TERMINAL);
-        assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
-        assert_true(priv(state)->search.count >= 0 && priv(state)->search.count < ICOAC_SEARCH_BATCH_MAX);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, &in, &out));
+        TEST_ASSERT_TRUE(priv(state)->search.count >= 0 && priv(state)->search.count < ICOAC_SEARCH_BATCH_MAX);
     }
-    assert_int_equal(icoac_reset(state), ICOAC_ERR_CORRUPT_STATE);
-    free(state);
-    free(twin);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_CORRUPT_STATE, icoac_reset(state));
+    free_state(state);
+    free_state(twin);
 }
 
 /* Reproducer: policy.input_range edited after init kept its init-time 1/range (5979 of 6000
  * ticks differed from a fresh init). Now an edit alone changes nothing, and icoac_retune
  * applies it: the ticks then equal those of a fresh init with the edited configuration. */
-static void test_retune_applies_input_range(void **unused)
+static void test_retune_applies_input_range(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_config_t edited;
@@ -121,32 +145,31 @@ static void test_retune_applies_input_range(void **unused)
     icoac_state_t *fresh = new_state();
     test_rng_t rng = {2u};
     int k, differ = 0;
-    (void)unused;
-    assert_int_equal(icoac_init(&cfg, state, NULL, 5u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, state, NULL, 5u));
     edited = cfg;
     edited.policy.input_range[0] = ICOAC_R(1.2);
     edited.policy.input_range[2] = ICOAC_R(0.1);
-    assert_int_equal(icoac_init(&edited, fresh, NULL, 5u), ICOAC_OK);
-    assert_int_equal(icoac_retune(state, &edited), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&edited, fresh, NULL, 5u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_retune(state, &edited));
     test_assert_config_in_force(&edited, state);
     for (k = 0; k < 6000; ++k) {
         icoac_output_t out, out_fresh;
         icoac_input_t in = calm(&rng, 0u);
         memset(&out, 0, sizeof out); /* padding too (double build) */
         memset(&out_fresh, 0, sizeof out_fresh);
-        assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
-        assert_int_equal(icoac_step(fresh, &in, &out_fresh), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, &in, &out));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(fresh, &in, &out_fresh));
         differ += memcmp(&out, &out_fresh, sizeof out) != 0;
     }
-    assert_int_equal(differ, 0);
-    free(state);
-    free(fresh);
+    TEST_ASSERT_EQUAL_INT(0, differ);
+    free_state(state);
+    free_state(fresh);
 }
 
 /* search.floor and search.cov_scale: the floors follow a retune (floor * cov_scale * prior
  * variance), the learned Sigma_w is kept, and the next update holds Sigma_w's diagonal at the
  * new floors. */
-static void test_retune_search_floors(void **unused)
+static void test_retune_search_floors(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_config_t tuned;
@@ -154,34 +177,33 @@ static void test_retune_search_floors(void **unused)
     icoac_prior_t prior = test_prior(0.1, 0.2, 1.0, 0.3, 0.5), before, after;
     test_rng_t rng = {3u};
     int i, t;
-    (void)unused;
     cfg.mode = ICOAC_MODE_SEARCH;
     cfg.search.batch = 4;
     cfg.search.floor = ICOAC_R(1e-3);
-    assert_int_equal(icoac_init(&cfg, state, &prior, 9u), ICOAC_OK);
-    assert_int_equal(icoac_get_posterior(state, &before), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, state, &prior, 9u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(state, &before));
     tuned = cfg;
     tuned.search.floor = ICOAC_R(2.0);
     tuned.search.cov_scale = ICOAC_R(8.0);
-    assert_int_equal(icoac_retune(state, &tuned), ICOAC_OK);
-    assert_int_equal(icoac_get_posterior(state, &after), ICOAC_OK);
-    assert_memory_equal(&before, &after, sizeof before); /* nothing learned is lost */
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_retune(state, &tuned));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(state, &after));
+    TEST_ASSERT_EQUAL_MEMORY(&after, &before, sizeof before); /* nothing learned is lost */
     for (i = 0; i < N; ++i) {
-        assert_true(priv(state)->search.floor[i] == tuned.search.floor * (prior.cov[i][i] * tuned.search.cov_scale));
+        TEST_ASSERT_TRUE(priv(state)->search.floor[i] == tuned.search.floor * (prior.cov[i][i] * tuned.search.cov_scale));
     }
     for (t = 0; t < tuned.search.batch; ++t) {
         trial(state, &rng, 5);
     }
-    assert_int_equal(icoac_get_posterior(state, &after), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(state, &after));
     for (i = 0; i < N; ++i) {
-        assert_true(after.cov[i][i] >= priv(state)->search.floor[i]);
+        TEST_ASSERT_TRUE(after.cov[i][i] >= priv(state)->search.floor[i]);
     }
-    free(state);
+    free_state(state);
 }
 
 /* Reproducer: RL -> SEARCH without a re-init ran the search with a zero Cholesky factor and
  * explored nothing. A retune cannot change the mode; the state stays as it was. */
-static void test_retune_refuses_a_mode_change(void **unused)
+static void test_retune_refuses_a_mode_change(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_config_t other;
@@ -189,9 +211,8 @@ static void test_retune_refuses_a_mode_change(void **unused)
     icoac_state_t copy;
     test_rng_t rng = {4u};
     int mode;
-    (void)unused;
     cfg.mode = ICOAC_MODE_RL;
-    assert_int_equal(icoac_init(&cfg, state, NULL, 1u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, state, NULL, 1u));
     trial(state, &rng, 30);
     copy = *state;
     for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_SEARCH; ++mode) {
@@ -200,17 +221,17 @@ static void test_retune_refuses_a_mode_change(void **unused)
         }
         other = cfg;
         other.mode = mode;
-        assert_int_equal(icoac_retune(state, &other), ICOAC_ERR_RETUNE_MODE);
-        assert_memory_equal(state, &copy, sizeof copy);
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_RETUNE_MODE, icoac_retune(state, &other));
+        TEST_ASSERT_EQUAL_MEMORY(&copy, state, sizeof copy);
     }
-    free(state);
+    free_state(state);
 }
 
 /* Reproducer: mode 99 and ico.timing 7 ran a default branch with status OK. A retune refuses
  * them (state unchanged); forced into the state's copy, the tick refuses them with
  * ICOAC_ERR_CORRUPT_STATE (force 0, state unchanged but counters) and icoac_reset too. The same for
  * an unknown actor.update. */
-static void test_unknown_switches(void **unused)
+static void test_unknown_switches(void)
 {
     static const struct {
         int32_t mode;
@@ -224,7 +245,6 @@ static void test_unknown_switches(void **unused)
         {ICOAC_MODE_SEARCH, offsetof(icoac_config_t, mode), 3},
     };
     size_t c;
-    (void)unused;
     for (c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
         icoac_config_t cfg = test_default_config();
         icoac_config_t bad;
@@ -234,24 +254,24 @@ static void test_unknown_switches(void **unused)
         icoac_input_t in = test_input(0.1, 0.0, 0.02, 0.0, 0u);
         test_rng_t rng = {5u};
         cfg.mode = cases[c].mode;
-        assert_int_equal(icoac_init(&cfg, state, NULL, 1u), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, state, NULL, 1u));
         trial(state, &rng, 10);
-        assert_int_equal(icoac_reset(state), ICOAC_OK);
-        assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK); /* a transition to learn from next */
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(state));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, &in, &out)); /* a transition to learn from next */
         bad = cfg;
         memcpy((unsigned char *)&bad + cases[c].offset, &cases[c].value, sizeof cases[c].value);
         copy = *state;
-        assert_int_equal(icoac_retune(state, &bad), ICOAC_ERR_BAD_MODE);
-        assert_memory_equal(state, &copy, sizeof copy);
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_MODE, icoac_retune(state, &bad));
+        TEST_ASSERT_EQUAL_MEMORY(&copy, state, sizeof copy);
         memcpy((unsigned char *)&priv_mut(state)->config + cases[c].offset, &cases[c].value, sizeof cases[c].value);
         copy = *state;
         memset(&out, 0x7F, sizeof out);
-        assert_int_equal(icoac_step(state, &in, &out), ICOAC_ERR_CORRUPT_STATE);
-        assert_int_equal(out.status, ICOAC_ERR_CORRUPT_STATE);
-        assert_true(out.force == 0);
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_CORRUPT_STATE, icoac_step(state, &in, &out));
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_CORRUPT_STATE, out.status);
+        TEST_ASSERT_TRUE(out.force == 0);
         assert_unchanged_but_scratch(state, &copy);
-        assert_int_equal(icoac_reset(state), ICOAC_ERR_CORRUPT_STATE);
-        free(state);
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_CORRUPT_STATE, icoac_reset(state));
+        free_state(state);
     }
 }
 
@@ -261,7 +281,7 @@ static void test_unknown_switches(void **unused)
  * then run on the configuration in force. Corrupted learned values (NaN critic weights, as a
  * 1e38 rate used to leave) make the ticks ICOAC_ERR_NUMERIC and icoac_init restores the state;
  * corrupted actor weights are refused by icoac_reset too. */
-static void test_nonfinite_fields_and_recovery(void **unused)
+static void test_nonfinite_fields_and_recovery(void)
 {
     icoac_config_t cfg = test_default_config();
     icoac_config_t bad;
@@ -271,17 +291,16 @@ static void test_nonfinite_fields_and_recovery(void **unused)
     icoac_input_t in;
     test_rng_t rng = {6u};
     int t, k, numeric = 0;
-    (void)unused;
     cfg.mode = ICOAC_MODE_RL;
-    assert_int_equal(icoac_init(&cfg, state, NULL, 2u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, state, NULL, 2u));
     copy = *state;
     bad = cfg;
     bad.actor.noise_std = (icoac_real_t)NAN;
-    assert_int_equal(icoac_retune(state, &bad), ICOAC_ERR_BAD_ACTOR);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_ACTOR, icoac_retune(state, &bad));
     bad = cfg;
     bad.critic.rate = ICOAC_R(1e38);
-    assert_int_equal(icoac_retune(state, &bad), ICOAC_ERR_BAD_CRITIC);
-    assert_memory_equal(state, &copy, sizeof copy);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_CRITIC, icoac_retune(state, &bad));
+    TEST_ASSERT_EQUAL_MEMORY(&copy, state, sizeof copy);
     for (t = 0; t < 3; ++t) {
         trial(state, &rng, 50);
     }
@@ -289,29 +308,28 @@ static void test_nonfinite_fields_and_recovery(void **unused)
     for (k = 0; k < ICOAC_CARTPOLE_CRITIC_UNITS; ++k) {
         priv_mut(state)->v[k] = k % 2 ? (icoac_real_t)NAN : (icoac_real_t)INFINITY;
     }
-    assert_int_equal(icoac_reset(state), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(state));
     for (k = 0; k < 200; ++k) {
         in = calm(&rng, 0u);
         numeric += icoac_step(state, &in, &out) == ICOAC_ERR_NUMERIC;
     }
-    assert_true(numeric > 0);
+    TEST_ASSERT_TRUE(numeric > 0);
     priv_mut(state)->w[2] = (icoac_real_t)NAN;
-    assert_int_equal(icoac_reset(state), ICOAC_ERR_CORRUPT_STATE);
-    assert_int_equal(icoac_init(&cfg, state, NULL, 2u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_CORRUPT_STATE, icoac_reset(state));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, state, NULL, 2u));
     for (t = 0; t < 3; ++t) {
         trial(state, &rng, 50);
     }
-    free(state);
+    free_state(state);
 }
 
 /* Reproducer: elite_fraction 1e30 or NaN was an undefined float-to-int conversion. Forced into
  * the state's copy (a retune refuses it), a closing batch converts nothing out of range
  * (UBSan's float-cast-overflow) and the elite stays within the batch. */
-static void test_corrupted_elite_fraction(void **unused)
+static void test_corrupted_elite_fraction(void)
 {
     const icoac_real_t values[] = {ICOAC_R(1e30), (icoac_real_t)NAN, ICOAC_R(-1e30), (icoac_real_t)INFINITY};
     size_t v;
-    (void)unused;
     for (v = 0; v < sizeof values / sizeof values[0]; ++v) {
         icoac_config_t cfg = test_default_config();
         icoac_config_t bad;
@@ -322,34 +340,33 @@ static void test_corrupted_elite_fraction(void **unused)
         int t, k;
         cfg.mode = ICOAC_MODE_SEARCH;
         cfg.search.batch = 4;
-        assert_int_equal(icoac_init(&cfg, state, NULL, 4u), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, state, NULL, 4u));
         bad = cfg;
         bad.search.elite_fraction = values[v];
-        assert_int_equal(icoac_retune(state, &bad), ICOAC_ERR_BAD_SEARCH);
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_SEARCH, icoac_retune(state, &bad));
         priv_mut(state)->config.search.elite_fraction = values[v];
         for (t = 0; t < 2 * cfg.search.batch; ++t) {
             for (k = 0; k < 5 + t; ++k) {
                 in = calm(&rng, 0u);
-                assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, &in, &out));
             }
             in = calm(&rng, ICOAC_INPUT_TERMINAL);
-            assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, &in, &out));
             priv_mut(state)->magic = ICOAC_PRIV_STATE_MAGIC;
             priv_mut(state)->trial_ticks = 0u;
         }
-        assert_int_equal(icoac_reset(state), ICOAC_ERR_CORRUPT_STATE);
-        free(state);
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_CORRUPT_STATE, icoac_reset(state));
+        free_state(state);
     }
 }
 
 /* Reproducer: a corrupted state whose magic word survived made icoac_get_posterior read far
  * outside the state (through cov_slot). The slot is masked wherever it is read; icoac_reset
  * refuses the state. */
-static void test_corrupted_slots(void **unused)
+static void test_corrupted_slots(void)
 {
     const int32_t slots[] = {0x7FFFFFFF, -1, 2, (int32_t)0x80000000u};
     size_t s;
-    (void)unused;
     for (s = 0; s < sizeof slots / sizeof slots[0]; ++s) {
         icoac_config_t cfg = test_default_config();
         icoac_state_t *state = new_state();
@@ -360,28 +377,27 @@ static void test_corrupted_slots(void **unused)
         int k;
         cfg.mode = ICOAC_MODE_RL;
         test_literal_reading(&cfg); /* the posterior reading flips the covariance slot */
-        assert_int_equal(icoac_init(&cfg, state, NULL, 1u), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, state, NULL, 1u));
         priv_mut(state)->cov_slot = slots[s];
         priv_mut(state)->active_slot = slots[s];
-        assert_int_equal(icoac_get_posterior(state, &post), ICOAC_OK);
-        assert_memory_equal(post.cov, priv(state)->cov_buffer[slots[s] & 1], sizeof post.cov);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(state, &post));
+        TEST_ASSERT_EQUAL_MEMORY(priv(state)->cov_buffer[slots[s] & 1], post.cov, sizeof post.cov);
         for (k = 0; k < 50; ++k) {
             in = calm(&rng, 0u);
-            assert_int_equal(icoac_step(state, &in, &out), ICOAC_OK);
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, &in, &out));
         }
         priv_mut(state)->cov_slot = slots[s];
-        assert_int_equal(icoac_reset(state), ICOAC_ERR_CORRUPT_STATE);
-        free(state);
+        TEST_ASSERT_EQUAL_INT(ICOAC_ERR_CORRUPT_STATE, icoac_reset(state));
+        free_state(state);
     }
 }
 
 /* Reproducer: a repeated TERMINAL tick recorded the same search trial again (1000 repeats moved
  * mu_w far). Every tick after a terminal tick is refused with ICOAC_ERR_TRIAL_ENDED, the state
  * unchanged but for its tick counter, until icoac_reset; in every mode. */
-static void test_repeated_terminal(void **unused)
+static void test_repeated_terminal(void)
 {
     int mode;
-    (void)unused;
     for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_SEARCH; ++mode) {
         icoac_config_t cfg = test_default_config();
         icoac_state_t *state = new_state();
@@ -393,35 +409,38 @@ static void test_repeated_terminal(void **unused)
         int k;
         cfg.mode = mode;
         cfg.search.batch = 2;
-        assert_int_equal(icoac_init(&cfg, state, NULL, 1u), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, state, NULL, 1u));
         trial(state, &rng, 30);
         copy = *state;
         for (k = 0; k < 1000; ++k) {
             in = calm(&rng, k % 2 == 0 ? ICOAC_INPUT_TERMINAL : 0u);
             memset(&out, 0x7F, sizeof out);
-            assert_int_equal(icoac_step(state, &in, &out), ICOAC_ERR_TRIAL_ENDED);
-            assert_int_equal(out.status, ICOAC_ERR_TRIAL_ENDED);
-            assert_true(out.force == 0 && out.weight_norm == priv(state)->weight_norm);
+            TEST_ASSERT_EQUAL_INT(ICOAC_ERR_TRIAL_ENDED, icoac_step(state, &in, &out));
+            TEST_ASSERT_EQUAL_INT(ICOAC_ERR_TRIAL_ENDED, out.status);
+            TEST_ASSERT_TRUE(out.force == 0 && out.weight_norm == priv(state)->weight_norm);
         }
-        assert_int_equal(icoac_get_counters(state, &counters), ICOAC_OK);
-        assert_int_equal(counters.ticks, priv(&copy)->counters.ticks + 1000u);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_counters(state, &counters));
+        TEST_ASSERT_EQUAL_UINT32(priv(&copy)->counters.ticks + 1000u, counters.ticks);
         icoac_priv_state(&copy)->counters = counters;
-        assert_memory_equal(state, &copy, sizeof copy);
+        TEST_ASSERT_EQUAL_MEMORY(&copy, state, sizeof copy);
         trial(state, &rng, 30); /* a reset opens the next trial */
-        free(state);
+        free_state(state);
     }
 }
 
 /* The sparse kernel's update (the microcontrollers') on a kept-unit list of arbitrary bytes
  * writes only inside the state's weights: the heap block below holds exactly
- * ICOAC_PRIV_CRITIC_WEIGHTS reals. */
-static void test_corrupted_kept_unit_list(void **unused)
+ * ICOAC_PRIV_CRITIC_WEIGHTS reals (a static array on a bare-metal core, which has no heap). */
+static void test_corrupted_kept_unit_list(void)
 {
     test_rng_t rng = {10u};
+#if ICOAC_TEST_ON_TARGET
+    static icoac_real_t v[ICOAC_PRIV_CRITIC_WEIGHTS];
+#else
     icoac_real_t *v = malloc(sizeof(icoac_real_t) * ICOAC_PRIV_CRITIC_WEIGHTS);
+#endif
     int n;
-    (void)unused;
-    assert_non_null(v);
+    TEST_ASSERT_NOT_NULL(v);
     for (n = 0; n < 2000; ++n) {
         icoac_priv_critic_list_t list;
         unsigned char *bytes = (unsigned char *)&list;
@@ -434,18 +453,19 @@ static void test_corrupted_kept_unit_list(void **unused)
         }
         icoac_priv_critic_update_sparse(v, &list, ICOAC_R(1.0));
     }
+#if !ICOAC_TEST_ON_TARGET
     free(v);
+#endif
 }
 
 /* Random bytes in a state with a valid header, then every entry point: nothing outside the
  * state (ASan), no undefined behaviour (UBSan), a named status from each, force 0 on error, and
  * icoac_reset either refuses the state unchanged or leaves one that ticks. */
-static void test_random_state_bytes(void **unused)
+static void test_random_state_bytes(void)
 {
     test_rng_t rng = {11u};
     int n;
-    (void)unused;
-    for (n = 0; n < 3000; ++n) {
+    for (n = 0; n < TEST_ITERATIONS(3000, 300); ++n) { /* fewer on an emulated core (QEMU is slow) */
         icoac_state_t *state = new_state();
         icoac_state_t copy;
         icoac_config_t cfg = test_default_config();
@@ -465,43 +485,45 @@ static void test_random_state_bytes(void **unused)
             priv_mut(state)->config = cfg;
         }
         priv_mut(state)->magic = n % 5 == 0 ? ICOAC_PRIV_STATE_ENDED : ICOAC_PRIV_STATE_MAGIC;
-        assert_int_equal(icoac_get_posterior(state, &post), ICOAC_OK);
-        assert_int_equal(icoac_get_counters(state, &counters), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(state, &post));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_counters(state, &counters));
         for (k = 0; k < 5; ++k) {
             status = icoac_step(state, &in, &out);
-            assert_int_equal(out.status, status);
-            assert_true(status == ICOAC_OK || out.force == 0);
-            assert_true(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC || status == ICOAC_ERR_CORRUPT_STATE ||
-                        status == ICOAC_ERR_TRIAL_ENDED || status == ICOAC_ERR_NONFINITE_INPUT);
+            TEST_ASSERT_EQUAL_INT(status, out.status);
+            TEST_ASSERT_TRUE(status == ICOAC_OK || out.force == 0);
+            TEST_ASSERT_TRUE(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC || status == ICOAC_ERR_CORRUPT_STATE ||
+                             status == ICOAC_ERR_TRIAL_ENDED || status == ICOAC_ERR_NONFINITE_INPUT);
         }
         copy = *state;
         status = icoac_reset(state);
-        assert_true(status == ICOAC_OK || status == ICOAC_ERR_CORRUPT_STATE);
+        TEST_ASSERT_TRUE(status == ICOAC_OK || status == ICOAC_ERR_CORRUPT_STATE);
         if (status == ICOAC_ERR_CORRUPT_STATE) {
-            assert_memory_equal(state, &copy, sizeof copy);
+            TEST_ASSERT_EQUAL_MEMORY(&copy, state, sizeof copy);
         } else {
             in.flags = 0u;
             status = icoac_step(state, &in, &out);
-            assert_true(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC);
+            TEST_ASSERT_TRUE(status == ICOAC_OK || status == ICOAC_ERR_NUMERIC);
         }
-        free(state);
+        free_state(state);
     }
 }
 
+void setUp(void) {}
+void tearDown(void) {}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_search_batch_edited_after_init),
-        cmocka_unit_test(test_retune_applies_input_range),
-        cmocka_unit_test(test_retune_search_floors),
-        cmocka_unit_test(test_retune_refuses_a_mode_change),
-        cmocka_unit_test(test_unknown_switches),
-        cmocka_unit_test(test_nonfinite_fields_and_recovery),
-        cmocka_unit_test(test_corrupted_elite_fraction),
-        cmocka_unit_test(test_corrupted_slots),
-        cmocka_unit_test(test_repeated_terminal),
-        cmocka_unit_test(test_corrupted_kept_unit_list),
-        cmocka_unit_test(test_random_state_bytes),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_search_batch_edited_after_init);
+    RUN_TEST(test_retune_applies_input_range);
+    RUN_TEST(test_retune_search_floors);
+    RUN_TEST(test_retune_refuses_a_mode_change);
+    RUN_TEST(test_unknown_switches);
+    RUN_TEST(test_nonfinite_fields_and_recovery);
+    RUN_TEST(test_corrupted_elite_fraction);
+    RUN_TEST(test_corrupted_slots);
+    RUN_TEST(test_repeated_terminal);
+    RUN_TEST(test_corrupted_kept_unit_list);
+    RUN_TEST(test_random_state_bytes);
+    return UNITY_END();
 }

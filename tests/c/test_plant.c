@@ -62,7 +62,7 @@ static void check_integrator(int integrator)
     int i;
     icoac_sim_plant_default(&plant);
     plant.integrator = integrator;
-    assert_int_equal(icoac_sim_plant_check(&plant), ICOAC_SIM_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_check(&plant));
     for (a = 0; a < sizeof states / sizeof states[0]; ++a) {
         for (f = 0; f < sizeof forces / sizeof forces[0]; ++f) {
             double s[4];
@@ -71,7 +71,7 @@ static void check_integrator(int integrator)
                 s[i] = states[a][i];
                 r[i] = states[a][i];
             }
-            assert_int_equal(icoac_sim_plant_step(&plant, s, forces[f]), ICOAC_SIM_OK);
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_step(&plant, s, forces[f]));
             if (integrator == ICOAC_SIM_RK4) {
                 ref_rk4(r, forces[f], 0.01L);
             } else {
@@ -84,25 +84,22 @@ static void check_integrator(int integrator)
     }
 }
 
-static void test_euler_step(void **unused)
+static void test_euler_step(void)
 {
-    (void)unused;
     check_integrator(ICOAC_SIM_EULER);
 }
 
-static void test_rk4_step(void **unused)
+static void test_rk4_step(void)
 {
-    (void)unused;
     check_integrator(ICOAC_SIM_RK4);
 }
 
 /* Sanity of the reference itself: hand values at the upright and the sign convention. */
-static void test_reference_sanity(void **unused)
+static void test_reference_sanity(void)
 {
     icoac_sim_plant_t plant;
     double s[4] = {0, 0, 0, 0};
     long double ds[4], r[4] = {0, 0, 0, 0};
-    (void)unused;
     /* upright, F = 1 N: theta_acc = -1/1.1 / (0.5 (4/3 - 0.1/1.1)), x_acc = 1/1.1 - 0.1 * 0.5 * theta_acc / 1.1 */
     ref_deriv(r, 1.0L, ds);
     {
@@ -112,50 +109,49 @@ static void test_reference_sanity(void **unused)
     }
     /* pushing +x tips the pole toward -x; a pole leaning +x falls further +x */
     icoac_sim_plant_default(&plant);
-    assert_int_equal(icoac_sim_plant_step(&plant, s, 10.0), ICOAC_SIM_OK);
-    assert_true(s[1] > 0 && s[3] < 0 && s[0] == 0.0 && s[2] == 0.0); /* Euler: positions use old velocities */
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_step(&plant, s, 10.0));
+    TEST_ASSERT_TRUE(s[1] > 0 && s[3] < 0 && s[0] == 0.0 && s[2] == 0.0); /* Euler: positions use old velocities */
     s[0] = s[1] = s[3] = 0;
     s[2] = 0.1;
-    assert_int_equal(icoac_sim_plant_step(&plant, s, 0.0), ICOAC_SIM_OK);
-    assert_true(s[3] > 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_step(&plant, s, 0.0));
+    TEST_ASSERT_TRUE(s[3] > 0);
     /* RK4 and Euler differ (the switch is effective) */
     {
         double e[4] = {0.1, 0.2, 0.1, 0.3}, k[4] = {0.1, 0.2, 0.1, 0.3};
-        assert_int_equal(icoac_sim_plant_step(&plant, e, 3.0), ICOAC_SIM_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_step(&plant, e, 3.0));
         plant.integrator = ICOAC_SIM_RK4;
-        assert_int_equal(icoac_sim_plant_step(&plant, k, 3.0), ICOAC_SIM_OK);
-        assert_true(fabs(e[0] - k[0]) > 1e-6);
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_step(&plant, k, 3.0));
+        TEST_ASSERT_TRUE(fabs(e[0] - k[0]) > 1e-6);
     }
-    assert_int_equal(icoac_sim_plant_step(NULL, s, 0.0), ICOAC_SIM_ERR_BAD_ARGUMENT);
-    assert_int_equal(icoac_sim_plant_step(&plant, NULL, 0.0), ICOAC_SIM_ERR_BAD_ARGUMENT);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_step(NULL, s, 0.0));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_step(&plant, NULL, 0.0));
 }
 
-static void test_failure_strict(void **unused)
+static void test_failure_strict(void)
 {
     icoac_sim_plant_t plant;
     const double lim = 12.0 * TEST_PI / 180.0;
     double s[4];
     int c;
-    (void)unused;
     icoac_sim_plant_default(&plant);
     assert_close(plant.theta_limit, lim, 1e-16);
     assert_close(plant.x_limit, 2.4, 0.0);
 #define FAILED(x, th) (s[0] = (x), s[1] = 0.3, s[2] = (th), s[3] = -0.2, icoac_sim_failed(&plant, s))
-    assert_int_equal(FAILED(0.0, 0.0), 0);
-    assert_int_equal(FAILED(2.4, 0.0), 0);
-    assert_int_equal(FAILED(-2.4, 0.0), 0);
-    assert_int_equal(FAILED(2.4 + 1e-12, 0.0), 1);
-    assert_int_equal(FAILED(-2.4 - 1e-12, 0.0), 1);
-    assert_int_equal(FAILED(0.0, lim), 0);
-    assert_int_equal(FAILED(0.0, -lim), 0);
-    assert_int_equal(FAILED(2.4, -lim), 0);
-    assert_int_equal(FAILED(0.0, nextafter(lim, 1.0)), 1);
-    assert_int_equal(FAILED(0.0, -nextafter(lim, 1.0)), 1);
-    assert_int_equal(FAILED(0.0, lim + 1e-12), 1);
-    assert_int_equal(FAILED((double)NAN, 0.0), 1);
-    assert_int_equal(FAILED(0.0, (double)NAN), 1);
-    assert_int_equal(FAILED((double)INFINITY, 0.0), 1);
-    assert_int_equal(FAILED(0.0, -(double)INFINITY), 1);
+    TEST_ASSERT_EQUAL_INT(0, FAILED(0.0, 0.0));
+    TEST_ASSERT_EQUAL_INT(0, FAILED(2.4, 0.0));
+    TEST_ASSERT_EQUAL_INT(0, FAILED(-2.4, 0.0));
+    TEST_ASSERT_EQUAL_INT(1, FAILED(2.4 + 1e-12, 0.0));
+    TEST_ASSERT_EQUAL_INT(1, FAILED(-2.4 - 1e-12, 0.0));
+    TEST_ASSERT_EQUAL_INT(0, FAILED(0.0, lim));
+    TEST_ASSERT_EQUAL_INT(0, FAILED(0.0, -lim));
+    TEST_ASSERT_EQUAL_INT(0, FAILED(2.4, -lim));
+    TEST_ASSERT_EQUAL_INT(1, FAILED(0.0, nextafter(lim, 1.0)));
+    TEST_ASSERT_EQUAL_INT(1, FAILED(0.0, -nextafter(lim, 1.0)));
+    TEST_ASSERT_EQUAL_INT(1, FAILED(0.0, lim + 1e-12));
+    TEST_ASSERT_EQUAL_INT(1, FAILED((double)NAN, 0.0));
+    TEST_ASSERT_EQUAL_INT(1, FAILED(0.0, (double)NAN));
+    TEST_ASSERT_EQUAL_INT(1, FAILED((double)INFINITY, 0.0));
+    TEST_ASSERT_EQUAL_INT(1, FAILED(0.0, -(double)INFINITY));
 #undef FAILED
     /* non-finite velocities: the state is not finite (header contract) */
     for (c = 1; c <= 3; c += 2) {
@@ -164,9 +160,9 @@ static void test_failure_strict(void **unused)
         s[2] = 0.0;
         s[3] = 0.0;
         s[c] = (double)NAN;
-        assert_int_equal(icoac_sim_failed(&plant, s), 1);
+        TEST_ASSERT_EQUAL_INT(1, icoac_sim_failed(&plant, s));
         s[c] = (double)INFINITY;
-        assert_int_equal(icoac_sim_failed(&plant, s), 1);
+        TEST_ASSERT_EQUAL_INT(1, icoac_sim_failed(&plant, s));
     }
 }
 
@@ -195,7 +191,7 @@ PMUT(p_l_tiny, p->half_length = 1e-9)
 PMUT(p_xl_huge, p->x_limit = 1e300)
 PMUT(p_tl_big, p->theta_limit = 4.0)
 
-static void test_plant_and_run_checks(void **unused)
+static void test_plant_and_run_checks(void)
 {
     static const plant_mut muts[] = {p_g0, p_gnan, p_mc, p_mp, p_l, p_dt0, p_dtbig, p_xl, p_tl, p_int, p_intneg,
                                      p_dt_subnormal, p_dt_tiny, p_g_subnormal, p_g_huge, p_mc_subnormal,
@@ -203,47 +199,46 @@ static void test_plant_and_run_checks(void **unused)
     icoac_sim_plant_t plant;
     icoac_sim_run_t run;
     size_t i;
-    (void)unused;
     icoac_sim_plant_default(&plant);
     assert_close(plant.gravity, 9.8, 0);
     assert_close(plant.cart_mass, 1.0, 0);
     assert_close(plant.pole_mass, 0.1, 0);
     assert_close(plant.half_length, 0.5, 0);
     assert_close(plant.dt, 0.01, 0);
-    assert_int_equal(plant.integrator, ICOAC_SIM_EULER);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_EULER, plant.integrator);
     for (i = 0; i < sizeof muts / sizeof muts[0]; ++i) {
         icoac_sim_plant_default(&plant);
         muts[i](&plant);
-        assert_int_equal(icoac_sim_plant_check(&plant), ICOAC_SIM_ERR_BAD_PLANT);
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_check(&plant));
     }
-    assert_int_equal(icoac_sim_plant_check(NULL), ICOAC_SIM_ERR_BAD_ARGUMENT);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_check(NULL));
     icoac_sim_run_default(&run);
-    assert_true(run.max_trials == 100000 && run.success_steps == 100000);
+    TEST_ASSERT_TRUE(run.max_trials == 100000 && run.success_steps == 100000);
     assert_close(run.init_velocity_noise, 1e-4, 0);
-    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_check(&run));
     run.max_trials = 0;
-    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_check(&run));
     icoac_sim_run_default(&run);
     run.success_steps = -1;
-    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_check(&run));
     icoac_sim_run_default(&run);
     run.init_velocity_noise = -1e-4;
-    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_check(&run));
     run.init_velocity_noise = (double)NAN;
-    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_check(&run));
     run.init_velocity_noise = 1e-310; /* subnormal */
-    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_check(&run));
     run.init_velocity_noise = 1e4;
-    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_ERR_BAD_RUN);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_check(&run));
     run.init_velocity_noise = 0.0;
-    assert_int_equal(icoac_sim_run_check(&run), ICOAC_SIM_OK);
-    assert_int_equal(icoac_sim_run_check(NULL), ICOAC_SIM_ERR_BAD_ARGUMENT);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_check(&run));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_check(NULL));
     /* the bounds themselves are valid */
     icoac_sim_plant_default(&plant);
     plant.dt = ICOAC_SIM_DT_MIN;
     plant.gravity = ICOAC_SIM_PHYS_MAX;
     plant.theta_limit = ICOAC_SIM_THETA_LIMIT_MAX;
-    assert_int_equal(icoac_sim_plant_check(&plant), ICOAC_SIM_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_check(&plant));
 }
 
 static int cmp_u64(const void *a, const void *b)
@@ -252,80 +247,80 @@ static int cmp_u64(const void *a, const void *b)
     return x < y ? -1 : (x > y);
 }
 
-static void test_paper_grid(void **unused)
+static void test_paper_grid(void)
 {
     static icoac_sim_cell_t cells[ICOAC_SIM_GRID_CELLS];
     static icoac_sim_cell_t other[ICOAC_SIM_GRID_CELLS];
     static uint64_t seeds[ICOAC_SIM_GRID_CELLS];
     int row, col, i, differ = 0;
-    (void)unused;
-    assert_int_equal(ICOAC_SIM_GRID_CELLS, 1225);
-    assert_int_equal(ICOAC_SIM_GRID_THETAS, 25);
-    assert_int_equal(ICOAC_SIM_GRID_XS, 49);
+    TEST_ASSERT_EQUAL_INT(1225, ICOAC_SIM_GRID_CELLS);
+    TEST_ASSERT_EQUAL_INT(25, ICOAC_SIM_GRID_THETAS);
+    TEST_ASSERT_EQUAL_INT(49, ICOAC_SIM_GRID_XS);
     memset(cells, 0x33, sizeof cells);
-    assert_int_equal(icoac_sim_paper_grid(cells, 1225, 42u), ICOAC_SIM_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_paper_grid(cells, 1225, 42u));
     for (row = 0; row < 25; ++row) {
         for (col = 0; col < 49; ++col) {
             const icoac_sim_cell_t *c = &cells[row * 49 + col];
             assert_close(c->theta0, (double)(-12 + row) / 180.0 * TEST_PI, 1e-15);
             assert_close(c->x0, -2.4 + 0.1 * col, 1e-12);
-            assert_int_equal(c->outcome, ICOAC_SIM_PENDING);
-            assert_int_equal(c->trials, 0);
-            assert_int_equal(c->total_steps, 0);
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_PENDING, c->outcome);
+            TEST_ASSERT_EQUAL_INT64(0, c->trials);
+            TEST_ASSERT_EQUAL_INT64(0, c->total_steps);
         }
     }
     /* the corners and centre exactly on the documented values */
-    assert_true(cells[0].x0 == -2.4 && cells[0].theta0 == -12.0 * TEST_PI / 180.0);
+    TEST_ASSERT_TRUE(cells[0].x0 == -2.4 && cells[0].theta0 == -12.0 * TEST_PI / 180.0);
     assert_close(cells[1224].x0, 2.4, 1e-12);
     assert_close(cells[1224].theta0, 12.0 * TEST_PI / 180.0, 1e-15);
     assert_close(cells[12 * 49 + 24].x0, 0.0, 1e-12);
-    assert_true(cells[12 * 49 + 24].theta0 == 0.0);
+    TEST_ASSERT_TRUE(cells[12 * 49 + 24].theta0 == 0.0);
     for (i = 0; i < 1225; ++i) {
         seeds[i] = cells[i].seed;
     }
     qsort(seeds, 1225, sizeof seeds[0], cmp_u64);
     for (i = 1; i < 1225; ++i) {
-        assert_true(seeds[i] != seeds[i - 1]);
+        TEST_ASSERT_TRUE(seeds[i] != seeds[i - 1]);
     }
     /* the grid seed drives the cell seeds, and reproducibly */
-    assert_int_equal(icoac_sim_paper_grid(other, 1225, 42u), ICOAC_SIM_OK);
-    assert_memory_equal(other, cells, sizeof cells);
-    assert_int_equal(icoac_sim_paper_grid(other, 1225, 43u), ICOAC_SIM_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_paper_grid(other, 1225, 42u));
+    TEST_ASSERT_EQUAL_MEMORY(cells, other, sizeof cells);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_paper_grid(other, 1225, 43u));
     for (i = 0; i < 1225; ++i) {
         differ += other[i].seed != cells[i].seed;
     }
-    assert_int_equal(differ, 1225);
-    assert_int_equal(icoac_sim_paper_grid(cells, 1224, 42u), ICOAC_SIM_ERR_BAD_ARGUMENT);
-    assert_int_equal(icoac_sim_paper_grid(NULL, 1225, 42u), ICOAC_SIM_ERR_BAD_ARGUMENT);
+    TEST_ASSERT_EQUAL_INT(1225, differ);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_paper_grid(cells, 1224, 42u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_paper_grid(NULL, 1225, 42u));
 }
 
-static void test_sim_sizes_and_strings(void **unused)
+static void test_sim_sizes_and_strings(void)
 {
     static const int32_t statuses[] = {ICOAC_SIM_OK, ICOAC_SIM_ERR_BAD_PLANT, ICOAC_SIM_ERR_BAD_RUN,
                                        ICOAC_SIM_ERR_BAD_ARGUMENT, ICOAC_SIM_ERR_THREAD, ICOAC_SIM_CANCELLED,
                                        ICOAC_ERR_BAD_PRIOR, 12345};
     size_t i;
-    (void)unused;
-    assert_int_equal(icoac_sim_abi_version(), ICOAC_SIM_ABI_VERSION);
-    assert_int_equal(icoac_sim_sizeof_plant(), sizeof(icoac_sim_plant_t));
-    assert_int_equal(icoac_sim_sizeof_run(), sizeof(icoac_sim_run_t));
-    assert_int_equal(icoac_sim_sizeof_cell(), sizeof(icoac_sim_cell_t));
+    TEST_ASSERT_EQUAL_UINT32(ICOAC_SIM_ABI_VERSION, icoac_sim_abi_version());
+    TEST_ASSERT_EQUAL_size_t(sizeof(icoac_sim_plant_t), icoac_sim_sizeof_plant());
+    TEST_ASSERT_EQUAL_size_t(sizeof(icoac_sim_run_t), icoac_sim_sizeof_run());
+    TEST_ASSERT_EQUAL_size_t(sizeof(icoac_sim_cell_t), icoac_sim_sizeof_cell());
     for (i = 0; i < sizeof statuses / sizeof statuses[0]; ++i) {
-        assert_non_null(icoac_sim_status_str(statuses[i]));
+        TEST_ASSERT_NOT_NULL(icoac_sim_status_str(statuses[i]));
     }
-    assert_string_equal(icoac_sim_status_str(ICOAC_ERR_BAD_PRIOR), icoac_status_str(ICOAC_ERR_BAD_PRIOR));
+    TEST_ASSERT_EQUAL_STRING(icoac_status_str(ICOAC_ERR_BAD_PRIOR), icoac_sim_status_str(ICOAC_ERR_BAD_PRIOR));
 }
+
+void setUp(void) {}
+void tearDown(void) {}
 
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_euler_step),
-        cmocka_unit_test(test_rk4_step),
-        cmocka_unit_test(test_reference_sanity),
-        cmocka_unit_test(test_failure_strict),
-        cmocka_unit_test(test_plant_and_run_checks),
-        cmocka_unit_test(test_paper_grid),
-        cmocka_unit_test(test_sim_sizes_and_strings),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_euler_step);
+    RUN_TEST(test_rk4_step);
+    RUN_TEST(test_reference_sanity);
+    RUN_TEST(test_failure_strict);
+    RUN_TEST(test_plant_and_run_checks);
+    RUN_TEST(test_paper_grid);
+    RUN_TEST(test_sim_sizes_and_strings);
+    return UNITY_END();
 }

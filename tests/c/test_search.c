@@ -32,7 +32,7 @@ static void step_ok(const icoac_config_t *cfg, icoac_state_t *state, const icoac
 {
     test_assert_config_in_force(cfg, state);
     memset(out, 0x7F, sizeof *out);
-    assert_int_equal(icoac_step(state, in, out), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(state, in, out));
 }
 
 static const icoac_priv_state_t *priv(const icoac_state_t *state)
@@ -44,7 +44,7 @@ static void posterior_of(const icoac_state_t *state, gauss_t *g)
 {
     icoac_prior_t post;
     int i, j;
-    assert_int_equal(icoac_get_posterior(state, &post), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(state, &post));
     for (i = 0; i < N; ++i) {
         g->mean[i] = (double)post.mean[i];
         for (j = 0; j < N; ++j) {
@@ -76,7 +76,7 @@ static icoac_config_t search_config(int batch, double rho, double step, double f
     cfg.search.step = (icoac_real_t)step;
     cfg.search.floor = (icoac_real_t)floor_;
     cfg.search.cov_scale = (icoac_real_t)cov_scale;
-    assert_int_equal(icoac_config_check(&cfg), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&cfg));
     return cfg;
 }
 
@@ -162,12 +162,12 @@ static double expected_draw(const icoac_state_t *state, double w[N], int *singul
     int i, j, k;
     posterior_of(state, &g);
     if (min_relative_pivot(g.cov) > SINGULAR_PIVOT) {
-        assert_true(cholesky(g.cov, lower));
+        TEST_ASSERT_TRUE(cholesky(g.cov, lower));
     } else {
         for (i = 0; i < N; ++i) {
             for (j = 0; j < N; ++j) {
                 lower[i][j] = (double)priv(state)->search.lower[i][j];
-                assert_true(j <= i ? (j < i || lower[i][i] > 0.0) : lower[i][j] == 0.0);
+                TEST_ASSERT_TRUE(j <= i ? (j < i || lower[i][i] > 0.0) : lower[i][j] == 0.0);
             }
         }
         for (i = 0; i < N; ++i) {
@@ -203,7 +203,7 @@ static icoac_status_t run_trial(const icoac_config_t *cfg, icoac_state_t *state,
     icoac_input_t in;
     icoac_output_t out;
     int t;
-    assert_int_equal(icoac_reset(state), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(state));
     for (t = 0; t < ticks; ++t) {
         in = random_input(rng, 0);
         step_ok(cfg, state, &in, &out);
@@ -295,15 +295,15 @@ static void assert_gauss_close(const gauss_t *got, const gauss_t *want, double m
     int i, j;
     for (i = 0; i < N; ++i) {
         if (!(fabs(got->mean[i] - want->mean[i]) <= mean_tol)) {
-            print_error("%s %d: mean[%d] = %.9g, expected %.9g (tol %.3g)\n", what, n, i, got->mean[i],
+            TEST_PRINTF("%s %d: mean[%d] = %g, expected %g (tol %g)", what, n, i, got->mean[i],
                         want->mean[i], mean_tol);
-            fail();
+            TEST_FAIL();
         }
         for (j = 0; j < N; ++j) {
             if (!(fabs(got->cov[i][j] - want->cov[i][j]) <= cov_tol)) {
-                print_error("%s %d: cov[%d][%d] = %.9g, expected %.9g (tol %.3g)\n", what, n, i, j,
+                TEST_PRINTF("%s %d: cov[%d][%d] = %g, expected %g (tol %g)", what, n, i, j,
                             got->cov[i][j], want->cov[i][j], cov_tol);
-                fail();
+                TEST_FAIL();
             }
         }
     }
@@ -344,12 +344,11 @@ static double singular_band(const reference_t *ref, double wmax)
 /* Random configurations (the floor often active, steps up to 1), several batches each: between
  * updates mu_w and Sigma_w stay; each trial's w is mu + L n; each update is the reference's,
  * with its fallback where Sigma' is singular. */
-static void test_update_matches_reference(void **unused)
+static void test_update_matches_reference(void)
 {
     static const double rhos[] = {1e-3, 0.1, 0.25, 0.3, 0.5, 0.6, 0.75, 1.0};
     test_rng_t rng = {0x5EA5Cu};
     int n, updates = 0, floored = 0, fallbacks = 0, singular_draws = 0;
-    (void)unused;
     for (n = 0; n < 120; ++n) {
         const int batch = 1 + (int)test_uniform(&rng, 0, KMAX);
         const double rho = rhos[(int)test_uniform(&rng, 0, 8)];
@@ -363,11 +362,11 @@ static void test_update_matches_reference(void **unused)
         icoac_state_t state;
         double floor_d[N];
         int round, i, j;
-        assert_int_equal(icoac_init(&cfg, &state, &p, 1000u + (uint64_t)n), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, &p, 1000u + (uint64_t)n));
         for (i = 0; i < N; ++i) {
             /* Sigma0 = c * the prior covariance; the floor f * Sigma0_ii */
             for (j = 0; j < N; ++j) {
-                assert_true(icoac_priv_cov_c(priv(&state))[i][j] == p.cov[i][j] * cfg.search.cov_scale);
+                TEST_ASSERT_TRUE(icoac_priv_cov_c(priv(&state))[i][j] == p.cov[i][j] * cfg.search.cov_scale);
             }
             floor_d[i] = (double)cfg.search.floor * (double)(p.cov[i][i] * cfg.search.cov_scale);
         }
@@ -383,7 +382,7 @@ static void test_update_matches_reference(void **unused)
                 /* few distinct lengths: many ties */
                 ticks[k] = (int)test_uniform(&rng, 0, 5);
                 tol = expected_draw(&state, drawn, &singular_draws);
-                assert_int_equal(icoac_reset(&state), ICOAC_OK);
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
                 w_act_of(&state, w[k]);
                 for (i = 0; i < N; ++i) {
                     assert_close(w[k][i], drawn[i], tol);
@@ -401,11 +400,11 @@ static void test_update_matches_reference(void **unused)
                 }
                 posterior_of(&state, &now);
                 if (k + 1 < cfg.search.batch) {
-                    assert_memory_equal(&now, &start, sizeof now);
-                    assert_int_equal(priv(&state)->search.count, k + 1);
+                    TEST_ASSERT_EQUAL_MEMORY(&start, &now, sizeof now);
+                    TEST_ASSERT_EQUAL_INT(k + 1, priv(&state)->search.count);
                 }
             }
-            assert_int_equal(priv(&state)->search.count, 0);
+            TEST_ASSERT_EQUAL_INT(0, priv(&state)->search.count);
             reference_update(&cfg, &start, floor_d, w, ticks, &want, elite);
             {
                 const double scale = 1.0 + max_abs_mat(start.cov) + max_abs_mat(want.fallback.cov);
@@ -421,20 +420,20 @@ static void test_update_matches_reference(void **unused)
                                                         "search update", n);
             }
             for (i = 0; i < N; ++i) {
-                assert_true(now.cov[i][i] >= floor_d[i] * (1.0 - 4.0 * REAL_EPS));
+                TEST_ASSERT_TRUE(now.cov[i][i] >= floor_d[i] * (1.0 - 4.0 * REAL_EPS));
                 floored += now.cov[i][i] == (double)priv(&state)->search.floor[i];
                 for (j = 0; j < N; ++j) {
-                    assert_true(icoac_priv_cov_c(priv(&state))[i][j] == icoac_priv_cov_c(priv(&state))[j][i]);
+                    TEST_ASSERT_TRUE(icoac_priv_cov_c(priv(&state))[i][j] == icoac_priv_cov_c(priv(&state))[j][i]);
                 }
             }
             ++updates;
         }
     }
-    assert_int_equal(updates, 480);
-    assert_true(floored > 100); /* the floor was exercised */
-    print_message("%d of %d updates fell back to Sigma' + diag(floor); %d draws from a singular Sigma_w\n",
-                  fallbacks, updates, singular_draws);
-    assert_true(fallbacks > 0); /* and the fallback (test_step_one_small_elites: many of them) */
+    TEST_ASSERT_EQUAL_INT(480, updates);
+    TEST_ASSERT_TRUE(floored > 100); /* the floor was exercised */
+    TEST_PRINTF("%d of %d updates fell back to Sigma' + diag(floor); %d draws from a singular Sigma_w",
+                fallbacks, updates, singular_draws);
+    TEST_ASSERT_TRUE(fallbacks > 0); /* and the fallback (test_step_one_small_elites: many of them) */
 }
 
 /* `ticks` non-terminal ticks and a terminal one, in the trial drawn at the last reset. */
@@ -454,7 +453,7 @@ static icoac_status_t finish_trial(const icoac_config_t *cfg, icoac_state_t *sta
 /* Hand-made batches: the elite is chosen by length, ties to the earlier trial; its size is
  * max(1, round(rho K)). With mu = 0 and a = 1/2, mu' = mean_elite / 2: checked against the
  * expected elite, and (ties) shown to differ from the other way of breaking them. */
-static void test_elite_choice(void **unused)
+static void test_elite_choice(void)
 {
     typedef struct {
         int batch;
@@ -475,7 +474,6 @@ static void test_elite_choice(void **unused)
         {2, 0.5, {0, 0}, {0, -1}, {1, -1}},                       /* empty trials tie too */
     };
     size_t c;
-    (void)unused;
     for (c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
         const elite_case_t *ec = &cases[c];
         icoac_config_t cfg = search_config(ec->batch, ec->rho, 0.5, 1e-3, 1.0);
@@ -484,11 +482,11 @@ static void test_elite_choice(void **unused)
         double w[KMAX][N], want[N] = {0}, other[N] = {0}, diff = 0;
         gauss_t now;
         int k, i, n_e = 0, n_o = 0;
-        assert_int_equal(icoac_init(&cfg, &state, NULL, 50u + c), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 50u + c));
         for (k = 0; k < ec->batch; ++k) {
-            assert_int_equal(icoac_reset(&state), ICOAC_OK);
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
             w_act_of(&state, w[k]);
-            assert_int_equal(finish_trial(&cfg, &state, &rng, ec->ticks[k]), ICOAC_OK);
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, finish_trial(&cfg, &state, &rng, ec->ticks[k]));
         }
         while (n_e < 6 && ec->elite[n_e] >= 0) {
             ++n_e;
@@ -512,7 +510,7 @@ static void test_elite_choice(void **unused)
             diff += fabs(want[i] - other[i]);
         }
         if (n_o > 0) {
-            assert_true(diff > 1e-2); /* the other tie-break would have been seen */
+            TEST_ASSERT_TRUE(diff > 1e-2); /* the other tie-break would have been seen */
         }
     }
 }
@@ -533,33 +531,33 @@ static void assert_sigma_spd(const icoac_state_t *state, double margin, const ch
         for (j = 0; j < N; ++j) {
             m[i][j] = (double)cov[i][j];
             if (!isfinite(m[i][j]) || cov[i][j] != cov[j][i] || (i == j && !(cov[i][i] >= st->search.floor[i]))) {
-                print_error("%s %d: cov[%d][%d] = %g (floor %g), not finite, symmetric or above the floor\n", what,
+                TEST_PRINTF("%s %d: cov[%d][%d] = %g (floor %g), not finite, symmetric or above the floor", what,
                             n, i, j, m[i][j], (double)st->search.floor[i]);
-                fail();
+                TEST_FAIL();
             }
         }
     }
     if (!icoac_priv_cholesky(cov, lower_r, ICOAC_CARTPOLE_INPUTS)) {
-        print_error("%s %d: cov not positive definite\n", what, n);
-        fail();
+        TEST_PRINTF("%s %d: cov not positive definite", what, n);
+        TEST_FAIL();
     }
     for (i = 0; i < N; ++i) {
-        assert_true(st->search.lower[i][i] > 0);
+        TEST_ASSERT_TRUE(st->search.lower[i][i] > 0);
         for (j = 0; j < N; ++j) {
             double sum = 0;
             for (q = 0; q < N; ++q) {
                 sum += (double)st->search.lower[i][q] * (double)st->search.lower[j][q];
             }
             assert_close(sum, m[i][j], (REAL_IS_FLOAT ? 1e-5 : 1e-13) * max_abs_mat(m));
-            assert_true(j <= i || st->search.lower[i][j] == 0);
+            TEST_ASSERT_TRUE(j <= i || st->search.lower[i][j] == 0);
         }
     }
     for (i = 0; i < N; ++i) {
         m[i][i] += margin * max_abs_mat(m);
     }
     if (!cholesky(m, l)) {
-        print_error("%s %d: cov not positive definite in double (margin %g)\n", what, n, margin);
-        fail();
+        TEST_PRINTF("%s %d: cov not positive definite in double (margin %g)", what, n, margin);
+        TEST_FAIL();
     }
 }
 
@@ -571,11 +569,11 @@ static void trial_with(const icoac_config_t *cfg, icoac_state_t *state, const do
 {
     test_rng_t rng = {(uint64_t)ticks + 1u};
     int i;
-    assert_int_equal(icoac_reset(state), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(state));
     for (i = 0; i < N; ++i) {
         icoac_priv_state(state)->w_act[i] = (icoac_real_t)w[i];
     }
-    assert_int_equal(finish_trial(cfg, state, &rng, ticks), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, finish_trial(cfg, state, &rng, ticks));
 }
 
 /* A step of 1 with a rank-deficient elite (L4): Sigma' = Cov_elite (floored) is singular
@@ -592,7 +590,7 @@ static void trial_with(const icoac_config_t *cfg, icoac_state_t *state, const do
  *   (assert_update_is_reference: Sigma' where it is positive definite, the fallback where the
  *   library's Cholesky factorisation of it fails), Sigma_w positive definite after each, the
  *   fallback taken often and never where Sigma' is clearly positive definite. */
-static void test_step_one_small_elites(void **unused)
+static void test_step_one_small_elites(void)
 {
     static const double hand[3][N] = {{1, 1, 1, 1}, {1, 1, 0.1, 0.1}, {1, 0.1, 0.1, 0.1}};
     typedef struct {
@@ -602,14 +600,13 @@ static void test_step_one_small_elites(void **unused)
     static const step_one_case_t cases[] = {{4, 0.5, 0.1, 1.0}, {8, 0.25, 1.0, 64.0}, {3, 1.0, 0.01, 1.0},
                                             {16, 0.25, 0.1, 1.0}};
     size_t h, c;
-    (void)unused;
     for (h = 0; h < 3; ++h) {
         const icoac_config_t cfg = search_config(2, 1.0, 1.0, 0.1, 1.0);
         icoac_state_t state;
         double plus[N], minus[N];
         gauss_t now;
         int i, j, above = 0;
-        assert_int_equal(icoac_init(&cfg, &state, NULL, 5u + h), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, NULL, 5u + h));
         for (i = 0; i < N; ++i) {
             plus[i] = (double)(icoac_real_t)hand[h][i];
             minus[i] = -plus[i];
@@ -617,10 +614,10 @@ static void test_step_one_small_elites(void **unused)
         }
         trial_with(&cfg, &state, plus, 3);
         trial_with(&cfg, &state, minus, 2); /* the update: OK, no numeric fault */
-        assert_int_equal(priv(&state)->search.count, 0);
+        TEST_ASSERT_EQUAL_INT(0, priv(&state)->search.count);
         posterior_of(&state, &now);
         for (i = 0; i < N; ++i) {
-            assert_true(now.mean[i] == 0.0);
+            TEST_ASSERT_TRUE(now.mean[i] == 0.0);
             for (j = 0; j < N; ++j) {
                 double want = plus[i] * plus[j];
                 if (i == j) {
@@ -634,7 +631,7 @@ static void test_step_one_small_elites(void **unused)
         {
             /* the next draws go through the new factor */
             double drawn[N], w[N], tol = expected_draw(&state, drawn, NULL);
-            assert_int_equal(icoac_reset(&state), ICOAC_OK);
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
             w_act_of(&state, w);
             for (i = 0; i < N; ++i) {
                 assert_close(w[i], drawn[i], tol);
@@ -648,7 +645,7 @@ static void test_step_one_small_elites(void **unused)
         icoac_state_t state;
         double floor_d[N];
         int u, k, i, fallbacks = 0, clear = 0;
-        const int updates = 20000;
+        const int updates = TEST_ITERATIONS(20000, 1000); /* fewer on an emulated core (QEMU is slow) */
         for (u = 0; u < updates; ++u) {
             double w[KMAX][N], wmax = 1.0;
             int ticks[KMAX], elite[KMAX];
@@ -657,7 +654,7 @@ static void test_step_one_small_elites(void **unused)
             if (u % 250 == 0) {
                 /* a fresh prior now and then: mu_w random-walks at a = 1 */
                 icoac_prior_t p = test_random_prior(&rng, 1.0, test_uniform(&rng, 0.05, 1.0));
-                assert_int_equal(icoac_init(&cfg, &state, u % 500 ? &p : NULL, 9u + (uint64_t)u), ICOAC_OK);
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, u % 500 ? &p : NULL, 9u + (uint64_t)u));
                 for (i = 0; i < N; ++i) {
                     floor_d[i] = (double)priv(&state)->search.floor[i];
                 }
@@ -665,11 +662,11 @@ static void test_step_one_small_elites(void **unused)
             posterior_of(&state, &start);
             for (k = 0; k < sc->batch; ++k) {
                 ticks[k] = (int)(test_rng_u64(&rng) % 4u);
-                assert_int_equal(icoac_reset(&state), ICOAC_OK);
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
                 w_act_of(&state, w[k]);
                 if (finish_trial(&cfg, &state, &rng, ticks[k]) != ICOAC_OK) {
-                    print_error("case %u, update %d: terminal tick not OK\n", (unsigned)c, u);
-                    fail();
+                    TEST_PRINTF("case %u, update %d: terminal tick not OK", (unsigned)c, u);
+                    TEST_FAIL();
                 }
                 for (i = 0; i < N; ++i) {
                     wmax = fabs(w[k][i]) > wmax ? fabs(w[k][i]) : wmax;
@@ -687,10 +684,10 @@ static void test_step_one_small_elites(void **unused)
             }
             assert_sigma_spd(&state, PSD_MARGIN, "step 1 update", u);
         }
-        print_message("K %d, rho %g: %d of %d updates fell back, %d with Sigma' clearly positive definite\n",
-                      sc->batch, sc->rho, fallbacks, updates, clear);
-        assert_true(fallbacks > updates / 50);
-        assert_true(clear > updates / 2);
+        TEST_PRINTF("K %d, rho %g: %d of %d updates fell back, %d with Sigma' clearly positive definite",
+                    sc->batch, sc->rho, fallbacks, updates, clear);
+        TEST_ASSERT_TRUE(fallbacks > updates / 50);
+        TEST_ASSERT_TRUE(clear > updates / 2);
     }
 }
 
@@ -699,12 +696,11 @@ static void test_step_one_small_elites(void **unused)
  * rounding of c Sigma): search-mode icoac_init rejects it with ICOAC_ERR_BAD_PRIOR before it
  * clears the state, so the state is untouched, byte for byte, whether it was never initialised
  * (a fill) or held a learning controller; with c = 1 the same prior is accepted. */
-static void test_rejected_prior_leaves_state(void **unused)
+static void test_rejected_prior_leaves_state(void)
 {
     static const double scales[] = {3.0, 1.1, 7.0, 1000.0};
     test_rng_t rng = {0xBAD9u};
     int tries, found = 0;
-    (void)unused;
     for (tries = 0; tries < 100000 && found < 8; ++tries) {
         icoac_prior_t p;
         double v[3][N];
@@ -748,30 +744,30 @@ static void test_rejected_prior_leaves_state(void **unused)
             /* a never-initialised state */
             memset(&state, 0xA5, sizeof state);
             memset(&sentinel, 0xA5, sizeof sentinel);
-            assert_int_equal(icoac_init(&cfg, &state, &p, 3u), ICOAC_ERR_BAD_PRIOR);
-            assert_memory_equal(&state, &sentinel, sizeof state);
+            TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_PRIOR, icoac_init(&cfg, &state, &p, 3u));
+            TEST_ASSERT_EQUAL_MEMORY(&sentinel, &state, sizeof state);
             /* a running controller: a search one with a trial recorded */
             {
                 icoac_config_t running = search_config(4, 0.5, 0.5, 0.1, 2.0);
                 test_rng_t in = {7u};
-                assert_int_equal(icoac_init(&running, &state, NULL, 4u), ICOAC_OK);
-                assert_int_equal(run_trial(&running, &state, &in, 5), ICOAC_OK);
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&running, &state, NULL, 4u));
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, run_trial(&running, &state, &in, 5));
                 sentinel = state;
-                assert_int_equal(icoac_init(&cfg, &state, &p, 3u), ICOAC_ERR_BAD_PRIOR);
-                assert_memory_equal(&state, &sentinel, sizeof state);
-                assert_int_equal(run_trial(&running, &state, &in, 5), ICOAC_OK); /* and it still runs */
+                TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_PRIOR, icoac_init(&cfg, &state, &p, 3u));
+                TEST_ASSERT_EQUAL_MEMORY(&sentinel, &state, sizeof state);
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, run_trial(&running, &state, &in, 5)); /* and it still runs */
             }
             /* the prior itself is accepted: by the other modes, and by search with c = 1 */
             for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
                 icoac_config_t other = cfg;
                 other.mode = mode;
-                assert_int_equal(icoac_init(&other, &state, &p, 3u), ICOAC_OK);
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&other, &state, &p, 3u));
             }
             cfg.search.cov_scale = 1;
-            assert_int_equal(icoac_init(&cfg, &state, &p, 3u), ICOAC_OK);
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, &p, 3u));
         }
     }
-    assert_true(found >= 8);
+    TEST_ASSERT_TRUE(found >= 8);
 }
 
 /* Over many resets, the trials' w have mean mu_w and covariance Sigma_w (sample statistics
@@ -789,7 +785,7 @@ static void check_sample_statistics(const icoac_config_t *cfg, icoac_state_t *st
         if (n % 997 == 0) {
             tol = expected_draw(state, drawn, NULL);
         }
-        assert_int_equal(icoac_reset(state), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(state));
         w_act_of(state, w);
         if (n % 997 == 0) {
             for (i = 0; i < N; ++i) {
@@ -814,7 +810,11 @@ static void check_sample_statistics(const icoac_config_t *cfg, icoac_state_t *st
     }
 }
 
-static void test_samples_through_cholesky(void **unused)
+/* Draws of each statistics check: fewer on an emulated core (QEMU is slow); the tolerances
+ * follow the count. */
+#define SAMPLES TEST_ITERATIONS(200000, 20000)
+
+static void test_samples_through_cholesky(void)
 {
     test_rng_t rng = {0xC401u};
     icoac_config_t cfg = search_config(8, 0.5, 0.6, 1e-3, 3.0);
@@ -823,13 +823,12 @@ static void test_samples_through_cholesky(void **unused)
     icoac_prior_t p = test_random_prior(&rng, 1.0, 0.5);
     gauss_t g;
     int i, j, k;
-    (void)unused;
-    assert_int_equal(icoac_init(&cfg, &state, &p, 7u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, &p, 7u));
     posterior_of(&state, &g);
     for (i = 0; i < N; ++i) {
-        assert_true(g.mean[i] == (double)p.mean[i]);
+        TEST_ASSERT_TRUE(g.mean[i] == (double)p.mean[i]);
         for (j = 0; j < N; ++j) {
-            assert_true(g.cov[i][j] == (double)(p.cov[i][j] * cfg.search.cov_scale)); /* Sigma0 = c Sigma_prior */
+            TEST_ASSERT_TRUE(g.cov[i][j] == (double)(p.cov[i][j] * cfg.search.cov_scale)); /* Sigma0 = c Sigma_prior */
         }
     }
     /* the first trial's w, drawn by icoac_init: four normals from the seeded generator */
@@ -841,9 +840,9 @@ static void test_samples_through_cholesky(void **unused)
             n[i] = (double)icoac_rng_normal(&gen);
         }
         /* the generator is where the four draws leave it: the stream is the controller's */
-        assert_true(gen.state == priv(&state)->rng.state && gen.increment == priv(&state)->rng.increment &&
-                    gen.has_spare == priv(&state)->rng.has_spare);
-        assert_true(cholesky(g.cov, lower));
+        TEST_ASSERT_TRUE(gen.state == priv(&state)->rng.state && gen.increment == priv(&state)->rng.increment &&
+                         gen.has_spare == priv(&state)->rng.has_spare);
+        TEST_ASSERT_TRUE(cholesky(g.cov, lower));
         w_act_of(&state, w);
         for (i = 0; i < N; ++i) {
             double want = g.mean[i];
@@ -853,17 +852,17 @@ static void test_samples_through_cholesky(void **unused)
             assert_close(w[i], want, (REAL_IS_FLOAT ? 2e-6 : 1e-13) * (1.0 + fabs(want)));
         }
     }
-    check_sample_statistics(&cfg, &state, 200000);
+    check_sample_statistics(&cfg, &state, SAMPLES);
     /* one update (a correlated elite covariance), then the same statistics without learning */
     for (k = 0; k < cfg.search.batch; ++k) {
-        assert_int_equal(run_trial(&cfg, &state, &rng, k % 5), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, run_trial(&cfg, &state, &rng, k % 5));
     }
     frozen = cfg;
     frozen.learn = 0;
-    assert_int_equal(icoac_retune(&state, &frozen), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_retune(&state, &frozen));
     posterior_of(&state, &g);
-    assert_true(fabs(g.cov[0][1] - (double)p.cov[0][1] * 3.0) > 1e-3); /* Sigma_w moved */
-    check_sample_statistics(&frozen, &state, 200000);
+    TEST_ASSERT_TRUE(fabs(g.cov[0][1] - (double)p.cov[0][1] * 3.0) > 1e-3); /* Sigma_w moved */
+    check_sample_statistics(&frozen, &state, SAMPLES);
 }
 
 /* Sigma_w stays exactly symmetric and positive definite (and above its floor) over 1e6 updates
@@ -875,7 +874,7 @@ static void test_samples_through_cholesky(void **unused)
  * with ICOAC_ERR_NUMERIC. Those settings (`singular`) can also keep a Sigma' that is singular
  * only up to rounding, which the library's Cholesky factorisation passes: positive semidefinite
  * up to rounding in double there, positive definite in double for the others. */
-static void test_spd_over_many_updates(void **unused)
+static void test_spd_over_many_updates(void)
 {
     typedef struct {
         int batch;
@@ -894,7 +893,6 @@ static void test_spd_over_many_updates(void **unused)
     };
     size_t c;
     long total = 0;
-    (void)unused;
     for (c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
         const spd_case_t *sc = &cases[c];
         icoac_config_t cfg = search_config(sc->batch, sc->rho, sc->step, sc->floor_, sc->cov_scale);
@@ -903,56 +901,57 @@ static void test_spd_over_many_updates(void **unused)
         icoac_state_t state;
         const icoac_priv_state_t *st = priv(&state);
         int u, k, i, j;
-        assert_int_equal(icoac_init(&cfg, &state, &p, 3u + c), ICOAC_OK);
-        for (u = 0; u < sc->updates; ++u) {
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, &p, 3u + c));
+        /* 1/50 of the updates on an emulated core (QEMU is slow) */
+        for (u = 0; u < TEST_ITERATIONS(sc->updates, sc->updates / 50); ++u) {
             const icoac_real_t(*cov)[M];
             icoac_real_t lower[M][M] = {{0}};
             for (k = 0; k < sc->batch; ++k) {
                 icoac_input_t in;
                 icoac_output_t out;
                 int t, ticks = (int)(test_rng_u64(&rng) % 4u);
-                assert_int_equal(icoac_reset(&state), ICOAC_OK);
+                TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
                 for (t = 0; t < ticks; ++t) {
                     in = test_input(0.1, 0.0, 0.01, 0.0, 0);
                     step_ok(&cfg, &state, &in, &out);
                 }
                 in = test_input(0.1, 0.0, 0.3, 0.0, ICOAC_INPUT_TERMINAL);
                 if (icoac_step(&state, &in, &out) != ICOAC_OK) {
-                    print_error("case %u, update %d: terminal tick -> %d\n", (unsigned)c, u, (int)out.status);
-                    fail();
+                    TEST_PRINTF("case %u, update %d: terminal tick -> %d", (unsigned)c, u, (int)out.status);
+                    TEST_FAIL();
                 }
             }
             cov = icoac_priv_cov_c(st);
             for (i = 0; i < N; ++i) {
                 if (!(cov[i][i] >= st->search.floor[i]) || !isfinite((double)cov[i][i])) {
-                    print_error("case %u, update %d: cov[%d][%d] = %g, floor %g\n", (unsigned)c, u, i, i,
+                    TEST_PRINTF("case %u, update %d: cov[%d][%d] = %g, floor %g", (unsigned)c, u, i, i,
                                 (double)cov[i][i], (double)st->search.floor[i]);
-                    fail();
+                    TEST_FAIL();
                 }
                 for (j = i + 1; j < N; ++j) {
                     if (cov[i][j] != cov[j][i]) {
-                        print_error("case %u, update %d: cov not symmetric at (%d, %d)\n", (unsigned)c, u, i, j);
-                        fail();
+                        TEST_PRINTF("case %u, update %d: cov not symmetric at (%d, %d)", (unsigned)c, u, i, j);
+                        TEST_FAIL();
                     }
                 }
             }
             if (!icoac_priv_cholesky(cov, lower, ICOAC_CARTPOLE_INPUTS)) {
-                print_error("case %u, update %d: cov not positive definite\n", (unsigned)c, u);
-                fail();
+                TEST_PRINTF("case %u, update %d: cov not positive definite", (unsigned)c, u);
+                TEST_FAIL();
             }
-            if (u % 5000 == 0) {
+            if (u % TEST_ITERATIONS(5000, 100) == 0) {
                 /* independent check in double, and the stored factor L L^T = Sigma_w */
                 assert_sigma_spd(&state, sc->singular ? PSD_MARGIN : 0.0, "spd case", (int)c);
             }
             ++total;
         }
     }
-    assert_int_equal(total, 1000000);
+    TEST_ASSERT_EQUAL_INT64(TEST_ITERATIONS(1000000, 20000), total);
 }
 
 /* Same seed, same observations: the same samples, outputs and state, bytewise; another seed
  * draws other samples. */
-static void test_deterministic_for_a_seed(void **unused)
+static void test_deterministic_for_a_seed(void)
 {
     icoac_config_t cfg = search_config(3, 0.5, 0.5, 0.1, 2.0);
     test_rng_t rng_p = {77u};
@@ -960,32 +959,31 @@ static void test_deterministic_for_a_seed(void **unused)
     icoac_state_t a, b, other;
     test_rng_t inputs = {0xD5u};
     int trial;
-    (void)unused;
-    assert_int_equal(icoac_init(&cfg, &a, &p, 42u), ICOAC_OK);
-    assert_int_equal(icoac_init(&cfg, &b, &p, 42u), ICOAC_OK);
-    assert_int_equal(icoac_init(&cfg, &other, &p, 43u), ICOAC_OK);
-    assert_memory_equal(&a, &b, sizeof a);
-    assert_true(memcmp(priv(&a)->w_act, priv(&other)->w_act, sizeof priv(&a)->w_act) != 0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &a, &p, 42u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &b, &p, 42u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &other, &p, 43u));
+    TEST_ASSERT_EQUAL_MEMORY(&b, &a, sizeof a);
+    TEST_ASSERT_TRUE(memcmp(priv(&a)->w_act, priv(&other)->w_act, sizeof priv(&a)->w_act) != 0);
     for (trial = 0; trial < 60; ++trial) {
         const int ticks = (int)test_uniform(&inputs, 0, 30);
         int t;
-        assert_int_equal(icoac_reset(&a), ICOAC_OK);
-        assert_int_equal(icoac_reset(&b), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&a));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&b));
         for (t = 0; t <= ticks; ++t) {
             icoac_input_t in = random_input(&inputs, t == ticks ? ICOAC_INPUT_TERMINAL : 0u);
             icoac_output_t oa, ob;
             step_ok(&cfg, &a, &in, &oa);
             step_ok(&cfg, &b, &in, &ob);
-            assert_memory_equal(&oa, &ob, sizeof oa);
+            TEST_ASSERT_EQUAL_MEMORY(&ob, &oa, sizeof oa);
         }
     }
-    assert_memory_equal(&a, &b, sizeof a);
+    TEST_ASSERT_EQUAL_MEMORY(&b, &a, sizeof a);
 }
 
 /* learn = 0 (the no-learning control of a search condition): over many full batches mu_w,
  * Sigma_w, the factor and the record stay bitwise; the trials still draw their w, the same
  * ones as a learning twin with the same seed until its first update, other ones after it. */
-static void test_no_learning_control(void **unused)
+static void test_no_learning_control(void)
 {
     icoac_config_t learning = search_config(4, 0.5, 0.5, 0.1, 2.0);
     icoac_config_t control = learning;
@@ -995,49 +993,47 @@ static void test_no_learning_control(void **unused)
     icoac_state_t start;
     test_rng_t in_c = {9u}, in_l = {9u};
     int trial, distinct = 0;
-    (void)unused;
     control.learn = 0;
-    assert_int_equal(icoac_init(&control, &c_state, &p, 11u), ICOAC_OK);
-    assert_int_equal(icoac_init(&learning, &l_state, &p, 11u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&control, &c_state, &p, 11u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&learning, &l_state, &p, 11u));
     start = c_state;
     for (trial = 0; trial < 40; ++trial) {
         double wc[N], wl[N], w_prev[N];
         const int ticks = trial % 6;
         w_act_of(&c_state, w_prev);
-        assert_int_equal(icoac_reset(&c_state), ICOAC_OK);
-        assert_int_equal(icoac_reset(&l_state), ICOAC_OK);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&c_state));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&l_state));
         w_act_of(&c_state, wc);
         w_act_of(&l_state, wl);
         distinct += memcmp(wc, w_prev, sizeof wc) != 0;
         if (trial < learning.search.batch) {
-            assert_memory_equal(wc, wl, sizeof wc); /* the same draws before the first update */
+            TEST_ASSERT_EQUAL_MEMORY(wl, wc, sizeof wc); /* the same draws before the first update */
         } else {
-            assert_true(memcmp(wc, wl, sizeof wc) != 0);
+            TEST_ASSERT_TRUE(memcmp(wc, wl, sizeof wc) != 0);
         }
-        assert_int_equal(finish_trial(&control, &c_state, &in_c, ticks), ICOAC_OK);
-        assert_int_equal(finish_trial(&learning, &l_state, &in_l, ticks), ICOAC_OK);
-        assert_memory_equal(priv(&c_state)->w, priv(&start)->w, sizeof priv(&start)->w);
-        assert_memory_equal(icoac_priv_cov_c(priv(&c_state)), icoac_priv_cov_c(priv(&start)),
-                            sizeof(icoac_real_t) * N * N);
-        assert_memory_equal(&priv(&c_state)->search, &priv(&start)->search, sizeof priv(&start)->search);
-        assert_true(priv(&c_state)->weight_norm == priv(&start)->weight_norm);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, finish_trial(&control, &c_state, &in_c, ticks));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, finish_trial(&learning, &l_state, &in_l, ticks));
+        TEST_ASSERT_EQUAL_MEMORY(priv(&start)->w, priv(&c_state)->w, sizeof priv(&start)->w);
+        TEST_ASSERT_EQUAL_MEMORY(icoac_priv_cov_c(priv(&start)), icoac_priv_cov_c(priv(&c_state)),
+                                 sizeof(icoac_real_t) * N * N);
+        TEST_ASSERT_EQUAL_MEMORY(&priv(&start)->search, &priv(&c_state)->search, sizeof priv(&start)->search);
+        TEST_ASSERT_TRUE(priv(&c_state)->weight_norm == priv(&start)->weight_norm);
     }
-    assert_int_equal(distinct, 40);
+    TEST_ASSERT_EQUAL_INT(40, distinct);
     /* the learning twin did learn */
-    assert_true(memcmp(priv(&l_state)->w, priv(&start)->w, sizeof priv(&start)->w) != 0);
+    TEST_ASSERT_TRUE(memcmp(priv(&l_state)->w, priv(&start)->w, sizeof priv(&start)->w) != 0);
 }
 
 /* A search tick acts like the ICO policy with the trial's w: F = G w^T x~ + reflex, no noise;
  * no critic outputs; the covariance's trace; a terminal tick outputs no force. */
-static void test_tick_outputs(void **unused)
+static void test_tick_outputs(void)
 {
     icoac_config_t cfg = search_config(2, 0.5, 0.5, 0.1, 1.0);
     icoac_state_t state;
     test_rng_t rng = {31u};
     icoac_prior_t p = test_random_prior(&rng, 1.0, 0.5);
     int k, i;
-    (void)unused;
-    assert_int_equal(icoac_init(&cfg, &state, &p, 8u), ICOAC_OK);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&cfg, &state, &p, 8u));
     for (k = 0; k < 400; ++k) {
         const int terminal = k % 20 == 19;
         icoac_input_t in = random_input(&rng, terminal ? ICOAC_INPUT_TERMINAL : 0u);
@@ -1055,12 +1051,12 @@ static void test_tick_outputs(void **unused)
         }
         if (fabs((double)in.s[2]) > 0.20071286397934788 || fabs((double)in.s[0]) > 2.35) {
             reflex = (double)out.reflex;
-            assert_true(reflex != 0);
+            TEST_ASSERT_TRUE(reflex != 0);
         }
-        assert_true(out.noise == 0 && out.value == 0 && out.td_error == 0 && out.q == 0);
+        TEST_ASSERT_TRUE(out.noise == 0 && out.value == 0 && out.td_error == 0 && out.q == 0);
         if (terminal) {
-            assert_true(out.force == 0 && out.z == 0);
-            assert_int_equal(icoac_reset(&state), ICOAC_OK);
+            TEST_ASSERT_TRUE(out.force == 0 && out.z == 0);
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&state));
         } else {
             assert_close(out.z, z, (REAL_IS_FLOAT ? 1e-5 : 1e-13) * (1.0 + fabs(z)));
             assert_close(out.force, GAIN * z + reflex, (REAL_IS_FLOAT ? 1e-4 : 1e-12) * (1.0 + fabs(GAIN * z)));
@@ -1074,18 +1070,20 @@ static void test_tick_outputs(void **unused)
     }
 }
 
+void setUp(void) {}
+void tearDown(void) {}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_update_matches_reference),
-        cmocka_unit_test(test_elite_choice),
-        cmocka_unit_test(test_step_one_small_elites),
-        cmocka_unit_test(test_rejected_prior_leaves_state),
-        cmocka_unit_test(test_samples_through_cholesky),
-        cmocka_unit_test(test_spd_over_many_updates),
-        cmocka_unit_test(test_deterministic_for_a_seed),
-        cmocka_unit_test(test_no_learning_control),
-        cmocka_unit_test(test_tick_outputs),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_update_matches_reference);
+    RUN_TEST(test_elite_choice);
+    RUN_TEST(test_step_one_small_elites);
+    RUN_TEST(test_rejected_prior_leaves_state);
+    RUN_TEST(test_samples_through_cholesky);
+    RUN_TEST(test_spd_over_many_updates);
+    RUN_TEST(test_deterministic_for_a_seed);
+    RUN_TEST(test_no_learning_control);
+    RUN_TEST(test_tick_outputs);
+    return UNITY_END();
 }
