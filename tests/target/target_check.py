@@ -7,12 +7,17 @@
   nm      <preset>                         no heap allocator in the library or the example
   compare <host-exe|out> <target-out>      ICO bit-exact, RL and search within tolerance of the host build
   stack   <target-out> <budget>            peak stack of the tick loops (and of the search update) within budget (bytes)
+  unit-build <preset> <dir> <unity-src>    configure <dir> from a cross preset with the firmware unit tests
+                                           (tests/unit_target) and build them
+  unit-run   <preset> <elf> <timeout>      run one unit test under QEMU: passes on exit 0, Unity's summary
+                                           with 0 failures and OK, no FAIL line, within timeout (s)
 """
 import os
 import re
 import struct
 import subprocess
 import sys
+import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BOARDS = {"cortex-m4f": "mps2-an386", "cortex-m0plus": "microbit"}
@@ -44,10 +49,13 @@ def cmd_build(preset):
     subprocess.run(["cmake", "--build", "--preset", preset], cwd=ROOT, check=True)
 
 
+def qemu_command(preset, kernel, options=()):
+    return ["qemu-system-arm", "-M", BOARDS[preset], "-nographic", "-monitor", "none", "-serial", "none",
+            "-semihosting-config", "enable=on,target=native", *options, "-kernel", kernel]
+
+
 def run_qemu(preset):
-    r = subprocess.run(["qemu-system-arm", "-M", BOARDS[preset], "-nographic", "-monitor", "none",
-                        "-serial", "none", "-semihosting-config", "enable=on,target=native",
-                        "-icount", "shift=0", "-kernel", elf(preset)],
+    r = subprocess.run(qemu_command(preset, elf(preset), ("-icount", "shift=0")),
                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=120, text=True)
     out = r.stdout + r.stderr  # QEMU writes semihosting SYS_WRITE0 output to stderr
     if r.returncode != 0 or "END" not in out.splitlines():
@@ -154,6 +162,43 @@ def cmd_stack(target_path, budget):
         sys.exit("stack budget exceeded")
 
 
+def cmd_unit_build(preset, directory, unity_src):
+    subprocess.run(["cmake", "--preset", preset, "-B", directory, "-DICOAC_BUILD_TARGET_TESTS=ON",
+                    "-DFETCHCONTENT_SOURCE_DIR_UNITY=" + unity_src],
+                   cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+    subprocess.run(["cmake", "--build", directory, "--target", "icoac_unit_target_tests"], check=True)
+
+
+# Unity's closing lines: "<n> Tests <f> Failures <i> Ignored", then OK or FAIL.
+UNITY_SUMMARY = re.compile(r"^(\d+) Tests (\d+) Failures (\d+) Ignored *\n(OK|FAIL)$", re.M)
+
+
+def cmd_unit_run(preset, kernel, timeout):
+    start = time.monotonic()
+    try:
+        r = subprocess.run(qemu_command(preset, kernel), stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, timeout=timeout, text=True)
+    except subprocess.TimeoutExpired as e:
+        out = e.stdout.decode(errors="replace") if isinstance(e.stdout, bytes) else (e.stdout or "")
+        sys.exit("%s\ntimeout: no exit within %g s on %s" % (out, timeout, BOARDS[preset]))
+    out = r.stdout  # semihosting SYS_WRITE0 goes to QEMU's stderr, merged here
+    print(out, end="")
+    print("%s on %s: %.2f s wall, exit %d" % (os.path.basename(kernel), BOARDS[preset],
+                                             time.monotonic() - start, r.returncode))
+    summary = UNITY_SUMMARY.findall(out)
+    problems = []
+    if r.returncode != 0:
+        problems.append("exit status %d" % r.returncode)
+    if any(":FAIL" in line for line in out.splitlines()):
+        problems.append("a test failed")
+    if not summary:
+        problems.append("no Unity summary line")
+    elif summary[-1][1] != "0" or summary[-1][3] != "OK":
+        problems.append("the summary counts failures")
+    if problems:
+        sys.exit("FAILED: " + ", ".join(problems))
+
+
 def main(argv):
     cmd = argv[1] if len(argv) > 1 else ""
     if cmd == "build":
@@ -166,6 +211,10 @@ def main(argv):
         cmd_compare(argv[2], argv[3])
     elif cmd == "stack":
         cmd_stack(argv[2], int(argv[3]))
+    elif cmd == "unit-build":
+        cmd_unit_build(argv[2], argv[3], argv[4])
+    elif cmd == "unit-run":
+        cmd_unit_run(argv[2], argv[3], float(argv[4]))
     else:
         sys.exit(__doc__)
 
