@@ -17,6 +17,7 @@ import re
 import struct
 import subprocess
 import sys
+import threading
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -175,21 +176,37 @@ UNITY_SUMMARY = re.compile(r"^(\d+) Tests (\d+) Failures (\d+) Ignored *\n(OK|FA
 
 def cmd_unit_run(preset, kernel, timeout):
     start = time.monotonic()
+    proc = subprocess.Popen(qemu_command(preset, kernel), stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)  # semihosting output is on stderr
+    lines = []
+
+    def read():  # each line with the seconds since the previous one (Unity prints one per test)
+        last = start
+        for line in proc.stdout:
+            now = time.monotonic()
+            lines.append((line.rstrip("\n"), now - last))
+            last = now
+
+    reader = threading.Thread(target=read)
+    reader.start()
     try:
-        r = subprocess.run(qemu_command(preset, kernel), stdout=subprocess.PIPE,
-                           stderr=subprocess.STDOUT, timeout=timeout, text=True)
-    except subprocess.TimeoutExpired as e:
-        out = e.stdout.decode(errors="replace") if isinstance(e.stdout, bytes) else (e.stdout or "")
-        sys.exit("%s\ntimeout: no exit within %g s on %s" % (out, timeout, BOARDS[preset]))
-    out = r.stdout  # semihosting SYS_WRITE0 goes to QEMU's stderr, merged here
-    print(out, end="")
+        returncode = proc.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        returncode = None
+    reader.join()
+    for line, seconds in lines:
+        print("%s  [%.2f s]" % (line, seconds) if re.search(r":(PASS|FAIL|IGNORE)", line) else line)
+    out = "".join(line + "\n" for line, _ in lines)
+    if returncode is None:
+        sys.exit("FAILED: timeout, no exit within %g s on %s" % (timeout, BOARDS[preset]))
     print("%s on %s: %.2f s wall, exit %d" % (os.path.basename(kernel), BOARDS[preset],
-                                             time.monotonic() - start, r.returncode))
+                                             time.monotonic() - start, returncode))
     summary = UNITY_SUMMARY.findall(out)
     problems = []
-    if r.returncode != 0:
-        problems.append("exit status %d" % r.returncode)
-    if any(":FAIL" in line for line in out.splitlines()):
+    if returncode != 0:
+        problems.append("exit status %d" % returncode)
+    if any(":FAIL" in line for line, _ in lines):
         problems.append("a test failed")
     if not summary:
         problems.append("no Unity summary line")
