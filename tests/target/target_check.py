@@ -172,6 +172,8 @@ def cmd_unit_build(preset, directory, unity_src):
 
 # Unity's closing lines: "<n> Tests <f> Failures <i> Ignored", then OK or FAIL.
 UNITY_SUMMARY = re.compile(r"^(\d+) Tests (\d+) Failures (\d+) Ignored *\n(OK|FAIL)$", re.M)
+# A test's result line: "<file>:<line>:<test>:PASS" (or FAIL, IGNORE, with a message).
+UNITY_RESULT = re.compile(r":(PASS|FAIL|IGNORE)\b")
 
 
 def cmd_unit_run(preset, kernel, timeout):
@@ -180,12 +182,13 @@ def cmd_unit_run(preset, kernel, timeout):
                             stderr=subprocess.STDOUT, text=True)  # semihosting output is on stderr
     lines = []
 
-    def read():  # each line with the seconds since the previous one (Unity prints one per test)
+    def read():  # each line with the seconds since the previous test's result line
         last = start
         for line in proc.stdout:
             now = time.monotonic()
             lines.append((line.rstrip("\n"), now - last))
-            last = now
+            if UNITY_RESULT.search(line):
+                last = now
 
     reader = threading.Thread(target=read)
     reader.start()
@@ -196,7 +199,7 @@ def cmd_unit_run(preset, kernel, timeout):
         returncode = None
     reader.join()
     for line, seconds in lines:
-        print("%s  [%.2f s]" % (line, seconds) if re.search(r":(PASS|FAIL|IGNORE)", line) else line)
+        print("%s  [%.2f s]" % (line, seconds) if UNITY_RESULT.search(line) else line)
     out = "".join(line + "\n" for line, _ in lines)
     if returncode is None:
         sys.exit("FAILED: timeout, no exit within %g s on %s" % (timeout, BOARDS[preset]))
