@@ -5,7 +5,8 @@
 # Makefile's UNITY_DIR).
 #
 # Gives the target `unity`, built for whatever compiler the including project uses (host or
-# arm-none-eabi), with doubles and 64-bit integers in its assertions.
+# arm-none-eabi), with doubles and 64-bit integers in its assertions and TEST_PRINTF (a printf of
+# its own, through UNITY_OUTPUT_CHAR, for failure context on cores without stdio).
 include_guard(GLOBAL)
 include(FetchContent)
 FetchContent_Declare(unity
@@ -13,4 +14,4 @@ FetchContent_Declare(unity
   GIT_TAG cbcd08fa7de711053a3deec6339ee89cad5d2697 # v2.6.1
   GIT_SHALLOW FALSE)
 FetchContent_MakeAvailable(unity)
-target_compile_definitions(unity PUBLIC UNITY_INCLUDE_DOUBLE UNITY_SUPPORT_64)
+target_compile_definitions(unity PUBLIC UNITY_INCLUDE_DOUBLE UNITY_SUPPORT_64 UNITY_INCLUDE_PRINT_FORMATTED)

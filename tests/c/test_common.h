@@ -8,6 +8,11 @@
 
 #include "unity.h"
 
+/* Failure context is printed with TEST_PRINTF (Unity's own printf, no stdio on the targets). */
+#ifndef UNITY_INCLUDE_PRINT_FORMATTED
+#error "build Unity with UNITY_INCLUDE_PRINT_FORMATTED (cmake/modules/IcoacUnity.cmake)"
+#endif
+
 #include <math.h>
 #include <string.h>
 

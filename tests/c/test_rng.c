@@ -60,7 +60,11 @@ static void test_pcg32_matches_reference(void)
         TEST_ASSERT_TRUE(rng.increment & 1u);
         for (i = 0; i < 10000; ++i) {
             const uint32_t r = ref_next(&ref);
-            TEST_ASSERT_EQUAL_HEX32(r, icoac_rng_next_u32(&rng));
+            const uint32_t got = icoac_rng_next_u32(&rng);
+            if (got != r) {
+                TEST_PRINTF("seed %u draw %d", (unsigned)s, i);
+            }
+            TEST_ASSERT_EQUAL_HEX32(r, got);
         }
         TEST_ASSERT_EQUAL_HEX64(ref.state, rng.state);
     }
@@ -91,6 +95,9 @@ static void test_uniform_range(void)
         const uint32_t bits = icoac_rng_next_u32(&twin);
         /* exact mapping: top 24 bits * 2^-24 (float), 32 bits * 2^-32 (double) */
         const double expect = REAL_IS_FLOAT ? (double)(bits >> 8) / 16777216.0 : (double)bits / 4294967296.0;
+        if (u != expect) {
+            TEST_PRINTF("draw %d", i);
+        }
         TEST_ASSERT_DOUBLE_WITHIN(0.0, expect, u); /* exactly */
         TEST_ASSERT_TRUE(u >= 0.0 && u < 1.0);
         sum += u;
