@@ -7,18 +7,12 @@
   nm      <preset>                         no heap allocator in the library or the example
   compare <host-exe|out> <target-out>      ICO bit-exact, RL and search within tolerance of the host build
   stack   <target-out> <budget>            peak stack of the tick loops (and of the search update) within budget (bytes)
-  unit-build <preset> <dir> <unity-src>    configure <dir> from a cross preset with the firmware unit tests
-                                           (tests/unit_target) and build them
-  unit-run   <preset> <elf> <timeout>      run one unit test under QEMU: passes on exit 0, Unity's summary
-                                           with 0 failures, 0 ignored and OK, no FAIL line, within timeout (s)
 """
 import os
 import re
 import struct
 import subprocess
 import sys
-import threading
-import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BOARDS = {"cortex-m4f": "mps2-an386", "cortex-m0plus": "microbit"}
@@ -163,64 +157,6 @@ def cmd_stack(target_path, budget):
         sys.exit("stack budget exceeded")
 
 
-def cmd_unit_build(preset, directory, unity_src):
-    subprocess.run(["cmake", "--preset", preset, "-B", directory, "-DICOAC_BUILD_TARGET_TESTS=ON",
-                    "-DFETCHCONTENT_SOURCE_DIR_UNITY=" + unity_src],
-                   cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
-    subprocess.run(["cmake", "--build", directory, "--target", "icoac_unit_target_tests"], check=True)
-
-
-# Unity's closing lines: "<n> Tests <f> Failures <i> Ignored", then OK or FAIL.
-UNITY_SUMMARY = re.compile(r"^(\d+) Tests (\d+) Failures (\d+) Ignored *\n(OK|FAIL)$", re.M)
-# A test's result line: "<file>:<line>:<test>:PASS" (or FAIL, IGNORE, with a message).
-UNITY_RESULT = re.compile(r":(PASS|FAIL|IGNORE)\b")
-
-
-def cmd_unit_run(preset, kernel, timeout):
-    start = time.monotonic()
-    proc = subprocess.Popen(qemu_command(preset, kernel), stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True)  # semihosting output is on stderr
-    lines = []
-
-    def read():  # each line with the seconds since the previous test's result line
-        last = start
-        for line in proc.stdout:
-            now = time.monotonic()
-            lines.append((line.rstrip("\n"), now - last))
-            if UNITY_RESULT.search(line):
-                last = now
-
-    reader = threading.Thread(target=read)
-    reader.start()
-    try:
-        returncode = proc.wait(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        returncode = None
-    reader.join()
-    for line, seconds in lines:
-        print("%s  [%.2f s]" % (line, seconds) if UNITY_RESULT.search(line) else line)
-    out = "".join(line + "\n" for line, _ in lines)
-    if returncode is None:
-        sys.exit("FAILED: timeout, no exit within %g s on %s" % (timeout, BOARDS[preset]))
-    print("%s on %s: %.2f s wall, exit %d" % (os.path.basename(kernel), BOARDS[preset],
-                                             time.monotonic() - start, returncode))
-    summary = UNITY_SUMMARY.findall(out)
-    problems = []
-    if returncode != 0:
-        problems.append("exit status %d" % returncode)
-    if any(":FAIL" in line for line, _ in lines):
-        problems.append("a test failed")
-    if not summary:
-        problems.append("no Unity summary line")
-    elif summary[-1][1] != "0" or summary[-1][3] != "OK":
-        problems.append("the summary counts failures")
-    elif summary[-1][2] != "0":  # a skip is no pass: leave such a test out of the core's build
-        problems.append("ignored tests")
-    if problems:
-        sys.exit("FAILED: " + ", ".join(problems))
-
-
 def main(argv):
     cmd = argv[1] if len(argv) > 1 else ""
     if cmd == "build":
@@ -233,10 +169,6 @@ def main(argv):
         cmd_compare(argv[2], argv[3])
     elif cmd == "stack":
         cmd_stack(argv[2], int(argv[3]))
-    elif cmd == "unit-build":
-        cmd_unit_build(argv[2], argv[3], argv[4])
-    elif cmd == "unit-run":
-        cmd_unit_run(argv[2], argv[3], float(argv[4]))
     else:
         sys.exit(__doc__)
 
