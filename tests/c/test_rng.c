@@ -28,7 +28,7 @@ static void ref_seed(ref_pcg_t *g, uint64_t seed, uint64_t stream)
     (void)ref_next(g);
 }
 
-static void test_pcg32_published_vector(void **unused)
+static void test_pcg32_published_vector(void)
 {
     /* pcg32-demo of the PCG reference C library, pcg32_srandom_r(&rng, 42, 54). */
     static const uint32_t expected[6] = {0xa15c02b7u, 0x7b47f409u, 0xba1d3330u,
@@ -36,39 +36,37 @@ static void test_pcg32_published_vector(void **unused)
     icoac_rng_t rng;
     ref_pcg_t ref;
     int i;
-    (void)unused;
     icoac_rng_seed(&rng, 42u, 54u);
     ref_seed(&ref, 42u, 54u);
     for (i = 0; i < 6; ++i) {
         const uint32_t r = ref_next(&ref);
-        assert_int_equal(r, expected[i]); /* the reference implementation itself */
-        assert_int_equal(icoac_rng_next_u32(&rng), expected[i]);
+        TEST_ASSERT_EQUAL_HEX32(expected[i], r); /* the reference implementation itself */
+        TEST_ASSERT_EQUAL_HEX32(expected[i], icoac_rng_next_u32(&rng));
     }
 }
 
-static void test_pcg32_matches_reference(void **unused)
+static void test_pcg32_matches_reference(void)
 {
     static const uint64_t seeds[][2] = {
         {0u, 0u}, {1u, 0u}, {0u, 1u}, {42u, 54u}, {0xFFFFFFFFFFFFFFFFULL, 0x7FFFFFFFFFFFFFFFULL},
         {0x853c49e6748fea9bULL, 0xda3e39cb94b95bdbULL}, {123456789u, 0x1C0ACu}};
     size_t s;
     int i;
-    (void)unused;
     for (s = 0; s < sizeof seeds / sizeof seeds[0]; ++s) {
         icoac_rng_t rng;
         ref_pcg_t ref;
         icoac_rng_seed(&rng, seeds[s][0], seeds[s][1]);
         ref_seed(&ref, seeds[s][0], seeds[s][1]);
-        assert_true(rng.increment & 1u);
+        TEST_ASSERT_TRUE(rng.increment & 1u);
         for (i = 0; i < 10000; ++i) {
             const uint32_t r = ref_next(&ref);
             const uint32_t got = icoac_rng_next_u32(&rng);
             if (got != r) {
-                print_error("seed %zu draw %d: %08x != %08x\n", s, i, (unsigned)got, (unsigned)r);
-                fail();
+                TEST_PRINTF("seed %u draw %d", (unsigned)s, i);
             }
+            TEST_ASSERT_EQUAL_HEX32(r, got);
         }
-        assert_true(rng.state == ref.state);
+        TEST_ASSERT_EQUAL_HEX64(ref.state, rng.state);
     }
     /* different streams with the same seed differ */
     {
@@ -79,18 +77,17 @@ static void test_pcg32_matches_reference(void **unused)
         for (i = 0; i < 100; ++i) {
             same += icoac_rng_next_u32(&a) == icoac_rng_next_u32(&b);
         }
-        assert_true(same < 3);
+        TEST_ASSERT_LESS_THAN_INT(3, same);
     }
 }
 
-static void test_uniform_range(void **unused)
+static void test_uniform_range(void)
 {
-    const int n = 1000000;
+    const int n = TEST_ITERATIONS(1000000, 100000); /* fewer under QEMU; 5 SE at either n */
     icoac_rng_t rng, twin;
     double sum = 0, mean, se;
     double lo = 1, hi = 0;
     int i;
-    (void)unused;
     icoac_rng_seed(&rng, 2024u, 3u);
     icoac_rng_seed(&twin, 2024u, 3u);
     for (i = 0; i < n; ++i) {
@@ -99,37 +96,36 @@ static void test_uniform_range(void **unused)
         /* exact mapping: top 24 bits * 2^-24 (float), 32 bits * 2^-32 (double) */
         const double expect = REAL_IS_FLOAT ? (double)(bits >> 8) / 16777216.0 : (double)bits / 4294967296.0;
         if (u != expect) {
-            print_error("draw %d: %.17g != %.17g\n", i, u, expect);
-            fail();
+            TEST_PRINTF("draw %d", i);
         }
-        assert_true(u >= 0.0 && u < 1.0);
+        TEST_ASSERT_DOUBLE_WITHIN(0.0, expect, u); /* exactly */
+        TEST_ASSERT_TRUE(u >= 0.0 && u < 1.0);
         sum += u;
         lo = u < lo ? u : lo;
         hi = u > hi ? u : hi;
     }
     /* the largest possible value is still below 1 */
-    assert_true(REAL_IS_FLOAT ? (float)(16777215.0 / 16777216.0) < 1.0f
-                              : 4294967295.0 * (1.0 / 4294967296.0) < 1.0);
+    TEST_ASSERT_TRUE(REAL_IS_FLOAT ? (float)(16777215.0 / 16777216.0) < 1.0f
+                                   : 4294967295.0 * (1.0 / 4294967296.0) < 1.0);
     mean = sum / n;
     se = sqrt(1.0 / 12.0 / n);
     assert_close(mean, 0.5, 5.0 * se);
-    assert_true(lo < 1e-4 && hi > 1.0 - 1e-4);
+    TEST_ASSERT_TRUE(lo < 1e-4 && hi > 1.0 - 1e-4);
 }
 
-static void test_normal_statistics(void **unused)
+static void test_normal_statistics(void)
 {
-    const int n = 1000000;
+    const int n = TEST_ITERATIONS(1000000, 100000); /* fewer under QEMU; 5 SE at either n */
     const double p1 = 0.68268949213708585; /* P(|Z| < 1) = erf(1/sqrt 2) */
     icoac_rng_t rng;
     double s1 = 0, s2 = 0, s4 = 0;
     long within = 0;
     int i;
-    (void)unused;
     assert_close(p1, erf(1.0 / sqrt(2.0)), 1e-15);
     icoac_rng_seed(&rng, 99u, 17u);
     for (i = 0; i < n; ++i) {
         const double z = (double)icoac_rng_normal(&rng);
-        assert_true(isfinite(z));
+        TEST_ASSERT_TRUE(isfinite(z));
         s1 += z;
         s2 += z * z;
         s4 += z * z * z * z;
@@ -152,11 +148,10 @@ static void test_normal_statistics(void **unused)
 /* Polar-method pairs: from uniforms (u1, u2), u = 2 u1 - 1, v = 2 u2 - 1, points with
  * s = u^2 + v^2 outside (0, 1) are rejected; an accepted point gives u f and v f with
  * f = sqrt(-2 ln s / s). The twin generator replays the uniforms. */
-static void test_normal_polar_pairs(void **unused)
+static void test_normal_polar_pairs(void)
 {
     icoac_rng_t rng, twin;
     int i, rejected = 0;
-    (void)unused;
     icoac_rng_seed(&rng, 5u, 6u);
     icoac_rng_seed(&twin, 5u, 6u);
     for (i = 0; i < 2000; ++i) {
@@ -177,10 +172,11 @@ static void test_normal_polar_pairs(void **unused)
         assert_close(z1, u * f, tol);
         assert_close(z2, v * f, tol);
         /* the pair consumed exactly the twin's uniforms, rejections included */
-        assert_true(rng.state == twin.state);
+        TEST_ASSERT_EQUAL_HEX64(twin.state, rng.state);
     }
     /* acceptance pi/4: about 0.27 rejections per pair */
-    assert_true(rejected > 400 && rejected < 700);
+    TEST_ASSERT_GREATER_THAN_INT(400, rejected);
+    TEST_ASSERT_LESS_THAN_INT(700, rejected);
 }
 
 /* SplitMix64 (Steele, Lea, Flood 2014): the i-th output of a generator seeded with `seed`. */
@@ -198,29 +194,35 @@ static uint64_t ref_splitmix(uint64_t seed, uint64_t index)
     return z;
 }
 
-static void test_mix_seed(void **unused)
+static void test_mix_seed(void)
 {
     uint64_t i;
-    (void)unused;
     /* published first output of SplitMix64 seeded with 0 */
-    assert_true(ref_splitmix(0u, 0u) == 0xE220A8397B1DCDAFULL);
-    assert_true(icoac_mix_seed(0u, 0u) == 0xE220A8397B1DCDAFULL);
+    TEST_ASSERT_EQUAL_HEX64(0xE220A8397B1DCDAFULL, ref_splitmix(0u, 0u));
+    TEST_ASSERT_EQUAL_HEX64(0xE220A8397B1DCDAFULL, icoac_mix_seed(0u, 0u));
     for (i = 0; i < 50; ++i) {
-        assert_true(icoac_mix_seed(12345u, i) == ref_splitmix(12345u, i));
-        assert_true(icoac_mix_seed(0xDEADBEEFULL, i) == ref_splitmix(0xDEADBEEFULL, i));
-        assert_true(icoac_mix_seed(1u, i) != icoac_mix_seed(2u, i));
+        TEST_ASSERT_EQUAL_HEX64(ref_splitmix(12345u, i), icoac_mix_seed(12345u, i));
+        TEST_ASSERT_EQUAL_HEX64(ref_splitmix(0xDEADBEEFULL, i), icoac_mix_seed(0xDEADBEEFULL, i));
+        TEST_ASSERT_TRUE(icoac_mix_seed(1u, i) != icoac_mix_seed(2u, i));
     }
+}
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
 }
 
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_pcg32_published_vector),
-        cmocka_unit_test(test_pcg32_matches_reference),
-        cmocka_unit_test(test_uniform_range),
-        cmocka_unit_test(test_normal_statistics),
-        cmocka_unit_test(test_normal_polar_pairs),
-        cmocka_unit_test(test_mix_seed),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    UNITY_BEGIN();
+    RUN_TEST(test_pcg32_published_vector);
+    RUN_TEST(test_pcg32_matches_reference);
+    RUN_TEST(test_uniform_range);
+    RUN_TEST(test_normal_statistics);
+    RUN_TEST(test_normal_polar_pairs);
+    RUN_TEST(test_mix_seed);
+    return UNITY_END();
 }

@@ -47,10 +47,13 @@ def cmd_build(preset):
     subprocess.run(["cmake", "--build", "--preset", preset], cwd=ROOT, check=True)
 
 
+def qemu_command(preset, kernel, options=()):
+    return ["qemu-system-arm", "-M", BOARDS[preset], "-nographic", "-monitor", "none", "-serial", "none",
+            "-semihosting-config", "enable=on,target=native", *options, "-kernel", kernel]
+
+
 def run_qemu(preset):
-    r = subprocess.run(["qemu-system-arm", "-M", BOARDS[preset], "-nographic", "-monitor", "none",
-                        "-serial", "none", "-semihosting-config", "enable=on,target=native",
-                        "-icount", "shift=0", "-kernel", elf(preset)],
+    r = subprocess.run(qemu_command(preset, elf(preset), ("-icount", "shift=0")),
                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=120, text=True)
     out = r.stdout + r.stderr  # QEMU writes semihosting SYS_WRITE0 output to stderr
     if r.returncode != 0 or "END" not in out.splitlines():
