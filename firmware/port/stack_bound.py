@@ -391,12 +391,8 @@ def target_runtime(build, externals, frames, edges):
     cache = cmake_cache(build)
     cc = cache["ICOAC_ARM_GCC"]  # cmake/toolchain/arm-none-eabi.cmake
     prefix = cc[:-3] if cc.endswith("gcc") else cc
-    elf = os.path.join(build, "icoac_stack_link.elf")
-    lib = find_in(build, "libicoac.a", False)
-    # the library whole, newlib-nano and libm as the port example; icoac_step as the entry
-    subprocess.run([cc] + cache.get("CMAKE_C_FLAGS", "").split() +
-                   ["-nostartfiles", "--specs=nano.specs", "-Wl,--whole-archive", lib,
-                    "-Wl,--no-whole-archive", "-lm", "-Wl,-e,icoac_step", "-o", elf], check=True)
+    # the library whole, newlib-nano and libm, linked by the preset (firmware/port/CMakeLists.txt)
+    elf = find_in(build, "icoac_stack_link.elf", False)
     syms = symbol_addresses(prefix + "nm", elf)
     funcs, words = disassemble(prefix + "objdump", elf)
     graph = runtime_graph(funcs, words, lambda addr, n: read_words(prefix + "objdump", elf, addr, n))
