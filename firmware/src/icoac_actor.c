@@ -79,6 +79,7 @@ static inline int posterior_step(const icoac_actor_config_t *actor, const icoac_
     for (i = 0; i < n; ++i) {
         icoac_real_t a_cov_h;
         for (j = 0; j < n; ++j) {
+            /* cppcheck-suppress uninitvar ; gain[i] is set above for every i < n */
             row[j] = prior[i][j] - gain[i] * cov_h[j];
         }
         a_cov_h = icoac_priv_dot_n(row, h, n);
@@ -181,7 +182,7 @@ ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, cons
             precision[i][j] += st->batch.info[i][j];
         }
     }
-    if (h_last != 0) {
+    if (h_last != NULL) {
         add_info(actor, h_last, precision);
     }
     if (!icoac_priv_spd_inverse(ICOAC_PRIV_CONST_MAT(precision), cov, icoac_priv_inputs(&st->config))) {
@@ -228,13 +229,13 @@ static inline int actor_step(const icoac_actor_config_t *actor, icoac_priv_state
     /* u_ob - h^T mu_w, with u_ob = h^T w_act + alpha * delta * eps (Eq. 7-8); acting with mu_w,
      * w_act is mu_w bit for bit and the first term is exactly 0 */
     icoac_real_t innovation = actor->scale * delta * st->noise_prev;
-    if (actor->act_with_sample) {
+    if (actor->act_with_sample != 0) {
         innovation += icoac_priv_dot_n(h, st->w_act, n) - icoac_priv_dot_n(h, st->w, n);
     }
-    if (actor->batch) {
+    if (actor->batch != 0) {
         icoac_real_t *shift = st->batch.staged_shift;
         icoac_priv_copy(shift, st->batch.shift);
-        if (observed) {
+        if (observed != 0) {
             const icoac_real_t observation =
                 actor->update == ICOAC_ACTOR_GRADIENT ? delta * st->noise_prev : innovation;
             if (!icoac_priv_finite(batch_shift(actor, st, h, observation, shift))) {
@@ -245,7 +246,7 @@ static inline int actor_step(const icoac_actor_config_t *actor, icoac_priv_state
             icoac_priv_copy(w, st->w);
             return 0;
         }
-        return batch_end(actor, st, observed ? h : 0, shift, w, cov);
+        return batch_end(actor, st, observed ? h : NULL, shift, w, cov);
     }
     if (!observed) {
         icoac_priv_copy_n(w, st->w, n);
@@ -285,7 +286,7 @@ void icoac_priv_actor_commit_batch(const icoac_actor_config_t *actor, icoac_priv
 {
     int i;
     int j;
-    if (trial_end) {
+    if (trial_end != 0) {
         for (i = 0; i < N; ++i) {
             for (j = 0; j < N; ++j) {
                 st->batch.info[i][j] = ICOAC_R(0.0);
