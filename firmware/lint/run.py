@@ -196,10 +196,11 @@ def misra_check(found, failed, record, show_rules):
     print(f"== cppcheck MISRA C:2012: {sum(misra.values())} finding(s) over {len(misra)} rule(s) "
           f"({', '.join(f'{c} {n}' for c, n in sorted(by_category.items()))}); record: docs/misra.md")
     print(table(rows, ["rule", "category", "before", "ceiling", "now", "verdict"]))
-    for rule in show_rules:
-        for (path, line, col, rule_id), (_, message) in sorted(found.items()):
-            if rule_id == "misra-c2012-" + rule:
-                print(f"  {path}:{line}:{col}: [{rule}]")
+    listed = [(rule_key(rule_id[len("misra-c2012-"):]), path, line, col) for path, line, col, rule_id in found
+              if rule_id.startswith("misra-c2012-")
+              and (rule_id[len("misra-c2012-"):] in show_rules or "all" in show_rules)]
+    for key, path, line, col in sorted(listed):
+        print(f"  {path}:{line}:{col}: [{'.'.join(map(str, key))}]")
     print()
     return ok and not problems
 
@@ -208,7 +209,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--jobs", type=int, default=2, help="tool runs at once (default 2)")
     parser.add_argument("--tools", default="gcc,clang-tidy,cppcheck", help="comma-separated subset to run")
-    parser.add_argument("--show-misra", default="", help="comma-separated rules whose findings to list")
+    parser.add_argument("--show-misra", default="", help="comma-separated rules whose findings to list, or all")
     args = parser.parse_args()
     tools = args.tools.split(",")
     start = time.monotonic()
