@@ -8,7 +8,7 @@ VENV := .venv
 VPY := $(VENV)/bin/python
 APT_PACKAGES := cmake ninja-build gcc libc6-dev python3 python3-venv git \
   gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm binutils-arm-none-eabi \
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev cppcheck clang-tidy
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # Unity (the C test framework): empty, CMake fetches v2.6.1 from GitHub; else a local copy of that
 # release (offline builds), given to the configures that build the C tests (release, debug-asan;
@@ -43,7 +43,7 @@ FUZZ_SOURCES = $(shell git ls-tree HEAD $(FUZZ_C_SOURCES) 2>/dev/null | git hash
   cut -c1-12)$(shell git diff --quiet HEAD -- $(FUZZ_C_SOURCES) 2>/dev/null || echo -modified)
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_sim fuzz_model
 
-.PHONY: all deps venv build dist build-asan build-fuzz test test-c test-asan test-python test-fuzz fuzz fuzz-campaign fuzz-ledger bench \
+.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-fuzz fuzz fuzz-campaign fuzz-ledger bench \
   bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
@@ -108,7 +108,12 @@ build-fuzz: deps
 test-fuzz: build-fuzz
 	ctest --preset fuzz
 
-test: test-asan test-c test-python test-fuzz
+# Static analysis of the library (firmware/lint/run.py): gcc -fanalyzer and clang-tidy clean, cppcheck's
+# MISRA C:2012 findings within the record of docs/misra.md; every variant of the library.
+lint: deps
+	$(PYTHON) firmware/lint/run.py
+
+test: lint test-asan test-c test-python test-fuzz
 
 # Long fuzzing: FUZZ_TIME s per target, FUZZ_JOBS at a time, from tests/fuzz/corpus/<target>;
 # new inputs, logs and crash reproducers go to build/fuzz/work/<target>/, a line per run to

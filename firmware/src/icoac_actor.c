@@ -79,6 +79,7 @@ static inline int posterior_step(const icoac_actor_config_t *actor, const icoac_
     for (i = 0; i < n; ++i) {
         icoac_real_t a_cov_h;
         for (j = 0; j < n; ++j) {
+            /* cppcheck-suppress uninitvar ; gain[i] is set above for every i < n */
             row[j] = prior[i][j] - gain[i] * cov_h[j];
         }
         a_cov_h = icoac_priv_dot_n(row, h, n);
@@ -148,10 +149,10 @@ ICOAC_PRIV_NOINLINE static void batch_prior(const icoac_actor_config_t *actor, c
     /* one loop over the N * N entries, not unrolled into a frame of spilled values */
     icoac_real_t *const entry = &cov[0][0];
     int k;
-    memcpy(cov, icoac_priv_cov_c(st), sizeof st->cov_buffer[0]);
+    (void)memcpy(cov, icoac_priv_cov_c(st), sizeof st->cov_buffer[0]);
     if (actor->update == ICOAC_ACTOR_POSTERIOR && actor->forgetting < ICOAC_R(1.0)) {
         const icoac_real_t inflate = ICOAC_R(1.0) / actor->forgetting;
-        for (k = 0; k < N * N; ++k) {
+        for (k = 0; k < (N * N); ++k) {
             entry[k] *= inflate;
         }
     }
@@ -181,7 +182,7 @@ ICOAC_PRIV_NOINLINE static int batch_mean(const icoac_actor_config_t *actor, con
     if (actor->update != ICOAC_ACTOR_POSTERIOR) {
         return 0;
     }
-    for (i = 0; i + 1 < N; ++i) {
+    for (i = 0; (i + 1) < N; ++i) {
         if (!icoac_priv_all_finite(&cov[i][i + 1], N - 1 - i)) {
             return -1; /* an off-diagonal entry (the caller checks the diagonal) */
         }
@@ -216,7 +217,7 @@ ICOAC_PRIV_NOINLINE static int batch_end(const icoac_actor_config_t *actor, cons
         return -1;
     }
     batch_precision(st, cov);
-    if (h_last != 0) {
+    if (h_last != NULL) {
         add_info(actor, h_last, cov); /* and this tick's observation */
     }
     if (!icoac_priv_spd_inverse(cov, n)) {
@@ -252,13 +253,13 @@ static inline int actor_step(const icoac_actor_config_t *actor, icoac_priv_state
     /* u_ob - h^T mu_w, with u_ob = h^T w_act + alpha * delta * eps (Eq. 7-8); acting with mu_w,
      * w_act is mu_w bit for bit and the first term is exactly 0 */
     icoac_real_t innovation = actor->scale * delta * st->noise_prev;
-    if (actor->act_with_sample) {
+    if (actor->act_with_sample != 0) {
         innovation += icoac_priv_dot_n(h, st->w_act, n) - icoac_priv_dot_n(h, st->w, n);
     }
-    if (actor->batch) {
+    if (actor->batch != 0) {
         icoac_real_t *shift = st->batch.staged_shift;
         icoac_priv_copy(shift, st->batch.shift);
-        if (observed) {
+        if (observed != 0) {
             const icoac_real_t observation =
                 actor->update == ICOAC_ACTOR_GRADIENT ? delta * st->noise_prev : innovation;
             if (!icoac_priv_finite(batch_shift(actor, st, h, observation, shift))) {
@@ -269,7 +270,7 @@ static inline int actor_step(const icoac_actor_config_t *actor, icoac_priv_state
             icoac_priv_copy(w, st->w);
             return 0;
         }
-        return batch_end(actor, st, observed ? h : 0, shift, w, cov);
+        return batch_end(actor, st, observed ? h : NULL, shift, w, cov);
     }
     if (!observed) {
         icoac_priv_copy_n(w, st->w, n);
@@ -309,7 +310,7 @@ void icoac_priv_actor_commit_batch(const icoac_actor_config_t *actor, icoac_priv
 {
     int i;
     int j;
-    if (trial_end) {
+    if (trial_end != 0) {
         for (i = 0; i < N; ++i) {
             for (j = 0; j < N; ++j) {
                 st->batch.info[i][j] = ICOAC_R(0.0);

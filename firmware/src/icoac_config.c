@@ -46,7 +46,7 @@ static void task_cartpole(icoac_task_config_t *task)
                                                                  -CARTPOLE_ZONE_THETA, CARTPOLE_ZONE_X};
     static const icoac_real_t reflex[ICOAC_CARTPOLE_RULES] = {ICOAC_R(1.0), ICOAC_R(1.0), ICOAC_R(-1.0), ICOAC_R(-1.0)};
     int k;
-    memset(task, 0, sizeof *task);
+    (void)memset(task, 0, sizeof *task);
     task->n_inputs = ICOAC_CARTPOLE_INPUTS;
     task->late_source = ICOAC_LATE_RULES;
     task->n_rules = ICOAC_CARTPOLE_RULES;
@@ -61,7 +61,7 @@ static void task_cartpole(icoac_task_config_t *task)
 void icoac_task_cartpole(icoac_config_t *cfg)
 {
     int i;
-    if (cfg == 0) {
+    if (cfg == NULL) {
         return;
     }
     task_cartpole(&cfg->task);
@@ -75,7 +75,7 @@ void icoac_task_cartpole(icoac_config_t *cfg)
 void icoac_policy_config_default(icoac_policy_config_t *policy)
 {
     int i;
-    if (policy == 0) {
+    if (policy == NULL) {
         return;
     }
     for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
@@ -89,7 +89,7 @@ void icoac_policy_config_default(icoac_policy_config_t *policy)
 
 void icoac_ico_config_default(icoac_ico_config_t *ico)
 {
-    if (ico == 0) {
+    if (ico == NULL) {
         return;
     }
     ico->rate = ICOAC_R(1.0e-4);
@@ -99,7 +99,7 @@ void icoac_ico_config_default(icoac_ico_config_t *ico)
 void icoac_critic_config_default(icoac_critic_config_t *critic)
 {
     int i;
-    if (critic == 0) {
+    if (critic == NULL) {
         return;
     }
     critic->rate = ICOAC_R(0.6);
@@ -115,7 +115,7 @@ void icoac_critic_config_default(icoac_critic_config_t *critic)
 
 void icoac_actor_config_default(icoac_actor_config_t *actor)
 {
-    if (actor == 0) {
+    if (actor == NULL) {
         return;
     }
     /* sigma_u and the reading below were chosen by the learner sweeps (docs/results.md); the
@@ -134,7 +134,7 @@ void icoac_actor_config_default(icoac_actor_config_t *actor)
 
 void icoac_search_config_default(icoac_search_config_t *search)
 {
-    if (search == 0) {
+    if (search == NULL) {
         return;
     }
     /* chosen by the learner sweeps for ICO->search (docs/results.md) */
@@ -147,7 +147,7 @@ void icoac_search_config_default(icoac_search_config_t *search)
 
 void icoac_config_default(icoac_config_t *cfg)
 {
-    if (cfg == 0) {
+    if (cfg == NULL) {
         return;
     }
     cfg->mode = ICOAC_MODE_ICO;
@@ -388,16 +388,16 @@ static int config_ok(const icoac_config_t *cfg, bad_field_t *bad)
 icoac_status_t icoac_config_check_field(const icoac_config_t *cfg, const char **field)
 {
     bad_field_t bad = {0, ICOAC_OK};
-    if (field != 0) {
-        *field = 0;
+    if (field != NULL) {
+        *field = NULL;
     }
-    if (cfg == 0) {
+    if (cfg == NULL) {
         return ICOAC_ERR_NULL;
     }
-    if (config_ok(cfg, &bad)) {
+    if (config_ok(cfg, &bad) != 0) {
         return ICOAC_OK;
     }
-    if (field != 0) {
+    if (field != NULL) {
         *field = bad.field;
     }
     return bad.status;
@@ -414,7 +414,7 @@ icoac_status_t icoac_prior_check(const icoac_prior_t *prior, int32_t n_inputs)
     const int n = (int)n_inputs;
     int i;
     int j;
-    if (prior == 0) {
+    if (prior == NULL) {
         return ICOAC_ERR_NULL;
     }
     if (n_inputs < 1 || n_inputs > ICOAC_MAX_INPUTS) {

@@ -47,7 +47,7 @@ void icoac_priv_critic_grid(const icoac_config_t *cfg, icoac_priv_grid_t *grid)
     const int split = icoac_priv_critic_split(cfg->critic.units, n) - 1;
     int cartpole_grid = n == ICOAC_CARTPOLE_INPUTS;
     int i;
-    memset(grid, 0, sizeof *grid);
+    (void)memset(grid, 0, sizeof *grid);
     if (cfg->mode != ICOAC_MODE_RL) {
         return; /* no critic: its group is not checked, nothing derived from it */
     }
@@ -56,7 +56,7 @@ void icoac_priv_critic_grid(const icoac_config_t *cfg, icoac_priv_grid_t *grid)
     for (i = 0; cartpole_grid && i < ICOAC_CARTPOLE_INPUTS; ++i) {
         cartpole_grid = cfg->critic.units[i] == cartpole_units[i];
     }
-    if (cartpole_grid) {
+    if (cartpole_grid != 0) {
         grid->shape |= ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC;
     }
 }
@@ -64,7 +64,7 @@ void icoac_priv_critic_grid(const icoac_config_t *cfg, icoac_priv_grid_t *grid)
 int icoac_priv_critic_shape(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
                             icoac_priv_shape_t *shape)
 {
-    const int n = grid->n <= ICOAC_MAX_INPUTS ? (int)grid->n : ICOAC_MAX_INPUTS;
+    const int n = ((int)grid->n <= ICOAC_MAX_INPUTS) ? (int)grid->n : ICOAC_MAX_INPUTS;
     const int split = grid->split;
     int rows = 1;
     int cells = 1;
@@ -138,7 +138,9 @@ static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, con
     row_product[0] = ICOAC_R(1.0);
     ICOAC_PRIV_UNROLL
     for (i = 0; i < split; ++i) {
-        icoac_priv_factors(s[i], critic->range[i], units[i], g);
+        /* units[i] is set for i < n (icoac_priv_critic_shape, or the cart-pole's constant): the
+         * analyzer loses split < n through the shape's copy and calls it uninitialised */
+        icoac_priv_factors(s[i], critic->range[i], units[i], g); /* NOLINT(clang-analyzer-core.CallAndMessage) */
         entries = icoac_priv_critic_expand_all(row_product, g, units[i], entries);
     }
     /* The cell inputs but the last: the products and indices of their kept units, expanded at
@@ -169,7 +171,7 @@ static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, con
         kept_range(g, count, threshold, &begin, &end);
         for (e = 0; e < entries; ++e) {
             const icoac_real_t p = cell_product[prefix_first + e];
-            const int base = cell_index[prefix_first + e] * count;
+            const int base = (int)cell_index[prefix_first + e] * count;
             for (k = begin; k < end; ++k) {
                 const icoac_real_t product = p * g[k];
                 int j = cells;
@@ -192,7 +194,8 @@ static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, con
     cell_product[cells] = ICOAC_R(0.0);
     for (r = 0; r < rows; ++r) {
         const icoac_real_t product_r = row_product[r];
-        const icoac_real_t *u = v + r * stride;
+        /* r * stride <= ICOAC_MAX_CRITIC_UNITS (checked by the caller): no int overflow */
+        const icoac_real_t *u = v + (r * stride); /* NOLINT(bugprone-implicit-widening-of-multiplication-result) */
         const icoac_real_t *product = cell_product;
         const uint8_t *cell = cell_index;
         icoac_real_t unit_b;
@@ -205,7 +208,7 @@ static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, con
         }
         ICOAC_PRIV_OPAQUE(u); /* the row's weights in a register: one add per unit's address */
         unit_b = product_r * *product;
-        while (icoac_priv_nonneg_at_least(unit_b, threshold)) {
+        while (icoac_priv_nonneg_at_least(unit_b, threshold) != 0) {
             value += u[*cell++] * unit_b;
             unit_b = product_r * *++product;
         }
@@ -232,7 +235,7 @@ static inline void sparse_update(icoac_real_t *v, const icoac_priv_critic_list_t
         return;
     }
     for (i = 0; i < cells; ++i) {
-        if (cell_index[i] >= stride) {
+        if ((int)cell_index[i] >= stride) {
             return;
         }
     }
@@ -242,7 +245,8 @@ static inline void sparse_update(icoac_real_t *v, const icoac_priv_critic_list_t
         const uint8_t *cell = cell_index;
         const uint8_t *const end = cell + kept;
         const icoac_real_t *product = cell_product;
-        icoac_real_t *u = v + r * stride;
+        /* r * stride <= ICOAC_MAX_CRITIC_UNITS (checked by the caller): no int overflow */
+        icoac_real_t *u = v + (r * stride); /* NOLINT(bugprone-implicit-widening-of-multiplication-result) */
         if (kept > cells) {
             return;
         }
@@ -254,10 +258,10 @@ static inline void sparse_update(icoac_real_t *v, const icoac_priv_critic_list_t
 }
 
 /* The general instances: the shape of the state's configuration, checked. */
-ICOAC_PRIV_NOINLINE static icoac_real_t value_general(const icoac_critic_config_t *critic,
-                                                      const icoac_priv_grid_t *grid, const icoac_real_t *v,
-                                                      const icoac_real_t s[ICOAC_MAX_INPUTS],
-                                                      icoac_priv_critic_list_t *list)
+ICOAC_PRIV_NOINLINE static icoac_real_t sparse_value_general(const icoac_critic_config_t *critic,
+                                                             const icoac_priv_grid_t *grid, const icoac_real_t *v,
+                                                             const icoac_real_t s[ICOAC_MAX_INPUTS],
+                                                             icoac_priv_critic_list_t *list)
 {
     icoac_priv_shape_t shape;
     if (!icoac_priv_critic_shape(critic, grid, &shape) || shape.n > ICOAC_MAX_INPUTS || shape.split >= shape.n) {
@@ -293,7 +297,7 @@ icoac_real_t icoac_priv_critic_value_sparse(const icoac_critic_config_t *critic,
     if ((grid->shape & ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) != 0u) {
         return value_cartpole(critic, v, s, list);
     }
-    return value_general(critic, grid, v, s, list);
+    return sparse_value_general(critic, grid, v, s, list);
 }
 
 void icoac_priv_critic_update_sparse(icoac_real_t *v, const icoac_priv_critic_list_t *list, icoac_real_t step)

@@ -17,6 +17,14 @@ typedef int64_t real_bits_t;
 typedef int32_t real_bits_t;
 #endif
 
+/* A value and its bit pattern. A union rather than memcpy: GCC 12's -fanalyzer takes the bits
+ * of an integer expression copied by memcpy for uninitialised (a false positive); the object
+ * code is the same. */
+typedef union {
+    icoac_real_t real;
+    real_bits_t bits;
+} real_view_t;
+
 /* b >= threshold ? kept : otherwise, for b >= 0 and threshold > 0, in integer operations on
  * the bit patterns (a float compare and select would be a branch under -ftrapping-math, the
  * default). Non-negative IEEE-754 values order like their bits as signed integers; NaN counts
@@ -24,15 +32,18 @@ typedef int32_t real_bits_t;
 static inline icoac_real_t select_kept(icoac_real_t b, icoac_real_t threshold, icoac_real_t kept,
                                        icoac_real_t otherwise)
 {
-    real_bits_t bits_b, bits_threshold, bits_kept, bits_otherwise, mask;
-    memcpy(&bits_b, &b, sizeof b);
-    memcpy(&bits_threshold, &threshold, sizeof threshold);
-    memcpy(&bits_kept, &kept, sizeof kept);
-    memcpy(&bits_otherwise, &otherwise, sizeof otherwise);
-    mask = -(real_bits_t)(bits_b >= bits_threshold);
-    bits_kept = (bits_kept & mask) | (bits_otherwise & ~mask);
-    memcpy(&kept, &bits_kept, sizeof kept);
-    return kept;
+    real_view_t view_b;
+    real_view_t view_threshold;
+    real_view_t view_kept;
+    real_view_t view_otherwise;
+    real_bits_t mask;
+    view_b.real = b;
+    view_threshold.real = threshold;
+    view_kept.real = kept;
+    view_otherwise.real = otherwise;
+    mask = -(real_bits_t)(view_b.bits >= view_threshold.bits);
+    view_kept.bits = (view_kept.bits & mask) | (view_otherwise.bits & ~mask);
+    return view_kept.real;
 }
 
 /* The dense kernel for the grid of n inputs with these units, split and rows x stride (checked
@@ -54,7 +65,10 @@ static inline icoac_real_t dense_value(const icoac_critic_config_t *critic, cons
     int entries = 1;
     int begin = 0;
     int end = 0;
-    int i, c, r, j;
+    int i;
+    int c;
+    int r;
+    int j;
     row_product[0] = ICOAC_R(1.0);
     ICOAC_PRIV_UNROLL
     for (i = 0; i < split; ++i) {
@@ -91,7 +105,8 @@ static inline icoac_real_t dense_value(const icoac_critic_config_t *critic, cons
     }
     for (r = 0; r < rows; ++r) {
         const icoac_real_t product_r = row_product[r];
-        const icoac_real_t *u = v + r * stride;
+        /* r * stride <= ICOAC_MAX_CRITIC_UNITS (checked by the caller): no int overflow */
+        const icoac_real_t *u = v + (r * stride); /* NOLINT(bugprone-implicit-widening-of-multiplication-result) */
         for (j = begin; j < end; ++j) {
             const icoac_real_t unit_b = product_r * cell_product[j];
             cell_sum[j] += select_kept(unit_b, threshold, u[j] * unit_b, ICOAC_R(0.0));
@@ -111,12 +126,14 @@ static inline void dense_update(const icoac_critic_config_t *critic, icoac_real_
     const icoac_real_t threshold = icoac_priv_critic_floor(critic);
     const icoac_real_t *const cell_product = products->product + rows;
     const int begin = products->cell_begin;
-    const int end = products->cell_end < stride ? (int)products->cell_end : stride;
-    int r, j;
+    const int end = ((int)products->cell_end < stride) ? (int)products->cell_end : stride;
+    int r;
+    int j;
     for (r = 0; r < rows; ++r) {
         const icoac_real_t product_r = products->product[r];
         const icoac_real_t row_step = step * product_r;
-        icoac_real_t *u = v + r * stride;
+        /* r * stride <= ICOAC_MAX_CRITIC_UNITS (checked by the caller): no int overflow */
+        icoac_real_t *u = v + (r * stride); /* NOLINT(bugprone-implicit-widening-of-multiplication-result) */
         for (j = begin; j < end; ++j) {
             const icoac_real_t unit = u[j];
             const icoac_real_t updated = unit + row_step * cell_product[j];
@@ -125,10 +142,10 @@ static inline void dense_update(const icoac_critic_config_t *critic, icoac_real_
     }
 }
 
-ICOAC_PRIV_NOINLINE static icoac_real_t value_general(const icoac_critic_config_t *critic,
-                                                      const icoac_priv_grid_t *grid, const icoac_real_t *v,
-                                                      const icoac_real_t s[ICOAC_MAX_INPUTS],
-                                                      icoac_priv_critic_products_t *products)
+ICOAC_PRIV_NOINLINE static icoac_real_t dense_value_general(const icoac_critic_config_t *critic,
+                                                            const icoac_priv_grid_t *grid, const icoac_real_t *v,
+                                                            const icoac_real_t s[ICOAC_MAX_INPUTS],
+                                                            icoac_priv_critic_products_t *products)
 {
     icoac_priv_shape_t shape;
     if (!icoac_priv_critic_shape(critic, grid, &shape) || shape.n > ICOAC_MAX_INPUTS || shape.split >= shape.n) {
@@ -151,7 +168,7 @@ icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic, 
         return dense_value(critic, v, s, products, ICOAC_CARTPOLE_INPUTS, cartpole_units, 2,
                            ICOAC_PRIV_CARTPOLE_ROWS, ICOAC_PRIV_CARTPOLE_CELLS);
     }
-    return value_general(critic, grid, v, s, products);
+    return dense_value_general(critic, grid, v, s, products);
 }
 
 void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,

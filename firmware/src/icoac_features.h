@@ -34,11 +34,11 @@ static inline int icoac_priv_within_unit(icoac_real_t a)
 {
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE
     uint64_t bits;
-    memcpy(&bits, &a, sizeof bits);
+    (void)memcpy(&bits, &a, sizeof bits);
     return (bits & 0x7FFFFFFFFFFFFFFFull) <= 0x3FF0000000000000ull;
 #else
     uint32_t bits;
-    memcpy(&bits, &a, sizeof bits);
+    (void)memcpy(&bits, &a, sizeof bits);
     return (bits & 0x7FFFFFFFu) <= 0x3F800000u;
 #endif
 }
@@ -52,7 +52,7 @@ static inline void icoac_priv_scale_inputs(const icoac_policy_config_t *policy, 
     for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
         scaled[i] = i < n ? s[i] * st->inv_range[i] : ICOAC_R(0.0);
     }
-    if (policy->clip_inputs) {
+    if (policy->clip_inputs != 0) {
         for (i = 0; i < n && i < ICOAC_MAX_INPUTS; ++i) {
             if (!icoac_priv_within_unit(scaled[i])) {
                 scaled[i] = icoac_priv_clip_unit(scaled[i]);

@@ -14,7 +14,7 @@ int icoac_priv_cholesky(const icoac_real_t m[N][N], icoac_real_t lower[N][N], in
      * may be m itself */
     for (i = 0; i < N; ++i) {
         for (j = 0; j < N; ++j) {
-            if (j > i || i >= n) {
+            if ((j > i) || (i >= n)) {
                 lower[i][j] = ICOAC_R(0.0);
             }
         }
@@ -52,7 +52,7 @@ ICOAC_PRIV_NOINLINE static int inverse_from_factor(icoac_real_t m[N][N], int n)
     for (k = 0; k < n; ++k) {
         /* L y = e_k, then L^T x = y: x is column k of the inverse */
         for (i = 0; i < n; ++i) {
-            icoac_real_t sum = i == k ? ICOAC_R(1.0) : ICOAC_R(0.0);
+            icoac_real_t sum = (i == k) ? ICOAC_R(1.0) : ICOAC_R(0.0);
             for (j = 0; j < i; ++j) {
                 sum -= m[i][j] * column[j];
             }
@@ -68,6 +68,7 @@ ICOAC_PRIV_NOINLINE static int inverse_from_factor(icoac_real_t m[N][N], int n)
         for (i = 0; i < k; ++i) {
             m[i][k] = column[i];
         }
+        /* cppcheck-suppress uninitvar ; both passes above set column[0 .. n-1], and k < n */
         diagonal[k] = column[k];
     }
     /* exactly symmetric */

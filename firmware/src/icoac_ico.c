@@ -30,11 +30,9 @@ static int code_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
                        icoac_output_t *out)
 {
     const icoac_real_t drop = cfg->learn ? st->penalty_prev - penalty : ICOAC_R(0.0);
-    icoac_real_t w[ICOAC_MAX_INPUTS];
-    icoac_real_t norm = ICOAC_R(0.0);
     icoac_real_t z;
     icoac_real_t force;
-    if (terminal) {
+    if (terminal != 0) {
         out->q = ICOAC_R(0.0);
         out->z = ICOAC_R(0.0);
         out->force = ICOAC_R(0.0);
@@ -42,16 +40,20 @@ static int code_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
     }
     z = icoac_priv_dot(st->w, scaled);
     force = cfg->policy.gain * z + icoac_priv_reflex_force(&cfg->policy, out->reflex);
-    if (drop > ICOAC_R(0.0)) {
-        norm = learn_weights(cfg, st, scaled, drop, w);
-    }
-    if (!icoac_priv_finite(force) || !icoac_priv_finite(norm)) {
+    if (!icoac_priv_finite(force)) {
         return 0;
     }
-    out->q = ICOAC_R(0.0);
     if (drop > ICOAC_R(0.0)) {
+        /* the new weights live in this branch only: learnt, checked and committed together */
+        icoac_real_t w[ICOAC_MAX_INPUTS];
+        const icoac_real_t norm = learn_weights(cfg, st, scaled, drop, w);
+        if (!icoac_priv_finite(norm)) {
+            return 0;
+        }
         commit_weights(st, w, norm);
         out->q = drop;
+    } else {
+        out->q = ICOAC_R(0.0);
     }
     st->penalty_prev = penalty;
     out->z = z;
@@ -72,7 +74,7 @@ static int literal_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
     icoac_real_t norm = ICOAC_R(0.0);
     icoac_real_t z;
     icoac_real_t force = ICOAC_R(0.0);
-    if (learn) {
+    if (learn != 0) {
         norm = learn_weights(cfg, st, st->x_prev, drop, w);
     }
     z = icoac_priv_dot(learn ? w : st->w, scaled);
@@ -83,7 +85,7 @@ static int literal_timing(const icoac_config_t *cfg, icoac_priv_state_t *st,
         return 0;
     }
     out->q = ICOAC_R(0.0);
-    if (learn) {
+    if (learn != 0) {
         commit_weights(st, w, norm);
         out->q = drop;
     }

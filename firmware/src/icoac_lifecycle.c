@@ -8,11 +8,11 @@ static void clear_trial(icoac_priv_state_t *st)
     st->has_prev = 0;
     st->value_prev = ICOAC_R(0.0);
     st->noise_prev = ICOAC_R(0.0);
-    memset(st->x_prev, 0, sizeof st->x_prev);
+    (void)memset(st->x_prev, 0, sizeof st->x_prev);
     icoac_priv_critic_clear(&st->active[0]);
     icoac_priv_critic_clear(&st->active[1]);
     st->trial_ticks = 0u;
-    memset(&st->batch, 0, sizeof st->batch);
+    (void)memset(&st->batch, 0, sizeof st->batch);
 }
 
 /* 1 when the task's rule table is laid out as the cart-pole preset's: 4 inputs, 4 rules on the
@@ -40,7 +40,7 @@ static void derive(icoac_priv_state_t *st)
         st->inv_range[i] = i < n ? ICOAC_R(1.0) / st->config.policy.input_range[i] : ICOAC_R(0.0);
     }
     icoac_priv_critic_grid(&st->config, &st->grid);
-    if (cartpole_rules(&st->config.task)) {
+    if (cartpole_rules(&st->config.task) != 0) {
         st->grid.shape |= ICOAC_PRIV_SHAPE_CARTPOLE_RULES;
     }
     if (st->config.mode == ICOAC_MODE_SEARCH) {
@@ -95,7 +95,7 @@ ICOAC_PRIV_NOINLINE static icoac_status_t init_state(const icoac_config_t *cfg, 
     int n;
     int i;
     int j;
-    if (cfg == 0 || state == 0) {
+    if ((cfg == NULL) || (state == NULL)) {
         return ICOAC_ERR_NULL;
     }
     status = icoac_config_check(cfg);
@@ -103,14 +103,14 @@ ICOAC_PRIV_NOINLINE static icoac_status_t init_state(const icoac_config_t *cfg, 
         return status;
     }
     n = (int)cfg->task.n_inputs;
-    if (prior != 0) {
+    if (prior != NULL) {
         status = icoac_prior_check(prior, cfg->task.n_inputs);
     }
     /* the prior's leading n entries (N(0, I) without one), 0 past them */
     for (i = 0; i < n; ++i) {
-        mean[i] = prior != 0 ? prior->mean[i] : ICOAC_R(0.0);
+        mean[i] = (prior != NULL) ? prior->mean[i] : ICOAC_R(0.0);
         for (j = 0; j < n; ++j) {
-            cov[i][j] = prior != 0 ? prior->cov[i][j] : (i == j ? ICOAC_R(1.0) : ICOAC_R(0.0));
+            cov[i][j] = (prior != NULL) ? prior->cov[i][j] : ((i == j) ? ICOAC_R(1.0) : ICOAC_R(0.0));
         }
     }
     if (status == ICOAC_OK && cfg->mode == ICOAC_MODE_SEARCH &&
@@ -120,10 +120,10 @@ ICOAC_PRIV_NOINLINE static icoac_status_t init_state(const icoac_config_t *cfg, 
     if (status != ICOAC_OK) {
         return status;
     }
-    memset(state, 0, sizeof *state);
+    (void)memset(state, 0, sizeof *state);
     st->config = *cfg;
-    memcpy(st->w, mean, sizeof st->w);
-    memcpy(st->cov_buffer[0], cov, sizeof st->cov_buffer[0]);
+    (void)memcpy(st->w, mean, sizeof st->w);
+    (void)memcpy(st->cov_buffer[0], cov, sizeof st->cov_buffer[0]);
     if (cfg->mode == ICOAC_MODE_SEARCH) {
         icoac_priv_search_init(&st->config.search, st);
     }
@@ -144,7 +144,7 @@ icoac_status_t icoac_retune(icoac_state_t *state, const icoac_config_t *cfg)
 {
     icoac_priv_state_t *st = icoac_priv_state(state);
     icoac_status_t status;
-    if (cfg == 0 || state == 0) {
+    if ((cfg == NULL) || (state == NULL)) {
         return ICOAC_ERR_NULL;
     }
     if (!icoac_priv_initialised(st)) {
@@ -166,7 +166,7 @@ icoac_status_t icoac_retune(icoac_state_t *state, const icoac_config_t *cfg)
 icoac_status_t icoac_reset(icoac_state_t *state)
 {
     icoac_priv_state_t *st = icoac_priv_state(state);
-    if (state == 0) {
+    if (state == NULL) {
         return ICOAC_ERR_NULL;
     }
     if (!icoac_priv_initialised(st)) {
@@ -191,21 +191,21 @@ icoac_status_t icoac_reset(icoac_state_t *state)
 icoac_status_t icoac_get_posterior(const icoac_state_t *state, icoac_prior_t *posterior)
 {
     const icoac_priv_state_t *st = icoac_priv_state_c(state);
-    if (state == 0 || posterior == 0) {
+    if ((state == NULL) || (posterior == NULL)) {
         return ICOAC_ERR_NULL;
     }
     if (!icoac_priv_initialised(st)) {
         return ICOAC_ERR_NOT_INITIALISED;
     }
-    memcpy(posterior->mean, st->w, sizeof posterior->mean);
-    memcpy(posterior->cov, icoac_priv_cov_c(st), sizeof posterior->cov);
+    (void)memcpy(posterior->mean, st->w, sizeof posterior->mean);
+    (void)memcpy(posterior->cov, icoac_priv_cov_c(st), sizeof posterior->cov);
     return ICOAC_OK;
 }
 
 icoac_status_t icoac_get_counters(const icoac_state_t *state, icoac_counters_t *counters)
 {
     const icoac_priv_state_t *st = icoac_priv_state_c(state);
-    if (state == 0 || counters == 0) {
+    if ((state == NULL) || (counters == NULL)) {
         return ICOAC_ERR_NULL;
     }
     if (!icoac_priv_initialised(st)) {
@@ -218,7 +218,7 @@ icoac_status_t icoac_get_counters(const icoac_state_t *state, icoac_counters_t *
 icoac_status_t icoac_get_config(const icoac_state_t *state, icoac_config_t *cfg)
 {
     const icoac_priv_state_t *st = icoac_priv_state_c(state);
-    if (state == 0 || cfg == 0) {
+    if ((state == NULL) || (cfg == NULL)) {
         return ICOAC_ERR_NULL;
     }
     if (!icoac_priv_initialised(st)) {

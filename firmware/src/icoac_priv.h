@@ -137,8 +137,8 @@ static inline int icoac_priv_nonneg_at_least(icoac_real_t a, icoac_real_t b)
     uint32_t bits_a;
     uint32_t bits_b;
 #endif
-    memcpy(&bits_a, &a, sizeof bits_a);
-    memcpy(&bits_b, &b, sizeof bits_b);
+    (void)memcpy(&bits_a, &a, sizeof bits_a);
+    (void)memcpy(&bits_b, &b, sizeof bits_b);
     return bits_a >= bits_b;
 }
 
@@ -153,7 +153,7 @@ static inline int icoac_priv_finite(icoac_real_t v)
     const uint32_t exponent = 0x7F800000u;
     uint32_t bits;
 #endif
-    memcpy(&bits, &v, sizeof bits);
+    (void)memcpy(&bits, &v, sizeof bits);
     return (bits & exponent) != exponent;
 }
 
@@ -170,7 +170,7 @@ static inline int icoac_priv_zero_or_normal(icoac_real_t v)
     const uint32_t magnitude = 0x7FFFFFFFu;
     uint32_t bits;
 #endif
-    memcpy(&bits, &v, sizeof bits);
+    (void)memcpy(&bits, &v, sizeof bits);
     return (bits & exponent) != 0u || (bits & magnitude) == 0u;
 }
 
@@ -219,6 +219,7 @@ static inline void icoac_priv_copy_n(icoac_real_t *dst, const icoac_real_t *src,
  * nonzero sum unchanged, so a task's n gives the sum over all entries. */
 static inline icoac_real_t icoac_priv_dot_n(const icoac_real_t *a, const icoac_real_t *b, int n)
 {
+    /* cppcheck-suppress uninitvar ; n >= 4 (a task has at least 4 inputs), the first n entries are set */
     icoac_real_t sum = (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
     int i;
     for (i = 4; i + 1 < n && i + 1 < ICOAC_MAX_INPUTS; i += 2) {
@@ -368,7 +369,9 @@ static inline void icoac_priv_factors_of(icoac_real_t value, icoac_real_t range,
     ratio = down;
     for (j = n - 2; j >= 0; --j) {
         const int below = j < nearest;
-        const icoac_real_t next = g[j + 1] * ratio;
+        /* j + 1 < n <= ICOAC_CRITIC_UNITS_PER_INPUT_MAX (the shape check bounds n): the analyzer,
+         * losing that bound, lets n - 2 wrap around */
+        const icoac_real_t next = g[j + 1] * ratio; /* NOLINT(clang-analyzer-core.UndefinedBinaryOperatorResult) */
         g[j] = below ? next : g[j];
         ratio = below ? ratio * exp_minus_4 : ratio;
     }
@@ -425,8 +428,8 @@ static inline int icoac_priv_critic_expand_of(icoac_real_t *product, uint8_t *in
     for (e = entries - 1; e >= 0; --e) {
         const icoac_real_t p = product[e];
         const int first = e * width - begin;
-        if (index != 0) {
-            const int base = index[e] * count;
+        if (index != NULL) {
+            const int base = (int)index[e] * count;
             for (j = end - 1; j >= begin; --j) {
                 index[first + j] = (uint8_t)(base + j);
             }
@@ -479,7 +482,7 @@ static inline void icoac_priv_critic_clear(icoac_priv_critic_active_t *active)
     active->dense.cell_begin = 0u;
     active->dense.cell_end = 0u;
 #else
-    memset(active->sparse.index, 0, sizeof active->sparse.index);
+    (void)memset(active->sparse.index, 0, sizeof active->sparse.index);
     active->sparse.cells = 0u;
 #endif
 }

@@ -49,15 +49,15 @@ static inline int rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, con
     if (!terminal || cfg->critic.quirks) {
         /* fills the spare slot: the current one stays the eligibility of this update */
         value = icoac_priv_critic_value(&cfg->critic, &st->grid, st->v, s, &st->active[slot_prev ^ 1]);
-        if (terminal) {
+        if (terminal != 0) {
             value = ICOAC_R(0.0); /* quirks: only the kept units of s_t+1 were wanted */
         }
     }
-    if (learn) {
+    if (learn != 0) {
         const icoac_real_t reward = terminal ? ICOAC_R(-1.0) : ICOAC_R(0.0);
         delta = clip_td(reward + cfg->critic.discount * value - st->value_prev, cfg->critic.td_clip);
     }
-    if (update) {
+    if (update != 0) {
         for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
             h[i] = i < n ? cfg->policy.gain * st->x_prev[i] : ICOAC_R(0.0);
         }
@@ -66,7 +66,7 @@ static inline int rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, con
             return cov_changed == -1 ? ICOAC_PRIV_TICK_NUMERIC : ICOAC_PRIV_TICK_CORRUPT;
         }
         norm = ICOAC_PRIV_SQRT(icoac_priv_dot_n(w, w, n));
-        if (cov_changed) {
+        if (cov_changed != 0) {
             trace = icoac_priv_trace_n(ICOAC_PRIV_CONST_MAT(cov), n); /* the actor checked the rest */
         } else {
             trace = icoac_priv_trace_n(icoac_priv_cov_c(st), n);
@@ -83,7 +83,7 @@ static inline int rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, con
         return 0;
     }
     /* commit */
-    if (update) {
+    if (update != 0) {
         icoac_priv_critic_update(&cfg->critic, &st->grid, st->v,
                                  &st->active[cfg->critic.quirks ? slot_prev ^ 1 : slot_prev], cfg->critic.rate * delta);
         icoac_priv_copy_n(st->w, w, n);
@@ -92,7 +92,7 @@ static inline int rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, con
         if (!cfg->actor.act_with_sample) {
             icoac_priv_copy_n(st->w_act, w, n);
         }
-        if (cfg->actor.batch) {
+        if (cfg->actor.batch != 0) {
             icoac_priv_actor_commit_batch(&cfg->actor, st, h, observed, terminal);
         }
     }
@@ -100,7 +100,7 @@ static inline int rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, con
     out->td_error = delta;
     out->value = value;
     out->cov_trace = trace;
-    if (terminal) {
+    if (terminal != 0) {
         out->z = ICOAC_R(0.0);
         out->noise = ICOAC_R(0.0);
         out->force = ICOAC_R(0.0);
@@ -113,7 +113,7 @@ static inline int rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, con
     out->z = z;
     out->noise = noise;
     out->force = policy_force + noise;
-    if (cfg->actor.reflex) {
+    if (cfg->actor.reflex != 0) {
         out->force += icoac_priv_reflex_force(&cfg->policy, out->reflex);
     }
     st->active_slot = slot_prev ^ 1;

@@ -46,7 +46,7 @@ icoac_real_t icoac_rng_normal(icoac_rng_t *rng)
     icoac_real_t v;
     icoac_real_t s;
     icoac_real_t f;
-    if (rng->has_spare) {
+    if (rng->has_spare != 0) {
         rng->has_spare = 0;
         return rng->spare_normal;
     }

@@ -82,8 +82,10 @@ static uint32_t trial_ticks(const closing_batch_t *b, int k)
     return k < b->count ? b->recorded->ticks[k] : b->last_ticks;
 }
 
-/* The n_elite longest trials, longest first; ties go to the earlier trial. */
-static void choose_elite(const closing_batch_t *b, int n_elite, uint8_t elite[ICOAC_SEARCH_BATCH_MAX])
+/* The n_elite longest trials, longest first; ties go to the earlier trial. Returns how many were
+ * chosen: n_elite, as a closing batch holds at least that many trials (if it held fewer, the
+ * loop would stop when every trial is taken, rather than shift by -1). */
+static int choose_elite(const closing_batch_t *b, int n_elite, uint8_t elite[ICOAC_SEARCH_BATCH_MAX])
 {
     uint32_t taken = 0u;
     int e;
@@ -91,13 +93,17 @@ static void choose_elite(const closing_batch_t *b, int n_elite, uint8_t elite[IC
     for (e = 0; e < n_elite; ++e) {
         int best = -1;
         for (k = 0; k < b->size; ++k) {
-            if (((taken >> k) & 1u) == 0u && (best < 0 || trial_ticks(b, k) > trial_ticks(b, best))) {
+            if ((((taken >> (uint32_t)k) & 1u) == 0u) && ((best < 0) || (trial_ticks(b, k) > trial_ticks(b, best)))) {
                 best = k;
             }
         }
-        taken |= 1u << best;
+        if (best < 0) {
+            break; /* every trial taken */
+        }
+        taken |= 1u << (uint32_t)best;
         elite[e] = (uint8_t)best;
     }
+    return e;
 }
 
 /* Elite size n_e = max(1, round(rho K)), at most K; the value is bounded before its conversion,
@@ -134,16 +140,16 @@ static int well_conditioned(const icoac_real_t cov[N][N], icoac_real_t lower[N][
  * Sigma' = (1-a) Sigma + a Cov_elite about mu' (upper triangle mirrored), then
  * Sigma'_ii >= floor_i. Returns 0 when a value is not finite. */
 static int search_update(const icoac_search_config_t *search, const icoac_priv_state_t *st, const closing_batch_t *b,
-                         int n_elite, icoac_real_t w[N], icoac_real_t cov[N][N])
+                         int elite_size_wanted, icoac_real_t w[N], icoac_real_t cov[N][N])
 {
     const icoac_real_t (*sigma)[N] = icoac_priv_cov_c(st);
     const icoac_real_t a = search->step;
-    const icoac_real_t inv_n = ICOAC_R(1.0) / (icoac_real_t)n_elite;
     uint8_t elite[ICOAC_SEARCH_BATCH_MAX];
+    const int n_elite = choose_elite(b, elite_size_wanted, elite);
+    const icoac_real_t inv_n = ICOAC_R(1.0) / (icoac_real_t)n_elite;
     int e;
     int i;
     int j;
-    choose_elite(b, n_elite, elite);
     for (i = 0; i < N; ++i) {
         icoac_real_t sum = ICOAC_R(0.0);
         for (e = 0; e < n_elite; ++e) {
@@ -268,7 +274,7 @@ int icoac_priv_search_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
     out->value = ICOAC_R(0.0);
     out->td_error = ICOAC_R(0.0);
     out->noise = ICOAC_R(0.0);
-    if (terminal) {
+    if (terminal != 0) {
         if (!end_trial(cfg, st)) {
             return 0;
         }

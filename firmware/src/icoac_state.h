@@ -139,7 +139,7 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
 
 ICOAC_STATIC_ASSERT(sizeof(icoac_priv_state_t) <= sizeof(icoac_state_t), state_fits_its_storage);
 ICOAC_STATIC_ASSERT(sizeof(icoac_priv_state_t) + 128 > sizeof(icoac_state_t), state_storage_not_oversized);
-ICOAC_STATIC_ASSERT(sizeof(icoac_state_t) == ICOAC_STATE_SIZE, state_size_as_documented);
+ICOAC_STATIC_ASSERT(sizeof(icoac_state_t) == (size_t)ICOAC_STATE_SIZE, state_size_as_documented);
 
 /* The layout of a caller's state. */
 static inline icoac_priv_state_t *icoac_priv_state(icoac_state_t *state)

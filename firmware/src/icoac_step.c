@@ -105,7 +105,7 @@ static inline icoac_status_t tick(icoac_priv_state_t *st, const icoac_input_t *i
         st->counters.numeric_faults++;
         return rejected(st, out, ICOAC_ERR_NUMERIC);
     }
-    if (terminal) {
+    if (terminal != 0) {
         st->magic = ICOAC_PRIV_STATE_ENDED;
     }
     out->weight_norm = st->weight_norm;
@@ -125,8 +125,8 @@ ICOAC_PRIV_NOINLINE static icoac_status_t tick_general(icoac_priv_state_t *st, c
 icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
 {
     icoac_priv_state_t *st = icoac_priv_state(state);
-    if (state == 0 || in == 0 || out == 0) {
-        if (out != 0) {
+    if ((state == NULL) || (in == NULL) || (out == NULL)) {
+        if (out != NULL) {
             clear_output(out);
             out->status = ICOAC_ERR_NULL;
         }
