@@ -392,7 +392,7 @@ def target_runtime(build, externals, frames, edges):
     cc = cache["ICOAC_ARM_GCC"]  # cmake/toolchain/arm-none-eabi.cmake
     prefix = cc[:-3] if cc.endswith("gcc") else cc
     # the library whole, newlib-nano and libm, linked by the preset (firmware/port/CMakeLists.txt)
-    elf = find_in(build, "icoac_stack_link.elf", False)
+    elf = build_path(build, "firmware", "port", "icoac_stack_link.elf")
     syms = symbol_addresses(prefix + "nm", elf)
     funcs, words = disassemble(prefix + "objdump", elf)
     graph = runtime_graph(funcs, words, lambda addr, n: read_words(prefix + "objdump", elf, addr, n))
@@ -453,19 +453,18 @@ def bounds(frames, edges, runtime, accept_bounded, tails=frozenset()):
     return memo
 
 
-def find_in(build, name, want_dir):
-    """The one path named name under build (CMake's object directory of a target, a library)."""
-    found = [os.path.join(d, name) for d, dirs, files in os.walk(build) if name in (dirs if want_dir else files)]
-    if len(found) != 1:
-        raise AnalysisError("%s: %d of %s under %s (build the library first)" % (
-            "directory" if want_dir else "file", len(found), name, build))
-    return found[0]
+def build_path(build, *parts):
+    """A path the build makes (the library's object directory, the link of the cross presets)."""
+    path = os.path.join(build, *parts)
+    if not os.path.exists(path):
+        raise AnalysisError("%s: not found (build the library first)" % path)
+    return path
 
 
 def analyse(config, build=None):
     build_rel, lib = CONFIGS[config]
     build = build or os.path.join(ROOT, build_rel)
-    obj_dir = find_in(build, lib + ".dir", True)
+    obj_dir = build_path(build, "firmware", "CMakeFiles", lib + ".dir")
     frames, edges = read_callgraph(obj_dir)
     externals = sorted({c for cs in edges.values() for c in cs if c not in frames and c != "__indirect_call"})
     tails = set()

@@ -4,6 +4,7 @@
 #include "test_common.h"
 
 #include "icoac_priv.h"
+#include "icoac/icoac_version.h"
 
 #define NAN_R ((icoac_real_t)NAN)
 #define INF_R ((icoac_real_t)INFINITY)
@@ -1064,6 +1065,36 @@ static void test_status_strings(void)
     }
 }
 
+/* The library's version is the header's, MAJOR.MINOR.PATCH of its three numbers. */
+static void test_version(void)
+{
+    const char *v = icoac_version();
+    char expected[32];
+    int major = ICOAC_VERSION_MAJOR, minor = ICOAC_VERSION_MINOR, patch = ICOAC_VERSION_PATCH;
+    int parts[3];
+    int p, k = 0;
+    TEST_ASSERT_NOT_NULL(v);
+    TEST_ASSERT_EQUAL_STRING(ICOAC_VERSION_STRING, v);
+    parts[0] = major;
+    parts[1] = minor;
+    parts[2] = patch;
+    /* the expected text written digit by digit (no stdio on the cores) */
+    for (p = 0; p < 3; ++p) {
+        char digits[12];
+        int d = 0, x = parts[p];
+        TEST_ASSERT_TRUE(x >= 0);
+        do {
+            digits[d++] = (char)('0' + x % 10);
+            x /= 10;
+        } while (x > 0);
+        while (d > 0) {
+            expected[k++] = digits[--d];
+        }
+        expected[k++] = p < 2 ? '.' : '\0';
+    }
+    TEST_ASSERT_EQUAL_STRING(expected, v);
+}
+
 static void test_sizeof_functions(void)
 {
     TEST_ASSERT_EQUAL_UINT32(ICOAC_ABI_VERSION, icoac_abi_version());
@@ -1106,6 +1137,7 @@ int main(void)
     RUN_TEST(test_null_pointers);
     RUN_TEST(test_not_initialised);
     RUN_TEST(test_status_strings);
+    RUN_TEST(test_version);
     RUN_TEST(test_sizeof_functions);
     return UNITY_END();
 }

@@ -27,6 +27,11 @@ static const grid_t grids[] = {
 
 /* Room for any grid: the library's weight array. */
 #define KMAX ICOAC_PRIV_CRITIC_WEIGHTS
+
+/* The activations of the two sides of a comparison and a unit list, shared by the tests (they
+ * run one after another), so that the test fits the Cortex-M0+ board's 16 KiB of RAM. */
+static double bl[KMAX], bd[KMAX];
+static int listed[KMAX];
 #define K ICOAC_CARTPOLE_CRITIC_UNITS
 
 static int units_of(const grid_t *g)
@@ -219,7 +224,6 @@ static void test_grid_centres(void)
 static void test_separable_equals_direct(void)
 {
     test_rng_t rng = {0xC0FFEEu};
-    static double bl[KMAX], bd[KMAX];
     int gi, n, k;
     for (gi = 0; gi < N_GRIDS; ++gi) {
         const grid_t *g = &grids[gi];
@@ -263,7 +267,6 @@ static void check_value(const grid_t *g, icoac_real_t threshold, unsigned seed, 
     const int units = units_of(g);
     icoac_real_t v[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t active;
-    static double bd[KMAX];
     int n, k;
     cfg.critic.threshold = threshold;
     for (n = 0; n < STATES / 2; ++n) {
@@ -296,7 +299,6 @@ static void test_value_is_weighted_sum(void)
 static void test_threshold_drops_small_activations(void)
 {
     test_rng_t rng = {8u};
-    static double bl[KMAX], bd[KMAX];
     int gi, n, k, dropped = 0, kept = 0;
     for (gi = 0; gi < N_GRIDS; ++gi) {
         const grid_t *g = &grids[gi];
@@ -331,8 +333,6 @@ static void test_kept_unit_list(void)
     test_rng_t rng = {12u};
     icoac_real_t v[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t active;
-    static double bd[KMAX];
-    static int listed[KMAX];
     int gi, n, i, r, total_kept = 0, total_units = 0, all_kept_grids = 0;
     memset(v, 0, sizeof v);
     for (gi = 0; gi < N_GRIDS; ++gi) {
@@ -409,7 +409,6 @@ static void test_dense_matches_sparse(void)
     test_rng_t rng = {0xD15Eu};
     icoac_real_t v_sparse[KMAX], v_dense[KMAX], s[ICOAC_MAX_INPUTS];
     icoac_priv_critic_active_t sparse, dense;
-    static double bd[KMAX];
     double max_rel = 0;
     int gi, t, n, k;
     for (gi = 0; gi < N_GRIDS; ++gi) {
