@@ -89,30 +89,30 @@ def map_jobs(jobs, commands):
         return list(pool.map(run, commands))
 
 
-def gcc_analyzer(jobs):
-    commands = [["gcc", "-std=c99", level, "-fanalyzer", "-Werror", *INCLUDES, *defines,
-                 "-c", src, "-o", os.devnull]
-                for defines in VARIANTS.values() for level in ANALYZER_LEVELS for src in sources()]
+def run_diagnostics(jobs, commands):
+    """({location: diagnostic}, failed runs) of compiler-style tools: a run that fails without a
+    diagnostic (a crash, a missing header) is a failed run."""
     found = {}
     failed = []
     for cmd, (status, output) in zip(commands, map_jobs(jobs, commands)):
-        found.update(parse_diagnostics(output))
-        if status != 0 and not parse_diagnostics(output):
+        diagnostics = parse_diagnostics(output)
+        found.update(diagnostics)
+        if status != 0 and not diagnostics:
             failed.append(" ".join(cmd) + "\n" + output)
     return found, failed
+
+
+def gcc_analyzer(jobs):
+    return run_diagnostics(jobs, [["gcc", "-std=c99", level, "-fanalyzer", "-Werror", *INCLUDES, *defines,
+                                   "-c", src, "-o", os.devnull]
+                                  for defines in VARIANTS.values() for level in ANALYZER_LEVELS
+                                  for src in sources()])
 
 
 def clang_tidy(jobs):
-    commands = [["clang-tidy", "--quiet", "--header-filter=firmware/", src, "--",
-                 "-std=c99", *INCLUDES, *defines]
-                for defines in VARIANTS.values() for src in sources()]
-    found = {}
-    failed = []
-    for cmd, (status, output) in zip(commands, map_jobs(jobs, commands)):
-        found.update(parse_diagnostics(output))
-        if status != 0 and not parse_diagnostics(output):
-            failed.append(" ".join(cmd) + "\n" + output)
-    return found, failed
+    return run_diagnostics(jobs, [["clang-tidy", "--quiet", "--header-filter=firmware/", src, "--",
+                                   "-std=c99", *INCLUDES, *defines]
+                                  for defines in VARIANTS.values() for src in sources()])
 
 
 def cppcheck(jobs):
