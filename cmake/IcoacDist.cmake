@@ -16,7 +16,9 @@ file(REMOVE_RECURSE ${stage})
 file(MAKE_DIRECTORY ${stage}/${name}/docs)
 file(COPY ${ICOAC_SOURCE_DIR}/CMakeLists.txt ${ICOAC_SOURCE_DIR}/LICENSE ${ICOAC_SOURCE_DIR}/README.md
           ${ICOAC_SOURCE_DIR}/cmake ${ICOAC_SOURCE_DIR}/firmware
-     DESTINATION ${stage}/${name} PATTERN __pycache__ EXCLUDE)
+     DESTINATION ${stage}/${name} PATTERN __pycache__ EXCLUDE
+     # the project's own checks: static analysis, and the test framework's fetch
+     PATTERN lint EXCLUDE PATTERN .clang-tidy EXCLUDE PATTERN modules EXCLUDE)
 file(COPY ${ICOAC_SOURCE_DIR}/docs/porting.md ${ICOAC_SOURCE_DIR}/docs/changelog.md DESTINATION ${stage}/${name}/docs)
 
 set(archive ${ICOAC_DIST_DIR}/${name}.tar.gz)
