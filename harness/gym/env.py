@@ -17,6 +17,7 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.error import ResetNeeded
 
+from .. import _binding as B
 from .plants import PLANTS, PlantSpec
 
 
@@ -71,6 +72,12 @@ class IcoacPlantEnv(gymnasium.Env):
         if self._state is None or self._terminated:
             raise ResetNeeded("call reset() before step() (and after an episode terminated)")
         force = parse_force(action, self.force_limit)
-        self.plant.step(self.parameters, self._state, force)
-        self._terminated = self.plant.failed(self.parameters, self._state)
+        try:
+            self.plant.step(self.parameters, self._state, force)
+        except B.IcoacError as err:  # the step would leave no finite state: it ends, the state kept
+            if err.status != B.SIM_ERR_NONFINITE:
+                raise
+            self._terminated = True
+        else:
+            self._terminated = self.plant.failed(self.parameters, self._state)
         return self._state.copy(), 1.0, self._terminated, False, {"force": force}

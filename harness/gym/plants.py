@@ -77,7 +77,10 @@ def cart_pole_step(cfg: RunConfig, state: np.ndarray, force: float) -> None:
 
 
 def cart_pole_failed(cfg: RunConfig, state: np.ndarray) -> bool:
-    return bool(B.lib.icoac_sim_failed(ctypes.byref(cfg.plant), state))
+    failed = B.lib.icoac_sim_failed(ctypes.byref(cfg.plant), state)
+    if failed not in (0, 1):  # a status: the plant or the arguments refused
+        B.check_status(failed, "failure test")
+    return failed == 1
 
 
 @functools.lru_cache(maxsize=1)

@@ -27,11 +27,6 @@ void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *
 #define SIM_CART_POLE_X_LIMIT 4
 #define SIM_CART_POLE_THETA_LIMIT 5
 
-static inline int32_t sim_failed(const icoac_sim_plant_t *plant, const double s[ICOAC_CARTPOLE_INPUTS])
-{
-    return sim_cart_pole_failed(plant->x_limit, plant->theta_limit, s);
-}
-
 /* Check the controller configuration, model and (if not NULL) run parameters, and that the
  * controller build takes the plant's observation (params.c). */
 int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_model_t *model,

@@ -127,6 +127,49 @@ static void test_reference_sanity(void)
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_step(&plant, NULL, 0.0));
 }
 
+/* The cart-pole's icoac_sim_plant_t entries check what the model API checks: a plant the check
+ * refuses, a non-finite state or force, and a step that overflows get a status and leave the
+ * state as it was; NULL pointers a status, never a dereference. */
+static void test_plant_entries_refuse_bad_input(void)
+{
+    icoac_sim_plant_t plant;
+    const double start[4] = {0.1, -0.2, 0.05, 0.3};
+    double s[4];
+    int c;
+    for (c = 0; c < 6; ++c) {
+        icoac_sim_plant_default(&plant);
+        switch (c) {
+        case 0: plant.dt = NAN; break;
+        case 1: plant.gravity = NAN; break;
+        case 2: plant.cart_mass = 0.0; plant.pole_mass = 0.0; break; /* masses summing to 0 */
+        case 3: plant.integrator = 7; break;
+        case 4: plant.x_limit = INFINITY; break;
+        default: plant.dt = -0.01; break;
+        }
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_check(&plant));
+        memcpy(s, start, sizeof s);
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_step(&plant, s, 1.0));
+        TEST_ASSERT_EQUAL_MEMORY(start, s, sizeof s);
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_failed(&plant, s));
+    }
+    icoac_sim_plant_default(&plant);
+    memcpy(s, start, sizeof s);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_NONFINITE, icoac_sim_plant_step(&plant, s, NAN));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_NONFINITE, icoac_sim_plant_step(&plant, s, INFINITY));
+    TEST_ASSERT_EQUAL_MEMORY(start, s, sizeof s);
+    s[3] = NAN;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_NONFINITE, icoac_sim_plant_step(&plant, s, 1.0));
+    TEST_ASSERT_EQUAL_INT(1, icoac_sim_failed(&plant, s)); /* a non-finite state has failed */
+    /* a step that overflows: refused, the state as it was */
+    memcpy(s, start, sizeof s);
+    s[3] = 1e300;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_NONFINITE, icoac_sim_plant_step(&plant, s, 1.0));
+    TEST_ASSERT_TRUE(s[3] == 1e300 && s[0] == start[0]);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_failed(NULL, start));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_failed(&plant, NULL));
+    TEST_ASSERT_EQUAL_INT(0, icoac_sim_failed(&plant, start));
+}
+
 static void test_failure_strict(void)
 {
     icoac_sim_plant_t plant;
@@ -318,6 +361,7 @@ int main(void)
     RUN_TEST(test_euler_step);
     RUN_TEST(test_rk4_step);
     RUN_TEST(test_reference_sanity);
+    RUN_TEST(test_plant_entries_refuse_bad_input);
     RUN_TEST(test_failure_strict);
     RUN_TEST(test_plant_and_run_checks);
     RUN_TEST(test_paper_grid);

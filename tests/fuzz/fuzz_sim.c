@@ -33,7 +33,10 @@
  *
  * Contract (abort on violation): statuses are known (icoac_sim_status_str not "unknown");
  * a call refused by a check returns one of the failing checks' statuses; the checks accept
- * only documented ranges; icoac_sim_failed matches its definition; after a run every cell is
+ * only documented ranges; icoac_sim_plant_step refuses a refused plant, a non-finite state or
+ * force and a step made non-finite, with its status and the state unchanged, and never returns OK
+ * with a non-finite state; NULL arguments get ICOAC_SIM_ERR_BAD_ARGUMENT; icoac_sim_failed
+ * matches its definition (ICOAC_SIM_ERR_BAD_PLANT for a refused plant); after a run every cell is
  * SUCCESS, FAILED or ERROR with counts that fit the outcome, and a non-ERROR cell has status
  * OK and finite weights and cov; a refused grid leaves its cells untouched and a finished cell
  * is never rerun; a trajectory has n_steps in [0, max_steps], finite recorded states but for a
@@ -177,20 +180,44 @@ static int checks_fail(const setup_t *su, int with_run)
 static void op_plant(fz_reader_t *r, const setup_t *su)
 {
     double s[N];
+    double before[N];
     double force;
+    int32_t step;
     int32_t failed;
+    const int plant_ok = icoac_sim_plant_check(&su->plant) == ICOAC_SIM_OK;
+    int finite = 1;
     int i;
     for (i = 0; i < N; ++i) {
         s[i] = fz_double(r);
+        finite = finite && isfinite(s[i]);
     }
     force = fz_double(r);
-    FZ_CHECK(icoac_sim_plant_step(&su->plant, s, force) == ICOAC_SIM_OK, "plant_step refused a plant");
+    memcpy(before, s, sizeof s);
+    step = icoac_sim_plant_step(&su->plant, s, force);
+    if (!plant_ok) {
+        FZ_CHECK(step == ICOAC_SIM_ERR_BAD_PLANT, "plant_step of a plant the check refuses: status %d", (int)step);
+    } else if (!finite || !isfinite(force)) {
+        FZ_CHECK(step == ICOAC_SIM_ERR_NONFINITE, "plant_step of a non-finite state or force: status %d", (int)step);
+    } else {
+        FZ_CHECK(step == ICOAC_SIM_OK || step == ICOAC_SIM_ERR_NONFINITE, "plant_step: status %d", (int)step);
+    }
+    if (step == ICOAC_SIM_OK) {
+        for (i = 0; i < N; ++i) {
+            FZ_CHECK(isfinite(s[i]), "plant_step returned OK with a non-finite state");
+        }
+    } else {
+        FZ_CHECK(memcmp(before, s, sizeof s) == 0, "a refused plant_step changed the state");
+    }
     FZ_CHECK(icoac_sim_plant_step(0, s, force) == ICOAC_SIM_ERR_BAD_ARGUMENT, "plant_step(NULL plant)");
+    FZ_CHECK(icoac_sim_plant_step(&su->plant, 0, force) == ICOAC_SIM_ERR_BAD_ARGUMENT, "plant_step(NULL state)");
+    FZ_CHECK(icoac_sim_failed(0, s) == ICOAC_SIM_ERR_BAD_ARGUMENT, "icoac_sim_failed(NULL plant)");
+    FZ_CHECK(icoac_sim_failed(&su->plant, 0) == ICOAC_SIM_ERR_BAD_ARGUMENT, "icoac_sim_failed(NULL state)");
     failed = icoac_sim_failed(&su->plant, s);
-    FZ_CHECK(failed == 0 || failed == 1, "icoac_sim_failed returned %d", (int)failed);
-    if (icoac_sim_plant_check(&su->plant) == ICOAC_SIM_OK) {
+    if (plant_ok) {
         FZ_CHECK(failed == failed_reference(&su->plant, s), "icoac_sim_failed(%g, %g, %g, %g) = %d", s[0], s[1], s[2],
                  s[3], (int)failed);
+    } else {
+        FZ_CHECK(failed == ICOAC_SIM_ERR_BAD_PLANT, "icoac_sim_failed of a plant the check refuses: %d", (int)failed);
     }
 }
 

@@ -159,6 +159,11 @@ def test_bad_actions_and_order():
     raw = env.unwrapped
     raw.reset(options={"state": [2.39, 5.0, 0.0, 0.0]})
     assert raw.step([0.0])[2] is True  # x beyond 2.4 m
+    # a step the plant cannot represent (it overflows) terminates, the state kept as it was
+    start = [0.0, 0.0, 0.0, 1e300]
+    raw.reset(options={"state": start})
+    obs, _, terminated, _, _ = raw.step([0.0])
+    assert terminated is True and np.array_equal(obs, start)
     with pytest.raises(ResetNeeded, match="terminated"):
         raw.step([0.0])
 
@@ -317,6 +322,10 @@ def test_registry_plant_parameters_and_bad_input(env_id, plant):
     for bad in ([np.nan], [np.inf], [1.0, 2.0], "1.5", True):
         with pytest.raises(ValueError, match="one finite"):
             env.step(bad)
+    # a step the plant cannot represent (it overflows) terminates, as on the cart-pole
+    env.reset(options={"state": np.full(n, 1e300)})
+    obs, _, terminated, _, _ = env.step([0.0])
+    assert terminated is True and np.array_equal(obs, np.full(n, 1e300))
     with pytest.raises(B.ConfigError):
         gymnasium.make(env_id, **{first: -1.0})
     with pytest.raises(B.ConfigError):

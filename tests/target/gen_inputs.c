@@ -76,7 +76,7 @@ static int emit(const char *name, const char *upper, int32_t mode, uint64_t seed
             flags = 2u;
         } else {
             icoac_sim_plant_step(&plant, s, (double)out.force);
-            flags = icoac_sim_failed(&plant, s) ? 1u : 0u;
+            flags = icoac_sim_failed(&plant, s) == 1 ? 1u : 0u;
         }
     }
     printf("};\n\n");

@@ -116,10 +116,15 @@ int32_t icoac_sim_plant_check(const icoac_sim_plant_t *plant);
 void icoac_sim_run_default(icoac_sim_run_t *run);
 int32_t icoac_sim_run_check(const icoac_sim_run_t *run);
 
-/* Advance state (x, x_dot, theta, theta_dot) by one dt under force (N). */
+/* Advance state (x, x_dot, theta, theta_dot) by one dt under force (N). Checked as
+ * icoac_sim_model_step checks, the state left as it was on an error: ICOAC_SIM_ERR_BAD_ARGUMENT
+ * (NULL), ICOAC_SIM_ERR_BAD_PLANT (a plant icoac_sim_plant_check refuses: a parameter, dt or
+ * integrator), ICOAC_SIM_ERR_NONFINITE (state or force not finite, or made so by the step). */
 int32_t icoac_sim_plant_step(const icoac_sim_plant_t *plant, double state[ICOAC_CARTPOLE_INPUTS], double force);
 
-/* 1 when state is outside the strict limits (or not finite), else 0. */
+/* 1 when state is outside the strict limits (or not finite), else 0; a status for bad arguments:
+ * ICOAC_SIM_ERR_BAD_ARGUMENT (NULL), ICOAC_SIM_ERR_BAD_PLANT (a plant icoac_sim_plant_check
+ * refuses). */
 int32_t icoac_sim_failed(const icoac_sim_plant_t *plant, const double state[ICOAC_CARTPOLE_INPUTS]);
 
 /* Fill the paper's grid, row-major over theta (row i: theta0 = (-12 + i) deg) then x

@@ -103,22 +103,49 @@ int32_t icoac_sim_plant_check(const icoac_sim_plant_t *plant)
     return icoac_sim_model_check(&model);
 }
 
+/* The plant's model and the first 4 entries of a model state (the rest 0): the model API checks
+ * the plant's parameters, dt, integrator and state as it does for every plant. */
+static void as_model(const icoac_sim_plant_t *plant, const double state[4], icoac_sim_model_t *model,
+                     double s[ICOAC_SIM_MAX_STATE])
+{
+    int i;
+    (void)icoac_sim_model_from_plant(plant, model);
+    for (i = 0; i < ICOAC_SIM_MAX_STATE; ++i) {
+        s[i] = i < 4 ? state[i] : 0.0;
+    }
+}
+
 int32_t icoac_sim_plant_step(const icoac_sim_plant_t *plant, double state[4], double force)
 {
+    icoac_sim_model_t model;
+    double s[ICOAC_SIM_MAX_STATE];
+    int32_t status;
+    int i;
     if (plant == 0 || state == 0) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
-    {
-        const double p[N_PARAMS] = {plant->gravity, plant->cart_mass, plant->pole_mass,
-                                    plant->half_length, plant->x_limit, plant->theta_limit};
-        sim_cart_pole_step(p, plant->dt, plant->integrator, state, force);
+    as_model(plant, state, &model, s);
+    status = icoac_sim_model_step(&model, s, force);
+    if (status == ICOAC_SIM_OK) {
+        for (i = 0; i < 4; ++i) {
+            state[i] = s[i];
+        }
     }
-    return ICOAC_SIM_OK;
+    return status;
 }
 
-int32_t icoac_sim_failed(const icoac_sim_plant_t *plant, const double s[4])
+int32_t icoac_sim_failed(const icoac_sim_plant_t *plant, const double state[4])
 {
-    return sim_failed(plant, s);
+    icoac_sim_model_t model;
+    double s[ICOAC_SIM_MAX_STATE];
+    int32_t failed = 1;
+    int32_t status;
+    if (plant == 0 || state == 0) {
+        return ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
+    as_model(plant, state, &model, s);
+    status = icoac_sim_model_failed(&model, s, &failed);
+    return status == ICOAC_SIM_OK ? failed : status;
 }
 
 int32_t icoac_sim_model_from_plant(const icoac_sim_plant_t *plant, icoac_sim_model_t *model)
