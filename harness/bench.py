@@ -359,6 +359,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
     ICO->search, search), summary, figures. Every argument and override is validated here, before
     anything runs or is written."""
     profile = PROFILES[opt.profile]
+    P.check_prior_std(opt.prior_std)
     out = Path(opt.out)
     figdir = Path(opt.figures) if opt.figures else None
     seeds = opt.seed_list()

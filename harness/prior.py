@@ -138,6 +138,20 @@ _COVS = {"ico": lambda ico, std, n: ico.cov.copy(), "isotropic": lambda ico, std
 assert tuple(_MEANS) == MEAN_RULES and tuple(_COVS) == COV_RULES
 
 
+# sigma_w of an isotropic prior: sigma_w^2 must be a covariance the controller takes (at most
+# ICOAC_PRIOR_COV_MAX, and a normal float).
+PRIOR_STD_RANGE = (1e-18, math.sqrt(B.constant("ICOAC_PRIOR_COV_MAX")))
+
+
+def check_prior_std(std: Any, what: str = "--prior-std") -> float:
+    """std as a float in PRIOR_STD_RANGE; PriorError (one line) otherwise."""
+    lo, hi = PRIOR_STD_RANGE
+    if isinstance(std, bool) or not isinstance(std, (int, float)) or not lo <= std <= hi:
+        raise PriorError(f"{what} must be a number in [{lo:g}, {hi:g}] (sigma_w^2 is the prior's variance), "
+                         f"got {std!r:.40}")
+    return float(std)
+
+
 def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_STD,
                     n_inputs: int = B.N_INPUTS) -> PriorInfo:
     """The prior of a condition by its rule (harness.registry) for a task of n_inputs inputs (the
@@ -152,8 +166,8 @@ def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_
     from_ico = rule.takes_ico
     if from_ico and ico is None:
         raise PriorError(f"condition {condition} needs an ICO prior (--prior-from ICO_RESULTS_DIR)")
-    if cov_rule == "isotropic" and not (math.isfinite(std) and std > 0):
-        raise PriorError(f"--prior-std must be a finite number > 0, got {std!r}")
+    if cov_rule == "isotropic":
+        check_prior_std(std)
     if ico is not None and len(ico.mean) != n_inputs:
         raise PriorError(f"condition {condition}: the ICO prior has {len(ico.mean)} weights, the task {n_inputs} inputs")
     mean, cov = _MEANS[mean_rule](ico, n_inputs), _COVS[cov_rule](ico, std, n_inputs)

@@ -61,9 +61,11 @@ def parse_params(items: Sequence[str]) -> dict[str, list[Any]]:
         if name == "prior_ridge" and any(isinstance(v, bool) or not isinstance(v, (int, float))
                                          or not math.isfinite(v) or v < 0 for v in vals):
             raise SweepError("--param prior_ridge: values must be finite numbers >= 0")
-        if name == "prior_std" and any(isinstance(v, bool) or not isinstance(v, (int, float))
-                                       or not math.isfinite(v) or v <= 0 for v in vals):
-            raise SweepError("--param prior_std: values must be finite numbers > 0")
+        if name == "prior_std":
+            try:
+                vals = [P.check_prior_std(v, "--param prior_std") for v in vals]
+            except P.PriorError as exc:
+                raise SweepError(str(exc)) from None
         if name in out:
             raise SweepError(f"--param {name} given twice")
         out[name] = vals
@@ -205,6 +207,10 @@ def run_sweep(opt: SweepOptions) -> int:
     """Run every setting not yet in OUT/sweep.csv; 130 if interrupted. With ``opt.dask`` one Dask
     session (harness.cluster), opened after every check, runs every grid."""
     ico_dir = results.check_results_dir(opt.prior_from, "--prior-from")
+    try:
+        P.check_prior_std(opt.prior_std)
+    except P.PriorError as exc:
+        raise SweepError(str(exc)) from None
     params = parse_params(opt.params)
     names = list(params)
     todo = settings(params, opt.one_at_a_time)

@@ -42,6 +42,7 @@ static const icoac_sim_constant_t constants[] = {
     CONSTANT(ICOAC_SIM_RK4),
     /* the largest configurable force (N): the action bound of the harness's Gymnasium env */
     CONSTANT(ICOAC_FORCE_MAX),
+    CONSTANT(ICOAC_PRIOR_COV_MAX),
     /* statuses */
     CONSTANT(ICOAC_OK),
     CONSTANT(ICOAC_ERR_NULL),

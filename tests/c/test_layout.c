@@ -97,6 +97,7 @@ static void test_constants_table(void)
     TEST_ASSERT_TRUE(constant("ICOAC_STATE_SIZE") == (double)icoac_sizeof_state());
     TEST_ASSERT_TRUE(constant("ICOAC_INPUT_TERMINAL") == ICOAC_INPUT_TERMINAL);
     TEST_ASSERT_TRUE(constant("ICOAC_FORCE_MAX") == (double)ICOAC_FORCE_MAX);
+    TEST_ASSERT_TRUE(constant("ICOAC_PRIOR_COV_MAX") == (double)ICOAC_PRIOR_COV_MAX);
     TEST_ASSERT_TRUE(constant("ICOAC_MODE_ICO") == ICOAC_MODE_ICO);
     TEST_ASSERT_TRUE(constant("ICOAC_MODE_RL") == ICOAC_MODE_RL);
     TEST_ASSERT_TRUE(constant("ICOAC_MODE_SEARCH") == ICOAC_MODE_SEARCH);

@@ -32,6 +32,13 @@ def run(*args, timeout=60):
     (["grid"], "--out"),
     (["figures", "--results", "{tmp}/missing", "--out", "{tmp}/f"], "does not exist"),
     (["bench", "--profile", "huge", "--out", "{tmp}/b"], "invalid choice"),
+    # sigma_w of the isotropic prior: its square must be a variance the controller takes, checked
+    # before any stage (before: an OverflowError traceback, or after both ICO grids of a bench)
+    (["grid", "--condition", "rl", "--out", "{tmp}/a", "--prior-std", "1.35e154"], "--prior-std must be"),
+    (["grid", "--condition", "rl", "--out", "{tmp}/a", "--prior-std", "2e6"], "--prior-std must be"),
+    (["bench", "--profile", "quick", "--out", "{tmp}/b", "--prior-std", "1e20"], "--prior-std must be"),
+    (["sweep", "--prior-from", "tests/python/fixtures/abi3_ico", "--out", "{tmp}/s", "--param", "prior_std=1e200"],
+     "--param prior_std must be"),
     ([], "required"),
 ])
 def test_user_errors_one_line_exit_2(tmp_path, args, words):
@@ -41,6 +48,7 @@ def test_user_errors_one_line_exit_2(tmp_path, args, words):
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("icoac-harness: error: ")
     assert words in lines[0]
+    assert not any(tmp_path.iterdir())  # refused before anything was written
 
 
 def test_grid_resume_and_mismatch(tmp_path):
