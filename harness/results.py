@@ -226,12 +226,18 @@ def record_plant(record: Mapping[str, Any]) -> str:
 
 
 def check_cells(cells: np.ndarray, where: str = "cells", plant: str = CART_POLE) -> None:
-    """Structural checks of a cell array: known outcomes, finite coordinates on the plant's grid."""
+    """Structural checks of a cell array: known outcomes, counts and elapsed times finite and >= 0,
+    finite coordinates on the plant's grid."""
     bad = ~np.isin(cells["outcome"], list(B.OUTCOME_NAMES))
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise _err(f"{where}: cell {i} has unknown outcome {int(cells['outcome'][i])} "
                    f"(valid: {', '.join(f'{k} {v}' for k, v in B.OUTCOME_NAMES.items())})")
+    for name in ("trials", "total_steps", "last_trial_steps", "elapsed_time"):
+        bad = ~(np.isfinite(cells[name]) & (cells[name] >= 0))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise _err(f"{where}: cell {i} has {name} = {cells[name][i].item()!r}, which must be finite and >= 0")
     try:
         on_grid = geometry.of(plant).on_grid(cells)
     except B.ConfigError:

@@ -118,6 +118,13 @@ def _outcome(c):
     return c
 
 
+def _field(name, value):
+    def fn(c):
+        c[name][2] = value
+        return c
+    return fn
+
+
 def _other_dtype(c):
     d = [(n, c.dtype[n]) for n in c.dtype.names]
     d[3] = ("outcome", "<i8")
@@ -147,6 +154,9 @@ CORRUPTIONS = {
     "run.json wall_time string": (lambda d: edit_record(d, _set(["wall_time"], "x")), ["wall_time"]),
     "NaN cell coordinate": (_cells_edit(_x0_nan), ["cell 1", "x0 = nan"]),
     "unknown outcome": (_cells_edit(_outcome), ["unknown outcome 7"]),
+    "negative trials": (_cells_edit(_field("trials", -3)), ["cell 2 has trials = -3"]),
+    "negative elapsed time": (_cells_edit(_field("elapsed_time", -1.0)), ["cell 2 has elapsed_time = -1.0"]),
+    "NaN elapsed time": (_cells_edit(_field("elapsed_time", np.nan)), ["cell 2 has elapsed_time = nan"]),
     "other dtype": (_cells_edit(_other_dtype), ["different cell layout"]),
 }
 
