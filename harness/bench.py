@@ -393,7 +393,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
 
     def prior_stage(seed: int):
         def run(ctx):
-            info = P.from_results(seed_dir(out, "ico", seed), frame, opt.ridge)
+            info = P.from_results(seed_dir(out, "ico", seed), frame, opt.ridge, opt.plant)
             for cond in REGISTRY.values():
                 if cond.prior is not None and cond.learns:
                     ctx[("prior", cond.name, seed)] = P.condition_prior(cond.name, info, opt.prior_std, plant_grid.n_inputs)

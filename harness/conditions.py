@@ -41,7 +41,8 @@ def condition_prior(condition: str, prior_from, frame, ridge: float, std: float 
         return None if rule is None else P.condition_prior(condition, None, std, geometry.of(plant).n_inputs)
     if prior_from is None:
         raise UsageError(f"condition {condition} needs --prior-from ICO_RESULTS_DIR")
-    return P.condition_prior(condition, P.from_results(prior_from, frame, ridge), std, geometry.of(plant).n_inputs)
+    return P.condition_prior(condition, P.from_results(prior_from, frame, ridge, plant), std,
+                             geometry.of(plant).n_inputs)
 
 
 def prior_extra(info: P.PriorInfo | None) -> dict | None:

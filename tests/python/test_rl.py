@@ -4,6 +4,7 @@ import csv
 import ctypes
 import json
 import math
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -115,6 +116,22 @@ def test_prior_from_results_records_provenance(ico_dir):
     np.testing.assert_allclose(info.mean, cells["weights"][ok][:, :4].mean(axis=0))
     assert info.source_commit == record["git"]["commit"]
     assert info.ico_phase_simulated_time == pytest.approx(float(cells["elapsed_time"].sum()))
+    d = info.to_dict()
+    assert (d["source_plant"], d["source_condition"], d["source_learn"]) == ("cart_pole", "ico", 1)
+
+
+def test_prior_from_refuses_another_plant_or_a_run_that_did_not_learn(ico_dir, tmp_path):
+    """A prior is for the plant of its ICO run, and only a run that learned is an ICO prior."""
+    assert P.from_results(ico_dir, plant="cart_pole").source_seed is not None
+    with pytest.raises(P.PriorError, match="an ICO run of the cart_pole, not of the furuta"):
+        P.from_results(ico_dir, plant="furuta")
+    cells, record = results.load(ico_dir)
+    record["config"]["controller"]["learn"] = False  # e.g. a ceiling's evaluation of a fixed w
+    fixed = tmp_path / "fixed"
+    shutil.copytree(ico_dir, fixed)
+    (fixed / results.RUN_FILE).write_text(json.dumps(record))
+    with pytest.raises(P.PriorError, match="did not learn"):
+        P.from_results(fixed)
 
 
 # -- RL grids ------------------------------------------------------------------------------------------
