@@ -119,7 +119,11 @@ def plot_map(ax, values: np.ndarray, *, cmap="viridis", norm=None, title: str | 
 
 
 def success_title(label: str, summary: Mapping) -> str:
-    return (f"{label}: success {percent(summary['success_rate'])} ({summary['n_cells']} cells), "
+    """The map's title; a partial grid says how many of its cells are still pending (they count
+    in the rate's denominator as not successful)."""
+    pending = summary["outcomes"].get("pending", 0)
+    cells = f"{summary['n_cells']} cells" + (f", {pending} still pending" if pending else "")
+    return (f"{label}: success {percent(summary['success_rate'])} ({cells}), "
             f"interior {percent(summary['success_rate_interior'])}")
 
 

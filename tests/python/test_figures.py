@@ -38,3 +38,14 @@ def test_map_with_outline_and_bars(tmp_path):
     b = figures.plot_bars(tmp_path / "b.png", ["ICO", "RL", "ICO->RL"], [0.68, 0.3, 0.84], [0.01, 0.02, 0.01],
                           ylabel="success rate")
     assert b.read_bytes()[:8] == PNG
+
+
+def test_success_title_counts_pending_cells():
+    """A partial grid's map says how many cells are still pending (they are in the denominator)."""
+    cells = make_cells(0, range(400))
+    cells["outcome"][:22] = 1  # success
+    cells["outcome"][22:100] = 2  # failed; the other 300 pending
+    title = figures.success_title("ICO", metrics.summary(cells))
+    assert title.startswith("ICO: success 5.5 % (400 cells, 300 still pending), interior")
+    cells["outcome"][100:] = 2
+    assert "pending" not in figures.success_title("ICO", metrics.summary(cells))
