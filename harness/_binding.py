@@ -31,7 +31,7 @@ BUILD_INFO = PACKAGE_LIBRARY.parent / "build_info.json"   # the commit the packa
 DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.so"
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
-ABI_VERSION = 8
+ABI_VERSION = 9
 SIM_ABI_VERSION = 3
 
 
@@ -270,6 +270,7 @@ class TaskConfig(ctypes.Structure):
     """icoac_task_config_t: the plant's inputs and late signal (every mode)."""
     _fields_ = [
         ("n_inputs", ctypes.c_int32),
+        ("input_sign", ctypes.c_int32 * MAX_INPUTS),
         ("late_source", ctypes.c_int32),
         ("n_rules", ctypes.c_int32),
         ("rule_input", ctypes.c_int32 * MAX_RULES),

@@ -22,7 +22,7 @@ const char *icoac_status_str(icoac_status_t status)
     case ICOAC_ERR_BAD_CRITIC: return "invalid critic parameter (rate [0, 10], discount [0, 1], td_clip [1e-6, 1e3], range [1e-6, 1e6], threshold [0, 1))";
     case ICOAC_ERR_BAD_ACTOR: return "invalid actor parameter (noise_std [1e-3, 1e3], scale [0, 1e3], forgetting [0.5, 1], update 0-2, rate [0, 1e3], likelihood_std 0 or [1e-3, 1e3], explore_ticks [0, 1e8])";
     case ICOAC_ERR_BAD_SEARCH: return "invalid search parameter (batch [1, 16], elite_fraction (0, 1], step (0, 1], floor [1e-6, 1e3], cov_scale [1, 1e3])";
-    case ICOAC_ERR_BAD_TASK: return "invalid task (n_inputs [1, max], late_source 0-1, n_rules [0, max], rule_input [0, n_inputs), rule_side 0-1)";
+    case ICOAC_ERR_BAD_TASK: return "invalid task (n_inputs [1, max], input_sign +1 or -1, late_source 0-1, n_rules [0, max], rule_input [0, n_inputs), rule_side 0-1)";
     case ICOAC_ERR_BAD_PRIOR: return "invalid prior (|mean| <= 1e6, covariance entries |c| <= 1e12, zero or normal, symmetric positive definite)";
     default: return "unknown status";
     }
@@ -48,6 +48,9 @@ static void task_cartpole(icoac_task_config_t *task)
     int k;
     (void)memset(task, 0, sizeof *task);
     task->n_inputs = ICOAC_CARTPOLE_INPUTS;
+    for (k = 0; k < ICOAC_MAX_INPUTS; ++k) {
+        task->input_sign[k] = 1;
+    }
     task->late_source = ICOAC_LATE_RULES;
     task->n_rules = ICOAC_CARTPOLE_RULES;
     for (k = 0; k < ICOAC_CARTPOLE_RULES; ++k) {
@@ -191,6 +194,7 @@ typedef struct {
 static const char *const input_range_names[16] = NAMES16("policy.input_range");
 static const char *const critic_range_names[16] = NAMES16("critic.range");
 static const char *const critic_units_names[16] = NAMES16("critic.units");
+static const char *const input_sign_names[16] = NAMES16("task.input_sign");
 static const char *const rule_input_names[16] = NAMES16("task.rule_input");
 static const char *const rule_side_names[16] = NAMES16("task.rule_side");
 static const char *const rule_threshold_names[16] = NAMES16("task.rule_threshold");
@@ -202,6 +206,11 @@ static int task_ok(const icoac_task_config_t *t, bad_field_t *bad)
     int k;
     if (t->n_inputs < 1 || t->n_inputs > ICOAC_MAX_INPUTS) {
         ICOAC_PRIV_FAIL("task.n_inputs", ICOAC_ERR_BAD_TASK);
+    }
+    for (k = 0; k < t->n_inputs; ++k) {
+        if (t->input_sign[k] != 1 && t->input_sign[k] != -1) {
+            ICOAC_PRIV_FAIL(input_sign_names[k], ICOAC_ERR_BAD_TASK);
+        }
     }
     if (t->late_source != ICOAC_LATE_RULES && t->late_source != ICOAC_LATE_SENSOR) {
         ICOAC_PRIV_FAIL("task.late_source", ICOAC_ERR_BAD_TASK);

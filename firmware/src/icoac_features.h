@@ -43,7 +43,8 @@ static inline int icoac_priv_within_unit(icoac_real_t a)
 #endif
 }
 
-/* x~_i = clip(s_i / range_i) for i < n, with 1 / range_i precomputed by icoac_init; 0 past n. */
+/* x~_i = clip(sign_i * s_i / range_i) for i < n, with sign_i / range_i precomputed by icoac_init (the clip
+ * is symmetric: sign_i * clip(s_i / range_i)); 0 past n. */
 static inline void icoac_priv_scale_inputs(const icoac_policy_config_t *policy, const icoac_priv_state_t *st, int n,
                                            const icoac_real_t s[ICOAC_MAX_INPUTS],
                                            icoac_real_t scaled[ICOAC_MAX_INPUTS])

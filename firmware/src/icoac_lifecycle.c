@@ -30,14 +30,17 @@ static int cartpole_rules(const icoac_task_config_t *task)
     return same;
 }
 
-/* What the tick takes from the configuration in force, derived once: 1 / policy.input_range
- * (0 past the task's inputs), the critic's geometry, the shape tags and the search's floors. */
+/* What the tick takes from the configuration in force, derived once: task.input_sign /
+ * policy.input_range (0 past the task's inputs; the sign folded in, so a tick pays nothing for
+ * it, and +1 gives 1 / range bit for bit), the critic's geometry, the shape tags and the search's
+ * floors. */
 static void derive(icoac_priv_state_t *st)
 {
     const int n = icoac_priv_inputs(&st->config);
     int i;
     for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
-        st->inv_range[i] = i < n ? ICOAC_R(1.0) / st->config.policy.input_range[i] : ICOAC_R(0.0);
+        const icoac_real_t sign = st->config.task.input_sign[i] < 0 ? ICOAC_R(-1.0) : ICOAC_R(1.0);
+        st->inv_range[i] = i < n ? sign / st->config.policy.input_range[i] : ICOAC_R(0.0);
     }
     icoac_priv_critic_grid(&st->config, &st->grid);
     if (cartpole_rules(&st->config.task) != 0) {

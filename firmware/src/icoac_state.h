@@ -117,7 +117,7 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
     icoac_config_t config;                            /* in force: checked by icoac_init / icoac_retune,
                                                          checked again by icoac_reset */
     icoac_priv_grid_t grid;                           /* the critic's geometry, derived */
-    icoac_real_t inv_range[ICOAC_MAX_INPUTS];           /* 1 / policy.input_range (0 past n), derived by icoac_init */
+    icoac_real_t inv_range[ICOAC_MAX_INPUTS];           /* task.input_sign / policy.input_range (0 past n), derived by icoac_init */
     icoac_real_t w[ICOAC_MAX_INPUTS];                   /* ICO weights, or actor mean mu_w */
     icoac_real_t weight_norm;                         /* |w|, refreshed when w changes */
     icoac_real_t w_act[ICOAC_MAX_INPUTS];               /* weights used to act (mu_w or a sample) */

@@ -99,6 +99,7 @@ static const icoac_sim_field_t fields[] = {
     FIELD(icoac_config_t, mode),
     FIELD(icoac_config_t, learn),
     FIELD(icoac_config_t, task.n_inputs),
+    FIELD(icoac_config_t, task.input_sign),
     FIELD(icoac_config_t, task.late_source),
     FIELD(icoac_config_t, task.n_rules),
     FIELD(icoac_config_t, task.rule_input),

@@ -31,6 +31,9 @@ static void test_defaults_match_spec(void)
     assert_close(cfg.policy.reflex_force, 1.0, 0.0);
     /* the cart-pole task: Eq. (4)'s zone as four rules, first match wins */
     TEST_ASSERT_EQUAL_INT(4, cfg.task.n_inputs);
+    for (int i = 0; i < ICOAC_MAX_INPUTS; ++i) {
+        TEST_ASSERT_EQUAL_INT(1, cfg.task.input_sign[i]); /* the paper's: no sign changed */
+    }
     TEST_ASSERT_EQUAL_INT(ICOAC_LATE_RULES, cfg.task.late_source);
     TEST_ASSERT_EQUAL_INT(4, cfg.task.n_rules);
     TEST_ASSERT_EQUAL_INT(ICOAC_IDX_THETA, cfg.task.rule_input[0]);
@@ -174,6 +177,10 @@ MUT(m_rule_input0_neg, c->task.rule_input[0] = -1)
 MUT(m_late_source_2, c->task.late_source = 2)
 MUT(m_n_inputs_zero, c->task.n_inputs = 0)
 MUT(m_n_rules_neg, c->task.n_rules = -1)
+MUT(m_input_sign0_zero, c->task.input_sign[0] = 0)
+RLMUT(m_rl_input_sign3_2, c->task.input_sign[3] = 2)
+MUT(m_n_inputs_6_sign5_unset, { c->task.n_inputs = 6; c->policy.input_range[4] = 1; c->policy.input_range[5] = 1;
+                                c->task.input_sign[5] = 0; })
 MUT(m_n_inputs_6_ranges_unset, c->task.n_inputs = 6)
 RLMUT(m_units2_17, c->critic.units[2] = 17)
 RLMUT(m_units0_zero, c->critic.units[0] = 0)
@@ -329,6 +336,7 @@ MUT(ok_no_rules, { c->task.n_rules = 0; c->task.rule_side[0] = 5; })
 MUT(ok_rule_bounds, { c->task.rule_threshold[0] = ICOAC_RULE_THRESHOLD_MAX; c->task.rule_threshold[1] = -ICOAC_RULE_THRESHOLD_MAX;
                       c->task.rule_reflex[2] = 0; c->task.rule_reflex[3] = (icoac_real_t)0.25; })
 MUT(ok_one_input, { c->task.n_inputs = 1; c->task.n_rules = 1; c->task.rule_input[0] = 0; })
+MUT(ok_input_signs, { c->task.input_sign[0] = -1; c->task.input_sign[3] = -1; c->task.input_sign[4] = 0; })
 RLMUT(ok_six_inputs, { c->task.n_inputs = 6; c->policy.input_range[4] = 1; c->policy.input_range[5] = 1;
                        c->critic.range[4] = 1; c->critic.range[5] = 1; c->critic.units[0] = 3; c->critic.units[1] = 3;
                        c->critic.units[2] = 3; c->critic.units[3] = 2; c->critic.units[4] = 2; c->critic.units[5] = 2; })
@@ -369,6 +377,9 @@ static const config_case_t config_cases[] = {
     {"task.late_source=2", m_late_source_2, ICOAC_ERR_BAD_TASK, "task.late_source"},
     {"task.n_inputs=0", m_n_inputs_zero, ICOAC_ERR_BAD_TASK, "task.n_inputs"},
     {"task.n_rules=-1", m_n_rules_neg, ICOAC_ERR_BAD_TASK, "task.n_rules"},
+    {"task.input_sign[0]=0", m_input_sign0_zero, ICOAC_ERR_BAD_TASK, "task.input_sign[0]"},
+    {"RL, task.input_sign[3]=2", m_rl_input_sign3_2, ICOAC_ERR_BAD_TASK, "task.input_sign[3]"},
+    {"task.n_inputs=6, task.input_sign[5]=0", m_n_inputs_6_sign5_unset, ICOAC_ERR_BAD_TASK, "task.input_sign[5]"},
     {"task.n_inputs=6, ranges 4-5 unset", m_n_inputs_6_ranges_unset, ICOAC_ERR_BAD_SCALE, "policy.input_range[4]"},
     {"RL, critic.units[2]=17", m_units2_17, ICOAC_ERR_BAD_CRITIC, "critic.units[2]"},
     {"RL, critic.units[0]=0", m_units0_zero, ICOAC_ERR_BAD_CRITIC, "critic.units[0]"},
@@ -503,6 +514,7 @@ static const config_case_t config_cases[] = {
     {"no rules", ok_no_rules, ICOAC_OK, NULL},
     {"rule thresholds and reflexes at their bounds", ok_rule_bounds, ICOAC_OK, NULL},
     {"one input, one rule", ok_one_input, ICOAC_OK, NULL},
+    {"input signs -1 (and an unused one 0)", ok_input_signs, ICOAC_OK, NULL},
     {"RL, six inputs, critic 3x3x3x2x2x2", ok_six_inputs, ICOAC_OK, NULL},
     {"RL, critic 1x1x16x13", ok_units_max_per_input, ICOAC_OK, NULL},
 };
@@ -610,6 +622,12 @@ static const config_field_t config_fields[] = {
     INT_FIELD(learn, G_POLICY, ICOAC_ERR_BAD_MODE), /* checked in every mode, like the policy */
     /* the task: checked in every mode; entries past the cart-pole's 4 inputs and 4 rules unused */
     INT_FIELD(task.n_inputs, G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD_BAD(task.input_sign[0], G_POLICY, ICOAC_ERR_BAD_TASK, 0),
+    INT_FIELD(task.input_sign[1], G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD_BAD(task.input_sign[2], G_POLICY, ICOAC_ERR_BAD_TASK, -2),
+    INT_FIELD(task.input_sign[3], G_POLICY, ICOAC_ERR_BAD_TASK),
+    INT_FIELD(task.input_sign[4], G_UNUSED, ICOAC_OK),
+    INT_FIELD(task.input_sign[5], G_UNUSED, ICOAC_OK),
     INT_FIELD(task.late_source, G_POLICY, ICOAC_ERR_BAD_TASK),
     INT_FIELD(task.n_rules, G_POLICY, ICOAC_ERR_BAD_TASK),
     INT_FIELD(task.rule_input[0], G_POLICY, ICOAC_ERR_BAD_TASK),
@@ -1098,7 +1116,7 @@ static void test_version(void)
 static void test_sizeof_functions(void)
 {
     TEST_ASSERT_EQUAL_UINT32(ICOAC_ABI_VERSION, icoac_abi_version());
-    TEST_ASSERT_EQUAL_INT(8, ICOAC_ABI_VERSION);
+    TEST_ASSERT_EQUAL_INT(9, ICOAC_ABI_VERSION);
     TEST_ASSERT_EQUAL_INT(19, ICOAC_ERR_BAD_TASK);
     TEST_ASSERT_EQUAL_INT(18, ICOAC_ERR_BAD_SEARCH);
     TEST_ASSERT_EQUAL_INT(2, ICOAC_MODE_SEARCH);

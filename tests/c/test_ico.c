@@ -444,6 +444,110 @@ static void test_jump_over_zone(void)
 void setUp(void) {}
 void tearDown(void) {}
 
+/* ---- input signs (task.input_sign, method.md: input signs) ---- */
+
+/* A task whose input i has sign -1 behaves, tick for tick and bit for bit, as the same task with
+ * sign +1 fed -s_i, in every mode: the features, the learning and the force read sign_i * s_i.
+ * The late signal comes from a sensor and the critic has one unit along each flipped input (a
+ * constant factor), so nothing reads the raw flipped inputs. */
+static void run_signs(int32_t mode, int32_t timing)
+{
+    static const int32_t sign[4] = {-1, 1, -1, 1};
+    icoac_config_t signed_cfg = test_default_config();
+    icoac_config_t mirror_cfg;
+    icoac_state_t signed_state, mirror_state;
+    icoac_prior_t prior = test_prior(0.3, 0.1, 0.7, 0.2, 0.5);
+    test_rng_t rng = {0x51617u};
+    int trial, k, i;
+    signed_cfg.mode = mode;
+    signed_cfg.ico.timing = timing;
+    signed_cfg.ico.rate = (icoac_real_t)0.01;
+    signed_cfg.search.batch = 2;
+    signed_cfg.task.late_source = ICOAC_LATE_SENSOR;
+    signed_cfg.critic.units[0] = 1;
+    signed_cfg.critic.units[2] = 1;
+    mirror_cfg = signed_cfg;
+    for (i = 0; i < 4; ++i) {
+        signed_cfg.task.input_sign[i] = sign[i];
+    }
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&signed_cfg, &signed_state, &prior, 5u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_init(&mirror_cfg, &mirror_state, &prior, 5u));
+    for (trial = 0; trial < 6; ++trial) {
+        for (k = 0; k < 60; ++k) {
+            const uint32_t late = (k % 7 == 3 || k % 7 == 4) ? ICOAC_INPUT_LATE : 0u;
+            const uint32_t flags = late | (k == 59 ? ICOAC_INPUT_TERMINAL : 0u);
+            icoac_input_t in = test_input(test_uniform(&rng, -3, 3), test_uniform(&rng, -5, 5),
+                                          test_uniform(&rng, -0.3, 0.3), test_uniform(&rng, -3, 3), flags);
+            icoac_input_t mirrored = in;
+            icoac_output_t a, b;
+            memset(&a, 0, sizeof a); /* the padding of a double build compares equal */
+            memset(&b, 0, sizeof b);
+            in.reflex = (icoac_real_t)test_uniform(&rng, -1, 1);
+            mirrored.reflex = in.reflex;
+            for (i = 0; i < 4; ++i) {
+                mirrored.s[i] = sign[i] < 0 ? -in.s[i] : in.s[i];
+            }
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&signed_state, &in, &a));
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&mirror_state, &mirrored, &b));
+            TEST_ASSERT_EQUAL_MEMORY(&b, &a, sizeof a);
+        }
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&signed_state));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_reset(&mirror_state));
+    }
+    {
+        icoac_prior_t pa, pb;
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(&signed_state, &pa));
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_get_posterior(&mirror_state, &pb));
+        TEST_ASSERT_EQUAL_MEMORY(&pb, &pa, sizeof pa);
+        TEST_ASSERT_TRUE(memcmp(&pa, &prior, sizeof pa) != 0); /* it learned */
+    }
+}
+
+static void test_signs_ico_code(void)
+{
+    run_signs(ICOAC_MODE_ICO, ICOAC_ICO_TIMING_CODE);
+}
+
+static void test_signs_ico_literal(void)
+{
+    run_signs(ICOAC_MODE_ICO, ICOAC_ICO_TIMING_LITERAL);
+}
+
+static void test_signs_rl(void)
+{
+    run_signs(ICOAC_MODE_RL, ICOAC_ICO_TIMING_CODE);
+}
+
+static void test_signs_search(void)
+{
+    run_signs(ICOAC_MODE_SEARCH, ICOAC_ICO_TIMING_CODE);
+}
+
+/* A sign flips the input's contribution to the feature: z = sum_i w_i sign_i x~_i. */
+static void test_sign_flips_the_feature(void)
+{
+    icoac_config_t cfg = test_default_config();
+    icoac_state_t state;
+    icoac_output_t out;
+    const icoac_input_t in = test_input(1.2, 0.7, 0.1, -0.5, 0);
+    double z = 0;
+    int i;
+    cfg.ico.rate = 0;
+    cfg.task.input_sign[1] = -1;
+    cfg.task.input_sign[2] = -1;
+    init_with_w(&cfg, &state, 0.5, 0.25, 2.0, 1.0);
+    TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_step(&state, &in, &out));
+    {
+        const double w[4] = {0.5, 0.25, 2.0, 1.0};
+        const double sgn[4] = {1, -1, -1, 1};
+        for (i = 0; i < 4; ++i) {
+            z += w[i] * sgn[i] * test_scale(i, (double)in.s[i], 1);
+        }
+    }
+    assert_close(out.z, z, tol_of(8.0));
+    assert_close(out.force, 10.0 * z, tol_of(80.0));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -459,5 +563,10 @@ int main(void)
     RUN_TEST(test_ico_literal_timing);
     RUN_TEST(test_ico_literal_timing_terminal);
     RUN_TEST(test_jump_over_zone);
+    RUN_TEST(test_signs_ico_code);
+    RUN_TEST(test_signs_ico_literal);
+    RUN_TEST(test_signs_rl);
+    RUN_TEST(test_signs_search);
+    RUN_TEST(test_sign_flips_the_feature);
     return UNITY_END();
 }

@@ -46,6 +46,12 @@ typedef enum {
  *   switch, a limit switch).
  * - critic (RL mode): critic.units[i] normalized Gaussian units along input i over
  *   [-critic.range[i], critic.range[i]], the grid being their product (method.md, critic).
+ * - input signs: task.input_sign[i] (+1 or -1) multiplies the scaled input, x~_i = sign_i *
+ *   clip(s_i / range_i), so that a weight w_i >= 0 (all ICO learns) pushes with the sign the
+ *   plant's stabilising feedback needs on input i (method.md, input signs; a step beyond the
+ *   paper). The features, ICO's weights, the actor's and the search's weights and the prior are
+ *   in these signed inputs; the rules and the critic read the raw inputs s_i. +1 everywhere: the
+ *   paper's controller.
  * The inputs a task does not use (index n and up) are never read. icoac_task_cartpole gives the
  * cart-pole task, which icoac_config_default installs. */
 typedef enum {
@@ -103,6 +109,7 @@ typedef enum {
 /* Task: the plant's inputs and late signal (above). Defaults: the cart-pole (icoac_task_cartpole). */
 typedef struct {
     int32_t n_inputs;                             /* n, [1, ICOAC_MAX_INPUTS]. 4 */
+    int32_t input_sign[ICOAC_MAX_INPUTS];         /* sign of each scaled input, +1 or -1. 1 */
     int32_t late_source;                          /* icoac_late_source_t. rules */
     int32_t n_rules;                              /* rules in the table, [0, ICOAC_MAX_RULES]. 4 */
     int32_t rule_input[ICOAC_MAX_RULES];          /* input index, [0, n) */
@@ -211,7 +218,7 @@ typedef struct {
 #define ICOAC_STATE_REALS                                                                                \
     (4 * ICOAC_MAX_INPUTS * ICOAC_MAX_INPUTS + 26 * ICOAC_MAX_INPUTS + 2 * ICOAC_MAX_RULES + ICOAC_MAX_CRITIC_UNITS + \
      2 * ICOAC_STATE_LIST + 32)
-#define ICOAC_STATE_WORDS (2 * ICOAC_MAX_RULES + ICOAC_MAX_INPUTS + 41)
+#define ICOAC_STATE_WORDS (2 * ICOAC_MAX_RULES + 2 * ICOAC_MAX_INPUTS + 41)
 #define ICOAC_STATE_SIZE                                                                                  \
     (((int)sizeof(icoac_real_t) * ICOAC_STATE_REALS + 4 * ICOAC_STATE_WORDS + 2 * ICOAC_STATE_LIST + 63) / 64 * 64)
 typedef struct {
