@@ -206,15 +206,17 @@ _INT_LIMITS = {ctypes.c_int32: (-2 ** 31, 2 ** 31 - 1), ctypes.c_int64: (-2 ** 6
 
 
 def _probe_statuses() -> dict[str, int]:
-    """Status the C checks give when each field alone is invalid (NaN, or -1 for integers), so
-    that a value rejected on the Python side carries the status C would give for that field.
-    A controller field is probed in each mode until one validates its group."""
+    """Status the C checks give when each field alone is invalid (NaN, or 0 for integers, -1 for
+    those that take 0: flags and counts), so that a value rejected on the Python side carries the
+    status C would give for that field. A controller field is probed in each mode until one
+    validates its group."""
     out: dict[str, int] = {}
     probes = ((B.Config, B.lib.icoac_config_default, B.lib.icoac_config_check, CONTROLLER_FIELDS),
               (B.Plant, B.lib.icoac_sim_plant_default, B.lib.icoac_sim_plant_check, PLANT_FIELDS),
               (B.Run, B.lib.icoac_sim_run_default, B.lib.icoac_sim_run_check, RUN_FIELDS))
     for kind, default, check, names in probes:
         for name in names:
+            status = B.OK
             for mode in (B.MODES.values() if kind is B.Config and name != "mode" else (None,)):
                 probe = kind()
                 default(ctypes.byref(probe))
@@ -223,17 +225,19 @@ def _probe_statuses() -> dict[str, int]:
                 owner, leaf = _owner(probe, name)
                 ctype = dict(owner._fields_)[leaf]
                 scalar = ctype._type_ if issubclass(ctype, ctypes.Array) else ctype
-                bad = -1 if scalar in _INT_LIMITS else math.nan
-                if issubclass(ctype, ctypes.Array):
-                    getattr(owner, leaf)[0] = bad
-                else:
-                    setattr(owner, leaf, bad)
-                status = int(check(ctypes.byref(probe)))
+                for bad in ((-1, 0) if scalar in _INT_LIMITS else (math.nan,)):
+                    if issubclass(ctype, ctypes.Array):
+                        getattr(owner, leaf)[0] = bad
+                    else:
+                        setattr(owner, leaf, bad)
+                    status = int(check(ctypes.byref(probe)))
+                    if status != B.OK:
+                        break
                 if status != B.OK:
                     out[name] = status
                     break
             else:
-                raise B.LibraryError(f"the C check accepts {name} = {bad}; rebuild the library")
+                raise B.LibraryError(f"the C check accepts every probe of {name}; rebuild the library")
     return out
 
 
@@ -338,6 +342,8 @@ def _set_field(struct: ctypes.Structure, name: str, value: Any) -> None:
                 [v for v in value.replace("[", "").replace("]", "").split(",") if v.strip()]
         if isinstance(value, np.ndarray):
             value = value.tolist()
+        if name == SIGN_FIELD and _is_number(value):
+            value = [value] * ctype._length_  # one sign for every input: --set task.input_sign=1
         # every entry, or the leading ones a task uses (the others keep their values): the
         # cart-pole's N_INPUTS of an input array, any number of a rule array (task.n_rules)
         sizes = (set(range(1, ctype._length_ + 1)) if name.startswith("task.rule_") else
@@ -661,10 +667,13 @@ def check_prior(prior: B.Prior, n: int) -> None:
 
 # -- building and reading configurations ---------------------------------------------------------------
 def build_config(overrides: Mapping[str, Any] | None = None, condition: str | None = None,
-                 prior: B.Prior | None = None, check: bool = True, plant: str = CART_POLE) -> RunConfig:
+                 prior: B.Prior | None = None, check: bool = True, plant: str = CART_POLE,
+                 derive_signs: bool = True) -> RunConfig:
     """C defaults, then the condition's overrides, then ``overrides`` by field name (canonical or
     alias; a later name for the same field wins); validated by C. A registry plant other than the
-    cart-pole takes the overrides named after its parameters (and dt, integrator)."""
+    cart-pole takes the overrides named after its parameters (and dt, integrator). With
+    derive_signs, task.input_sign comes from the plant's LQR gain (harness.signs) unless a layer
+    gives it (--set task.input_sign=1: the paper's signs)."""
     if overrides is not None and not isinstance(overrides, Mapping):
         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"overrides must be a mapping name -> value, got {_short(overrides)}")
     if prior is not None and not isinstance(prior, B.Prior):
@@ -685,14 +694,36 @@ def build_config(overrides: Mapping[str, Any] | None = None, condition: str | No
         params = plant_params(plant)
         cfg.model = build_model(plant, {name: value for name, value in items if name in params})
         items = [(name, value) for name, value in items if name not in params]
+    given = set()
     for name, value in items:
         name = canonical(name)
         if cfg.model is not None and group_of(name) == "plant":
             raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {plant} has no parameter {name}")
         _set_field(cfg._struct(name), name, value)
+        given.add(name)
+    if derive_signs and SIGN_FIELD not in given:
+        _derive_signs(cfg)
     if check:
         cfg.check()
     return cfg
+
+
+# The field harness.signs derives.
+SIGN_FIELD = "task.input_sign"
+
+
+def _derive_signs(cfg: RunConfig) -> None:
+    """task.input_sign of cfg from its plant's LQR gain (harness.signs), when the rest of cfg is
+    valid (an invalid one is refused by its check, naming the field)."""
+    from .signs import derive_input_signs  # here: harness.signs imports this module through the ceiling
+
+    try:
+        cfg.check()
+    except ConfigError:
+        return
+    signs = derive_input_signs(cfg)
+    for i, sign in enumerate(signs or ()):
+        cfg.controller.task.input_sign[i] = sign
 
 
 def _controller_items(values: Mapping[str, Any], prefix: str = ""):
@@ -753,5 +784,7 @@ def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
         # a record from before the learners (ABI <= 5): its controller ran the literal reading
         literal = parse_sets(NAMED_CONFIGURATIONS["literal"])
         overrides = [(n, v) for n, v in literal.items() if n in LEARNER_FIELDS] + overrides
-    cfg = build_config(dict(overrides), prior=prior_from_dict(data.get("prior")), check=False, plant=plant)
+    # a record's signs are its own (a record without them ran with +1): never derived again
+    cfg = build_config(dict(overrides), prior=prior_from_dict(data.get("prior")), check=False, plant=plant,
+                       derive_signs=False)
     return cfg.check() if check else cfg

@@ -1,0 +1,98 @@
+# SPDX-License-Identifier: Apache-2.0
+"""ICO's input signs from the plant (harness.signs, task.input_sign; docs/method.md, input signs)."""
+import ctypes
+
+import numpy as np
+import pytest
+
+from harness import _binding as B
+from harness import config as C
+from harness import signs
+from harness.ceiling import lqr
+
+PLANTS = [B.plant_info(i)["name"] for i in range(int(B.lib.icoac_sim_plant_count()))]
+
+
+def _bytes(struct) -> bytes:
+    return ctypes.string_at(ctypes.addressof(struct), ctypes.sizeof(struct))
+
+
+@pytest.mark.parametrize("condition", [None, "ico", "ico-rl", "rl", "search"])
+def test_cart_pole_derived_signs_are_todays(condition):
+    """The cart-pole's derived signs are +1 on every input, so its configuration is byte for byte
+    the one without the derivation (and its results the paper's, test_reference_cells.py)."""
+    derived = C.build_config(condition=condition)
+    plain = C.build_config(condition=condition, derive_signs=False)
+    assert signs.derive_input_signs(derived) == (1, 1, 1, 1)
+    assert list(plain.controller.task.input_sign) == [1] * B.MAX_INPUTS
+    assert _bytes(derived.controller) == _bytes(plain.controller)
+
+
+def test_shipped_plants_derived_signs():
+    """The derived signs of the shipped plants: the cart-pole's and the Furuta's are today's (+1),
+    the double pendulum's are those of the best single w its ceiling found (docs/results.md):
+    the cart's and the upper link's against the lower link's."""
+    got = {p: tuple(C.build_config(plant=p).controller.task.input_sign)[:C.build_config(plant=p).n_inputs]
+           for p in PLANTS}
+    assert got == {"cart_pole": (1, 1, 1, 1), "furuta": (1, 1, 1, 1), "double_cart_pole": (-1, -1, 1, 1, -1, -1)}
+
+
+@pytest.mark.parametrize("plant", PLANTS)
+def test_derived_signs_are_the_lqr_gain_pattern(plant):
+    """sign_i = sign(-K_i) of the LQR gain with R = 1 / G^2, so that the LQR feedback's weights
+    w_i = -K_i range_i sign_i / G are all >= 0: the feedback ICO's growing weights can reach."""
+    cfg = C.build_config(plant=plant)
+    n = cfg.n_inputs
+    a, b = lqr.linearise(cfg)
+    ranges = np.array(list(cfg.controller.policy.input_range)[:n])
+    gain = float(cfg.controller.policy.gain)
+    k = lqr.lqr_gain(a, b, np.diag(1 / ranges ** 2), 1 / gain ** 2)
+    sign = np.array(list(cfg.controller.task.input_sign)[:n])
+    assert np.all(-k * ranges * sign / gain >= 0)
+    # and the ceiling's LQR start at that R is those weights
+    starts = dict(lqr.lqr_starts(cfg))
+    if gain in lqr.LQR_FORCES:
+        np.testing.assert_allclose(starts[f"lqr R=1/{gain:g}^2"], -k * ranges * sign / gain, rtol=1e-5, atol=1e-6)
+
+
+def test_lqr_signs_of_a_mixed_pattern():
+    """A plant whose LQR gain has mixed signs gets mixed input signs (a double integrator pushed
+    away from its goal: u = -K s with K > 0 on both states gives -1, -1)."""
+    dt = 0.01
+    a = np.array([[1.0, dt], [0.0, 1.0]])
+    b = np.array([[0.5 * dt * dt], [dt]])
+    assert signs.lqr_signs(a, b, np.array([1.0, 1.0]), 10.0) == (-1, -1)
+    assert signs.lqr_signs(a, -b, np.array([1.0, 1.0]), 10.0) == (1, 1)
+    # no stabilising gain (an unstable mode the input cannot reach): None
+    assert signs.lqr_signs(np.diag([1.5, 1.0]), np.array([[0.0], [1.0]]), np.array([1.0, 1.0]), 1.0) is None
+
+
+def test_given_signs_switch_the_derivation_off():
+    """task.input_sign given by any layer wins: a list, or one number for every input; a record's
+    signs are its own, and a record without them ran with +1."""
+    plant = "double_cart_pole"
+    assert list(C.build_config({"task.input_sign": 1}, plant=plant).controller.task.input_sign) == [1] * 6
+    given = [1, -1, 1, -1, 1, -1]
+    cfg = C.build_config({"task.input_sign": given}, condition="ico", plant=plant)
+    assert list(cfg.controller.task.input_sign) == given
+    assert cfg.to_dict()["controller"]["task"]["input_sign"] == given
+    assert list(C.config_from_dict(cfg.to_dict()).controller.task.input_sign) == given
+    assert C.parse_sets(["task.input_sign=-1"]) == {"task.input_sign": -1}
+    record = C.build_config(plant=plant).to_dict()
+    del record["controller"]["task"]["input_sign"]
+    assert list(C.config_from_dict(record).controller.task.input_sign) == [1] * 6
+
+
+@pytest.mark.parametrize("bad", [0, 2, [1, 1, 0, 1, 1, 1]])
+def test_bad_signs_are_refused_by_name(bad):
+    with pytest.raises(B.ConfigError, match=r"task\.input_sign\[[0-9]\]") as err:
+        C.build_config({"task.input_sign": bad}, plant="double_cart_pole")
+    assert err.value.status == B.ERR_BAD_TASK
+
+
+def test_signs_follow_the_configured_task():
+    """The derivation reads the configuration in force (here the gain, R = 1 / G^2): the double
+    pendulum's lower-link velocity gain changes sign between G = 10 N and G = 100 N."""
+    plant = "double_cart_pole"
+    assert tuple(C.build_config({"policy.gain": 100}, plant=plant).controller.task.input_sign) == (-1, -1, 1, -1, -1, -1)
+    assert tuple(C.build_config({"policy.gain": 10}, plant=plant).controller.task.input_sign) == (-1, -1, 1, 1, -1, -1)
