@@ -7,7 +7,7 @@
  *   config  mode byte c. c odd: sizeof(icoac_config_t) raw bytes laid over
  *           icoac_config_default (fewer when the input ends; the nested layout of icoac.h,
  *           padding included). c even: the default with (c >> 1) % 8 mutations, each a field
- *           byte (% 73; indices in struct order over every array element of the default maxima,
+ *           byte (% 79; indices in struct order over every array element of the default maxima,
  *           6 inputs and 6 rules: table in fuzz_input.c) and a value: random task descriptions
  *           (input counts, rule tables, late-signal sources) and critic grids.
  *   prior   byte p. p % 3: 0 NULL, 1 mean 0 and cov I (6 x 6), 2 that with (p / 3) % 8
@@ -70,7 +70,7 @@
  *   retune  status = icoac_config_check when that fails, else ICOAC_ERR_RETUNE_MODE when the
  *           mode differs from the one in force, else OK. On an error the state is bytewise
  *           unchanged. On OK icoac_get_config returns the new configuration (every field
- *           bitwise), 1 / policy.input_range and (search) the floors search.floor *
+ *           bitwise), task.input_sign / policy.input_range and (search) the floors search.floor *
  *           (prior variance * search.cov_scale) are re-derived, the shape tag's rule-layout
  *           bit says whether the new rule table is the cart-pole preset's (4 inputs, its 4 rules'
  *           inputs and sides), and every other byte of the state is unchanged: w, |w|, cov, v, w_act, the batch sums, the search's record and
@@ -302,6 +302,11 @@ static int task_documented(const icoac_task_config_t *t)
         (t->late_source != ICOAC_LATE_RULES && t->late_source != ICOAC_LATE_SENSOR)) {
         return 0;
     }
+    for (k = 0; k < t->n_inputs; ++k) {
+        if (t->input_sign[k] != 1 && t->input_sign[k] != -1) {
+            return 0;
+        }
+    }
     for (k = 0; t->late_source == ICOAC_LATE_RULES && k < t->n_rules; ++k) {
         if (t->rule_input[k] < 0 || t->rule_input[k] >= t->n_inputs || !is_flag(t->rule_side[k]) ||
             !isfinite(t->rule_threshold[k]) || !(fabs((double)t->rule_reflex[k]) <= 1.0)) {
@@ -394,6 +399,12 @@ static const named_field_t named_fields[] = {
     {"mode", ICOAC_ERR_BAD_MODE, -1},
     {"learn", ICOAC_ERR_BAD_MODE, -1},
     {"task.n_inputs", ICOAC_ERR_BAD_TASK, -1},
+    {"task.input_sign[0]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.input_sign[1]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.input_sign[2]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.input_sign[3]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.input_sign[4]", ICOAC_ERR_BAD_TASK, -1},
+    {"task.input_sign[5]", ICOAC_ERR_BAD_TASK, -1},
     {"task.late_source", ICOAC_ERR_BAD_TASK, -1},
     {"task.n_rules", ICOAC_ERR_BAD_TASK, -1},
     {"task.rule_input[0]", ICOAC_ERR_BAD_TASK, -1},
@@ -775,9 +786,10 @@ static int check_retune(const icoac_config_t *in_force, icoac_state_t *state, co
     FZ_CHECK(icoac_get_config(state, &got) == ICOAC_OK && fz_config_equal(&got, next),
              "op %d: icoac_get_config after icoac_retune is not the new configuration", op);
     for (i = 0; i < N; ++i) {
-        const icoac_real_t inv = i < next->task.n_inputs ? ICOAC_R(1.0) / next->policy.input_range[i] : ICOAC_R(0.0);
-        FZ_CHECK(memcmp(&st->inv_range[i], &inv, sizeof inv) == 0, "op %d: icoac_retune: inv_range[%d] = %g, 1/%g", op,
-                 i, (double)st->inv_range[i], (double)next->policy.input_range[i]);
+        const icoac_real_t sign = next->task.input_sign[i] < 0 ? ICOAC_R(-1.0) : ICOAC_R(1.0);
+        const icoac_real_t inv = i < next->task.n_inputs ? sign / next->policy.input_range[i] : ICOAC_R(0.0);
+        FZ_CHECK(memcmp(&st->inv_range[i], &inv, sizeof inv) == 0, "op %d: icoac_retune: inv_range[%d] = %g, %g/%g", op,
+                 i, (double)st->inv_range[i], (double)sign, (double)next->policy.input_range[i]);
         if (next->mode == ICOAC_MODE_SEARCH) {
             const icoac_real_t floor = next->search.floor * (st->search.prior_var[i] * next->search.cov_scale);
             FZ_CHECK(memcmp(&st->search.floor[i], &floor, sizeof floor) == 0,

@@ -142,15 +142,15 @@ int64_t fz_i64(fz_reader_t *r)
 /* Config fields by index, in struct order (the order icoac_config_check walks them), every
  * array element of the default maxima (6 inputs, 6 rules): the member's offset and whether it is
  * an int32 (switch or count) or a real. Indices: 0 mode, 1 learn, 2 task.n_inputs,
- * 3 task.late_source, 4 task.n_rules, 5-10 task.rule_input, 11-16 task.rule_side,
- * 17-22 task.rule_threshold, 23-28 task.rule_reflex, 29-34 policy.input_range,
- * 35 policy.clip_inputs, 36 policy.gain, 37 policy.reflex_mode, 38 policy.reflex_force,
- * 39 ico.rate, 40 ico.timing, 41 critic.rate, 42 critic.discount, 43 critic.td_clip,
- * 44-49 critic.range, 50-55 critic.units, 56 critic.threshold, 57 critic.quirks,
- * 58 actor.noise_std, 59 actor.scale, 60 actor.forgetting, 61 actor.reflex,
- * 62 actor.act_with_sample, 63 actor.update, 64 actor.rate, 65 actor.likelihood_std,
- * 66 actor.batch, 67 actor.explore_ticks, 68 search.batch, 69 search.elite_fraction,
- * 70 search.step, 71 search.floor, 72 search.cov_scale. */
+ * 3-8 task.input_sign, 9 task.late_source, 10 task.n_rules, 11-16 task.rule_input,
+ * 17-22 task.rule_side, 23-28 task.rule_threshold, 29-34 task.rule_reflex,
+ * 35-40 policy.input_range, 41 policy.clip_inputs, 42 policy.gain, 43 policy.reflex_mode,
+ * 44 policy.reflex_force, 45 ico.rate, 46 ico.timing, 47 critic.rate, 48 critic.discount,
+ * 49 critic.td_clip, 50-55 critic.range, 56-61 critic.units, 62 critic.threshold,
+ * 63 critic.quirks, 64 actor.noise_std, 65 actor.scale, 66 actor.forgetting, 67 actor.reflex,
+ * 68 actor.act_with_sample, 69 actor.update, 70 actor.rate, 71 actor.likelihood_std,
+ * 72 actor.batch, 73 actor.explore_ticks, 74 search.batch, 75 search.elite_fraction,
+ * 76 search.step, 77 search.floor, 78 search.cov_scale. */
 typedef struct {
     size_t offset;
     int is_int;
@@ -165,6 +165,12 @@ static const config_field_t config_fields[] = {
     FZ_INT(mode),
     FZ_INT(learn),
     FZ_INT(task.n_inputs),
+    FZ_INT(task.input_sign[0]),
+    FZ_INT(task.input_sign[1]),
+    FZ_INT(task.input_sign[2]),
+    FZ_INT(task.input_sign[3]),
+    FZ_INT(task.input_sign[4]),
+    FZ_INT(task.input_sign[5]),
     FZ_INT(task.late_source),
     FZ_INT(task.n_rules),
     FZ_INT(task.rule_input[0]),

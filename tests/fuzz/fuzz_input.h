@@ -21,7 +21,7 @@ typedef struct {
 #define FZ_VALUE_RAW 4      /* 36..39: raw bits of the value, little endian */
 #define FZ_VALUE_KINDS (FZ_VALUE_TABLE + FZ_VALUE_BOUNDED + FZ_VALUE_RAW)
 
-#define FZ_CONFIG_FIELDS 73 /* config mutation field indices 0..72, struct order: fuzz_input.c */
+#define FZ_CONFIG_FIELDS 79 /* config mutation field indices 0..78, struct order: fuzz_input.c */
 #define FZ_PRIOR_FIELDS 42  /* 0..5 mean, 6 + 6i + j cov[i][j] (ICOAC_MAX_INPUTS 6) */
 
 void fz_reader_init(fz_reader_t *r, const uint8_t *data, size_t size);

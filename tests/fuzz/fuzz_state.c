@@ -61,14 +61,14 @@
  *           header MAGIC, has_prev 0, trial_ticks 0, batch sums 0, the configuration copy
  *           passes icoac_config_check and is unchanged, the slots 0 or 1, the counters and the
  *           learned values (w, |w|, covariances, critic weights, search record) unchanged,
- *           1 / policy.input_range re-derived. From then on, until the state is patched again,
- *           every tick with a finite s returns OK or ICOAC_ERR_NUMERIC (TRIAL_ENDED after an
+ *           task.input_sign / policy.input_range re-derived. From then on, until the state is
+ *           patched again, every tick with a finite s returns OK or ICOAC_ERR_NUMERIC (TRIAL_ENDED after an
  *           OK terminal tick), and OK with a finite force.
  *   retune  icoac_config_check's status when it refuses the configuration, else
  *           ICOAC_ERR_RETUNE_MODE when its mode is not the copy's, else OK. An error leaves the
  *           state bytewise unchanged; OK sets the copy (icoac_get_config returns the new
- *           configuration), re-derives 1 / policy.input_range and (search) the floors, and
- *           leaves every other byte of the state as it was.
+ *           configuration), re-derives task.input_sign / policy.input_range and (search) the
+ *           floors, and leaves every other byte of the state as it was.
  *   getters OK on any state with a valid header word; the posterior is w and the covariance
  *           in force (cov_buffer[cov_slot & 1]), the counters and the configuration those of
  *           the state; the state bytewise unchanged.
@@ -497,10 +497,11 @@ static int32_t check_reset(run_t *run)
                  memcmp(st->search.lower, was->search.lower, sizeof st->search.lower) == 0,
              "op %d: icoac_reset OK changed a learned value or the counters", run->op);
     for (i = 0; i < N; ++i) {
+        const icoac_real_t sign = st->config.task.input_sign[i] < 0 ? ICOAC_R(-1.0) : ICOAC_R(1.0);
         const icoac_real_t inv =
-            i < st->config.task.n_inputs ? ICOAC_R(1.0) / st->config.policy.input_range[i] : ICOAC_R(0.0);
-        FZ_CHECK(memcmp(&st->inv_range[i], &inv, sizeof inv) == 0, "op %d: icoac_reset: inv_range[%d] = %g, 1/%g",
-                 run->op, i, (double)st->inv_range[i], (double)st->config.policy.input_range[i]);
+            i < st->config.task.n_inputs ? sign / st->config.policy.input_range[i] : ICOAC_R(0.0);
+        FZ_CHECK(memcmp(&st->inv_range[i], &inv, sizeof inv) == 0, "op %d: icoac_reset: inv_range[%d] = %g, %g/%g",
+                 run->op, i, (double)st->inv_range[i], (double)sign, (double)st->config.policy.input_range[i]);
     }
     run->validated = 1;
     return status;
@@ -537,9 +538,10 @@ static void check_retune(run_t *run, const icoac_config_t *next)
     FZ_CHECK(icoac_get_config(run->state, run->got) == ICOAC_OK && fz_config_equal(run->got, next),
              "op %d: icoac_get_config after icoac_retune is not the new configuration", run->op);
     for (i = 0; i < N; ++i) {
-        const icoac_real_t inv = i < next->task.n_inputs ? ICOAC_R(1.0) / next->policy.input_range[i] : ICOAC_R(0.0);
-        FZ_CHECK(same_real(st->inv_range[i], inv), "op %d: icoac_retune: inv_range[%d] = %g, 1/%g", run->op, i,
-                 (double)st->inv_range[i], (double)next->policy.input_range[i]);
+        const icoac_real_t sign = next->task.input_sign[i] < 0 ? ICOAC_R(-1.0) : ICOAC_R(1.0);
+        const icoac_real_t inv = i < next->task.n_inputs ? sign / next->policy.input_range[i] : ICOAC_R(0.0);
+        FZ_CHECK(same_real(st->inv_range[i], inv), "op %d: icoac_retune: inv_range[%d] = %g, %g/%g", run->op, i,
+                 (double)st->inv_range[i], (double)sign, (double)next->policy.input_range[i]);
         if (next->mode == ICOAC_MODE_SEARCH) {
             const icoac_real_t floor = next->search.floor * (was->search.prior_var[i] * next->search.cov_scale);
             FZ_CHECK(same_real(st->search.floor[i], floor), "op %d: icoac_retune: search floor[%d] = %g, expected %g",

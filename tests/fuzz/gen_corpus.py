@@ -36,7 +36,7 @@ MAX_INPUTS = 6
 CONFIG_LAYOUT = [
     ("mode", "i"),
     ("learn", "i"),
-    ("task", [("n_inputs", "i"), ("late_source", "i"), ("n_rules", "i"), ("rule_input", "i6"), ("rule_side", "i6"),
+    ("task", [("n_inputs", "i"), ("input_sign", "i6"), ("late_source", "i"), ("n_rules", "i"), ("rule_input", "i6"), ("rule_side", "i6"),
               ("rule_threshold", "r6"), ("rule_reflex", "r6")]),
     ("policy", [("input_range", "r6"), ("clip_inputs", "i"), ("gain", "r"), ("reflex_mode", "i"),
                 ("reflex_force", "r")]),
@@ -49,7 +49,7 @@ CONFIG_LAYOUT = [
     ("search", [("batch", "i"), ("elite_fraction", "r"), ("step", "r"), ("floor", "r"), ("cov_scale", "r")]),
 ]
 # sizeof(icoac_config_t) with float and with double reals (x86-64 and AArch64 alignment).
-CONFIG_SIZES = {"f": 292, "d": 480}
+CONFIG_SIZES = {"f": 316, "d": 504}
 
 
 def config_fields():
@@ -72,7 +72,7 @@ def config_fields():
 # The mutation field indices of fuzz_input.c: struct order.
 CONFIG_FIELDS = [name for name, _ in config_fields()]
 CONFIG_INTS = {name for name, is_int in config_fields() if is_int}
-assert len(CONFIG_FIELDS) == 73
+assert len(CONFIG_FIELDS) == 79
 ZONE_THETA, ZONE_X = 0.20071286397934788, 2.35
 
 
@@ -82,7 +82,7 @@ def array(name, values):
 
 
 CONFIG_DEFAULT = {"mode": 0, "learn": 1,
-                  "task.n_inputs": 4, "task.late_source": 0, "task.n_rules": 4,
+                  "task.n_inputs": 4, **array("task.input_sign", [1] * 6), "task.late_source": 0, "task.n_rules": 4,
                   **array("task.rule_input", [2, 0, 2, 0]), **array("task.rule_side", [1, 0, 0, 1]),
                   **array("task.rule_threshold", [ZONE_THETA, -ZONE_X, -ZONE_THETA, ZONE_X]),
                   **array("task.rule_reflex", [1.0, 1.0, -1.0, -1.0]),
@@ -435,6 +435,10 @@ def controller_seeds(fmt):
                                        + steps((-0.2,), 4))
         s[f"task-sensor-{name}"] = (config({"mode": mode, "task.late_source": 1, "search.batch": 2}) + NO_PRIOR
                                     + seed(66 + mode) + sensor_ops)
+        # the double pendulum's derived input signs (harness.signs): mixed, on six inputs
+        s[f"task-six-signs-{name}"] = (config_raw(fmt, {**six, **array("task.input_sign", [-1, -1, 1, 1, -1, -1]),
+                                                        "mode": mode, "search.batch": 2}) + NO_PRIOR
+                                       + seed(90 + mode) + six_exercise * 2)
     rules = random.Random(20261202)
     for k in range(6):
         n_rules = rules.randrange(7)
@@ -447,6 +451,7 @@ def controller_seeds(fmt):
                                        + seed(70 + k) + EXERCISE + EXERCISE)
     s.update({
         "task-bad-rule-input": config({"task.rule_input[2]": 4}) + NO_PRIOR + seed(80) + EXERCISE,
+        "task-bad-input-sign": config({"task.input_sign[1]": 0}) + NO_PRIOR + seed(84) + EXERCISE,
         "task-bad-units": config({"mode": 1, "critic.units[0]": 16, "critic.units[1]": 16}) + NO_PRIOR + seed(81),
         "task-retune-inputs-and-grid": (config({"mode": 1}) + NO_PRIOR + seed(82) + EXERCISE
                                         + retune({"task.n_inputs": 3}) + retune({"critic.units[2]": 5})
