@@ -25,6 +25,7 @@ from . import _binding as B
 from . import geometry, literals, options
 from .plants import CART_POLE, spec as plant_spec
 from .registry import CONDITIONS, REGISTRY
+from .signs import derive_input_signs
 from ._binding import ConfigError
 from .errors import UsageError
 
@@ -715,8 +716,6 @@ SIGN_FIELD = "task.input_sign"
 def _derive_signs(cfg: RunConfig) -> None:
     """task.input_sign of cfg from its plant's LQR gain (harness.signs), when the rest of cfg is
     valid (an invalid one is refused by its check, naming the field)."""
-    from .signs import derive_input_signs  # here: harness.signs imports this module through the ceiling
-
     try:
         cfg.check()
     except ConfigError:

@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
-"""ICO's input signs from the plant (docs/method.md, "Input signs", a step beyond the paper).
+"""ICO's input signs from the plant's linearisation (docs/method.md, L8, a step beyond the paper),
+and that linearisation and its LQR gain (which the ceiling's LQR starts use too).
 
 ICO's weights only grow, so the force G * sum_i w_i * sign_i * x~_i it learns pushes on each input
 with the sign task.input_sign gives it. The sign a plant needs is that of its stabilising linear
@@ -15,7 +16,39 @@ import warnings
 
 import numpy as np
 
-from .ceiling.lqr import lqr_gain, linearise
+from . import _binding as B
+
+
+def linearise(cfg, h: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """(A, B) of one plant step at the upright state with zero input, by central differences of
+    the C plant step (icoac_sim_model_step): s' ~ A s + B u."""
+    model = cfg.engine_model()
+    n = cfg.n_inputs  # the task observes the whole state
+
+    def step(s, force):
+        full = np.zeros(B.MAX_STATE)
+        full[:n] = s
+        B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(model), full, float(force)), "plant step")
+        return full[:n]
+
+    eye = np.eye(n)
+    a = np.column_stack([(step(h * eye[j], 0.0) - step(-h * eye[j], 0.0)) / (2 * h) for j in range(n)])
+    b = ((step(np.zeros(n), h) - step(np.zeros(n), -h)) / (2 * h)).reshape(n, 1)
+    return a, b
+
+
+def lqr_gain(a: np.ndarray, b: np.ndarray, q: np.ndarray, r: float) -> np.ndarray | None:
+    """K of the discrete LQR with one input (u = -K s) from the stabilising solution of the discrete
+    algebraic Riccati equation; None if there is none."""
+    import scipy.linalg  # here: only the LQR needs it, and it takes a second to import
+
+    rr = np.array([[float(r)]])
+    try:
+        p = scipy.linalg.solve_discrete_are(a, b, q, rr)
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    k = np.linalg.solve(rr + b.T @ p @ b, b.T @ p @ a).ravel()
+    return k if np.all(np.isfinite(k)) else None
 
 
 def lqr_signs(a: np.ndarray, b: np.ndarray, ranges: np.ndarray, gain: float) -> tuple[int, ...] | None:

@@ -36,11 +36,12 @@ def test_alias_table_covers_the_abi3_names():
     assert set(old) - {"mode"} == set(ALIASES) | set(config.ZONE_ALIASES) == set(VALUES)
     # every ABI-3 field has its alias (the zone's set the cart-pole task's rule thresholds);
     # "learn" (the no-learning control), the learners' fields of ABI 6 (method.md, L2-L4, A10) and
-    # the task description of ABI 8 came after ABI 3 and have canonical names only
+    # the task description of ABI 8 and its input signs (ABI 9) came after ABI 3 and have canonical names only
     after_abi3 = {"mode", "learn", "critic.quirks", "actor.update", "actor.rate", "actor.likelihood_std",
                   "actor.batch", "actor.explore_ticks", "search.batch", "search.elite_fraction", "search.step",
                   "search.floor", "search.cov_scale", "task.n_inputs", "task.late_source", "task.n_rules",
-                  "task.rule_input", "task.rule_side", "task.rule_threshold", "task.rule_reflex", "critic.units"}
+                  "task.rule_input", "task.rule_side", "task.rule_threshold", "task.rule_reflex", "critic.units",
+                  "task.input_sign"}
     assert set(ALIASES.values()) & after_abi3 == set()
     assert sorted(ALIASES.values()) == sorted(n for n in config.CONTROLLER_FIELDS if n not in after_abi3)
     for alias, name in ALIASES.items():
