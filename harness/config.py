@@ -70,6 +70,10 @@ ZONE_RULES: dict[str, tuple[tuple[int, float], ...]] = {"policy.zone_theta": ((0
                                                         "policy.zone_x": ((1, -1.0), (3, 1.0))}
 ZONE_ALIASES = {"zone_theta": "policy.zone_theta", "zone_x": "policy.zone_x"}
 
+# ICO's input signs: derived from the plant (harness.signs) unless a layer gives them; one number
+# sets every input's.
+SIGN_FIELD = "task.input_sign"
+
 # Symbolic values of the switches (values from the C constant table) and the 0/1 flags.
 ENUMS: dict[str, dict[str, int]] = {
     "mode": B.MODES,
@@ -709,16 +713,13 @@ def build_config(overrides: Mapping[str, Any] | None = None, condition: str | No
     return cfg
 
 
-# The field harness.signs derives.
-SIGN_FIELD = "task.input_sign"
-
 
 def _derive_signs(cfg: RunConfig) -> None:
     """task.input_sign of cfg from its plant's LQR gain (harness.signs), when the rest of cfg is
     valid (an invalid one is refused by its check, naming the field)."""
     try:
         cfg.check()
-    except ConfigError:
+    except B.IcoacError:
         return
     signs = derive_input_signs(cfg)
     for i, sign in enumerate(signs or ()):

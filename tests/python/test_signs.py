@@ -17,15 +17,18 @@ def _bytes(struct) -> bytes:
     return ctypes.string_at(ctypes.addressof(struct), ctypes.sizeof(struct))
 
 
-@pytest.mark.parametrize("condition", [None, "ico", "ico-rl", "rl", "search"])
-def test_cart_pole_derived_signs_are_todays(condition):
-    """The cart-pole's derived signs are +1 on every input, so its configuration is byte for byte
-    the one without the derivation (and its results the paper's, test_reference_cells.py)."""
-    derived = C.build_config(condition=condition)
-    plain = C.build_config(condition=condition, derive_signs=False)
+@pytest.mark.parametrize("plant", ["cart_pole", "furuta"])
+@pytest.mark.parametrize("condition", [None, "ico", "ico-rl", "ico-rl-control", "rl", "search"])
+def test_derived_signs_keep_todays_configuration(plant, condition):
+    """The cart-pole's and the Furuta's derived signs are +1 on every input, so their configuration
+    is byte for byte the one without the derivation, and their results are today's (the
+    cart-pole's: test_reference_cells.py)."""
+    derived = C.build_config(condition=condition, plant=plant)
+    plain = C.build_config(condition=condition, plant=plant, derive_signs=False)
     assert signs.derive_input_signs(derived) == (1, 1, 1, 1)
     assert list(plain.controller.task.input_sign) == [1] * B.MAX_INPUTS
     assert _bytes(derived.controller) == _bytes(plain.controller)
+    assert derived.to_dict() == plain.to_dict()
 
 
 def test_shipped_plants_derived_signs():
