@@ -194,23 +194,39 @@ typedef struct {
 static const char *const input_range_names[16] = NAMES16("policy.input_range");
 static const char *const critic_range_names[16] = NAMES16("critic.range");
 static const char *const critic_units_names[16] = NAMES16("critic.units");
-static const char *const input_sign_names[16] = NAMES16("task.input_sign");
 static const char *const rule_input_names[16] = NAMES16("task.rule_input");
 static const char *const rule_side_names[16] = NAMES16("task.rule_side");
 static const char *const rule_threshold_names[16] = NAMES16("task.rule_threshold");
 static const char *const rule_reflex_names[16] = NAMES16("task.rule_reflex");
 
+/* task.n_inputs, then the input signs, +1 or -1 each; one exit. */
+static int inputs_ok(const icoac_task_config_t *t, bad_field_t *bad)
+{
+    static const char *const sign_names[16] = NAMES16("task.input_sign");
+    const char *field = NULL;
+    int k;
+    if ((t->n_inputs < 1) || (t->n_inputs > ICOAC_MAX_INPUTS)) {
+        field = "task.n_inputs";
+    } else {
+        for (k = t->n_inputs - 1; k >= 0; --k) {
+            if ((t->input_sign[k] != 1) && (t->input_sign[k] != -1)) {
+                field = sign_names[k]; /* the loop runs down: the first bad sign is the last found */
+            }
+        }
+    }
+    if (field != NULL) {
+        bad->field = field;
+        bad->status = ICOAC_ERR_BAD_TASK;
+    }
+    return (field == NULL) ? 1 : 0;
+}
+
 /* The task group; n_inputs first, as the other groups' arrays are checked up to it. */
 static int task_ok(const icoac_task_config_t *t, bad_field_t *bad)
 {
     int k;
-    if (t->n_inputs < 1 || t->n_inputs > ICOAC_MAX_INPUTS) {
-        ICOAC_PRIV_FAIL("task.n_inputs", ICOAC_ERR_BAD_TASK);
-    }
-    for (k = 0; k < t->n_inputs; ++k) {
-        if (t->input_sign[k] != 1 && t->input_sign[k] != -1) {
-            ICOAC_PRIV_FAIL(input_sign_names[k], ICOAC_ERR_BAD_TASK);
-        }
+    if (inputs_ok(t, bad) == 0) {
+        return 0;
     }
     if (t->late_source != ICOAC_LATE_RULES && t->late_source != ICOAC_LATE_SENSOR) {
         ICOAC_PRIV_FAIL("task.late_source", ICOAC_ERR_BAD_TASK);

@@ -39,7 +39,7 @@ static void derive(icoac_priv_state_t *st)
     const int n = icoac_priv_inputs(&st->config);
     int i;
     for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
-        const icoac_real_t sign = st->config.task.input_sign[i] < 0 ? ICOAC_R(-1.0) : ICOAC_R(1.0);
+        const icoac_real_t sign = (st->config.task.input_sign[i] < 0) ? ICOAC_R(-1.0) : ICOAC_R(1.0);
         st->inv_range[i] = i < n ? sign / st->config.policy.input_range[i] : ICOAC_R(0.0);
     }
     icoac_priv_critic_grid(&st->config, &st->grid);
