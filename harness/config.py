@@ -211,8 +211,8 @@ _INT_LIMITS = {ctypes.c_int32: (-2 ** 31, 2 ** 31 - 1), ctypes.c_int64: (-2 ** 6
 
 
 def _probe_statuses() -> dict[str, int]:
-    """Status the C checks give when each field alone is invalid (NaN, or 0 for integers, -1 for
-    those that take 0: flags and counts), so that a value rejected on the Python side carries the
+    """Status the C checks give when each field alone is invalid (NaN, or -1 for integers, 0 for
+    those that take -1: the input signs), so that a value rejected on the Python side carries the
     status C would give for that field. A controller field is probed in each mode until one
     validates its group."""
     out: dict[str, int] = {}
@@ -711,7 +711,6 @@ def build_config(overrides: Mapping[str, Any] | None = None, condition: str | No
     if check:
         cfg.check()
     return cfg
-
 
 
 def _derive_signs(cfg: RunConfig) -> None:
