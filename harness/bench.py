@@ -380,7 +380,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
             d = seed_dir(out, condition, seed)
             cells, record, cancelled = run_condition(
                 condition=condition, out=d, seed=seed, threads=opt.threads, overrides=overrides(condition),
-                cell_spec=cells_spec, resume=opt.resume and results.exists(d), fresh=not opt.resume,
+                cell_spec=cells_spec, resume=opt.resume and bool(results.present(d)), fresh=not opt.resume,
                 progress=not opt.quiet, info=ctx.get(("prior", condition, seed)),
                 start_over="rerun bench without --resume", dask=ctx.get("dask"), plant=opt.plant)
             ctx[(condition, seed)] = (cells, record)

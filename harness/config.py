@@ -97,13 +97,6 @@ NAMED_CONFIGURATIONS: dict[str, tuple[str, ...]] = {
 assert tuple(NAMED_CONFIGURATIONS) == options.CONFIGURATION_NAMES
 
 
-# Controller fields added with the learners (ABI 6). A record without any of them was written
-# by an earlier version, whose controller behaved as the literal configuration: loading it
-# fills them from "literal", not from today's defaults.
-LEARNER_FIELDS = ("critic.quirks", "actor.update", "actor.rate", "actor.likelihood_std", "actor.batch",
-                  "actor.explore_ticks")
-
-
 def named_sets(name: str, sets: Iterable[str] | None = None) -> list[str]:
     """The --set items of a named configuration, then ``sets``."""
     if name not in NAMED_CONFIGURATIONS:
@@ -712,9 +705,9 @@ def _controller_items(values: Mapping[str, Any], prefix: str = ""):
 
 
 def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
-    """Inverse of RunConfig.to_dict; also reads the flat controller dict of ABI-3 records (names
-    mapped through ALIASES). Groups may be partial (missing fields keep the C default); a field in
-    the wrong group, an unknown group or a malformed value raises ConfigError."""
+    """Inverse of RunConfig.to_dict. Groups may be partial (missing fields keep the C default: a
+    run record is checked complete against harness.schema first); a field in the wrong group, an
+    unknown group or a malformed value raises ConfigError."""
     if not isinstance(data, Mapping):
         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"configuration must be a mapping, got {_short(data)}")
     unknown = [k for k in data if k not in GROUPS + ("prior",)]
@@ -748,10 +741,5 @@ def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
                 raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
                                   f"{_short(name)} is a {group_of(name)} parameter, not a {group} one")
             overrides.append((name, value))
-    names = {name for name, _ in overrides}
-    if "controller" in data and not names & set(LEARNER_FIELDS):
-        # a record from before the learners (ABI <= 5): its controller ran the literal reading
-        literal = parse_sets(NAMED_CONFIGURATIONS["literal"])
-        overrides = [(n, v) for n, v in literal.items() if n in LEARNER_FIELDS] + overrides
     cfg = build_config(dict(overrides), prior=prior_from_dict(data.get("prior")), check=False, plant=plant)
     return cfg.check() if check else cfg

@@ -183,14 +183,14 @@ def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_
 
 def from_results(path: str | Path, frame: tuple[float, float] | str | None = DEFAULT_FRAME,
                  ridge: float = DEFAULT_RIDGE, plant: str | None = None) -> PriorInfo:
-    """ICO->RL prior from an ICO results directory, with its provenance (its plant, condition and
-    learning flag) and ICO-phase simulated time. ``plant``: the plant the prior is for, which must
+    """ICO->RL prior from an ICO results directory, with its provenance (its plant, condition, task
+    description and learning flag: schema.PRIOR_ORIGIN) and ICO-phase simulated time. ``plant``: the plant the prior is for, which must
     be the ICO run's (None: whatever the run's is)."""
     path = Path(path)
     cells, record = results.load(path, what="--prior-from")
     if record.get("condition") != "ico":
         raise PriorError(f"--prior-from: {str(path)!r} holds condition {record.get('condition')!r}, not ico")
-    if record["config"].get("controller", {}).get("learn") == 0:
+    if not record["config"]["controller"]["learn"]:
         raise PriorError(f"--prior-from: {str(path)!r} is a run that did not learn (learn = 0), not an ICO prior")
     if not record.get("complete", False):
         raise PriorError(f"--prior-from: {str(path)!r} is incomplete (PENDING cells); finish it with --resume")
@@ -204,6 +204,7 @@ def from_results(path: str | Path, frame: tuple[float, float] | str | None = DEF
     info.source_seed = record.get("seed")
     info.ico_phase_simulated_time = float(np.sum(cells["elapsed_time"]))
     info.extra = {**info.extra, "source_plant": plant, "source_condition": "ico", "source_learn": 1,
+                  "source_task": record["config"]["controller"]["task"],
                   "source_cells": int(cells.size),
                   "source_success_rate": record.get("summary", {}).get("success_rate")}
     return info
