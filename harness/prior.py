@@ -176,9 +176,10 @@ def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_
         extra["prior_std"] = float(std)
     if not from_ico:
         return PriorInfo(mean=mean, cov=cov, frame=None, n_cells=0, ridge=0.0, kind=condition, extra=extra)
+    origin = {key: value for key, value in ico.extra.items() if key.startswith("source_")}
     return PriorInfo(mean=mean, cov=cov, frame=ico.frame, n_cells=ico.n_cells, ridge=ico.ridge, kind=condition,
                      source=ico.source, source_commit=ico.source_commit, source_seed=ico.source_seed,
-                     ico_phase_simulated_time=ico.ico_phase_simulated_time, extra=extra)
+                     ico_phase_simulated_time=ico.ico_phase_simulated_time, extra={**origin, **extra})
 
 
 def from_results(path: str | Path, frame: tuple[float, float] | str | None = DEFAULT_FRAME,

@@ -37,12 +37,12 @@ def run(*args, timeout=60):
     (["grid", "--condition", "rl", "--out", "{tmp}/a", "--prior-std", "1.35e154"], "--prior-std must be"),
     (["grid", "--condition", "rl", "--out", "{tmp}/a", "--prior-std", "2e6"], "--prior-std must be"),
     (["bench", "--profile", "quick", "--out", "{tmp}/b", "--prior-std", "1e20"], "--prior-std must be"),
-    (["sweep", "--prior-from", "tests/python/fixtures/abi3_ico", "--out", "{tmp}/s", "--param", "prior_std=1e200"],
+    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/s", "--param", "prior_std=1e200"],
      "--param prior_std must be"),
     ([], "required"),
 ])
-def test_user_errors_one_line_exit_2(tmp_path, args, words):
-    res = run(*[a.format(tmp=tmp_path) for a in args])
+def test_user_errors_one_line_exit_2(tmp_path, ico_dir, args, words):
+    res = run(*[a.format(tmp=tmp_path, ico=ico_dir) for a in args])
     assert res.returncode == 2, res.stderr
     assert "Traceback" not in res.stderr and "Traceback" not in res.stdout
     lines = res.stderr.strip().splitlines()
