@@ -473,9 +473,11 @@ def stages(opt: BenchOptions) -> list[Stage]:
 def run_bench(opt: BenchOptions, argv: Sequence[str] = ()) -> int:
     """Validate, then run every stage, logging wall times to OUT/bench.json; 130 if interrupted.
     With ``opt.dask`` one Dask session (harness.cluster) serves every grid."""
-    from .cluster import open_backend
-
     todo = stages(opt)  # validates the arguments before anything is written
+    if opt.dask is None:  # the local engine: Dask is not imported
+        with store.DirectoryLock(opt.out):
+            return _run_stages(opt, todo, {"dask": None}, argv)
+    from .cluster import open_backend
     with store.DirectoryLock(opt.out), open_backend(opt.dask) as session:
         return _run_stages(opt, todo, {"dask": session}, argv)
 

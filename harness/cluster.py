@@ -145,7 +145,7 @@ class DaskSession:
                 raise WorkerError(f"cannot start a local Dask cluster of {spec.workers} workers: "
                                   f"{type(exc).__name__}: {exc}") from None
             try:
-                self.client.register_plugin(_worker.IgnoreSigint(), name="icoac-ignore-sigint")
+                self.client.register_plugin(_worker.ignore_sigint_plugin(), name="icoac-ignore-sigint")
             except Exception:  # pragma: no cover - only a nicer Ctrl-C
                 pass
         else:

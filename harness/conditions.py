@@ -80,7 +80,8 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     if resume and fresh:
         raise UsageError("--resume and --overwrite exclude each other")
     if resume and not (out.is_dir() and results.present(out)):
-        raise UsageError(f"--resume: no results to resume in {str(out)!r}")
+        raise UsageError(f"--resume: no results to resume in {str(out)!r} (none written yet: run the command "
+                         "without --resume)")
     try:
         indices = grid.parse_cell_indices(cell_spec)
     except B.ConfigError as exc:
@@ -91,7 +92,8 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     with store.ResultsStore(out, start_over=start_over) as st:
         have = st.present()
         if resume and not have:
-            raise UsageError(f"--resume: no results to resume in {str(out)!r}")
+            raise UsageError(f"--resume: no results to resume in {str(out)!r} (none written yet: run the command "
+                         "without --resume)")
         if have == [results.CELLS_FILE] and not fresh:  # never left by a run (store.ResultsStore)
             raise UsageError(f"{str(out)!r} holds {results.CELLS_FILE} but no {results.RUN_FILE}, which no run "
                              f"leaves behind: refusing to {'resume' if resume else 'replace'} it; {start_over} "
