@@ -360,6 +360,8 @@ def stages(opt: BenchOptions) -> list[Stage]:
     anything runs or is written."""
     profile = PROFILES[opt.profile]
     P.check_prior_std(opt.prior_std)
+    P.check_prior_ridge(opt.ridge)
+    grid.check_threads(opt.threads)
     out = Path(opt.out)
     figdir = Path(opt.figures) if opt.figures else None
     seeds = opt.seed_list()

@@ -103,8 +103,7 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | str | None = DEFAULT
     the grid's central frame) that ICO balanced ("successful", the paper's) or that it finished
     ("finished": balanced or failed, its weights learned either way; harness.plants says which
     plant takes it), mean and sample cov + ridge*I."""
-    if not (math.isfinite(ridge) and ridge >= 0):
-        raise PriorError(f"prior ridge must be finite and >= 0, got {ridge}")
+    check_prior_ridge(ridge)
     if use not in PRIOR_CELLS:
         raise PriorError(f"prior cells must be one of {', '.join(PRIOR_CELLS)}, got {use!r:.40}")
     if frame == CENTRAL:
@@ -141,6 +140,15 @@ assert tuple(_MEANS) == MEAN_RULES and tuple(_COVS) == COV_RULES
 # sigma_w of an isotropic prior: sigma_w^2 must be a covariance the controller takes (at most
 # ICOAC_PRIOR_COV_MAX, and a normal float).
 PRIOR_STD_RANGE = (1e-18, math.sqrt(B.constant("ICOAC_PRIOR_COV_MAX")))
+
+
+def check_prior_ridge(ridge: Any, what: str = "--prior-ridge") -> float:
+    """The ridge added to an ICO prior's covariance: in [0, ICOAC_PRIOR_COV_MAX] (a covariance the
+    controller takes); PriorError otherwise."""
+    hi = B.constant("ICOAC_PRIOR_COV_MAX")
+    if isinstance(ridge, bool) or not isinstance(ridge, (int, float)) or not 0 <= ridge <= hi:
+        raise PriorError(f"{what} must be a number in [0, {hi:g}], got {ridge!r:.40}")
+    return float(ridge)
 
 
 def check_prior_std(std: Any, what: str = "--prior-std") -> float:
