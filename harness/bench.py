@@ -20,7 +20,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from . import figures, geometry, grid, metrics, results, store, tables
+from . import geometry, grid, metrics, results, store, tables
 from . import prior as P
 from .ceiling.records import bench_ceiling, load_ceiling, reference_lines
 from .ceiling.weights import format_w
@@ -249,6 +249,8 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
                        grid: geometry.PlantGrid = geometry.CART_POLE) -> list[Path]:
     """Fig. 2b (first ICO->RL seed, ICO success domain outlined), Fig. 3a (with the linear-policy
     ceiling's reference lines when a ceiling record is given), Fig. 3b."""
+    from . import figures
+
     figdir = Path(figdir)
     written = []
     if icorl_cells is not None:
@@ -364,6 +366,8 @@ def stages(opt: BenchOptions) -> list[Stage]:
     grid.check_threads(opt.threads)
     out = Path(opt.out)
     figdir = Path(opt.figures) if opt.figures else None
+    if figdir is not None:
+        from . import figures  # noqa: F401  (MissingExtra before any stage without matplotlib)
     seeds = opt.seed_list()
     ico_sets = command_overrides(opt.configuration, opt.sets, plant=opt.plant)
     rl_sets = command_overrides(opt.configuration, opt.sets, {"--rl-max-trials": ("max_trials", opt.rl_max_trials)},
@@ -420,6 +424,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
     def figures_stage(ctx):
         if figdir is None:
             return
+        from . import figures
         cells, record = ctx[("ico", seeds[0])]
         for path in figures.make_figures(cells, record, figdir):
             progress(f"  wrote {path}")

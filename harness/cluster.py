@@ -37,7 +37,7 @@ import numpy as np
 from . import _binding as B
 from . import _worker, grid
 from .config import RunConfig
-from .errors import UsageError, WorkerError
+from .errors import MissingExtra, UsageError, WorkerError
 from .options import (AUTO_CHUNK_MAX, AUTO_CHUNKS_PER_THREAD, DASK_CANCEL_GRACE, DASK_CONNECT_TIMEOUT, DASK_RETRIES,
                       DASK_WORKER_TIMEOUT, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, MAX_CHUNK_CELLS,
                       MAX_THREADS, MAX_WORKERS)
@@ -73,6 +73,7 @@ class DaskSpec:
         if self.chunk_cells is not None and (not _is_int(self.chunk_cells)
                                              or not 1 <= self.chunk_cells <= MAX_CHUNK_CELLS):
             raise UsageError(f"--chunk-cells expects an integer in [1, {MAX_CHUNK_CELLS}], got {self.chunk_cells!r:.40}")
+        _import_distributed()  # installed, before any work
         return self
 
 
@@ -90,8 +91,8 @@ def chunks_of(pending: np.ndarray, size: int) -> list[np.ndarray]:
 def _import_distributed():
     try:
         import distributed
-    except ImportError as exc:  # pragma: no cover - distributed is a dependency of the harness
-        raise UsageError(f"the Dask backend needs dask.distributed ({exc}); `pip install distributed`") from None
+    except ImportError as exc:
+        raise MissingExtra("the Dask backend (--workers, --scheduler)", "dask", exc) from None
     return distributed
 
 

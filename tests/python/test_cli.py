@@ -114,3 +114,26 @@ def test_missing_library_is_one_line(tmp_path):
 def test_help_exits_zero():
     res = run("grid", "--help")
     assert res.returncode == 0 and "--set" in res.stdout and "--resume" in res.stdout
+
+
+@pytest.mark.parametrize("missing, args, words", [
+    ("matplotlib", ["figures", "--results", "{ico}", "--out", "{tmp}/f"],
+     "drawing figures needs the 'plot' extra (matplotlib): pip install 'icoac-harness[plot]'"),
+    ("matplotlib", ["bench", "--profile", "quick", "--out", "{tmp}/b", "--figures", "{tmp}/bf"], "'plot' extra"),
+    ("distributed", ["grid", "--out", "{tmp}/g", "--cells", "611", "--workers", "1"],
+     "the Dask backend (--workers, --scheduler) needs the 'dask' extra (distributed): pip install"),
+])
+def test_a_missing_extra_is_one_line_before_any_work(tmp_path, ico_dir, missing, args, words):
+    """Plotting and Dask are extras: without them, the commands that need them say which, in one
+    line (exit 2), and write nothing; every other command runs without them."""
+    code = (f"import sys; sys.modules[{missing!r}] = None\n"
+            "from harness.cli import main\nraise SystemExit(main(sys.argv[1:]))")
+    argv = [a.format(tmp=tmp_path, ico=ico_dir) for a in args]
+    res = subprocess.run([sys.executable, "-c", code, *argv], cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and words in lines[0], lines
+    assert not any(p.name in ("f", "b", "bf", "g") for p in tmp_path.iterdir())
+    grid = subprocess.run([sys.executable, "-c", code, "grid", "--out", str(tmp_path / "ok"), "--cells", "611",
+                           "--max-trials", "5", "--quiet"], cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert grid.returncode == 0, grid.stderr
