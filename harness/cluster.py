@@ -371,8 +371,7 @@ class _Run:
     def execute(self, checkpoint, checkpoint_every, checkpoint_cells, cancel_after, cancel_event,
                 t_start) -> grid.GridRun:
         self.client.subscribe_topic(_worker.PROGRESS_TOPIC, self._on_event)
-        saved = 0                      # merged cells at the last checkpoint
-        last_checkpoint = time.monotonic()
+        checkpoints = grid.Checkpoints(checkpoint, checkpoint_every, checkpoint_cells)
         last_worker_seen = time.monotonic()
         last_worker_check = time.monotonic()
         cancelled = user_cancelled = False
@@ -386,12 +385,8 @@ class _Run:
                             (cancel_after is not None and now - t_start >= cancel_after):
                         cancelled = True
                         break
-                    new = int(self.merged[0]) - saved
-                    if checkpoint is not None and new > 0 and self.futures \
-                            and (new >= checkpoint_cells or now - last_checkpoint >= checkpoint_every):
-                        checkpoint(self.cells.copy())
-                        saved = int(self.merged[0])
-                        last_checkpoint = time.monotonic()
+                    if self.futures:
+                        checkpoints.poll(int(self.merged[0]), self.cells.copy)
                     if now - last_worker_check >= 5.0:
                         last_worker_check = now
                         if self.session.nthreads() > 0:
@@ -409,9 +404,9 @@ class _Run:
                 self._stop(DASK_CANCEL_GRACE)
         except BaseException:
             self._stop(0.0)
-            if checkpoint is not None and int(self.merged[0]) > saved:
+            if checkpoints.unsaved(int(self.merged[0])):
                 try:  # an error in one chunk does not lose the merged ones
-                    checkpoint(self.cells.copy())
+                    checkpoints.flush(int(self.merged[0]), self.cells.copy)
                 except Exception:
                     pass
             raise
