@@ -50,6 +50,7 @@ def run_killed_at(k: int, argv: list[str], log: Path, refused: str | None = None
             fd = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
             os.dup2(fd, 1)
             os.dup2(fd, 2)
+            sys.stdout = sys.stderr = os.fdopen(fd, "w", buffering=1)  # past pytest's capture
             count = [0]
             real_write, real_remove = store.write_bytes, store.remove
 
@@ -70,6 +71,7 @@ def run_killed_at(k: int, argv: list[str], log: Path, refused: str | None = None
             store.write_bytes, store.remove = write_bytes, remove
             status = cli.main(argv)
         finally:
+            sys.stderr.flush()
             os._exit(status)
     _, status = os.waitpid(pid, 0)
     if os.WIFSIGNALED(status):
