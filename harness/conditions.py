@@ -45,6 +45,11 @@ def condition_prior(condition: str, prior_from, frame, ridge: float, std: float 
                              geometry.of(plant).n_inputs)
 
 
+def nothing_to_resume(out: Path) -> UsageError:
+    return UsageError(f"--resume: no results to resume in {str(out)!r} (none written yet: run the command "
+                      "without --resume)")
+
+
 def prior_extra(info: P.PriorInfo | None) -> dict | None:
     """What run.json records of a prior (None: nothing)."""
     return {"prior_info": info.to_dict()} if info is not None else None
@@ -80,8 +85,7 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     if resume and fresh:
         raise UsageError("--resume and --overwrite exclude each other")
     if resume and not (out.is_dir() and results.present(out)):
-        raise UsageError(f"--resume: no results to resume in {str(out)!r} (none written yet: run the command "
-                         "without --resume)")
+        raise nothing_to_resume(out)
     try:
         indices = grid.parse_cell_indices(cell_spec)
     except B.ConfigError as exc:
@@ -92,8 +96,7 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     with store.ResultsStore(out, start_over=start_over) as st:
         have = st.present()
         if resume and not have:
-            raise UsageError(f"--resume: no results to resume in {str(out)!r} (none written yet: run the command "
-                         "without --resume)")
+            raise nothing_to_resume(out)
         if have == [results.CELLS_FILE] and not fresh:  # never left by a run (store.ResultsStore)
             raise UsageError(f"{str(out)!r} holds {results.CELLS_FILE} but no {results.RUN_FILE}, which no run "
                              f"leaves behind: refusing to {'resume' if resume else 'replace'} it; {start_over} "
