@@ -6,13 +6,14 @@
  *
  * ICOAC_PARAM(group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc):
  * - group, field: the member cfg->group.field (group `config`: cfg->field);
- * - type: icoac_real_t or int32_t; dim: scalar, inputs (ICOAC_MAX_INPUTS entries, the first
+ * - type: icoac_real_t or int32_t (the run's rows: int64_t, double); dim: scalar, inputs (ICOAC_MAX_INPUTS entries, the first
  *   task.n_inputs checked and used) or rules (ICOAC_MAX_RULES, the first task.n_rules);
  * - check, with min and max (C constants of the field's type):
  *   real: min <= v <= max, v zero or normal; real_open_lo: min < v <= max; real_open_hi:
  *   min <= v < max; real_or_zero: v == 0 or min <= v <= max; int, flag (0/1), choice (an enum
- *   of values min..max): min <= v <= max; index: min <= v < task.n_inputs; units: int, and the
- *   units' product fits the critic (ICOAC_MAX_CRITIC_UNITS, blocks of ICOAC_CRITIC_BLOCK_MAX);
+ *   of values min..max): min <= v <= max; at_least: min <= v (max: the type's); index:
+ *   min <= v < task.n_inputs; units: int, and the units' product fits the critic
+ *   (ICOAC_MAX_CRITIC_UNITS, blocks of ICOAC_CRITIC_BLOCK_MAX);
  * - unit: the field's unit ("" for none; "input" for the unit of the input it applies to);
  * - def: the default of a scalar (arrays and the task group: the task preset, icoac_task_cartpole);
  * - modes: the modes that read it (ICOAC_PARAM_ICO | ICOAC_PARAM_RL | ICOAC_PARAM_SEARCH);
