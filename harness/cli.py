@@ -350,6 +350,7 @@ def build_parser() -> argparse.ArgumentParser:
                                        "and description, from the C parameter table")
     pa.add_argument("--tier", choices=("all", "essential", "advanced"), default="all",
                     help="the parameters of one tier only (default all)")
+    pa.add_argument("--plant", type=_plant, default=None, help="also list this registry plant's parameters")
     pa.set_defaults(func=cmd_params)
     return p
 
@@ -375,7 +376,7 @@ def _threads_arg(args) -> int:
 
 def cmd_params(args) -> int:
     from . import params
-    sys.stdout.write(params.text_table(None if args.tier == "all" else args.tier))
+    sys.stdout.write(params.text_table(None if args.tier == "all" else args.tier, args.plant))
     return 0
 
 

@@ -79,9 +79,18 @@ def rows(tier: str | None = None) -> list[dict[str, str]]:
     return out
 
 
-def text_table(tier: str | None = None) -> str:
-    """The listing of `python -m harness params`: aligned columns, one line per parameter."""
-    table = [dict(zip(COLUMNS, COLUMNS))] + rows(tier)
+def plant_rows(plant: str) -> list[dict[str, str]]:
+    """One dict of COLUMNS per parameter of a registry plant (its descriptor's table)."""
+    info = B.plant_info(plant)
+    return [{"name": p["name"], "unit": p["unit"], "default": _num(p["value"]),
+             "range": f"[{_num(p['min'])}, {_num(p['max'])}]", "modes": "all", "tier": "plant",
+             "description": f"{info['name']} parameter"} for p in info["params"]]
+
+
+def text_table(tier: str | None = None, plant: str | None = None) -> str:
+    """The listing of `python -m harness params`: aligned columns, one line per parameter (the
+    controller's and the run's; with plant, that registry plant's after them)."""
+    table = [dict(zip(COLUMNS, COLUMNS))] + rows(tier) + (plant_rows(plant) if plant else [])
     widths = {c: max(len(r[c]) for r in table) for c in COLUMNS[:-1]}
     return "\n".join("  ".join(r[c].ljust(widths[c]) for c in COLUMNS[:-1]) + "  " + r["description"]
                      for r in table).rstrip() + "\n"
