@@ -4,9 +4,11 @@
 C is the single source of every number this module exposes: at import it reads the library's
 constant table (icoac_sim_constants: sizes, enum values, statuses, outcomes, progress indices,
 grid geometry) and its field table (icoac_sim_fields: offset and size of every member of every
-public struct), and checks each ctypes mirror below (and the cell numpy dtype) against the field
-table - same fields, same offsets and sizes, same total size - so that a stale or mismatched
-library fails loudly with a LibraryError naming the field. The controller state is opaque
+public struct) and its parameter table (icoac_sim_param_table: every controller and run parameter
+with its type, unit, range, default, modes, tier, status and description, PARAMS). The mirrors of
+icoac_config_t and icoac_sim_run_t are built from the parameter table; every ctypes mirror (and the
+cell numpy dtype) is checked against the field table - same fields, same offsets and sizes, same
+total size - so that a stale or mismatched library fails loudly with a LibraryError naming the field. The controller state is opaque
 storage of icoac_sizeof_state() bytes, read through icoac_get_posterior / icoac_get_counters.
 Every prototype is declared once here.
 """
@@ -15,7 +17,7 @@ from __future__ import annotations
 import ctypes
 import os
 from pathlib import Path
-from typing import Mapping, Union
+from typing import Any, Mapping, Union
 
 import numpy as np
 from numpy.ctypeslib import ndpointer
@@ -184,6 +186,29 @@ for _row in _table(lib.icoac_sim_param_table):
 def params_of(c_type: str) -> dict[str, dict]:
     """The parameter rows of one C struct ("icoac_config_t", "icoac_sim_run_t"), in its order."""
     return {n: r for n, r in PARAMS.items() if r["type"] == c_type}
+
+
+def _g(value: float) -> str:
+    return f"{value:g}"
+
+
+def range_text(row: Mapping[str, Any], choices: tuple[str, ...] | None = None) -> str:
+    """A row's valid values in words, e.g. "[0, 10000]", "(0, 1]", "0 or [0.001, 1000]"."""
+    lo, hi, check = row["min"], row["max"], row["check"]
+    if check == "flag":
+        return "true, false"
+    if check == "choice":
+        return ", ".join(choices) if choices else f"{lo} .. {hi}"
+    if check == "index":
+        return f"[{lo}, task.n_inputs)"
+    if check == "at_least":
+        return f">= {_g(lo)}"
+    text = {"real_open_lo": "({}, {}]", "real_open_hi": "[{}, {})"}.get(check, "[{}, {}]").format(_g(lo), _g(hi))
+    if check == "real_or_zero":
+        return f"0 or {text}"
+    if check == "units":
+        return f"{text}, product <= {constant('ICOAC_MAX_CRITIC_UNITS')}"
+    return text
 
 
 def constant(name: str) -> Union[int, float]:

@@ -22,7 +22,7 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from . import _binding as B
-from . import geometry, literals, options, params
+from . import geometry, literals, options
 from .plants import CART_POLE, spec as plant_spec
 from .registry import CONDITIONS, REGISTRY
 from ._binding import ConfigError
@@ -542,7 +542,7 @@ def _designated(controller: B.Config, designator: str) -> str:
     for index in re.findall(r"\[([0-9]+)\]", m.group(2)):
         if isinstance(value, list) and int(index) < len(value):
             value = value[int(index)]
-    valid = params.range_text(B.PARAMS[m.group(1)], tuple(ENUMS[m.group(1)]) if m.group(1) in ENUMS else None)
+    valid = B.range_text(B.PARAMS[m.group(1)], tuple(ENUMS[m.group(1)]) if m.group(1) in ENUMS else None)
     return f"{designator}={value!r} (valid: {valid})"
 
 

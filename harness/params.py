@@ -16,25 +16,6 @@ def _num(value: float) -> str:
     return f"{value:g}"
 
 
-def range_text(row: Mapping[str, Any], choices: tuple[str, ...] | None = None) -> str:
-    """A row's valid values in words, e.g. "[0, 10000]", "(0, 1]", "0 or [0.001, 1000]"."""
-    lo, hi, check = row["min"], row["max"], row["check"]
-    if check == "flag":
-        return "true, false"
-    if check == "choice":
-        return ", ".join(choices) if choices else f"{lo} .. {hi}"
-    if check == "index":
-        return f"[{lo}, task.n_inputs)"
-    if check == "at_least":
-        return f">= {_num(lo)}"
-    text = {"real_open_lo": "({}, {}]", "real_open_hi": "[{}, {})"}.get(check, "[{}, {}]").format(_num(lo), _num(hi))
-    if check == "real_or_zero":
-        return f"0 or {text}"
-    if check == "units":
-        return f"{text}, product <= {B.constant('ICOAC_MAX_CRITIC_UNITS')}"
-    return text
-
-
 def modes_text(row: Mapping[str, Any]) -> str:
     names = [name for name, bit in B.PARAM_MODES.items() if row["modes"] & bit]
     return "all" if len(names) == len(B.PARAM_MODES) else ", ".join(names)
@@ -74,7 +55,7 @@ def rows(tier: str | None = None) -> list[dict[str, str]]:
             continue
         choices = tuple(C.ENUMS[name]) if name in C.ENUMS else None
         out.append({"name": name, "unit": row["unit"], "default": _value_text(defaults[name]),
-                    "range": range_text(row, choices), "modes": modes_text(row), "tier": row["tier"],
+                    "range": B.range_text(row, choices), "modes": modes_text(row), "tier": row["tier"],
                     "description": row["doc"]})
     return out
 

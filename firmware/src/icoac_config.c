@@ -72,10 +72,10 @@ void icoac_task_cartpole(icoac_config_t *cfg)
     }
 }
 
-/* A row's default (icoac_params.h) on the group struct p; the arrays are the task preset's. */
+/* A row's default (icoac_params.h) on the group struct p; the arrays are the task preset's (the rule
+ * table is the task group's, which the preset fills). */
 #define ICOAC_PRIV_DEFAULT_scalar(v, def) (v) = (def);
 #define ICOAC_PRIV_DEFAULT_inputs(v, def)
-#define ICOAC_PRIV_DEFAULT_rules(v, def)
 #define ICOAC_PRIV_DEFAULT(group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc) \
     ICOAC_PRIV_DEFAULT_##dim(p->field, def)
 
