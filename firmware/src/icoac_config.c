@@ -233,9 +233,13 @@ ICOAC_PARAMS(ICOAC_PRIV_NAMES)
 static int task_ok(const icoac_task_config_t *p, bad_field_t *bad)
 {
     const int32_t n_inputs = p->n_inputs;
-    const int32_t n_rules = p->late_source == ICOAC_LATE_RULES ? p->n_rules : 0;
+    const int32_t n_rules = p->n_rules;
     int32_t i;
-    ICOAC_PARAMS_TASK(ICOAC_PRIV_CHECK)
+    ICOAC_PARAMS_TASK_SIZES(ICOAC_PRIV_CHECK)
+    if (p->late_source != ICOAC_LATE_RULES) {
+        return 1; /* the table is not used */
+    }
+    ICOAC_PARAMS_TASK_RULES(ICOAC_PRIV_CHECK)
     return 1;
 }
 

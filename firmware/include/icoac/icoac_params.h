@@ -50,13 +50,17 @@
     X(config, learn, int32_t, scalar, flag, "", 0, 1, 1, ICOAC_PARAM_ALL, essential, ICOAC_ERR_BAD_MODE, \
       "1: learn; 0: every update off (w, Sigma_w, v fixed), the no-learning control")
 
-#define ICOAC_PARAMS_TASK(X) \
+/* The task: its sizes and late-signal source, then its rule table (checked only when it is the
+ * source). */
+#define ICOAC_PARAMS_TASK(X) ICOAC_PARAMS_TASK_SIZES(X) ICOAC_PARAMS_TASK_RULES(X)
+#define ICOAC_PARAMS_TASK_SIZES(X) \
     X(task, n_inputs, int32_t, scalar, int, "", 1, ICOAC_MAX_INPUTS, ICOAC_CARTPOLE_INPUTS, ICOAC_PARAM_ALL, essential, ICOAC_ERR_BAD_TASK, \
       "inputs n of the task: observations s_0 .. s_{n-1} per tick") \
     X(task, late_source, int32_t, scalar, choice, "", ICOAC_LATE_RULES, ICOAC_LATE_SENSOR, ICOAC_LATE_RULES, ICOAC_PARAM_ALL, advanced, ICOAC_ERR_BAD_TASK, \
       "late signal from the rule table (rules) or the plant's sensor flag (sensor)") \
     X(task, n_rules, int32_t, scalar, int, "", 0, ICOAC_MAX_RULES, ICOAC_CARTPOLE_RULES, ICOAC_PARAM_ALL, essential, ICOAC_ERR_BAD_TASK, \
-      "rules in the late-signal table, checked in order, the first match wins") \
+      "rules in the late-signal table, checked in order, the first match wins")
+#define ICOAC_PARAMS_TASK_RULES(X) \
     X(task, rule_input, int32_t, rules, index, "", 0, ICOAC_MAX_INPUTS - 1, 0, ICOAC_PARAM_ALL, essential, ICOAC_ERR_BAD_TASK, \
       "input a rule tests, below task.n_inputs") \
     X(task, rule_side, int32_t, rules, choice, "", ICOAC_RULE_BELOW, ICOAC_RULE_ABOVE, ICOAC_RULE_BELOW, ICOAC_PARAM_ALL, essential, ICOAC_ERR_BAD_TASK, \
