@@ -232,13 +232,15 @@ ICOAC_PARAMS(ICOAC_PRIV_NAMES)
  * input, then every side, threshold, reflex. */
 static int task_ok(const icoac_task_config_t *p, bad_field_t *bad)
 {
-    const int32_t n_inputs = p->n_inputs;
-    const int32_t n_rules = p->n_rules;
+    int32_t n_inputs;
+    int32_t n_rules;
     int32_t i;
     ICOAC_PARAMS_TASK_SIZES(ICOAC_PRIV_CHECK)
     if (p->late_source != ICOAC_LATE_RULES) {
         return 1; /* the table is not used */
     }
+    n_inputs = p->n_inputs;
+    n_rules = p->n_rules;
     ICOAC_PARAMS_TASK_RULES(ICOAC_PRIV_CHECK)
     return 1;
 }
