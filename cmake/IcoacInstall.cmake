@@ -16,6 +16,7 @@ install(TARGETS ${icoac_variants} EXPORT icoacTargets
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(FILES ${PROJECT_SOURCE_DIR}/firmware/include/icoac/icoac.h ${PROJECT_SOURCE_DIR}/firmware/include/icoac/icoac_types.h
               ${PROJECT_SOURCE_DIR}/firmware/include/icoac/icoac_rng.h
+              ${PROJECT_SOURCE_DIR}/firmware/include/icoac/icoac_params.h
               ${ICOAC_GENERATED_INCLUDE_DIR}/icoac/icoac_version.h
               ${ICOAC_GENERATED_INCLUDE_DIR}/icoac/icoac_build_config.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/icoac COMPONENT icoac)

@@ -4,9 +4,11 @@
 C is the single source of every number this module exposes: at import it reads the library's
 constant table (icoac_sim_constants: sizes, enum values, statuses, outcomes, progress indices,
 grid geometry) and its field table (icoac_sim_fields: offset and size of every member of every
-public struct), and checks each ctypes mirror below (and the cell numpy dtype) against the field
-table - same fields, same offsets and sizes, same total size - so that a stale or mismatched
-library fails loudly with a LibraryError naming the field. The controller state is opaque
+public struct) and its parameter table (icoac_sim_param_table: every controller and run parameter
+with its type, unit, range, default, modes, tier, status and description, PARAMS). The mirrors of
+icoac_config_t and icoac_sim_run_t are built from the parameter table; every ctypes mirror (and the
+cell numpy dtype) is checked against the field table - same fields, same offsets and sizes, same
+total size - so that a stale or mismatched library fails loudly with a LibraryError naming the field. The controller state is opaque
 storage of icoac_sizeof_state() bytes, read through icoac_get_posterior / icoac_get_counters.
 Every prototype is declared once here.
 """
@@ -15,7 +17,7 @@ from __future__ import annotations
 import ctypes
 import os
 from pathlib import Path
-from typing import Mapping, Union
+from typing import Any, Mapping, Union
 
 import numpy as np
 from numpy.ctypeslib import ndpointer
@@ -156,6 +158,61 @@ for _row in _table(lib.icoac_sim_fields):
     FIELDS.setdefault(_row.type.decode(), {})[_row.field.decode()] = (int(_row.offset), int(_row.size))
 
 
+class _ParamRow(ctypes.Structure):
+    """icoac_sim_param_row_t."""
+    _fields_ = [("type", ctypes.c_char_p), ("name", ctypes.c_char_p), ("group", ctypes.c_char_p),
+                ("ctype", ctypes.c_char_p), ("dim", ctypes.c_char_p), ("check", ctypes.c_char_p),
+                ("unit", ctypes.c_char_p), ("tier", ctypes.c_char_p), ("doc", ctypes.c_char_p),
+                ("min", ctypes.c_double), ("max", ctypes.c_double), ("default", ctypes.c_double),
+                ("modes", ctypes.c_uint32), ("status", ctypes.c_int32), ("offset", ctypes.c_uint32),
+                ("size", ctypes.c_uint32)]
+
+
+lib.icoac_sim_param_table.argtypes = [ctypes.POINTER(ctypes.c_int32)]
+lib.icoac_sim_param_table.restype = ctypes.POINTER(_ParamRow)
+
+# {canonical name: row} of every controller parameter (icoac_params.h) and run parameter
+# (ICOAC_SIM_RUN_PARAMS), in struct order: type (its C struct), name, group, ctype, dim (scalar,
+# inputs, rules), check, unit, tier, doc, min, max, default, modes (bit mask), status, offset, size.
+PARAMS: dict[str, dict] = {}
+for _row in _table(lib.icoac_sim_param_table):
+    PARAMS[_row.name.decode()] = {
+        **{k: getattr(_row, k).decode() for k in ("type", "name", "group", "ctype", "dim", "check", "unit",
+                                                   "tier", "doc")},
+        **{k: _number(getattr(_row, k)) for k in ("min", "max", "default")},
+        **{k: int(getattr(_row, k)) for k in ("modes", "status", "offset", "size")}}
+
+
+def params_of(c_type: str) -> dict[str, dict]:
+    """The parameter rows of one C struct ("icoac_config_t", "icoac_sim_run_t"), in its order."""
+    return {n: r for n, r in PARAMS.items() if r["type"] == c_type}
+
+
+def _g(value: float) -> str:
+    return f"{value:g}"
+
+
+def range_text(row: Mapping[str, Any], choices: tuple[str, ...] | None = None) -> str:
+    """A row's valid values in words, e.g. "[0, 10000]", "(0, 1]", "0 or [0.001, 1000]"."""
+    lo, hi, check = row["min"], row["max"], row["check"]
+    if check == "flag":
+        return "true, false"
+    if check == "choice":
+        return ", ".join(choices) if choices else f"{lo} .. {hi}"
+    if check == "sign":
+        return f"{lo:+g}, {hi:+g}"
+    if check == "index":
+        return f"[{lo}, task.n_inputs)"
+    if check == "at_least":
+        return f">= {_g(lo)}"
+    text = {"real_open_lo": "({}, {}]", "real_open_hi": "[{}, {})"}.get(check, "[{}, {}]").format(_g(lo), _g(hi))
+    if check == "real_or_zero":
+        return f"0 or {text}"
+    if check == "units":
+        return f"{text}, product <= {constant('ICOAC_MAX_CRITIC_UNITS')}"
+    return text
+
+
 def constant(name: str) -> Union[int, float]:
     """Value of a C constant from the library's table; LibraryError if the library lacks it."""
     try:
@@ -194,6 +251,7 @@ ICO_TIMINGS = enum("ICOAC_ICO_TIMING_")           # code, literal
 ACTOR_UPDATES = enum("ICOAC_ACTOR_", ("POSTERIOR", "MEAN", "GRADIENT"))  # posterior, mean, gradient
 INTEGRATORS = enum("ICOAC_SIM_", ("EULER", "RK4"))  # euler, rk4
 MODE_ICO, MODE_RL, MODE_SEARCH = MODES["ico"], MODES["rl"], MODES["search"]
+PARAM_MODES = enum("ICOAC_PARAM_", ("ICO", "RL", "SEARCH"))  # the modes column's bits: ico, rl, search
 SEARCH_BATCH_MAX = int(constant("ICOAC_SEARCH_BATCH_MAX"))
 EXPLORE_TICKS_MAX = int(constant("ICOAC_EXPLORE_TICKS_MAX"))
 
@@ -266,88 +324,37 @@ _RN = c_real * MAX_INPUTS
 _RNN = (c_real * MAX_INPUTS) * MAX_INPUTS
 
 
-class TaskConfig(ctypes.Structure):
-    """icoac_task_config_t: the plant's inputs and late signal (every mode)."""
-    _fields_ = [
-        ("n_inputs", ctypes.c_int32),
-        ("input_sign", ctypes.c_int32 * MAX_INPUTS),
-        ("late_source", ctypes.c_int32),
-        ("n_rules", ctypes.c_int32),
-        ("rule_input", ctypes.c_int32 * MAX_RULES),
-        ("rule_side", ctypes.c_int32 * MAX_RULES),
-        ("rule_threshold", c_real * MAX_RULES),
-        ("rule_reflex", c_real * MAX_RULES),
-    ]
+_CTYPES = {"icoac_real_t": c_real, "int32_t": ctypes.c_int32, "int64_t": ctypes.c_int64, "double": ctypes.c_double}
+_DIMS = {"scalar": 1, "inputs": MAX_INPUTS, "rules": MAX_RULES}
 
 
-class PolicyConfig(ctypes.Structure):
-    """icoac_policy_config_t: state -> feature z -> force (every mode)."""
-    _fields_ = [
-        ("input_range", _RN),
-        ("clip_inputs", ctypes.c_int32),
-        ("gain", c_real),
-        ("reflex_mode", ctypes.c_int32),
-        ("reflex_force", c_real),
-    ]
+def _param_ctype(row: dict):
+    scalar = _CTYPES[row["ctype"]]
+    return scalar if row["dim"] == "scalar" else scalar * _DIMS[row["dim"]]
 
 
-class IcoConfig(ctypes.Structure):
-    """icoac_ico_config_t: the ICO rule (ICO mode)."""
-    _fields_ = [("rate", c_real), ("timing", ctypes.c_int32)]
+def _param_struct(class_name: str, rows: list[dict], doc: str) -> type:
+    """A ctypes mirror whose members are the parameter rows (their last name part), in order."""
+    members = [(r["name"].rsplit(".", 1)[-1], _param_ctype(r)) for r in rows]
+    return type(class_name, (ctypes.Structure,), {"_fields_": members, "__doc__": doc})
 
 
-class CriticConfig(ctypes.Structure):
-    """icoac_critic_config_t: the normalized-Gaussian critic (RL mode)."""
-    _fields_ = [
-        ("rate", c_real),
-        ("discount", c_real),
-        ("td_clip", c_real),
-        ("range", _RN),
-        ("units", ctypes.c_int32 * MAX_INPUTS),
-        ("threshold", c_real),
-        ("quirks", ctypes.c_int32),
-    ]
+def _config_struct() -> type:
+    """icoac_config_t from its rows: the top-level fields, then one structure per group."""
+    rows = list(params_of("icoac_config_t").values())
+    members: list = [(r["name"], _param_ctype(r)) for r in rows if r["group"] == "config"]
+    groups = list(dict.fromkeys(r["group"] for r in rows if r["group"] != "config"))
+    for g in groups:
+        struct = _param_struct(f"{g.capitalize()}Config", [r for r in rows if r["group"] == g],
+                               f"icoac_{g}_config_t (its rows in icoac_params.h).")
+        globals()[struct.__name__] = struct
+        members.append((g, struct))
+    return type("Config", (ctypes.Structure,), {
+        "_fields_": members, "__doc__": "icoac_config_t: the mode and one group per concern (icoac_params.h)."})
 
 
-class ActorConfig(ctypes.Structure):
-    """icoac_actor_config_t: the actor, its reading and its exploration (RL mode)."""
-    _fields_ = [
-        ("noise_std", c_real),
-        ("scale", c_real),
-        ("forgetting", c_real),
-        ("reflex", ctypes.c_int32),
-        ("act_with_sample", ctypes.c_int32),
-        ("update", ctypes.c_int32),
-        ("rate", c_real),
-        ("likelihood_std", c_real),
-        ("batch", ctypes.c_int32),
-        ("explore_ticks", ctypes.c_int32),
-    ]
-
-
-class SearchConfig(ctypes.Structure):
-    """icoac_search_config_t: the episodic search (search mode)."""
-    _fields_ = [
-        ("batch", ctypes.c_int32),
-        ("elite_fraction", c_real),
-        ("step", c_real),
-        ("floor", c_real),
-        ("cov_scale", c_real),
-    ]
-
-
-class Config(ctypes.Structure):
-    """icoac_config_t: the mode and one group per concern."""
-    _fields_ = [
-        ("mode", ctypes.c_int32),
-        ("learn", ctypes.c_int32),
-        ("task", TaskConfig),
-        ("policy", PolicyConfig),
-        ("ico", IcoConfig),
-        ("critic", CriticConfig),
-        ("actor", ActorConfig),
-        ("search", SearchConfig),
-    ]
+# TaskConfig, PolicyConfig, IcoConfig, CriticConfig, ActorConfig, SearchConfig and Config.
+Config = _config_struct()
 
 
 class Prior(ctypes.Structure):
@@ -404,13 +411,8 @@ class Plant(ctypes.Structure):
     ]
 
 
-class Run(ctypes.Structure):
-    """icoac_sim_run_t."""
-    _fields_ = [
-        ("max_trials", ctypes.c_int64),
-        ("success_steps", ctypes.c_int64),
-        ("init_velocity_noise", ctypes.c_double),
-    ]
+Run = _param_struct("Run", list(params_of("icoac_sim_run_t").values()),
+                    "icoac_sim_run_t (its rows: ICOAC_SIM_RUN_PARAMS).")
 
 
 class Axis(ctypes.Structure):

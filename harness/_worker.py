@@ -41,23 +41,20 @@ def cancel_run(run_id: str) -> bool:
     return True
 
 
-try:
-    from distributed import WorkerPlugin as _WorkerPlugin
-except ImportError:  # pragma: no cover - distributed is a dependency of the harness
-    _WorkerPlugin = object
-
-
-class IgnoreSigint(_WorkerPlugin):
+def ignore_sigint_plugin():
     """Worker plugin of the LocalCluster of `--workers N`: its worker processes ignore SIGINT, so
     Ctrl-C in the terminal (sent to the whole process group) reaches the client alone, which then
-    stops the run in order."""
+    stops the run in order. Made on demand: importing this module does not import Dask."""
+    from distributed import WorkerPlugin
 
-    def setup(self, worker):  # runs in the worker's event loop, the main thread of its process
-        import signal
-        try:
-            signal.signal(signal.SIGINT, signal.SIG_IGN)
-        except ValueError:  # pragma: no cover - not the main thread
-            pass
+    class IgnoreSigint(WorkerPlugin):
+        def setup(self, worker):  # runs in the worker's event loop, the main thread of its process
+            import signal
+            try:
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+            except ValueError:  # pragma: no cover - not the main thread
+                pass
+    return IgnoreSigint()
 
 
 def _library_hint() -> str:

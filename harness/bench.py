@@ -20,7 +20,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from . import figures, geometry, grid, metrics, results, store, tables
+from . import geometry, grid, metrics, results, store, tables
 from . import prior as P
 from .ceiling.records import bench_ceiling, load_ceiling, reference_lines
 from .ceiling.weights import format_w
@@ -249,6 +249,8 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
                        grid: geometry.PlantGrid = geometry.CART_POLE) -> list[Path]:
     """Fig. 2b (first ICO->RL seed, ICO success domain outlined), Fig. 3a (with the linear-policy
     ceiling's reference lines when a ceiling record is given), Fig. 3b."""
+    from . import figures
+
     figdir = Path(figdir)
     written = []
     if icorl_cells is not None:
@@ -360,8 +362,12 @@ def stages(opt: BenchOptions) -> list[Stage]:
     anything runs or is written."""
     profile = PROFILES[opt.profile]
     P.check_prior_std(opt.prior_std)
+    P.check_prior_ridge(opt.ridge)
+    grid.check_threads(opt.threads)
     out = Path(opt.out)
     figdir = Path(opt.figures) if opt.figures else None
+    if figdir is not None:
+        from . import figures  # noqa: F401  (MissingExtra before any stage without matplotlib)
     seeds = opt.seed_list()
     ico_sets = command_overrides(opt.configuration, opt.sets, plant=opt.plant)
     rl_sets = command_overrides(opt.configuration, opt.sets, {"--rl-max-trials": ("max_trials", opt.rl_max_trials)},
@@ -380,7 +386,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
             d = seed_dir(out, condition, seed)
             cells, record, cancelled = run_condition(
                 condition=condition, out=d, seed=seed, threads=opt.threads, overrides=overrides(condition),
-                cell_spec=cells_spec, resume=opt.resume and results.exists(d), fresh=not opt.resume,
+                cell_spec=cells_spec, resume=opt.resume and bool(results.present(d)), fresh=not opt.resume,
                 progress=not opt.quiet, info=ctx.get(("prior", condition, seed)),
                 start_over="rerun bench without --resume", dask=ctx.get("dask"), plant=opt.plant)
             ctx[(condition, seed)] = (cells, record)
@@ -418,6 +424,7 @@ def stages(opt: BenchOptions) -> list[Stage]:
     def figures_stage(ctx):
         if figdir is None:
             return
+        from . import figures
         cells, record = ctx[("ico", seeds[0])]
         for path in figures.make_figures(cells, record, figdir):
             progress(f"  wrote {path}")
@@ -473,9 +480,11 @@ def stages(opt: BenchOptions) -> list[Stage]:
 def run_bench(opt: BenchOptions, argv: Sequence[str] = ()) -> int:
     """Validate, then run every stage, logging wall times to OUT/bench.json; 130 if interrupted.
     With ``opt.dask`` one Dask session (harness.cluster) serves every grid."""
-    from .cluster import open_backend
-
     todo = stages(opt)  # validates the arguments before anything is written
+    if opt.dask is None:  # the local engine: Dask is not imported
+        with store.DirectoryLock(opt.out):
+            return _run_stages(opt, todo, {"dask": None}, argv)
+    from .cluster import open_backend
     with store.DirectoryLock(opt.out), open_backend(opt.dask) as session:
         return _run_stages(opt, todo, {"dask": session}, argv)
 

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Command line: `python -m harness grid|figures|bench|sweep|ceiling ...`.
+"""Command line: `python -m harness grid|figures|bench|sweep|ceiling|params ...`.
 
 This module only parses arguments and reports; the work is done by harness.conditions (one
 condition's grid and prior), harness.bench (the benchmark stages), harness.sweep,
@@ -115,7 +115,8 @@ PLANT_HELP = ("registry plant (docs/plants.md; default cart_pole): its grid, dyn
 SET_HELP = ("override a parameter (repeatable): NAME is group.field (policy.gain, ico.timing, critic.range, "
             "actor.noise_std, ...), a plant or run parameter (dt, integrator, max_trials, ...) or a flat "
             "alias (gain, ico_timing, noise_std, ...); reals must be finite and normal, integers must fit "
-            "their C type, ranges are checked by the C library")
+            "their C type, ranges are checked by the C library; `params` lists every controller and run "
+            "parameter with its unit, default and range")
 
 
 def _add_prior_args(parser, prior_std: bool = True) -> None:
@@ -187,7 +188,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog=PROG, description="icoac grid benchmarks, results and figures")
     p.add_argument("--version", action=_VersionAction,
                    help="print the harness version and, if the C library loads, its version and ABI, then exit")
-    sub = p.add_subparsers(dest="command", metavar="{grid,figures,bench,sweep,ceiling}", parser_class=_Parser)
+    sub = p.add_subparsers(dest="command", metavar="{grid,figures,bench,sweep,ceiling,params}", parser_class=_Parser)
     sub.required = True
     cells_, every = O.DEFAULT_CHECKPOINT_CELLS, O.DEFAULT_CHECKPOINT_EVERY
 
@@ -345,6 +346,12 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--plant", type=_plant, default=O.CART_POLE, help=PLANT_HELP)
     c.add_argument("--quiet", action="store_true", help="no progress output")
     c.set_defaults(func=cmd_ceiling)
+    pa = sub.add_parser("params", help="list the controller and run parameters: unit, default, range, modes, tier "
+                                       "and description, from the C parameter table")
+    pa.add_argument("--tier", choices=("all", "essential", "advanced"), default="all",
+                    help="the parameters of one tier only (default all)")
+    pa.add_argument("--plant", type=_plant, default=None, help="also list this registry plant's parameters")
+    pa.set_defaults(func=cmd_params)
     return p
 
 
@@ -365,6 +372,12 @@ def _frame(args):
 
 def _threads_arg(args) -> int:
     return 0 if args.threads is None else args.threads
+
+
+def cmd_params(args) -> int:
+    from . import params
+    sys.stdout.write(params.text_table(None if args.tier == "all" else args.tier, args.plant))
+    return 0
 
 
 def _dask_spec(args):

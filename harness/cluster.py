@@ -37,7 +37,7 @@ import numpy as np
 from . import _binding as B
 from . import _worker, grid
 from .config import RunConfig
-from .errors import UsageError, WorkerError
+from .errors import MissingExtra, UsageError, WorkerError
 from .options import (AUTO_CHUNK_MAX, AUTO_CHUNKS_PER_THREAD, DASK_CANCEL_GRACE, DASK_CONNECT_TIMEOUT, DASK_RETRIES,
                       DASK_WORKER_TIMEOUT, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, MAX_CHUNK_CELLS,
                       MAX_THREADS, MAX_WORKERS)
@@ -73,6 +73,7 @@ class DaskSpec:
         if self.chunk_cells is not None and (not _is_int(self.chunk_cells)
                                              or not 1 <= self.chunk_cells <= MAX_CHUNK_CELLS):
             raise UsageError(f"--chunk-cells expects an integer in [1, {MAX_CHUNK_CELLS}], got {self.chunk_cells!r:.40}")
+        _import_distributed()  # installed, before any work
         return self
 
 
@@ -90,8 +91,8 @@ def chunks_of(pending: np.ndarray, size: int) -> list[np.ndarray]:
 def _import_distributed():
     try:
         import distributed
-    except ImportError as exc:  # pragma: no cover - distributed is a dependency of the harness
-        raise UsageError(f"the Dask backend needs dask.distributed ({exc}); `pip install distributed`") from None
+    except ImportError as exc:
+        raise MissingExtra("the Dask backend (--workers, --scheduler)", "dask", exc) from None
     return distributed
 
 
@@ -145,7 +146,7 @@ class DaskSession:
                 raise WorkerError(f"cannot start a local Dask cluster of {spec.workers} workers: "
                                   f"{type(exc).__name__}: {exc}") from None
             try:
-                self.client.register_plugin(_worker.IgnoreSigint(), name="icoac-ignore-sigint")
+                self.client.register_plugin(_worker.ignore_sigint_plugin(), name="icoac-ignore-sigint")
             except Exception:  # pragma: no cover - only a nicer Ctrl-C
                 pass
         else:
@@ -370,8 +371,7 @@ class _Run:
     def execute(self, checkpoint, checkpoint_every, checkpoint_cells, cancel_after, cancel_event,
                 t_start) -> grid.GridRun:
         self.client.subscribe_topic(_worker.PROGRESS_TOPIC, self._on_event)
-        saved = 0                      # merged cells at the last checkpoint
-        last_checkpoint = time.monotonic()
+        checkpoints = grid.Checkpoints(checkpoint, checkpoint_every, checkpoint_cells)
         last_worker_seen = time.monotonic()
         last_worker_check = time.monotonic()
         cancelled = user_cancelled = False
@@ -385,12 +385,8 @@ class _Run:
                             (cancel_after is not None and now - t_start >= cancel_after):
                         cancelled = True
                         break
-                    new = int(self.merged[0]) - saved
-                    if checkpoint is not None and new > 0 and self.futures \
-                            and (new >= checkpoint_cells or now - last_checkpoint >= checkpoint_every):
-                        checkpoint(self.cells.copy())
-                        saved = int(self.merged[0])
-                        last_checkpoint = time.monotonic()
+                    if self.futures:
+                        checkpoints.poll(int(self.merged[0]), self.cells.copy)
                     if now - last_worker_check >= 5.0:
                         last_worker_check = now
                         if self.session.nthreads() > 0:
@@ -408,9 +404,9 @@ class _Run:
                 self._stop(DASK_CANCEL_GRACE)
         except BaseException:
             self._stop(0.0)
-            if checkpoint is not None and int(self.merged[0]) > saved:
+            if checkpoints.unsaved(int(self.merged[0])):
                 try:  # an error in one chunk does not lose the merged ones
-                    checkpoint(self.cells.copy())
+                    checkpoints.flush(int(self.merged[0]), self.cells.copy)
                 except Exception:
                     pass
             raise

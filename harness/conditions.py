@@ -45,6 +45,11 @@ def condition_prior(condition: str, prior_from, frame, ridge: float, std: float 
                              geometry.of(plant).n_inputs)
 
 
+def nothing_to_resume(out: Path) -> UsageError:
+    return UsageError(f"--resume: no results to resume in {str(out)!r} (none written yet: run the command "
+                      "without --resume)")
+
+
 def prior_extra(info: P.PriorInfo | None) -> dict | None:
     """What run.json records of a prior (None: nothing)."""
     return {"prior_info": info.to_dict()} if info is not None else None
@@ -68,9 +73,10 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     a real write probe, the lock) and, when results exist, both files, the ABI of the library that
     wrote them, the recorded configuration and that the cells are exactly the recorded selection
     are checked. A resume writes nothing until new cells have finished (nothing at all when none
-    is pending); ``fresh`` discards existing results (after the checks). A directory holding only
-    one of the two files is refused unless ``fresh``. With ``resume`` and not ``explicit`` the
-    recorded condition, seed, cells, configuration and prior are used.
+    is pending), except that it first commits the cells of a run stopped between two writes (a
+    record that does not name its cells, repaired by store.ResultsStore.load); ``fresh`` discards
+    existing results (after the checks). With ``resume`` and not ``explicit`` the recorded
+    condition, seed, cells, configuration and prior are used.
     """
     out = store.check_out_dir(out)
     seed = grid.check_seed(seed)
@@ -79,7 +85,7 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     if resume and fresh:
         raise UsageError("--resume and --overwrite exclude each other")
     if resume and not (out.is_dir() and results.present(out)):
-        raise UsageError(f"--resume: no results to resume in {str(out)!r}")
+        raise nothing_to_resume(out)
     try:
         indices = grid.parse_cell_indices(cell_spec)
     except B.ConfigError as exc:
@@ -90,15 +96,14 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     with store.ResultsStore(out, start_over=start_over) as st:
         have = st.present()
         if resume and not have:
-            raise UsageError(f"--resume: no results to resume in {str(out)!r}")
-        if len(have) == 1 and not fresh:
-            missing = results.RUN_FILE if have[0] == results.CELLS_FILE else results.CELLS_FILE
-            raise UsageError(f"{str(out)!r} holds {have[0]} but no {missing}: refusing to "
-                             f"{'resume' if resume else 'replace'} it; restore {missing}, or {start_over} "
+            raise nothing_to_resume(out)
+        if have == [results.CELLS_FILE] and not fresh:  # never left by a run (store.ResultsStore)
+            raise UsageError(f"{str(out)!r} holds {results.CELLS_FILE} but no {results.RUN_FILE}, which no run "
+                             f"leaves behind: refusing to {'resume' if resume else 'replace'} it; {start_over} "
                              "to discard it and start over")
         record = None
-        if len(have) == 2 and not fresh:
-            cells, record = st.load()
+        if have and not fresh:
+            cells, record, stale = st.load(repair=resume)
             if cfg is None:
                 cfg = results.load_config(record)
                 condition, seed, indices = record["condition"], record["seed"], record["cells"]
@@ -108,7 +113,7 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
             n_pending = int((cells["outcome"] == B.PENDING).sum())
             if progress:
                 print(f"resuming {out}: {n_pending} of {cells.size} cells pending", file=sys.stderr)
-            if n_pending == 0:  # nothing to run: nothing is written, the record stays as it is
+            if n_pending == 0 and not stale:  # nothing to run: nothing is written, the record stays as it is
                 return cells, record, False
         else:
             cells = grid.make_cells(seed, indices, plant=cfg.plant_name)

@@ -32,10 +32,11 @@ from .errors import UsageError
 GROUPS = ("controller", "plant", "run")
 CONTROLLER_GROUPS = tuple(name for name, ctype in B.Config._fields_ if issubclass(ctype, ctypes.Structure))
 
-# Canonical names, in C order (nested members flattened with dots, as in the C field table).
-CONTROLLER_FIELDS = tuple(B.mirror_fields(B.Config))
+# Canonical names, in C order: the rows of the C parameter table (icoac_params.h, the run's rows);
+# the cart-pole plant struct's members.
+CONTROLLER_FIELDS = tuple(B.params_of("icoac_config_t"))
 PLANT_FIELDS = tuple(n for n in B.mirror_fields(B.Plant) if n != "reserved")
-RUN_FIELDS = tuple(B.mirror_fields(B.Run))
+RUN_FIELDS = tuple(B.params_of("icoac_sim_run_t"))
 ALL_FIELDS = CONTROLLER_FIELDS + PLANT_FIELDS + RUN_FIELDS
 _GROUP_OF = {**{n: "controller" for n in CONTROLLER_FIELDS}, **{n: "plant" for n in PLANT_FIELDS},
              **{n: "run" for n in RUN_FIELDS}}
@@ -84,7 +85,7 @@ ENUMS: dict[str, dict[str, int]] = {
     "task.rule_side": B.RULE_SIDES,
     "integrator": B.INTEGRATORS,
 }
-BOOLS = ("learn", "policy.clip_inputs", "critic.quirks", "actor.reflex", "actor.act_with_sample", "actor.batch")
+BOOLS = tuple(name for name, row in B.PARAMS.items() if row["check"] == "flag")
 _BOOL_NAMES = {"true": 1, "false": 0, "on": 1, "off": 0, "yes": 1, "no": 0, "1": 1, "0": 0}
 
 # Every field each condition sets over the C defaults (harness.registry defines them).
@@ -100,13 +101,6 @@ NAMED_CONFIGURATIONS: dict[str, tuple[str, ...]] = {
                 "actor.batch=0", "actor.explore_ticks=0", "critic.quirks=0"),
 }
 assert tuple(NAMED_CONFIGURATIONS) == options.CONFIGURATION_NAMES
-
-
-# Controller fields added with the learners (ABI 6). A record without any of them was written
-# by an earlier version, whose controller behaved as the literal configuration: loading it
-# fills them from "literal", not from today's defaults.
-LEARNER_FIELDS = ("critic.quirks", "actor.update", "actor.rate", "actor.likelihood_std", "actor.batch",
-                  "actor.explore_ticks")
 
 
 def named_sets(name: str, sets: Iterable[str] | None = None) -> list[str]:
@@ -210,43 +204,10 @@ def _struct_to_dict(struct: ctypes.Structure, prefix: str = "") -> dict[str, Any
 _INT_LIMITS = {ctypes.c_int32: (-2 ** 31, 2 ** 31 - 1), ctypes.c_int64: (-2 ** 63, 2 ** 63 - 1)}
 
 
-def _probe_statuses() -> dict[str, int]:
-    """Status the C checks give when each field alone is invalid (NaN, or -1 for integers, 0 for
-    those that take -1: the input signs), so that a value rejected on the Python side carries the
-    status C would give for that field. A controller field is probed in each mode until one
-    validates its group."""
-    out: dict[str, int] = {}
-    probes = ((B.Config, B.lib.icoac_config_default, B.lib.icoac_config_check, CONTROLLER_FIELDS),
-              (B.Plant, B.lib.icoac_sim_plant_default, B.lib.icoac_sim_plant_check, PLANT_FIELDS),
-              (B.Run, B.lib.icoac_sim_run_default, B.lib.icoac_sim_run_check, RUN_FIELDS))
-    for kind, default, check, names in probes:
-        for name in names:
-            status = B.OK
-            for mode in (B.MODES.values() if kind is B.Config and name != "mode" else (None,)):
-                probe = kind()
-                default(ctypes.byref(probe))
-                if mode is not None:
-                    probe.mode = mode
-                owner, leaf = _owner(probe, name)
-                ctype = dict(owner._fields_)[leaf]
-                scalar = ctype._type_ if issubclass(ctype, ctypes.Array) else ctype
-                for bad in ((-1, 0) if scalar in _INT_LIMITS else (math.nan,)):
-                    if issubclass(ctype, ctypes.Array):
-                        getattr(owner, leaf)[0] = bad
-                    else:
-                        setattr(owner, leaf, bad)
-                    status = int(check(ctypes.byref(probe)))
-                    if status != B.OK:
-                        break
-                if status != B.OK:
-                    out[name] = status
-                    break
-            else:
-                raise B.LibraryError(f"the C check accepts every probe of {name}; rebuild the library")
-    return out
-
-
-_FIELD_STATUS = _probe_statuses()
+# The status C gives a bad value of each field: the parameter table's (the cart-pole plant struct,
+# which has none, refuses any field with ICOAC_SIM_ERR_BAD_PLANT).
+_FIELD_STATUS = {**{name: row["status"] for name, row in B.PARAMS.items()},
+                 **{name: B.SIM_ERR_BAD_PLANT for name in PLANT_FIELDS}}
 
 
 def _bad(name: str, message: str) -> ConfigError:
@@ -581,7 +542,8 @@ def _designated(controller: B.Config, designator: str) -> str:
     for index in re.findall(r"\[([0-9]+)\]", m.group(2)):
         if isinstance(value, list) and int(index) < len(value):
             value = value[int(index)]
-    return f"{designator}={value!r}"
+    valid = B.range_text(B.PARAMS[m.group(1)], tuple(ENUMS[m.group(1)]) if m.group(1) in ENUMS else None)
+    return f"{designator}={value!r} (valid: {valid})"
 
 
 def _culprits(struct: ctypes.Structure, check_fn, default_fn) -> str:
@@ -742,9 +704,10 @@ def _controller_items(values: Mapping[str, Any], prefix: str = ""):
 
 
 def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
-    """Inverse of RunConfig.to_dict; also reads the flat controller dict of ABI-3 records (names
-    mapped through ALIASES). Groups may be partial (missing fields keep the C default); a field in
-    the wrong group, an unknown group or a malformed value raises ConfigError."""
+    """Inverse of RunConfig.to_dict. Groups may be partial (missing fields keep their default, as
+    in build_config: a run record is checked complete against harness.schema first, so its input
+    signs are its own); a field in the wrong group, an unknown group or a malformed value raises
+    ConfigError."""
     if not isinstance(data, Mapping):
         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"configuration must be a mapping, got {_short(data)}")
     unknown = [k for k in data if k not in GROUPS + ("prior",)]
@@ -778,12 +741,5 @@ def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
                 raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
                                   f"{_short(name)} is a {group_of(name)} parameter, not a {group} one")
             overrides.append((name, value))
-    names = {name for name, _ in overrides}
-    if "controller" in data and not names & set(LEARNER_FIELDS):
-        # a record from before the learners (ABI <= 5): its controller ran the literal reading
-        literal = parse_sets(NAMED_CONFIGURATIONS["literal"])
-        overrides = [(n, v) for n, v in literal.items() if n in LEARNER_FIELDS] + overrides
-    # a record's signs are its own (a record without them ran with +1): never derived again
-    cfg = build_config(dict(overrides), prior=prior_from_dict(data.get("prior")), check=False, plant=plant,
-                       derive_signs=False)
+    cfg = build_config(dict(overrides), prior=prior_from_dict(data.get("prior")), check=False, plant=plant)
     return cfg.check() if check else cfg

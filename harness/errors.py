@@ -37,3 +37,10 @@ class PriorError(HarnessError):
 
 class SweepError(UsageError):
     """A malformed sweep parameter list or sweep directory."""
+
+
+class MissingExtra(UsageError):
+    """A feature whose optional dependencies (an extra of the package) are not installed."""
+
+    def __init__(self, what: str, extra: str, exc: ImportError):
+        super().__init__(f"{what} needs the {extra!r} extra ({exc.name or exc}): pip install 'icoac-harness[{extra}]'")

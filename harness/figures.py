@@ -6,13 +6,18 @@ import math
 from pathlib import Path
 from typing import Mapping, Sequence
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib import colors  # noqa: E402
-from matplotlib.patches import Rectangle  # noqa: E402
+from .errors import MissingExtra
+
+try:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib import colors
+    from matplotlib.patches import Rectangle
+except ImportError as _exc:
+    raise MissingExtra("drawing figures", "plot", _exc) from None
 
 from . import _binding as B  # noqa: E402
 from . import geometry, metrics  # noqa: E402

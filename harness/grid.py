@@ -224,6 +224,31 @@ def check_coordinates(cells: np.ndarray) -> None:
         raise _bad_arg("cells must have finite x0 and theta0")
 
 
+class Checkpoints:
+    """The checkpoint policy of a running grid (the threaded engine's and the Dask backend's):
+    ``save(snapshot)`` at the first poll at which ``cells`` cells finished since the last save, or
+    ``every`` seconds passed since it and at least one cell finished. ``save`` None: never."""
+
+    def __init__(self, save: Callable[[np.ndarray], None] | None, every: float, cells: int):
+        self.save, self.every, self.cells = save, every, cells
+        self.saved = 0  # finished cells at the last save
+        self.last = time.monotonic()
+
+    def unsaved(self, finished: int) -> bool:
+        return self.save is not None and finished > self.saved
+
+    def poll(self, finished: int, snapshot: Callable[[], np.ndarray]) -> None:
+        """Save if the policy says so; ``finished``: cells finished so far."""
+        if self.unsaved(finished) and (finished - self.saved >= self.cells
+                                       or time.monotonic() - self.last >= self.every):
+            self.flush(finished, snapshot)
+
+    def flush(self, finished: int, snapshot: Callable[[], np.ndarray]) -> None:
+        self.save(snapshot())
+        self.saved = finished
+        self.last = time.monotonic()
+
+
 def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool = True,
              checkpoint: Callable[[np.ndarray], None] | None = None,
              checkpoint_every: float = DEFAULT_CHECKPOINT_EVERY,
@@ -284,8 +309,7 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
     bar = _Progress(cells.size, cells.size - pending, progress, desc)
     thread = threading.Thread(target=worker, name="icoac-grid", daemon=True)
     thread.start()
-    last_checkpoint = time.monotonic()
-    saved_cells = 0  # value of the finished-cells counter at the last checkpoint
+    checkpoints = Checkpoints(checkpoint, checkpoint_every, checkpoint_cells)
     user_cancelled = False
     try:
         while thread.is_alive():
@@ -298,13 +322,8 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
                 cancel[0] = 1
             if cancel_after is not None and now - t_start >= cancel_after and not cancel[0]:
                 cancel[0] = 1
-            finished = int(counters[B.PROGRESS_CELLS])
-            new = finished - saved_cells
-            if (checkpoint is not None and new > 0 and thread.is_alive()
-                    and (new >= checkpoint_cells or now - last_checkpoint >= checkpoint_every)):
-                checkpoint(finished_snapshot(cells))
-                saved_cells = finished
-                last_checkpoint = time.monotonic()
+            if thread.is_alive():
+                checkpoints.poll(int(counters[B.PROGRESS_CELLS]), lambda: finished_snapshot(cells))
     except KeyboardInterrupt:
         user_cancelled = True
         if progress:

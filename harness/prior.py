@@ -103,8 +103,7 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | str | None = DEFAULT
     the grid's central frame) that ICO balanced ("successful", the paper's) or that it finished
     ("finished": balanced or failed, its weights learned either way; harness.plants says which
     plant takes it), mean and sample cov + ridge*I."""
-    if not (math.isfinite(ridge) and ridge >= 0):
-        raise PriorError(f"prior ridge must be finite and >= 0, got {ridge}")
+    check_prior_ridge(ridge)
     if use not in PRIOR_CELLS:
         raise PriorError(f"prior cells must be one of {', '.join(PRIOR_CELLS)}, got {use!r:.40}")
     if frame == CENTRAL:
@@ -143,6 +142,15 @@ assert tuple(_MEANS) == MEAN_RULES and tuple(_COVS) == COV_RULES
 PRIOR_STD_RANGE = (1e-18, math.sqrt(B.constant("ICOAC_PRIOR_COV_MAX")))
 
 
+def check_prior_ridge(ridge: Any, what: str = "--prior-ridge") -> float:
+    """The ridge added to an ICO prior's covariance: in [0, ICOAC_PRIOR_COV_MAX] (a covariance the
+    controller takes); PriorError otherwise."""
+    hi = B.constant("ICOAC_PRIOR_COV_MAX")
+    if isinstance(ridge, bool) or not isinstance(ridge, (int, float)) or not 0 <= ridge <= hi:
+        raise PriorError(f"{what} must be a number in [0, {hi:g}], got {ridge!r:.40}")
+    return float(ridge)
+
+
 def check_prior_std(std: Any, what: str = "--prior-std") -> float:
     """std as a float in PRIOR_STD_RANGE; PriorError (one line) otherwise."""
     lo, hi = PRIOR_STD_RANGE
@@ -176,21 +184,22 @@ def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_
         extra["prior_std"] = float(std)
     if not from_ico:
         return PriorInfo(mean=mean, cov=cov, frame=None, n_cells=0, ridge=0.0, kind=condition, extra=extra)
+    origin = {key: value for key, value in ico.extra.items() if key.startswith("source_")}
     return PriorInfo(mean=mean, cov=cov, frame=ico.frame, n_cells=ico.n_cells, ridge=ico.ridge, kind=condition,
                      source=ico.source, source_commit=ico.source_commit, source_seed=ico.source_seed,
-                     ico_phase_simulated_time=ico.ico_phase_simulated_time, extra=extra)
+                     ico_phase_simulated_time=ico.ico_phase_simulated_time, extra={**origin, **extra})
 
 
 def from_results(path: str | Path, frame: tuple[float, float] | str | None = DEFAULT_FRAME,
                  ridge: float = DEFAULT_RIDGE, plant: str | None = None) -> PriorInfo:
-    """ICO->RL prior from an ICO results directory, with its provenance (its plant, condition and
-    learning flag) and ICO-phase simulated time. ``plant``: the plant the prior is for, which must
+    """ICO->RL prior from an ICO results directory, with its provenance (its plant, condition, task
+    description and learning flag: schema.PRIOR_ORIGIN) and ICO-phase simulated time. ``plant``: the plant the prior is for, which must
     be the ICO run's (None: whatever the run's is)."""
     path = Path(path)
     cells, record = results.load(path, what="--prior-from")
     if record.get("condition") != "ico":
         raise PriorError(f"--prior-from: {str(path)!r} holds condition {record.get('condition')!r}, not ico")
-    if record["config"].get("controller", {}).get("learn") == 0:
+    if not record["config"]["controller"]["learn"]:
         raise PriorError(f"--prior-from: {str(path)!r} is a run that did not learn (learn = 0), not an ICO prior")
     if not record.get("complete", False):
         raise PriorError(f"--prior-from: {str(path)!r} is incomplete (PENDING cells); finish it with --resume")
@@ -204,6 +213,7 @@ def from_results(path: str | Path, frame: tuple[float, float] | str | None = DEF
     info.source_seed = record.get("seed")
     info.ico_phase_simulated_time = float(np.sum(cells["elapsed_time"]))
     info.extra = {**info.extra, "source_plant": plant, "source_condition": "ico", "source_learn": 1,
+                  "source_task": record["config"]["controller"]["task"],
                   "source_cells": int(cells.size),
                   "source_success_rate": record.get("summary", {}).get("success_rate")}
     return info

@@ -1,11 +1,17 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Results directories: cells.npz (structured cell array) + run.json (provenance, config, summary)."""
+"""Results directories: cells.npz (structured cell array) + run.json (provenance, config, summary).
+
+run.json names the content hash of the cells it describes (``cells_sha256``, cells_digest). The
+results store writes run.json first and cells.npz second, so a run stopped between the two leaves
+a record that does not name its cells: reading such a directory is refused (StaleRecord) and a
+resumed run repairs it (store.ResultsStore.load). The summary of a record is recomputed from the
+cells it sits beside whenever a directory is read."""
 from __future__ import annotations
 
 import datetime as _dt
 import errno
+import hashlib
 import json
-import math
 import os
 import subprocess
 import zipfile
@@ -16,20 +22,23 @@ import numpy as np
 
 from . import _binding as B
 from . import geometry, metrics
+from .schema import FORMAT_VERSION, check_run_record
 from .config import CART_POLE, RunConfig, config_from_dict
 from .errors import ResultsError
 from .grid import make_cells, parse_cell_indices
-from .options import SEED_LIMIT
-from .registry import CONDITIONS
 
 CELLS_FILE = "cells.npz"
 RUN_FILE = "run.json"
-FORMAT_VERSION = 1
 MAX_JSON_BYTES = 16 * 2 ** 20   # run.json is a few KiB; refuse anything absurd before parsing
 
 
 def _err(message: str) -> ResultsError:
     return ResultsError(message)
+
+
+class StaleRecord(ResultsError):
+    """run.json does not describe the cells beside it: the run that wrote them stopped between its
+    two writes. Resuming the run repairs it."""
 
 
 def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
@@ -73,13 +82,16 @@ def build_entry(git: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def recorded_builds(record: Mapping[str, Any]) -> list[dict[str, Any]]:
-    """The ``builds`` of a run record; for a record written before the list existed, one entry
-    made of its ``git``, ``abi`` and ``timestamp`` (the build that wrote all its cells)."""
-    if isinstance(record.get("builds"), list):
-        return [dict(b) for b in record["builds"]]
-    git = record.get("git") or {}
-    return [{"commit": git.get("commit"), "dirty": git.get("dirty"), "abi": record.get("abi"),
-             "timestamp": record.get("timestamp")}]
+    """The ``builds`` of a run record."""
+    return [dict(b) for b in record["builds"]]
+
+
+def cells_digest(cells: np.ndarray) -> str:
+    """The content hash of a cell array: SHA-256 over its fields' bytes in order (padding excluded)."""
+    digest = hashlib.sha256()
+    for name in cells.dtype.names:
+        digest.update(np.ascontiguousarray(cells[name]).tobytes())
+    return digest.hexdigest()
 
 
 def make_record(cells: np.ndarray, cfg: RunConfig, *, condition: str, seed: int, wall_time: float, threads: int,
@@ -93,6 +105,7 @@ def make_record(cells: np.ndarray, cfg: RunConfig, *, condition: str, seed: int,
         "condition": condition,
         "seed": int(seed),
         "cells": cell_indices,
+        "cells_sha256": cells_digest(cells),
         "complete": bool(np.all(cells["outcome"] != B.PENDING)),
         "config": cfg.to_dict(),
         "git": {"commit": last.get("commit"), "dirty": last.get("dirty")},
@@ -134,24 +147,6 @@ def open_file(file: Path, follow: bool = True):
     return os.fdopen(fd, "rb")
 
 
-# The cell layout of the versions whose controller read 4 inputs (simulator ABI 2): read, and
-# widened to today's (the weights and covariance after the fourth input are 0, as the engine now
-# writes them for a 4-input task).
-_FOUR_INPUT_SHAPES = {"weights": (B.N_INPUTS,), "cov": (B.N_INPUTS, B.N_INPUTS)}
-FOUR_INPUT_CELL_DTYPE = np.dtype([(name, (np.float64, _FOUR_INPUT_SHAPES[name]) if name in _FOUR_INPUT_SHAPES
-                                   else B.CELL_DTYPE.fields[name][0]) for name in B.CELL_DTYPE.names], align=True)
-
-
-def _widened(old: np.ndarray) -> np.ndarray:
-    cells = np.zeros(old.shape, dtype=B.CELL_DTYPE)
-    for name in B.CELL_DTYPE.names:
-        if cells[name].ndim == 1:
-            cells[name] = old[name]
-    cells["weights"][:, :B.N_INPUTS] = old["weights"]
-    cells["cov"][:, :B.N_INPUTS, :B.N_INPUTS] = old["cov"]
-    return cells
-
-
 def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
     """The cell array of a cells.npz, read without trusting it: one member ``cells.npy`` whose
     header says a 1-D CELL_DTYPE array of at most GRID_CELLS cells and whose size matches.
@@ -173,7 +168,7 @@ def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
                     shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
                 else:
                     raise _err(f"{where}: unsupported .npy version {version}")
-                layout = FOUR_INPUT_CELL_DTYPE if dtype == FOUR_INPUT_CELL_DTYPE else B.CELL_DTYPE
+                layout = B.CELL_DTYPE
                 if dtype != layout:
                     raise _err(f"{where} has a different cell layout than this library "
                                f"({_dtype_difference(dtype)}); it was written by another version")
@@ -193,8 +188,7 @@ def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
         raise _err(f"cannot read {where}: {exc.strerror or exc}") from None
     except Exception as exc:  # any other decoding failure of untrusted bytes: zlib, EOF, header syntax
         raise _err(f"{where} is not a valid cells file ({type(exc).__name__}: {str(exc):.100})") from None
-    cells = np.frombuffer(data, dtype=layout).copy()
-    return cells if layout is B.CELL_DTYPE else _widened(cells)
+    return np.frombuffer(data, dtype=layout).copy()
 
 
 def _dtype_difference(dtype: np.dtype) -> str:
@@ -249,51 +243,19 @@ def check_cells(cells: np.ndarray, where: str = "cells", plant: str = CART_POLE)
                    f"not a point of {grid_name}")
 
 
-def _is_int(v: Any) -> bool:
-    return isinstance(v, int) and not isinstance(v, bool)
-
-
 def check_record(record: Any, where: str = RUN_FILE) -> dict[str, Any]:
-    """Shape of a run record (a run.json): required keys with the right types, a configuration the
-    C library accepts. Returns the record; raises ResultsError naming the first problem."""
-    if not isinstance(record, dict):
-        raise _err(f"{where}: expected a JSON object, got {type(record).__name__}")
-    missing = [k for k in ("condition", "seed", "cells", "config") if k not in record]
-    if missing:
-        raise _err(f"{where}: missing key(s) {', '.join(missing)}")
-    version = record.get("format_version", FORMAT_VERSION)
-    if version != FORMAT_VERSION:
-        raise _err(f"{where}: format_version {version!r:.40} is not {FORMAT_VERSION}")
-    if record["condition"] not in CONDITIONS:
-        raise _err(f"{where}: condition {record['condition']!r:.40} is not one of {', '.join(CONDITIONS)}")
-    seed = record["seed"]
-    if not _is_int(seed) or not 0 <= seed < SEED_LIMIT:
-        raise _err(f"{where}: seed {seed!r:.40} is not an integer in [0, 2^64)")
+    """A run record (a run.json) checked against the schema (harness.schema), its cell selection
+    parsed and its configuration accepted by the C library. Returns the record; raises
+    ResultsError naming the first problem."""
+    check_run_record(record, where)
     cells = record["cells"]
     if cells is not None:
-        if not isinstance(cells, list):
-            raise _err(f"{where}: cells must be null or a list of cell indices")
         try:
-            parsed = parse_cell_indices(cells)
+            parsed = parse_cell_indices(cells, geometry.of(record_plant(record)).cells)
         except B.ConfigError as exc:
             raise _err(f"{where}: cells: {exc}") from None
         if parsed != cells:
             raise _err(f"{where}: cells must be sorted and unique")
-    for key, kinds in (("git", (dict, type(None))), ("abi", (dict, type(None))), ("summary", dict),
-                       ("prior_info", (dict, type(None))), ("complete", bool), ("timestamp", str)):
-        if key in record and not isinstance(record[key], kinds):
-            raise _err(f"{where}: {key} has the wrong type ({type(record[key]).__name__})")
-    builds = record.get("builds", [{}])
-    if not isinstance(builds, list) or not builds or not all(
-            isinstance(b, dict) and isinstance(b.get("abi"), (dict, type(None))) for b in builds):
-        raise _err(f"{where}: builds must be a non-empty list of objects (commit, dirty, abi, timestamp)")
-    for key in ("wall_time", "threads"):
-        v = record.get(key, 0)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or v < 0 \
-                or (isinstance(v, float) and not math.isfinite(v)):
-            raise _err(f"{where}: {key} {v!r:.40} is not a number >= 0")
-    if not isinstance(record["config"], dict):
-        raise _err(f"{where}: config must be an object, got {type(record['config']).__name__}")
     try:
         config_from_dict(record["config"])
     except B.ConfigError as exc:
@@ -342,13 +304,26 @@ def check_results_dir(path: str | Path, what: str | None = None) -> Path:
 
 def load(path: str | Path, what: str | None = None, follow: bool = True) -> tuple[np.ndarray, dict[str, Any]]:
     """(cells, run record) of a results directory, both validated (check_results_dir, read_cells,
-    check_cells, read_record); every failure is a ResultsError. ``follow`` False: a results file
-    that is a symbolic link is refused (the results store reads the directory it writes so)."""
+    check_cells, read_record, check_cells_match) and the record naming these cells (StaleRecord
+    otherwise); its summary and completeness are recomputed from the cells. Every failure is a
+    ResultsError. ``follow`` False: a results file that is a symbolic link is refused (the
+    results store reads the directory it writes so)."""
     path = check_results_dir(path, what)
     record = read_record(path / RUN_FILE, follow)
     cells = read_cells(path / CELLS_FILE, follow)
     check_cells(cells, repr(str(path / CELLS_FILE)), record_plant(record))
-    return cells, record
+    check_cells_match(cells, record, repr(str(path / CELLS_FILE)))
+    if record["cells_sha256"] != cells_digest(cells):
+        lead = f"{what}: " if what else ""
+        raise StaleRecord(f"{lead}{str(path / RUN_FILE)!r} does not describe the cells beside it (the run that wrote "
+                          "them stopped between its two writes); resume that run with --resume to complete it")
+    return cells, with_summary(record, cells)
+
+
+def with_summary(record: Mapping[str, Any], cells: np.ndarray) -> dict[str, Any]:
+    """``record`` with its summary and completeness recomputed from ``cells``."""
+    return {**record, "complete": bool(np.all(cells["outcome"] != B.PENDING)),
+            "summary": metrics.summary(cells, geometry.of(record_plant(record)))}
 
 
 def check_cells_match(cells: np.ndarray, record: Mapping[str, Any], where: str = CELLS_FILE) -> None:

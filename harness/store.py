@@ -45,6 +45,7 @@ from . import _binding as B
 from . import results
 from .config import CART_POLE, RunConfig, config_from_dict
 from .errors import ResultsError, UsageError
+from .grid import make_cells
 
 LOCK_FILE = ".icoac.lock"
 # What a resumed run must share with the build that wrote the cells: anything else changes the
@@ -292,8 +293,8 @@ def check_resumable(record: Mapping[str, Any], *, condition: str, seed: int, cfg
     if record.get("cells") != cell_indices:
         diffs.append("cell selection differs")
     new = cfg.flat()
-    try:  # canonical names (an ABI-3 record's flat names map through the alias table)
-        old_cfg = config_from_dict(record.get("config", {}))
+    try:
+        old_cfg = config_from_dict(record["config"])
     except B.ConfigError as exc:
         raise ResultsError(f"recorded configuration: {exc}") from None
     old = old_cfg.flat()
@@ -315,11 +316,16 @@ class ResultsStore:
     """One results directory (cells.npz + run.json) held by one run::
 
         with ResultsStore(out) as store:
-            cells, record = store.load()      # existing results, if any
+            cells, record, stale = store.load()   # existing results, if any
             store.begin(record, fresh=False, git=results.git_info())
             store.save(cells, cfg, condition=..., seed=..., wall_time=..., threads=...)
 
-    ``start_over`` is the hint a refused directory's message gives (how to discard it)."""
+    The commit point of a checkpoint is run.json, which names the content hash of its cells
+    (results.cells_digest): save writes run.json, then cells.npz, and begin(fresh=True) removes
+    cells.npz, then run.json. So cells.npz never exists without a run.json of the same run, and a
+    run stopped between two writes leaves a record of that run beside its cells of the checkpoint
+    before (or none yet): load(repair=True) takes those cells, which the resumed run continues
+    and commits. ``start_over`` is the hint a refused directory's message gives."""
 
     def __init__(self, out: str | Path, what: str = "--out", start_over: str = "rerun with --overwrite"):
         self.out = check_out_dir(out, what)
@@ -337,37 +343,64 @@ class ResultsStore:
     def present(self) -> list[str]:
         return results.present(self.out)
 
-    def load(self) -> tuple[np.ndarray, dict[str, Any]]:
-        """The results in the directory, validated (results.load, no link followed), written by a
-        library of this ABI (check_build), the cells exactly the recorded selection; UsageError
-        with the start-over hint otherwise."""
+    def load(self, repair: bool = False) -> tuple[np.ndarray, dict[str, Any], bool]:
+        """(cells, record, stale) of the directory: validated (results.load, no link followed) and
+        written by a library of this ABI (check_build); UsageError with the start-over hint
+        otherwise. A record that does not name the cells beside it (a run stopped between two
+        writes, results.StaleRecord), or that has no cells yet, is refused unless ``repair``: then
+        the cells are those on disk (or the record's selection, all pending) and ``stale`` is True,
+        so that the caller commits them."""
+        run_file = self.out / results.RUN_FILE
         try:
-            cells, record = results.load(self.out, follow=False)
-            where = repr(str(self.out / results.RUN_FILE))
-            check_build(record, where)
-            results.check_cells_match(cells, record, repr(str(self.out / results.CELLS_FILE)))
+            try:
+                if self.present() == [results.RUN_FILE]:
+                    raise results.StaleRecord(f"{str(self.out)!r} holds {results.RUN_FILE} but no "
+                                              f"{results.CELLS_FILE} (the run stopped before writing its cells); "
+                                              "resume it with --resume")
+                cells, record = results.load(self.out, follow=False)
+                stale = False
+            except results.StaleRecord:
+                if not repair:
+                    raise
+                cells, record = self._repaired()
+                stale = True
+            check_build(record, repr(str(run_file)))
         except ResultsError as exc:
             raise UsageError(f"{exc} ({self.start_over} to discard these results and start over)") from None
-        return cells, record
+        return cells, record, stale
+
+    def _repaired(self) -> tuple[np.ndarray, dict[str, Any]]:
+        """The record and the cells of a run stopped between two writes (see the class)."""
+        record = results.read_record(self.out / results.RUN_FILE, follow=False)
+        plant = results.record_plant(record)
+        cells_file = self.out / results.CELLS_FILE
+        if results.CELLS_FILE in self.present():
+            cells = results.read_cells(cells_file, follow=False)
+            results.check_cells(cells, repr(str(cells_file)), plant)
+            results.check_cells_match(cells, record, repr(str(cells_file)))
+        else:
+            cells = make_cells(record["seed"], record["cells"], plant=plant)
+        return cells, results.with_summary(record, cells)
 
     def begin(self, previous: Mapping[str, Any] | None, *, fresh: bool, git: Mapping[str, Any]) -> None:
-        """Start this session's writes: ``fresh`` removes the results first (run.json first: an
-        interruption leaves a partial directory, which is refused later); the builds of the run
-        are those of ``previous`` (the record resumed, if any) and this one."""
+        """Start this session's writes: ``fresh`` removes the results first (cells.npz first; see
+        the class); the builds of the run are those of ``previous`` (the record resumed, if any)
+        and this one."""
         if fresh:
-            for name in (results.RUN_FILE, results.CELLS_FILE):
+            for name in (results.CELLS_FILE, results.RUN_FILE):
                 remove(self.out / name, self.lock.dir_fd)
         self.builds = (results.recorded_builds(previous) if previous is not None else []) + [results.build_entry(git)]
 
     def save(self, cells: np.ndarray, cfg: RunConfig, **fields) -> dict[str, Any]:
-        """Write cells.npz, then run.json (results.make_record of ``fields``); returns the record."""
+        """Commit a checkpoint: run.json (results.make_record of ``fields``, naming the cells' hash),
+        then cells.npz; returns the record."""
         if self.builds is None:
             raise RuntimeError("ResultsStore.save before begin")
         record = results.make_record(cells, cfg, builds=self.builds, **fields)
         buf = io.BytesIO()
         np.savez(buf, cells=cells)
-        write_bytes(self.out / results.CELLS_FILE, buf.getvalue(), self.lock.dir_fd)
         write_text(self.out / results.RUN_FILE, json.dumps(record, indent=2) + "\n", self.lock.dir_fd)
+        write_bytes(self.out / results.CELLS_FILE, buf.getvalue(), self.lock.dir_fd)
         return record
 
 

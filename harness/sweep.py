@@ -58,12 +58,10 @@ def parse_params(items: Sequence[str]) -> dict[str, list[Any]]:
             raise SweepError(f"--param {name}: no values")
         if name == "prior_frame" and any(v not in FRAME_NAMES for v in vals):
             raise SweepError(f"--param prior_frame: values must be {' or '.join(FRAME_NAMES)}")
-        if name == "prior_ridge" and any(isinstance(v, bool) or not isinstance(v, (int, float))
-                                         or not math.isfinite(v) or v < 0 for v in vals):
-            raise SweepError("--param prior_ridge: values must be finite numbers >= 0")
-        if name == "prior_std":
+        checks = {"prior_ridge": P.check_prior_ridge, "prior_std": P.check_prior_std}
+        if name in checks:
             try:
-                vals = [P.check_prior_std(v, "--param prior_std") for v in vals]
+                vals = [checks[name](v, f"--param {name}") for v in vals]
             except P.PriorError as exc:
                 raise SweepError(str(exc)) from None
         if name in out:

@@ -123,7 +123,7 @@ def evaluate_into(out: Path, w: Sequence[float], protocol: str, *, seed: int, in
     over.update(learn=0, max_trials=1 if protocol == "first" else max_trials, success_steps=success_steps)
     cells, record, cancelled = run_condition(
         condition="ico", out=out, seed=seed, threads=threads, overrides=over, cell_spec=indices,
-        resume=results.exists(out), progress=progress, info=FixedWeights(tuple(w), protocol),
+        resume=bool(results.present(out)), progress=progress, info=FixedWeights(tuple(w), protocol),
         start_over="use another --out", plant=plant)
     if cancelled:
         raise KeyboardInterrupt

@@ -49,6 +49,32 @@ def check_layout(env: gymnasium.Env, n_inputs: int = B.N_INPUTS) -> None:
                          "(for Gymnasium's CartPole-v1 use harness.gym.continuous_cartpole)")
 
 
+def env_plant(env: gymnasium.Env) -> str | None:
+    """The registry plant an env simulates: an icoac env's, the cart-pole for Gymnasium's
+    CartPole, None for any other env (its plant is not known)."""
+    from gymnasium.envs.classic_control.cartpole import CartPoleEnv
+
+    from .env import IcoacPlantEnv
+    from .plants import gym_name
+
+    inner = env.unwrapped
+    if isinstance(inner, CartPoleEnv):
+        return CART_POLE
+    if isinstance(inner, IcoacPlantEnv):
+        names = (B.plant_info(i)["name"] for i in range(int(B.lib.icoac_sim_plant_count())))
+        return next(name for name in names if gym_name(name) == inner.plant.name)
+    return None
+
+
+def check_plant(env: gymnasium.Env, plant: str) -> None:
+    """ValueError unless the env simulates ``plant`` (the plant the controller's task is for), when
+    the env's plant is known (env_plant)."""
+    other = env_plant(env)
+    if other is not None and other != plant:
+        raise ValueError(f"the policy's task is for the {plant}, but the env simulates the {other}; "
+                         f"build the policy with plant={other!r}")
+
+
 class IcoacPolicy:
     """A controller state initialised from ``config`` (a RunConfig: its controller and prior; e.g.
     harness.ceiling.fixed.fixed_config(w) for a fixed w) or else from ``condition``, ``overrides``,
@@ -118,6 +144,7 @@ class IcoacPolicy:
                     trace: bool = False) -> Episode:
         """One episode of env (reset with seed and options) under this controller, learning as
         the configuration says."""
+        check_plant(env, self.config.plant_name)
         check_layout(env, self.config.n_inputs)
         obs, reset_info = env.reset(seed=seed, options=options)
         self.reset()

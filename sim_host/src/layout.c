@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Constants and struct layouts exported for bindings (harness/_binding.py reads both tables
- * at import), so that sizes, enum values, statuses, grid geometry and field offsets are defined
- * once, in C. */
+/* Constants, struct layouts and parameter rows exported for bindings (harness/_binding.py reads
+ * the tables at import), so that sizes, enum values, statuses, grid geometry, field offsets and
+ * every parameter's description are defined once, in C. */
 #include <stddef.h>
 
 #include "icoac_sim/icoac_sim.h"
@@ -32,6 +32,9 @@ static const icoac_sim_constant_t constants[] = {
     CONSTANT(ICOAC_ACTOR_POSTERIOR),
     CONSTANT(ICOAC_ACTOR_MEAN),
     CONSTANT(ICOAC_ACTOR_GRADIENT),
+    CONSTANT(ICOAC_PARAM_ICO), /* the modes column of the parameter table */
+    CONSTANT(ICOAC_PARAM_RL),
+    CONSTANT(ICOAC_PARAM_SEARCH),
     CONSTANT(ICOAC_SEARCH_BATCH_MAX),
     CONSTANT(ICOAC_EXPLORE_TICKS_MAX),
     CONSTANT(ICOAC_REFLEX_UNIT),
@@ -95,46 +98,27 @@ static const icoac_sim_constant_t constants[] = {
 
 #define FIELD(type, member) {#type, #member, (uint32_t)offsetof(type, member), (uint32_t)sizeof(((type *)0)->member)}
 
+/* A parameter row's member designator in its struct (icoac_params.h, ICOAC_SIM_RUN_PARAMS). */
+#define MEMBER_config(f) f
+#define MEMBER_task(f) task.f
+#define MEMBER_policy(f) policy.f
+#define MEMBER_ico(f) ico.f
+#define MEMBER_critic(f) critic.f
+#define MEMBER_actor(f) actor.f
+#define MEMBER_search(f) search.f
+#define MEMBER_run(f) f
+#define MEMBER(group, field) MEMBER_##group(field)
+#define PARAM_FIELD(struct_type, group, field)                                                 \
+    {#struct_type, ICOAC_PARAM_PREFIX_##group #field, (uint32_t)offsetof(struct_type, MEMBER(group, field)), \
+     (uint32_t)sizeof(((struct_type *)0)->MEMBER(group, field))},
+#define CONFIG_FIELD(group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc) \
+    PARAM_FIELD(icoac_config_t, group, field)
+#define RUN_FIELD(group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc) \
+    PARAM_FIELD(icoac_sim_run_t, group, field)
+
 static const icoac_sim_field_t fields[] = {
-    FIELD(icoac_config_t, mode),
-    FIELD(icoac_config_t, learn),
-    FIELD(icoac_config_t, task.n_inputs),
-    FIELD(icoac_config_t, task.input_sign),
-    FIELD(icoac_config_t, task.late_source),
-    FIELD(icoac_config_t, task.n_rules),
-    FIELD(icoac_config_t, task.rule_input),
-    FIELD(icoac_config_t, task.rule_side),
-    FIELD(icoac_config_t, task.rule_threshold),
-    FIELD(icoac_config_t, task.rule_reflex),
-    FIELD(icoac_config_t, policy.input_range),
-    FIELD(icoac_config_t, policy.clip_inputs),
-    FIELD(icoac_config_t, policy.gain),
-    FIELD(icoac_config_t, policy.reflex_mode),
-    FIELD(icoac_config_t, policy.reflex_force),
-    FIELD(icoac_config_t, ico.rate),
-    FIELD(icoac_config_t, ico.timing),
-    FIELD(icoac_config_t, critic.rate),
-    FIELD(icoac_config_t, critic.discount),
-    FIELD(icoac_config_t, critic.td_clip),
-    FIELD(icoac_config_t, critic.range),
-    FIELD(icoac_config_t, critic.units),
-    FIELD(icoac_config_t, critic.threshold),
-    FIELD(icoac_config_t, critic.quirks),
-    FIELD(icoac_config_t, actor.noise_std),
-    FIELD(icoac_config_t, actor.scale),
-    FIELD(icoac_config_t, actor.forgetting),
-    FIELD(icoac_config_t, actor.reflex),
-    FIELD(icoac_config_t, actor.act_with_sample),
-    FIELD(icoac_config_t, actor.update),
-    FIELD(icoac_config_t, actor.rate),
-    FIELD(icoac_config_t, actor.likelihood_std),
-    FIELD(icoac_config_t, actor.batch),
-    FIELD(icoac_config_t, actor.explore_ticks),
-    FIELD(icoac_config_t, search.batch),
-    FIELD(icoac_config_t, search.elite_fraction),
-    FIELD(icoac_config_t, search.step),
-    FIELD(icoac_config_t, search.floor),
-    FIELD(icoac_config_t, search.cov_scale),
+    ICOAC_PARAMS(CONFIG_FIELD)
+    ICOAC_SIM_RUN_PARAMS(RUN_FIELD)
     FIELD(icoac_prior_t, mean),
     FIELD(icoac_prior_t, cov),
     FIELD(icoac_counters_t, ticks),
@@ -163,9 +147,6 @@ static const icoac_sim_field_t fields[] = {
     FIELD(icoac_sim_plant_t, theta_limit),
     FIELD(icoac_sim_plant_t, integrator),
     FIELD(icoac_sim_plant_t, reserved),
-    FIELD(icoac_sim_run_t, max_trials),
-    FIELD(icoac_sim_run_t, success_steps),
-    FIELD(icoac_sim_run_t, init_velocity_noise),
     FIELD(icoac_sim_cell_t, x0),
     FIELD(icoac_sim_cell_t, theta0),
     FIELD(icoac_sim_cell_t, seed),
@@ -227,6 +208,28 @@ static const icoac_sim_field_t fields[] = {
     FIELD(icoac_sim_model_t, dt),
     FIELD(icoac_sim_model_t, param),
 };
+
+#define PARAM_ROW(struct_type, group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc) \
+    {#struct_type, ICOAC_PARAM_PREFIX_##group #field, #group, #type, #dim, #check, unit, #tier, doc,           \
+     (double)(min), (double)(max), (double)(def), (uint32_t)(modes), (int32_t)(status),                     \
+     (uint32_t)offsetof(struct_type, MEMBER(group, field)), (uint32_t)sizeof(((struct_type *)0)->MEMBER(group, field))},
+#define CONFIG_ROW(group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc) \
+    PARAM_ROW(icoac_config_t, group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc)
+#define RUN_ROW(group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc) \
+    PARAM_ROW(icoac_sim_run_t, group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc)
+
+static const icoac_sim_param_row_t param_rows[] = {
+    ICOAC_PARAMS(CONFIG_ROW)
+    ICOAC_SIM_RUN_PARAMS(RUN_ROW)
+};
+
+const icoac_sim_param_row_t *icoac_sim_param_table(int32_t *count)
+{
+    if (count != 0) {
+        *count = (int32_t)(sizeof param_rows / sizeof param_rows[0]);
+    }
+    return param_rows;
+}
 
 const icoac_sim_constant_t *icoac_sim_constants(int32_t *count)
 {

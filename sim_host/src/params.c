@@ -1,34 +1,41 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Defaults and checks of the run parameters (ranges in icoac_sim.h); the cart-pole's own are in
- * plants/cart_pole.c. */
+/* Defaults and checks of the run parameters (their rows: ICOAC_SIM_RUN_PARAMS in icoac_sim.h);
+ * the cart-pole's own are in plants/cart_pole.c. */
 #include <math.h>
 
 #include "icoac_sim/icoac_sim.h"
 #include "sim_internal.h"
+
+#define RUN_DEFAULT(group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc) run->field = (def);
 
 void icoac_sim_run_default(icoac_sim_run_t *run)
 {
     if (run == 0) {
         return;
     }
-    run->max_trials = 100000;
-    run->success_steps = 100000;
-    run->init_velocity_noise = 1.0e-4;
+    ICOAC_SIM_RUN_PARAMS(RUN_DEFAULT)
 }
+
+/* A run row's check (the kinds of icoac_params.h that run rows use). */
+#define RUN_OK_at_least(v, lo, hi) ((v) >= (lo))
+#define RUN_OK_real_or_zero(v, lo, hi) ((v) == 0.0 || ((v) >= (lo) && (v) <= (hi)))
 
 int sim_velocity_noise_valid(double a)
 {
-    return a == 0.0 || (a >= ICOAC_SIM_NOISE_MIN && a <= ICOAC_SIM_NOISE_MAX);
+    return RUN_OK_real_or_zero(a, ICOAC_SIM_NOISE_MIN, ICOAC_SIM_NOISE_MAX);
 }
+
+#define RUN_CHECK(group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc) \
+    if (!RUN_OK_##check(run->field, min, max)) {                                              \
+        return status;                                                                        \
+    }
 
 int32_t icoac_sim_run_check(const icoac_sim_run_t *run)
 {
     if (run == 0) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
-    if (run->max_trials < 1 || run->success_steps < 1 || !sim_velocity_noise_valid(run->init_velocity_noise)) {
-        return ICOAC_SIM_ERR_BAD_RUN;
-    }
+    ICOAC_SIM_RUN_PARAMS(RUN_CHECK)
     return ICOAC_SIM_OK;
 }
 

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The constant and layout tables icoac_sim exports for bindings (sim_host/src/layout.c):
+/* The constant, layout and parameter tables icoac_sim exports for bindings (sim_host/src/layout.c):
  * non-empty, unique names, every field inside its type, the members of each struct listed
  * without overlap and covering it, and spot checks against this compiler's offsetof. */
 #include "test_common.h"
@@ -268,11 +268,77 @@ static void test_fields_spot_checks(void)
 void setUp(void) {}
 void tearDown(void) {}
 
+/* The parameter table: every row is a field of the layout table at the same place, names are
+ * unique, the columns are filled, and each scalar's default is what the default functions write. */
+static void test_param_table(void)
+{
+    int32_t n = 0;
+    const icoac_sim_param_row_t *rows = icoac_sim_param_table(&n);
+    icoac_config_t cfg;
+    icoac_sim_run_t run;
+    int32_t config_rows = 0;
+    int32_t i;
+    int32_t j;
+    icoac_config_default(&cfg);
+    icoac_sim_run_default(&run);
+    TEST_ASSERT_TRUE(n > 0);
+    for (i = 0; i < n; ++i) {
+        const icoac_sim_param_row_t *r = &rows[i];
+        const icoac_sim_field_t *f = find_field(r->type, r->name);
+        const unsigned char *base = strcmp(r->type, "icoac_config_t") == 0 ? (const unsigned char *)&cfg
+                                                                           : (const unsigned char *)&run;
+        TEST_ASSERT_EQUAL_UINT32(f->offset, r->offset);
+        TEST_ASSERT_EQUAL_UINT32(f->size, r->size);
+        TEST_ASSERT_TRUE(r->group[0] != '\0' && r->ctype[0] != '\0' && r->check[0] != '\0' && r->doc[0] != '\0');
+        TEST_ASSERT_TRUE(strcmp(r->tier, "essential") == 0 || strcmp(r->tier, "advanced") == 0);
+        TEST_ASSERT_TRUE(r->modes != 0u && (r->modes & ~(uint32_t)ICOAC_PARAM_ALL) == 0u);
+        TEST_ASSERT_TRUE(r->min <= r->max);
+        for (j = 0; j < i; ++j) {
+            TEST_ASSERT_TRUE_MESSAGE(strcmp(rows[j].name, r->name) != 0 || strcmp(rows[j].type, r->type) != 0, r->name);
+        }
+        if (strcmp(r->type, "icoac_config_t") == 0) {
+            ++config_rows;
+        }
+        if (strcmp(r->dim, "scalar") == 0) {
+            double value;
+            if (strcmp(r->ctype, "icoac_real_t") == 0) {
+                icoac_real_t v;
+                memcpy(&v, base + r->offset, sizeof v);
+                value = (double)v;
+            } else if (strcmp(r->ctype, "double") == 0) {
+                memcpy(&value, base + r->offset, sizeof value);
+            } else if (strcmp(r->ctype, "int64_t") == 0) {
+                int64_t v;
+                memcpy(&v, base + r->offset, sizeof v);
+                value = (double)v;
+            } else {
+                int32_t v;
+                memcpy(&v, base + r->offset, sizeof v);
+                value = (double)v;
+            }
+            TEST_ASSERT_TRUE_MESSAGE(value == r->def, r->name);
+        }
+    }
+    /* every member of icoac_config_t is a row (the layout table lists them from the rows too:
+     * count them against the struct's bytes, with float reals there is no padding) */
+    {
+        size_t bytes = 0;
+        for (i = 0; i < n; ++i) {
+            if (strcmp(rows[i].type, "icoac_config_t") == 0) {
+                bytes += rows[i].size;
+            }
+        }
+        TEST_ASSERT_TRUE(config_rows > 0);
+        TEST_ASSERT_TRUE(sizeof(icoac_config_t) - bytes < sizeof(icoac_real_t) * 2);
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_constants_table);
     RUN_TEST(test_fields_table);
     RUN_TEST(test_fields_spot_checks);
+    RUN_TEST(test_param_table);
     return UNITY_END();
 }

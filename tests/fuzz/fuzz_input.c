@@ -141,107 +141,36 @@ int64_t fz_i64(fz_reader_t *r)
 
 /* Config fields by index, in struct order (the order icoac_config_check walks them), every
  * array element of the default maxima (6 inputs, 6 rules): the member's offset and whether it is
- * an int32 (switch or count) or a real. Indices: 0 mode, 1 learn, 2 task.n_inputs,
- * 3-8 task.input_sign, 9 task.late_source, 10 task.n_rules, 11-16 task.rule_input,
- * 17-22 task.rule_side, 23-28 task.rule_threshold, 29-34 task.rule_reflex,
- * 35-40 policy.input_range, 41 policy.clip_inputs, 42 policy.gain, 43 policy.reflex_mode,
- * 44 policy.reflex_force, 45 ico.rate, 46 ico.timing, 47 critic.rate, 48 critic.discount,
- * 49 critic.td_clip, 50-55 critic.range, 56-61 critic.units, 62 critic.threshold,
- * 63 critic.quirks, 64 actor.noise_std, 65 actor.scale, 66 actor.forgetting, 67 actor.reflex,
- * 68 actor.act_with_sample, 69 actor.update, 70 actor.rate, 71 actor.likelihood_std,
- * 72 actor.batch, 73 actor.explore_ticks, 74 search.batch, 75 search.elite_fraction,
- * 76 search.step, 77 search.floor, 78 search.cov_scale. */
+ * an int32 (switch or count) or a real; made from the rows of icoac_params.h (0 mode, 1 learn,
+ * 2 task.n_inputs, 3-8 task.input_sign[0..5], ..., 11-16 task.rule_input[0..5], ...,
+ * 78 search.cov_scale). */
 typedef struct {
     size_t offset;
     int is_int;
 } config_field_t;
 
-#define FZ_INT(member) {offsetof(icoac_config_t, member), 1}
-#define FZ_REAL(member) {offsetof(icoac_config_t, member), 0}
+#define FZ_MEMBER_config(f) f
+#define FZ_MEMBER_task(f) task.f
+#define FZ_MEMBER_policy(f) policy.f
+#define FZ_MEMBER_ico(f) ico.f
+#define FZ_MEMBER_critic(f) critic.f
+#define FZ_MEMBER_actor(f) actor.f
+#define FZ_MEMBER_search(f) search.f
+#define FZ_IS_INT_int32_t 1
+#define FZ_IS_INT_icoac_real_t 0
+#define FZ_ELEM(member, is_int) {offsetof(icoac_config_t, member), is_int},
+#define FZ_ELEMS_scalar(member, is_int) FZ_ELEM(member, is_int)
+#define FZ_ELEMS_inputs(member, is_int)                                                                  \
+    FZ_ELEM(member[0], is_int) FZ_ELEM(member[1], is_int) FZ_ELEM(member[2], is_int)                    \
+    FZ_ELEM(member[3], is_int) FZ_ELEM(member[4], is_int) FZ_ELEM(member[5], is_int)
+#define FZ_ELEMS_rules(member, is_int) FZ_ELEMS_inputs(member, is_int)
+#define FZ_ELEMS(member, dim, is_int) FZ_ELEMS_##dim(member, is_int)
+#define FZ_ROW(group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc) \
+    FZ_ELEMS(FZ_MEMBER_##group(field), dim, FZ_IS_INT_##type)
 
 ICOAC_STATIC_ASSERT(ICOAC_MAX_INPUTS == 6 && ICOAC_MAX_RULES == 6, fz_tables_of_the_default_maxima);
 
-static const config_field_t config_fields[] = {
-    FZ_INT(mode),
-    FZ_INT(learn),
-    FZ_INT(task.n_inputs),
-    FZ_INT(task.input_sign[0]),
-    FZ_INT(task.input_sign[1]),
-    FZ_INT(task.input_sign[2]),
-    FZ_INT(task.input_sign[3]),
-    FZ_INT(task.input_sign[4]),
-    FZ_INT(task.input_sign[5]),
-    FZ_INT(task.late_source),
-    FZ_INT(task.n_rules),
-    FZ_INT(task.rule_input[0]),
-    FZ_INT(task.rule_input[1]),
-    FZ_INT(task.rule_input[2]),
-    FZ_INT(task.rule_input[3]),
-    FZ_INT(task.rule_input[4]),
-    FZ_INT(task.rule_input[5]),
-    FZ_INT(task.rule_side[0]),
-    FZ_INT(task.rule_side[1]),
-    FZ_INT(task.rule_side[2]),
-    FZ_INT(task.rule_side[3]),
-    FZ_INT(task.rule_side[4]),
-    FZ_INT(task.rule_side[5]),
-    FZ_REAL(task.rule_threshold[0]),
-    FZ_REAL(task.rule_threshold[1]),
-    FZ_REAL(task.rule_threshold[2]),
-    FZ_REAL(task.rule_threshold[3]),
-    FZ_REAL(task.rule_threshold[4]),
-    FZ_REAL(task.rule_threshold[5]),
-    FZ_REAL(task.rule_reflex[0]),
-    FZ_REAL(task.rule_reflex[1]),
-    FZ_REAL(task.rule_reflex[2]),
-    FZ_REAL(task.rule_reflex[3]),
-    FZ_REAL(task.rule_reflex[4]),
-    FZ_REAL(task.rule_reflex[5]),
-    FZ_REAL(policy.input_range[0]),
-    FZ_REAL(policy.input_range[1]),
-    FZ_REAL(policy.input_range[2]),
-    FZ_REAL(policy.input_range[3]),
-    FZ_REAL(policy.input_range[4]),
-    FZ_REAL(policy.input_range[5]),
-    FZ_INT(policy.clip_inputs),
-    FZ_REAL(policy.gain),
-    FZ_INT(policy.reflex_mode),
-    FZ_REAL(policy.reflex_force),
-    FZ_REAL(ico.rate),
-    FZ_INT(ico.timing),
-    FZ_REAL(critic.rate),
-    FZ_REAL(critic.discount),
-    FZ_REAL(critic.td_clip),
-    FZ_REAL(critic.range[0]),
-    FZ_REAL(critic.range[1]),
-    FZ_REAL(critic.range[2]),
-    FZ_REAL(critic.range[3]),
-    FZ_REAL(critic.range[4]),
-    FZ_REAL(critic.range[5]),
-    FZ_INT(critic.units[0]),
-    FZ_INT(critic.units[1]),
-    FZ_INT(critic.units[2]),
-    FZ_INT(critic.units[3]),
-    FZ_INT(critic.units[4]),
-    FZ_INT(critic.units[5]),
-    FZ_REAL(critic.threshold),
-    FZ_INT(critic.quirks),
-    FZ_REAL(actor.noise_std),
-    FZ_REAL(actor.scale),
-    FZ_REAL(actor.forgetting),
-    FZ_INT(actor.reflex),
-    FZ_INT(actor.act_with_sample),
-    FZ_INT(actor.update),
-    FZ_REAL(actor.rate),
-    FZ_REAL(actor.likelihood_std),
-    FZ_INT(actor.batch),
-    FZ_INT(actor.explore_ticks),
-    FZ_INT(search.batch),
-    FZ_REAL(search.elite_fraction),
-    FZ_REAL(search.step),
-    FZ_REAL(search.floor),
-    FZ_REAL(search.cov_scale),
-};
+static const config_field_t config_fields[] = {ICOAC_PARAMS(FZ_ROW)};
 
 ICOAC_STATIC_ASSERT(sizeof config_fields / sizeof config_fields[0] == FZ_CONFIG_FIELDS, fz_config_field_count);
 

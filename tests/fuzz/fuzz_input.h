@@ -21,7 +21,13 @@ typedef struct {
 #define FZ_VALUE_RAW 4      /* 36..39: raw bits of the value, little endian */
 #define FZ_VALUE_KINDS (FZ_VALUE_TABLE + FZ_VALUE_BOUNDED + FZ_VALUE_RAW)
 
-#define FZ_CONFIG_FIELDS 79 /* config mutation field indices 0..78, struct order: fuzz_input.c */
+/* Config mutation field indices, struct order, an index per array entry (fuzz_input.c): one per
+ * scalar row of icoac_params.h, ICOAC_MAX_INPUTS / ICOAC_MAX_RULES per array row (79). */
+#define FZ_COUNT_scalar 1
+#define FZ_COUNT_inputs ICOAC_MAX_INPUTS
+#define FZ_COUNT_rules ICOAC_MAX_RULES
+#define FZ_COUNT_ROW(group, field, type, dim, check, unit, min, max, def, modes, tier, status, doc) +FZ_COUNT_##dim
+#define FZ_CONFIG_FIELDS (0 ICOAC_PARAMS(FZ_COUNT_ROW))
 #define FZ_PRIOR_FIELDS 42  /* 0..5 mean, 6 + 6i + j cov[i][j] (ICOAC_MAX_INPUTS 6) */
 
 void fz_reader_init(fz_reader_t *r, const uint8_t *data, size_t size);

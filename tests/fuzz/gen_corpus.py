@@ -12,6 +12,7 @@ fuzz_state.c. Files named repro-* are known reproducers.
 import argparse
 import math
 import random
+import re
 import struct
 import sys
 from pathlib import Path
@@ -29,25 +30,28 @@ BOUNDED_SCALES = [1e-3, 1e-2, 0.1, 1.0, 3.0, 10.0, 100.0, 1e4]
 INT32_TABLE = [0, 1, 2, -1, 2**31 - 1, -2**31, 3]
 INT64_TABLE = [0, 1, 2, 3, -1, 300, 1000, 100000, 2**63 - 1, -2**63, 10]
 
-# icoac_config_t (icoac.h) with the default maxima (6 inputs, 6 rules), one group per concern:
-# (member, kind) with kind "i" an int32 (switch or count), "r" an icoac_real_t, "r6" / "i6" an
-# array of 6 of them, or a nested group.
+# icoac_config_t with the default maxima (6 inputs, 6 rules), one group per concern, read from the
+# rows of firmware/include/icoac/icoac_params.h: (member, kind) with kind "i" an int32 (switch or
+# count), "r" an icoac_real_t, "r6" / "i6" an array of 6 of them, or a nested group.
 MAX_INPUTS = 6
-CONFIG_LAYOUT = [
-    ("mode", "i"),
-    ("learn", "i"),
-    ("task", [("n_inputs", "i"), ("input_sign", "i6"), ("late_source", "i"), ("n_rules", "i"), ("rule_input", "i6"), ("rule_side", "i6"),
-              ("rule_threshold", "r6"), ("rule_reflex", "r6")]),
-    ("policy", [("input_range", "r6"), ("clip_inputs", "i"), ("gain", "r"), ("reflex_mode", "i"),
-                ("reflex_force", "r")]),
-    ("ico", [("rate", "r"), ("timing", "i")]),
-    ("critic", [("rate", "r"), ("discount", "r"), ("td_clip", "r"), ("range", "r6"), ("units", "i6"),
-                ("threshold", "r"), ("quirks", "i")]),
-    ("actor", [("noise_std", "r"), ("scale", "r"), ("forgetting", "r"), ("reflex", "i"),
-               ("act_with_sample", "i"), ("update", "i"), ("rate", "r"), ("likelihood_std", "r"),
-               ("batch", "i"), ("explore_ticks", "i")]),
-    ("search", [("batch", "i"), ("elite_fraction", "r"), ("step", "r"), ("floor", "r"), ("cov_scale", "r")]),
-]
+PARAMS_H = Path(__file__).resolve().parents[2] / "firmware" / "include" / "icoac" / "icoac_params.h"
+
+
+def config_layout():
+    layout, groups = [], {}
+    for group, field, ctype, dim in re.findall(r"^\s*X\((\w+), (\w+), (\w+), (\w+),", PARAMS_H.read_text(), re.M):
+        kind = ("i" if ctype == "int32_t" else "r") + ("" if dim == "scalar" else "6")
+        if group == "config":
+            layout.append((field, kind))
+        else:
+            if group not in groups:
+                groups[group] = []
+                layout.append((group, groups[group]))
+            groups[group].append((field, kind))
+    return layout
+
+
+CONFIG_LAYOUT = config_layout()
 # sizeof(icoac_config_t) with float and with double reals (x86-64 and AArch64 alignment).
 CONFIG_SIZES = {"f": 316, "d": 504}
 
@@ -72,7 +76,7 @@ def config_fields():
 # The mutation field indices of fuzz_input.c: struct order.
 CONFIG_FIELDS = [name for name, _ in config_fields()]
 CONFIG_INTS = {name for name, is_int in config_fields() if is_int}
-assert len(CONFIG_FIELDS) == 79
+assert CONFIG_FIELDS[:3] == ["mode", "learn", "task.n_inputs"], CONFIG_FIELDS[:3]  # the rows were found
 ZONE_THETA, ZONE_X = 0.20071286397934788, 2.35
 
 

@@ -300,9 +300,9 @@ def test_profile_gives_the_retries_the_learners_caps(tmp_path, extra, cap, horiz
     assert record["best"]["protocols"]["retries"]["max_trials"] == cap
 
 
-def test_prior_from_starts_the_search_at_the_ico_mean(tmp_path):
+def test_prior_from_starts_the_search_at_the_ico_mean(tmp_path, ico_dir):
     from harness import prior as P
-    ico = Path(__file__).resolve().parent / "fixtures" / "abi3_ico"
+    ico = Path(ico_dir)
     out = tmp_path / "p"
     res = run("ceiling", "--out", str(out), "--prior-from", str(ico), "--cells", "600-610", "--candidates", "3",
               "--screen-steps", "100", "--success-steps", "200", "--confirm", "1", "--protocol", "first", "--quiet")

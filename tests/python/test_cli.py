@@ -37,12 +37,17 @@ def run(*args, timeout=60):
     (["grid", "--condition", "rl", "--out", "{tmp}/a", "--prior-std", "1.35e154"], "--prior-std must be"),
     (["grid", "--condition", "rl", "--out", "{tmp}/a", "--prior-std", "2e6"], "--prior-std must be"),
     (["bench", "--profile", "quick", "--out", "{tmp}/b", "--prior-std", "1e20"], "--prior-std must be"),
-    (["sweep", "--prior-from", "tests/python/fixtures/abi3_ico", "--out", "{tmp}/s", "--param", "prior_std=1e200"],
+    (["bench", "--profile", "quick", "--out", "{tmp}/b", "--prior-ridge", "-1"], "--prior-ridge must be"),
+    (["bench", "--profile", "quick", "--out", "{tmp}/b", "--prior-ridge", "1e200"], "--prior-ridge must be"),
+    (["grid", "--condition", "ico-rl", "--prior-from", "{ico}", "--out", "{tmp}/a", "--prior-ridge", "1e40"],
+     "--prior-ridge must be"),
+    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/s", "--param", "prior_ridge=-1"], "--param prior_ridge must be"),
+    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/s", "--param", "prior_std=1e200"],
      "--param prior_std must be"),
     ([], "required"),
 ])
-def test_user_errors_one_line_exit_2(tmp_path, args, words):
-    res = run(*[a.format(tmp=tmp_path) for a in args])
+def test_user_errors_one_line_exit_2(tmp_path, ico_dir, args, words):
+    res = run(*[a.format(tmp=tmp_path, ico=ico_dir) for a in args])
     assert res.returncode == 2, res.stderr
     assert "Traceback" not in res.stderr and "Traceback" not in res.stdout
     lines = res.stderr.strip().splitlines()
@@ -109,3 +114,26 @@ def test_missing_library_is_one_line(tmp_path):
 def test_help_exits_zero():
     res = run("grid", "--help")
     assert res.returncode == 0 and "--set" in res.stdout and "--resume" in res.stdout
+
+
+@pytest.mark.parametrize("missing, args, words", [
+    ("matplotlib", ["figures", "--results", "{ico}", "--out", "{tmp}/f"],
+     "drawing figures needs the 'plot' extra (matplotlib): pip install 'icoac-harness[plot]'"),
+    ("matplotlib", ["bench", "--profile", "quick", "--out", "{tmp}/b", "--figures", "{tmp}/bf"], "'plot' extra"),
+    ("distributed", ["grid", "--out", "{tmp}/g", "--cells", "611", "--workers", "1"],
+     "the Dask backend (--workers, --scheduler) needs the 'dask' extra (distributed): pip install"),
+])
+def test_a_missing_extra_is_one_line_before_any_work(tmp_path, ico_dir, missing, args, words):
+    """Plotting and Dask are extras: without them, the commands that need them say which, in one
+    line (exit 2), and write nothing; every other command runs without them."""
+    code = (f"import sys; sys.modules[{missing!r}] = None\n"
+            "from harness.cli import main\nraise SystemExit(main(sys.argv[1:]))")
+    argv = [a.format(tmp=tmp_path, ico=ico_dir) for a in args]
+    res = subprocess.run([sys.executable, "-c", code, *argv], cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and words in lines[0], lines
+    assert not any(p.name in ("f", "b", "bf", "g") for p in tmp_path.iterdir())
+    grid = subprocess.run([sys.executable, "-c", code, "grid", "--out", str(tmp_path / "ok"), "--cells", "611",
+                           "--max-trials", "5", "--quiet"], cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert grid.returncode == 0, grid.stderr

@@ -36,10 +36,11 @@ def test_bad_values_raise_config_error_with_c_message(overrides, condition, stat
 
 
 def test_likelihood_std_zero_follows_the_noise():
-    """actor.likelihood_std 0 (the default) is accepted: sigma_L = sigma_u; the C message names
-    both forms of the range."""
+    """actor.likelihood_std 0 (the default) is accepted: sigma_L = sigma_u; a refusal names the
+    field and both forms of its range (from the C parameter table)."""
     assert build_config({"actor.likelihood_std": 0.0}, condition="rl").controller.actor.likelihood_std == 0.0
-    assert "likelihood_std 0 or [1e-3, 1e3]" in B.status_str(B.ERR_BAD_ACTOR)
+    with pytest.raises(B.ConfigError, match=r"actor\.likelihood_std=1e-05 \(valid: 0 or \[0\.001, 1000\]\)"):
+        build_config({"actor.likelihood_std": 1e-5}, condition="rl")
 
 
 def test_mode_checks_only_its_groups():

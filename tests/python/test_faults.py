@@ -100,6 +100,16 @@ def _del(key):
     return fn
 
 
+def _del_in(path, key):
+    def fn(rec):
+        node = rec
+        for k in path:
+            node = node[k]
+        del node[key]
+        return rec
+    return fn
+
+
 def _cells_edit(fn):
     def apply(d):
         c = load_cells(d)
@@ -138,13 +148,13 @@ CORRUPTIONS = {
     "cut inside the data": (lambda d: (d / "cells.npz").write_bytes((d / "cells.npz").read_bytes()[:-30]),
                             ["cells.npz"]),
     "cells.npz not a zip": (lambda d: (d / "cells.npz").write_bytes(b"\x93NUMPY garbage"), ["cells.npz"]),
-    "run.json [1,2]": (lambda d: (d / "run.json").write_text("[1, 2]"), ["run.json", "expected a JSON object"]),
-    "run.json {}": (lambda d: (d / "run.json").write_text("{}"), ["run.json", "missing key"]),
+    "run.json [1,2]": (lambda d: (d / "run.json").write_text("[1, 2]"), ["run.json", "[1, 2] is not of type 'object'"]),
+    "run.json {}": (lambda d: (d / "run.json").write_text("{}"), ["run.json", "format_version None is not 2"]),
     "run.json not JSON": (lambda d: (d / "run.json").write_text('{"seed": '), ["run.json", "not valid JSON"]),
-    "run.json config 5": (lambda d: edit_record(d, _set(["config"], 5)), ["config must be an object"]),
+    "run.json config 5": (lambda d: edit_record(d, _set(["config"], 5)), ["config: 5 is not of type 'object'"]),
     "run.json controller 5": (lambda d: edit_record(d, _set(["config", "controller"], 5)), ["controller"]),
-    "run.json no seed": (lambda d: edit_record(d, _del("seed")), ["missing key(s) seed"]),
-    "run.json no config": (lambda d: edit_record(d, _del("config")), ["missing key(s) config"]),
+    "run.json no seed": (lambda d: edit_record(d, _del("seed")), ["'seed' is a required property"]),
+    "run.json no config": (lambda d: edit_record(d, _del("config")), ["'config' is a required property"]),
     "run.json seed 2^64": (lambda d: edit_record(d, _set(["seed"], 2 ** 64)), ["seed"]),
     "run.json seed string": (lambda d: edit_record(d, _set(["seed"], "3")), ["seed"]),
     "run.json cells out of range": (lambda d: edit_record(d, _set(["cells"], [5000])), ["cells", "5000"]),
@@ -152,6 +162,12 @@ CORRUPTIONS = {
     "run.json gain -1": (lambda d: edit_record(d, _set(["config", "controller", "gain"], -1)), ["gain"]),
     "run.json dt NaN": (lambda d: edit_record(d, _set(["config", "plant", "dt"], float("nan"))), ["dt"]),
     "run.json wall_time string": (lambda d: edit_record(d, _set(["wall_time"], "x")), ["wall_time"]),
+    "run.json without a group": (lambda d: edit_record(d, _del_in(["config"], "run")), ["config: 'run' is a required"]),
+    "run.json empty config": (lambda d: edit_record(d, _set(["config"], {})), ["config: 'controller' is a required"]),
+    "run.json without a field": (lambda d: edit_record(d, _del_in(["config", "run"], "max_trials")),
+                                 ["config.run: 'max_trials' is a required"]),
+    "run.json unknown field": (lambda d: edit_record(d, _set(["config", "run", "max_trails"], 3)),
+                               ["config.run: Additional properties are not allowed ('max_trails'"]),
     "NaN cell coordinate": (_cells_edit(_x0_nan), ["cell 1", "x0 = nan"]),
     "unknown outcome": (_cells_edit(_outcome), ["unknown outcome 7"]),
     "negative trials": (_cells_edit(_field("trials", -3)), ["cell 2 has trials = -3"]),
@@ -236,14 +252,23 @@ def test_resume_then_succeeds_and_keeps_finished_cells(capsys, res):
 # -- one of the two files missing ----------------------------------------------------------------------
 @pytest.mark.parametrize("keep", ["cells.npz", "run.json"])
 def test_lone_results_file_is_not_replaced(capsys, res, keep):
+    """A lone cells.npz is never left by a run (run.json is written first): it is refused, resume
+    included. A lone run.json is what a run stopped before its first cells leaves: a new run is
+    refused, and --resume runs the recorded cells."""
     (res / ({"cells.npz", "run.json"} - {keep}).pop()).unlink()
     before = snapshot(res)
     rc, _, err = main(capsys, "grid", "--out", res, "--cells", "610-613", "--seed", SEED, *TINY_ARGS)
     assert_one_line_error(rc, err, keep, "--overwrite")
     assert snapshot(res) == before
     rc, _, err = main(capsys, "grid", "--out", res, "--resume", "--quiet")
-    assert_one_line_error(rc, err, keep)
-    assert snapshot(res) == before
+    if keep == "cells.npz":
+        assert_one_line_error(rc, err, keep, "no run leaves behind")
+        assert snapshot(res) == before
+    else:
+        assert rc == 0, err
+        ref = grid.make_cells(SEED, CELLS)
+        grid.run_grid(build_config(TINY), ref, threads=1, progress=False)
+        assert results.load(res)[0].tobytes() == ref.tobytes()
     # told to start over: a complete new result
     rc, _, err = main(capsys, "grid", "--out", res, "--cells", "611", "--seed", 9, "--overwrite", *TINY_ARGS)
     assert rc == 0, err

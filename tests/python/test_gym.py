@@ -337,11 +337,18 @@ def test_registry_plant_parameters_and_bad_input(env_id, plant):
             env.reset(options=bad)
 
 
-def test_policy_refuses_an_env_of_another_size():
-    with pytest.raises(ValueError, match="observation must be a Box of 4"):
+def test_policy_refuses_an_env_of_another_plant():
+    """A task is for one plant: a policy refuses any env of another, even of the same size."""
+    with pytest.raises(ValueError, match="task is for the cart_pole, but the env simulates the double_cart_pole"):
         hg.IcoacPolicy().run_episode(gymnasium.make("icoac/DoubleCartPole-v0"))
-    with pytest.raises(ValueError, match="observation must be a Box of 6"):
+    with pytest.raises(ValueError, match="task is for the double_cart_pole, but the env simulates the cart_pole"):
         hg.IcoacPolicy(plant="double_cart_pole").run_episode(gymnasium.make("icoac/CartPole-v0"))
+    with pytest.raises(ValueError, match="task is for the cart_pole, but the env simulates the furuta; build "
+                                         "the policy with plant='furuta'"):
+        hg.IcoacPolicy().run_episode(gymnasium.make("icoac/Furuta-v0"))
+    with pytest.raises(ValueError, match="task is for the furuta, but the env simulates the cart_pole"):
+        hg.IcoacPolicy(plant="furuta").run_episode(hg.continuous_cartpole())
+    assert hg.IcoacPolicy(plant="furuta").run_episode(gymnasium.make("icoac/Furuta-v0"), seed=1).steps > 0
 
 
 @pytest.mark.parametrize("env_id, plant", NEW_PLANTS.items())

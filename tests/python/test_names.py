@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Canonical names and their aliases, ABI-3 records (flat controller dict), and the import graph."""
+"""Canonical names and their aliases, and the import graph."""
 import json
 import shutil
 import subprocess
@@ -18,8 +18,6 @@ from harness.tools import imports
 
 REPO = Path(__file__).resolve().parents[2]
 FIXTURES = Path(__file__).resolve().parent / "fixtures"
-ABI3_ICO = FIXTURES / "abi3_ico"            # an ICO results directory written by the ABI-3 harness
-ABI3_ICORL = FIXTURES / "abi3_icorl_run.json"  # the ICO->RL run.json of the same bench, prior from ABI3_ICO
 
 # One non-default value per aliased field, valid in RL mode (every group the values touch is checked).
 VALUES = {
@@ -29,25 +27,6 @@ VALUES = {
     "critic_threshold": 0.0, "noise_std": 0.5, "actor_scale": 0.25, "forgetting": 0.999, "rl_reflex": False,
     "act_with_sample": True,
 }
-
-
-def test_alias_table_covers_the_abi3_names():
-    old = json.loads((ABI3_ICO / "run.json").read_text())["config"]["controller"]
-    assert set(old) - {"mode"} == set(ALIASES) | set(config.ZONE_ALIASES) == set(VALUES)
-    # every ABI-3 field has its alias (the zone's set the cart-pole task's rule thresholds);
-    # "learn" (the no-learning control), the learners' fields of ABI 6 (method.md, L2-L4, A10) and
-    # the task description of ABI 8 and its input signs (ABI 9) came after ABI 3 and have canonical names only
-    after_abi3 = {"mode", "learn", "critic.quirks", "actor.update", "actor.rate", "actor.likelihood_std",
-                  "actor.batch", "actor.explore_ticks", "search.batch", "search.elite_fraction", "search.step",
-                  "search.floor", "search.cov_scale", "task.n_inputs", "task.late_source", "task.n_rules",
-                  "task.rule_input", "task.rule_side", "task.rule_threshold", "task.rule_reflex", "critic.units",
-                  "task.input_sign"}
-    assert set(ALIASES.values()) & after_abi3 == set()
-    assert sorted(ALIASES.values()) == sorted(n for n in config.CONTROLLER_FIELDS if n not in after_abi3)
-    for alias, name in ALIASES.items():
-        assert canonical(alias) == canonical(name) == name
-    for name in ALL_FIELDS:
-        assert canonical(name) == name
 
 
 def test_zone_names_set_the_cartpole_rule_thresholds():
@@ -112,56 +91,6 @@ def test_rejection_names_the_c_field():
         build_config({"actor.forgetting": 0.25}, condition="rl")
     # ICO mode validates only the policy and ico groups (icoac_config_check)
     build_config({"actor.forgetting": 0.25}, condition="ico")
-
-
-# -- ABI-3 records ---------------------------------------------------------------------------------------
-def test_abi3_record_loads_with_the_same_configuration():
-    cells, record = results.load(ABI3_ICO)
-    assert record["abi"]["abi_version"] == 3 and "gain" in record["config"]["controller"]
-    cfg = results.load_config(record)
-    # a record from before the learners: their fields take the literal configuration's values (the
-    # record's own fields, sigma_u = 1 N among them, are those of the literal configuration too)
-    literal = parse_sets(named_sets("literal"))
-    assert cfg.to_dict() == build_config({"max_trials": 6000, "success_steps": 2000, **literal},
-                                         condition="ico").to_dict()
-    assert cfg.flat()["actor.update"] == "posterior" and cfg.flat()["actor.explore_ticks"] == 0
-    store.check_resumable(record, condition="ico", seed=record["seed"], cfg=cfg, cell_indices=record["cells"])
-    with pytest.raises(results.ResultsError, match=r"policy.gain 10.0 != 5.0"):
-        store.check_resumable(record, condition="ico", seed=record["seed"], cell_indices=record["cells"],
-                                cfg=build_config({"max_trials": 6000, "success_steps": 2000, "gain": 5}))
-    rl = json.loads(ABI3_ICORL.read_text())
-    rl_cfg = config_from_dict(rl["config"])
-    assert rl_cfg.controller.mode == B.MODE_RL and rl_cfg.prior is not None
-    assert config_from_dict(rl_cfg.to_dict()).to_dict() == rl_cfg.to_dict()
-
-
-def test_abi3_record_gives_the_same_prior():
-    rl = json.loads(ABI3_ICORL.read_text())
-    info = P.from_results(ABI3_ICO).to_dict()
-    for key in ("mean", "cov", "n_cells", "frame", "ridge", "ico_phase_simulated_time", "source_cells",
-                "source_success_rate"):
-        assert info[key] == rl["prior_info"][key], key
-
-
-def test_abi3_record_draws_figures(tmp_path):
-    cells, record = results.load(ABI3_ICO)
-    paths = figures.make_figures(cells, record, tmp_path / "fig", duration=2.0)
-    assert sorted(p.name for p in paths) == ["fig1b_success_map.png", "fig1cf_weights.png", "fig1g_trajectory.png"]
-
-
-def test_abi3_record_via_cli(tmp_path):
-    d = tmp_path / "old"
-    shutil.copytree(ABI3_ICO, d)
-    res = subprocess.run([sys.executable, "-m", "harness", "figures", "--results", str(d), "--out",
-                          str(tmp_path / "fig"), "--duration", "1"], cwd=REPO, capture_output=True, text=True,
-                         timeout=120)
-    assert res.returncode == 0, res.stderr
-    before = {p.name: p.read_bytes() for p in d.iterdir()}
-    res = subprocess.run([sys.executable, "-m", "harness", "grid", "--out", str(d), "--resume", "--quiet"],
-                         cwd=REPO, capture_output=True, text=True, timeout=120)
-    # readable, but not resumed: its cells were written by the ABI-3 library
-    assert res.returncode == 2 and "another ABI (abi_version 3, this library" in res.stderr, res.stderr
-    assert {p.name: p.read_bytes() for p in d.iterdir()} == before
 
 
 # -- import graph -----------------------------------------------------------------------------------------

@@ -37,7 +37,7 @@ def test_save_load_round_trip(tmp_path, small_cfg, small_run):
 
 def test_prior_recorded(tmp_path, small_run):
     cfg = build_config(SMALL, prior=make_prior([0.1, 0.05, 0.3, 0.08], np.eye(4) * 0.5))
-    store.save(tmp_path, small_run, cfg, condition="rl", seed=0, wall_time=0, threads=1)
+    store.save(tmp_path, small_run, cfg, condition="rl", seed=7, wall_time=0, threads=1, cell_indices=SMALL_CELLS)
     _, record = results.load(tmp_path)
     assert record["config"]["prior"]["mean"] == pytest.approx([0.1, 0.05, 0.3, 0.08])
     assert results.load_config(record).to_dict() == cfg.to_dict()

@@ -20,7 +20,6 @@ from harness.config import build_config
 from stepping import FAILED, REAL, controller, posterior, random_prior, random_state, reset, retune, scaled, stored, tick
 
 FIXTURES = Path(__file__).resolve().parent / "fixtures"
-ABI3_ICO = FIXTURES / "abi3_ico"  # an ICO results directory: the ico-search prior
 FLOAT = B.real_dtype == np.float32
 TINY = {"max_trials": 12, "success_steps": 300}
 
@@ -268,11 +267,11 @@ def test_deterministic_for_a_seed():
 
 
 @pytest.mark.parametrize("condition", ["ico-search", "search"])
-def test_no_learning_control_learns_nothing(condition):
+def test_no_learning_control_learns_nothing(condition, ico_dir):
     """The condition with learn = 0 (its no-learning control, method.md, L1): over a grid every cell ends
     with mu_w = the prior mean and Sigma_w = Sigma0 = c Sigma_prior exactly; tick by tick, full
     batches of failures change neither; the learning condition does change them."""
-    info = conditions.condition_prior(condition, ABI3_ICO if condition == "ico-search" else None,
+    info = conditions.condition_prior(condition, ico_dir if condition == "ico-search" else None,
                                       P.DEFAULT_FRAME, P.DEFAULT_RIDGE)
     prior = info.prior()
     over = {**TINY, "search.cov_scale": 2.0, "search.batch": 2}

@@ -7,8 +7,9 @@ import pytest
 
 from harness import _binding as B
 from harness import config as C
-from harness import signs
+from harness import grid, results, signs
 from harness.ceiling import lqr
+from harness.errors import ResultsError
 
 PLANTS = [B.plant_info(i)["name"] for i in range(int(B.lib.icoac_sim_plant_count()))]
 
@@ -72,7 +73,7 @@ def test_lqr_signs_of_a_mixed_pattern():
 
 def test_given_signs_switch_the_derivation_off():
     """task.input_sign given by any layer wins: a list, or one number for every input; a record's
-    signs are its own, and a record without them ran with +1."""
+    signs are its own, and a record without them is refused, never read as +1 or derived again."""
     plant = "double_cart_pole"
     assert list(C.build_config({"task.input_sign": 1}, plant=plant).controller.task.input_sign) == [1] * 6
     given = [1, -1, 1, -1, 1, -1]
@@ -81,9 +82,12 @@ def test_given_signs_switch_the_derivation_off():
     assert cfg.to_dict()["controller"]["task"]["input_sign"] == given
     assert list(C.config_from_dict(cfg.to_dict()).controller.task.input_sign) == given
     assert C.parse_sets(["task.input_sign=-1"]) == {"task.input_sign": -1}
-    record = C.build_config(plant=plant).to_dict()
-    del record["controller"]["task"]["input_sign"]
-    assert list(C.config_from_dict(record).controller.task.input_sign) == [1] * 6
+    record = results.make_record(grid.make_cells(indices=[0], plant=plant), cfg, condition="ico", seed=0,
+                                 wall_time=0.0, threads=1, builds=[results.build_entry({})], cell_indices=[0])
+    assert results.check_record(record) is record
+    del record["config"]["controller"]["task"]["input_sign"]
+    with pytest.raises(ResultsError, match=r"config\.controller\.task: 'input_sign' is a required property"):
+        results.check_record(record)
 
 
 @pytest.mark.parametrize("bad", [0, 2, [1, 1, 0, 1, 1, 1]])

@@ -127,7 +127,7 @@ def test_no_space_left_names_the_file(capsys, tmp_path, monkeypatch):
     out = tmp_path / "o"
     rc, _, err = main(capsys, "grid", "--out", out, *GRID)
     line = assert_one_line_error(rc, err, "No space left on device")
-    assert str(out / "cells.npz") in line, line
+    assert str(out / "run.json") in line, line  # the commit point of the second checkpoint
     results.load(out)  # the first (all PENDING) save is intact
     assert no_temporary_files(out)
 
@@ -235,10 +235,7 @@ def test_resume_of_another_abi_is_refused(capsys, partial, key, value):
     if B.abi_info()[key] == value:
         value = {"sizeof_real": 4, "critic_kernel": "dense"}.get(key, value)
 
-    def other(rec):
-        rec["abi"][key] = value
-        rec.pop("builds", None)  # a record written before the list of builds: abi is the only word
-    edit(partial, other)
+    edit(partial, lambda rec: rec["abi"].update({key: value}))
     before = snapshot(partial)
     rc, _, err = main(capsys, "grid", "--out", partial, "--resume", "--quiet")
     assert_one_line_error(rc, err, "another ABI", f"{key} {value!r}", f"this library {B.abi_info()[key]!r}")
@@ -246,21 +243,21 @@ def test_resume_of_another_abi_is_refused(capsys, partial, key, value):
 
 
 def test_resume_of_a_record_without_abi_is_refused(capsys, partial):
-    edit(partial, lambda rec: rec.update(abi=None, builds=[{"commit": None, "abi": None}]))
+    edit(partial, lambda rec: rec.update(abi=None))
     before = snapshot(partial)
     rc, _, err = main(capsys, "grid", "--out", partial, "--resume", "--quiet")
-    assert_one_line_error(rc, err, "no library ABI")
+    assert_one_line_error(rc, err, "abi: None is not of type 'object'")
     assert snapshot(partial) == before
 
 
 def test_resume_keeps_the_builds_that_wrote_the_cells(capsys, partial):
     old_commit = "0" * 40
 
-    def older(rec):  # another commit of the same ABI, recorded before the list of builds existed
+    def older(rec):  # another commit of the same ABI wrote the cells so far
         rec["git"] = {"commit": old_commit, "dirty": True}
         rec["abi"]["library"] = "/elsewhere/libicoac_sim.so"
-        rec["timestamp"] = "2020-01-01T00:00:00+00:00"
-        del rec["builds"]
+        rec["builds"] = [{"commit": old_commit, "dirty": True, "abi": rec["abi"],
+                          "timestamp": "2020-01-01T00:00:00+00:00"}]
     edit(partial, older)
     rc, _, err = main(capsys, "grid", "--out", partial, "--resume", "--quiet")
     assert rc == 0, err
@@ -270,8 +267,8 @@ def test_resume_keeps_the_builds_that_wrote_the_cells(capsys, partial):
                      "abi": dict(B.abi_info(), library="/elsewhere/libicoac_sim.so")}
     assert second["commit"] == results.git_info()["commit"] and second["abi"] == B.abi_info()
     assert record["git"] == {"commit": second["commit"], "dirty": second["dirty"]} and record["abi"] == B.abi_info()
-    # the list grows with every session that writes cells, and is never replaced
-    edit(partial, lambda rec: rec.update(complete=False))
+    # the list grows with every session that writes cells, and is never replaced (here the cells
+    # of an earlier checkpoint beside the last record, as a stop between two writes leaves them)
     cells = results.read_cells(partial / "cells.npz")
     grid.reset_pending(cells, np.arange(cells.size) == 3)
     np.savez(partial / "cells.npz", cells=cells)
@@ -285,10 +282,12 @@ def test_resume_keeps_the_builds_that_wrote_the_cells(capsys, partial):
     assert snapshot(partial) == before
 
 
-def test_old_records_stay_readable():
-    """A record without builds (every record before them) is read, its build recovered."""
-    rec = json.loads((REPO / "tests/python/fixtures/abi3_ico/run.json").read_text())
-    assert "builds" not in rec
+def test_old_records_are_refused_in_one_line(ico_dir):
+    """Before 1.0 an old record format is refused, never filled in from today's defaults."""
+    rec = json.loads((Path(ico_dir) / "run.json").read_text())
     results.check_record(rec)
-    assert results.recorded_builds(rec) == [{"commit": rec["git"]["commit"], "dirty": rec["git"]["dirty"],
-                                             "abi": rec["abi"], "timestamp": rec["timestamp"]}]
+    with pytest.raises(ResultsError, match=r"run.json: format_version 1 is not 2; this version reads only the records "):
+        results.check_record({**rec, "format_version": 1})
+    del rec["builds"]  # as every record before the list of builds
+    with pytest.raises(ResultsError, match=r"the record: 'builds' is a required property"):
+        results.check_record(rec)

@@ -11,6 +11,7 @@
 #ifndef ICOAC_H
 #define ICOAC_H
 
+#include "icoac_params.h"
 #include "icoac_rng.h"
 #include "icoac_types.h"
 
@@ -102,35 +103,24 @@ typedef enum {
 
 /* Configuration, one group per concern; a mode validates and uses only its groups (ICO:
  * task, policy, ico; RL: task, policy, critic, actor; search: task, policy, search). Integer switches are int32_t
- * so the layout is the same on every ABI. Ranges: the ICOAC_*_MIN / _MAX bounds above (search: its own
- * group). Arrays have room for ICOAC_MAX_INPUTS inputs or ICOAC_MAX_RULES rules; only the first
- * task.n_inputs or task.n_rules entries are checked and used. */
+ * so the layout is the same on every ABI. Every field's type, unit, range, default, modes and
+ * meaning: its row in icoac_params.h, which also makes the members below. Arrays have room for
+ * ICOAC_MAX_INPUTS inputs or ICOAC_MAX_RULES rules; only the first task.n_inputs or task.n_rules
+ * entries are checked and used. */
 
 /* Task: the plant's inputs and late signal (above). Defaults: the cart-pole (icoac_task_cartpole). */
 typedef struct {
-    int32_t n_inputs;                             /* n, [1, ICOAC_MAX_INPUTS]. 4 */
-    int32_t input_sign[ICOAC_MAX_INPUTS];         /* sign of each scaled input, +1 or -1. 1 */
-    int32_t late_source;                          /* icoac_late_source_t. rules */
-    int32_t n_rules;                              /* rules in the table, [0, ICOAC_MAX_RULES]. 4 */
-    int32_t rule_input[ICOAC_MAX_RULES];          /* input index, [0, n) */
-    int32_t rule_side[ICOAC_MAX_RULES];           /* icoac_rule_side_t */
-    icoac_real_t rule_threshold[ICOAC_MAX_RULES]; /* in the input's unit, |.| <= 1e6 */
-    icoac_real_t rule_reflex[ICOAC_MAX_RULES];    /* U of a match, [-1, 1] */
+    ICOAC_PARAMS_TASK(ICOAC_PARAM_MEMBER)
 } icoac_task_config_t;
 
 /* Policy: how the state becomes the feature z = w^T x~ and the force (every mode). */
 typedef struct {
-    icoac_real_t input_range[ICOAC_MAX_INPUTS]; /* s_i maps to +-1 at this value; [1e-6, 1e6]. 2.4, 3.5, 0.2094384, 2.0 */
-    int32_t clip_inputs;                      /* 1: clip scaled inputs to [-1, 1]; 0: no clip */
-    icoac_real_t gain;                        /* G (N per unit feature), [0, 1e4]. 10 */
-    int32_t reflex_mode;                      /* icoac_reflex_mode_t */
-    icoac_real_t reflex_force;                /* N per unit U in ICOAC_REFLEX_UNIT, [0, 1e4]. 1 */
+    ICOAC_PARAMS_POLICY(ICOAC_PARAM_MEMBER)
 } icoac_policy_config_t;
 
 /* ICO rule (ICOAC_MODE_ICO). */
 typedef struct {
-    icoac_real_t rate; /* mu, [0, 1]. 1e-4 */
-    int32_t timing;    /* icoac_ico_timing_t */
+    ICOAC_PARAMS_ICO(ICOAC_PARAM_MEMBER)
 } icoac_ico_config_t;
 
 /* Normalized-Gaussian critic (ICOAC_MODE_RL). Unit k of the grid is row-major over the inputs
@@ -138,31 +128,12 @@ typedef struct {
  * last inputs, from the first input m at which their product is <= 31, the rows the units of
  * inputs 0 .. m-1; the rows must be <= 31 too (ICOAC_CRITIC_BLOCK_MAX; the cart-pole: 9 x 18). */
 typedef struct {
-    icoac_real_t rate;                  /* eta_c, [0, 10]. 0.6 */
-    icoac_real_t discount;              /* gamma per tick, [0, 1]. 0.95 */
-    icoac_real_t td_clip;               /* |delta| limit, [1e-6, 1e3]. 1 */
-    icoac_real_t range[ICOAC_MAX_INPUTS]; /* grid half-widths (input units), [1e-6, 1e6]. 2.4, 3.5, 0.2094, 2.0 */
-    int32_t units[ICOAC_MAX_INPUTS];      /* units along each input, [1, 16]; their product <= ICOAC_MAX_CRITIC_UNITS
-                                             and splits into blocks (below). 3, 3, 6, 3 */
-    icoac_real_t threshold;             /* drop normalized activations below this, [0, 1). 0.001 (code); 0 = dense */
-    int32_t quirks;                     /* 1: the authors' code (A10): TD update on b(s_t+1), V_old = 0 at a
-                                           reset; 0: TD(0) on b(s_t), V(s_0) (default) */
+    ICOAC_PARAMS_CRITIC(ICOAC_PARAM_MEMBER)
 } icoac_critic_config_t;
 
 /* Actor and exploration (ICOAC_MODE_RL). Every reading observes u_ob = mu_u + alpha*delta*eps. */
 typedef struct {
-    icoac_real_t noise_std;      /* sigma_u (N), [1e-3, 1e3]. 3 (chosen by a sweep; literal: 1) */
-    icoac_real_t scale;          /* alpha, [0, 1e3]. 0.5 */
-    icoac_real_t forgetting;     /* lambda_f, [0.5, 1]. 1 (none); posterior reading only */
-    int32_t reflex;              /* 1: reflex added to the executed force; 0: off */
-    int32_t act_with_sample;     /* 1: act with a posterior sample of w per trial; 0: with mu_w */
-    int32_t update;              /* icoac_actor_update_t. gradient (chosen by a sweep; literal: posterior) */
-    icoac_real_t rate;           /* beta of the gradient reading, [0, 1e3]. 0.001 */
-    icoac_real_t likelihood_std; /* sigma_L (N) of the posterior and mean readings, [1e-3, 1e3], or 0: sigma_u
-                                    (literal). 0 */
-    int32_t batch;               /* 1: accumulate over a trial, one update at its terminal tick (A14); 0: per tick */
-    int32_t explore_ticks;       /* N: eps = 0 and no actor update from tick N of a trial on; 0: always explore
-                                    (literal). 1000 (10 s) */
+    ICOAC_PARAMS_ACTOR(ICOAC_PARAM_MEMBER)
 } icoac_actor_config_t;
 
 /* Episodic search over N(mu_w, Sigma_w) (ICOAC_MODE_SEARCH, method.md L4): each trial acts with one
@@ -170,18 +141,11 @@ typedef struct {
  * round(elite_fraction * batch) (at least 1) by length move mu_w and Sigma_w by `step`.
  * Defaults chosen by a sweep for the ICO prior (docs/results.md). */
 typedef struct {
-    int32_t batch;               /* K, trials per update, [1, ICOAC_SEARCH_BATCH_MAX]. 8 */
-    icoac_real_t elite_fraction; /* rho, (0, 1]; n_e = max(1, round half up(rho K)). 0.25 */
-    icoac_real_t step;           /* a, (0, 1]. 0.5 */
-    icoac_real_t floor;          /* f: Sigma_ii >= f * Sigma0_ii after each update, [1e-6, 1e3]. 1 */
-    icoac_real_t cov_scale;      /* c: Sigma0 = c * prior covariance, [1, 1e3]. 64 */
+    ICOAC_PARAMS_SEARCH(ICOAC_PARAM_MEMBER)
 } icoac_search_config_t;
 
 typedef struct {
-    int32_t mode;                 /* icoac_mode_t */
-    int32_t learn;                /* 1: learn (default); 0: every update off (w, Sigma_w, v fixed): the
-                                     no-learning control of a condition, or a fixed-w evaluation.
-                                     Acting, exploration noise and its random stream are unchanged */
+    ICOAC_PARAMS_CONFIG(ICOAC_PARAM_MEMBER)
     icoac_task_config_t task;
     icoac_policy_config_t policy;
     icoac_ico_config_t ico;

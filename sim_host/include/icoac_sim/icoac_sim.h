@@ -60,11 +60,20 @@ typedef struct {
     int32_t reserved;   /* 0 */
 } icoac_sim_plant_t;
 
-/* Benchmark protocol of one cell (method.md). */
+/* Benchmark protocol of one cell (method.md): one row per field, as the controller's
+ * (icoac_params.h, the same columns); its members, default, check and exported rows come from it. */
+#define ICOAC_PARAM_PREFIX_run ""
+/* clang-format off */
+#define ICOAC_SIM_RUN_PARAMS(X) \
+    X(run, max_trials, int64_t, scalar, at_least, "trial", 1, INT64_MAX, 100000, ICOAC_PARAM_ALL, essential, ICOAC_SIM_ERR_BAD_RUN, \
+      "trials before a cell counts as failed") \
+    X(run, success_steps, int64_t, scalar, at_least, "tick", 1, INT64_MAX, 100000, ICOAC_PARAM_ALL, essential, ICOAC_SIM_ERR_BAD_RUN, \
+      "ticks of one trial that make a success (1e5: 1000 s)") \
+    X(run, init_velocity_noise, double, scalar, real_or_zero, "state", ICOAC_SIM_NOISE_MIN, ICOAC_SIM_NOISE_MAX, 1.0e-4, ICOAC_PARAM_ALL, advanced, ICOAC_SIM_ERR_BAD_RUN, \
+      "a: the drawn start components (the cart-pole's velocities) ~ U(-a, a); 0: none")
+/* clang-format on */
 typedef struct {
-    int64_t max_trials;          /* trials before a cell counts as failed, >= 1. 1e5 */
-    int64_t success_steps;       /* steps of one trial that make a success, >= 1. 1e5 (1000 s) */
-    double init_velocity_noise;  /* initial x_dot, theta_dot ~ U(-a, a), a = 0 or [1e-12, 1e3]. 1e-4 */
+    ICOAC_SIM_RUN_PARAMS(ICOAC_PARAM_MEMBER)
 } icoac_sim_run_t;
 
 typedef enum {
@@ -144,9 +153,31 @@ typedef struct {
     uint32_t size;     /* sizeof the member */
 } icoac_sim_field_t;
 
+/* One parameter of the controller (a row of icoac_params.h) or of a run (ICOAC_SIM_RUN_PARAMS),
+ * with its place in its struct: what bindings, the command line and the docs know of it. */
+typedef struct {
+    const char *type;   /* its struct: "icoac_config_t" or "icoac_sim_run_t" */
+    const char *name;   /* member designator, e.g. "policy.gain", "max_trials" */
+    const char *group;  /* "config" (the top level), "task", ..., "search"; "run" */
+    const char *ctype;  /* "icoac_real_t", "int32_t", "int64_t", "double" */
+    const char *dim;    /* "scalar", "inputs" (ICOAC_MAX_INPUTS entries) or "rules" (ICOAC_MAX_RULES) */
+    const char *check;  /* real, real_open_lo, real_open_hi, real_or_zero, int, at_least, flag, choice, sign, index, units */
+    const char *unit;
+    const char *tier;   /* "essential" or "advanced" */
+    const char *doc;    /* one line */
+    double min;
+    double max;
+    double def;         /* default of a scalar (arrays: the task preset's) */
+    uint32_t modes;     /* ICOAC_PARAM_ICO | ICOAC_PARAM_RL | ICOAC_PARAM_SEARCH */
+    int32_t status;     /* status of a value the check refuses */
+    uint32_t offset;    /* offsetof(type, name) */
+    uint32_t size;      /* sizeof the member */
+} icoac_sim_param_row_t;
+
 /* Static tables; *count receives their length. */
 const icoac_sim_constant_t *icoac_sim_constants(int32_t *count);
 const icoac_sim_field_t *icoac_sim_fields(int32_t *count);
+const icoac_sim_param_row_t *icoac_sim_param_table(int32_t *count);
 
 /* One independent run of a cell from a fresh controller (prior NULL: icoac_init default). */
 int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
