@@ -32,7 +32,7 @@ DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.s
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
 ABI_VERSION = 8
-SIM_ABI_VERSION = 3
+SIM_ABI_VERSION = 4
 
 
 class IcoacError(HarnessError):
@@ -429,6 +429,18 @@ class Sweep(ctypes.Structure):
                 ("step", ctypes.c_double), ("degrees", ctypes.c_int32), ("reserved", ctypes.c_int32)]
 
 
+class Learner(ctypes.Structure):
+    """icoac_sim_learner_t: a plant's settings of some learning conditions (applied by C)."""
+    _fields_ = [("conditions", ctypes.c_char_p), ("apply", ctypes.c_void_p)]
+
+
+class PlantTask(ctypes.Structure):
+    """icoac_sim_task_t: the controller task a plant is benchmarked with (applied by C)."""
+    _fields_ = [("source", ctypes.c_char_p), ("apply", ctypes.c_void_p), ("n_learners", ctypes.c_int32),
+                ("paper", ctypes.c_int32), ("learners", ctypes.POINTER(Learner)),
+                ("prior_all_finished", ctypes.c_char_p)]
+
+
 class PlantDesc(ctypes.Structure):
     """icoac_sim_plant_desc_t: a registry plant (read only; its functions are opaque pointers)."""
     _fields_ = [
@@ -449,6 +461,7 @@ class PlantDesc(ctypes.Structure):
         ("derivatives", ctypes.c_void_p),
         ("failed", ctypes.c_void_p),
         ("energy", ctypes.c_void_p),
+        ("task", ctypes.POINTER(PlantTask)),
     ]
 
 
@@ -494,6 +507,8 @@ MIRRORS: dict[str, tuple[Mirror, str | None]] = {
     "icoac_sim_axis_t": (Axis, None),
     "icoac_sim_param_t": (Param, None),
     "icoac_sim_sweep_t": (Sweep, None),
+    "icoac_sim_learner_t": (Learner, None),
+    "icoac_sim_task_t": (PlantTask, None),
     "icoac_sim_plant_desc_t": (PlantDesc, None),
     "icoac_sim_model_t": (Model, None),
     "icoac_rng_t": (Rng, None),
@@ -634,6 +649,8 @@ _PROTOTYPES = {
     "icoac_sim_plant_count": ([], ctypes.c_int32),
     "icoac_sim_plant_info": ([ctypes.c_int32], _P(PlantDesc)),
     "icoac_sim_plant_find": ([ctypes.c_char_p], ctypes.c_int32),
+    "icoac_sim_plant_task": ([ctypes.c_int32, _P(Config)], ctypes.c_int32),
+    "icoac_sim_plant_learner": ([ctypes.c_int32, ctypes.c_char_p, _P(Config)], ctypes.c_int32),
     "icoac_sim_model_default": ([_P(Model), ctypes.c_int32], ctypes.c_int32),
     "icoac_sim_model_check": ([_P(Model)], ctypes.c_int32),
     "icoac_sim_model_from_plant": ([_P(Plant), _P(Model)], ctypes.c_int32),
@@ -739,7 +756,8 @@ def plant_index(name: str) -> int:
 def plant_info(plant: Union[int, str]) -> dict:
     """A registry plant's descriptor as plain data: name, title, source, input (name, unit),
     state [(name, unit)], params [{name, unit, value, min, max}], rows and cols of its grid
-    ({component, count, first, step, degrees}), start, drawn, observed, has_energy."""
+    ({component, count, first, step, degrees}), start, drawn, observed, has_energy, and its task
+    (None when it has none): {source, paper, learners (condition names), prior_all_finished}."""
     index = plant_index(plant) if isinstance(plant, str) else int(plant)
     ptr = lib.icoac_sim_plant_info(index)
     if not ptr:
@@ -758,7 +776,14 @@ def plant_info(plant: Union[int, str]) -> dict:
         "rows": sweep(d.rows), "cols": sweep(d.cols),
         "start": list(d.start[:n]), "drawn": [bool(v) for v in d.drawn[:n]], "observed": list(d.observed[:n]),
         "has_energy": bool(d.energy),
+        "task": _task_info(d.task.contents) if d.task else None,
     }
+
+
+def _task_info(t: PlantTask) -> dict:
+    return {"source": t.source.decode(), "paper": bool(t.paper),
+            "learners": [t.learners[i].conditions.decode().split() for i in range(t.n_learners)],
+            "prior_all_finished": t.prior_all_finished.decode() if t.prior_all_finished else None}
 
 
 def model_default(plant: Union[int, str], **params: float) -> Model:

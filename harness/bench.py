@@ -20,7 +20,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from . import figures, geometry, grid, metrics, results, store, tables
+from . import figures, geometry, grid, metrics, plants, results, store, tables
 from . import prior as P
 from .ceiling.records import bench_ceiling, load_ceiling, reference_lines
 from .ceiling.weights import format_w
@@ -28,8 +28,7 @@ from .conditions import run_condition
 from .config import build_config, command_overrides, named_sets
 from .errors import ResultsError
 from .metrics import percent
-from .options import PROFILE_NAMES
-from .plants import CART_POLE
+from .options import CART_POLE, PROFILE_NAMES
 from .registry import CONDITIONS, PRIOR_CONDITIONS, REGISTRY
 
 # Paper (Fig. 1b, 2b, 3a): ~68 % ICO, ~84 % ICO->RL; RL alone only "smaller" and "very slow" (Fig. 3 bars).
@@ -109,6 +108,11 @@ def _curves_and_quantiles(recs: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     return out
 
 
+def _paper_plant(plant: str) -> bool:
+    """Whether the paper's results apply to the plant's records (its C task says so)."""
+    return plants.PLANTS[plant].paper
+
+
 def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, Any]:
     """{condition: [run.json records over seeds]} -> mean/sd per statistic and condition."""
     out: dict[str, Any] = {}
@@ -120,7 +124,7 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, A
                                  "n_interior": recs[0]["summary"]["n_interior"],
                                  "max_trials": recs[0]["config"]["run"]["max_trials"],
                                  "success_steps": recs[0]["config"]["run"]["success_steps"],
-                                 "paper": PAPER.get(cond) if results.record_plant(recs[0]) == CART_POLE else None}
+                                 "paper": PAPER.get(cond) if _paper_plant(results.record_plant(recs[0])) else None}
         for key, _ in STATS:
             values = [r["summary"].get(key) for r in recs]
             mean, sd, n = _mean_sd(values)
@@ -213,10 +217,10 @@ def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None =
     lines += tables.curve_tables(agg, ceiling)
     lines += ["", f"Success rates use the cells run as denominator ({grid.cells} / {grid.n_interior} on "
               "the full grid)."]
-    if grid is geometry.CART_POLE:
+    if _paper_plant(grid.plant):
         lines[-1] += (f" The paper's ~{percent(PAPER['ico']['success_rate'], 0)} / "
                       f"~{percent(PAPER['ico-rl']['success_rate'], 0)} are read as fractions of all "
-                      f"{geometry.CELLS} cells.")
+                      f"{grid.cells} cells.")
     return "\n".join(lines) + "\n"
 
 
@@ -262,7 +266,7 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
         written.append(figures.plot_fig3a(figdir / "fig3a_success_rate.png", [REGISTRY[c].label for c in conds],
                                           [agg[c]["success_rate"] for c in conds],
                                           [agg[c]["success_rate_interior"] for c in conds],
-                                          [(PAPER.get(c) or {}).get("success_rate") for c in conds],
+                                          [(agg[c].get("paper") or {}).get("success_rate") for c in conds],
                                           ceiling=reference_lines(ceiling)))
         written.append(figures.plot_fig3b(figdir / "fig3b_elapsed_time.png", [REGISTRY[c].label for c in conds],
                                           [agg[c]["mean_elapsed_time_success"] for c in conds]))
@@ -347,7 +351,7 @@ class BenchOptions:
     prior_std: float = P.DEFAULT_STD
     ceiling: Path | None = None   # a ceiling.json (or its directory); default OUT/ceiling/ceiling.json
     dask: Any = None              # a harness.cluster.DaskSpec: every grid on that Dask cluster (None: threads)
-    plant: str = CART_POLE        # a plant of harness.plants: its grid, dynamics and task settings
+    plant: str = CART_POLE        # a registry plant (harness.plants): its grid, dynamics and task settings
 
     def seed_list(self) -> list[int]:
         n = self.seeds if self.seeds is not None else PROFILES[self.profile]["seeds"]

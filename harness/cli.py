@@ -111,7 +111,7 @@ _checkpoint_seconds = _positive_float(86400.0, "seconds in (0, 86400]")
 _duration = _positive_float(1e300, "a finite duration > 0 (s)")
 
 PLANT_HELP = ("registry plant (docs/plants.md; default cart_pole): its grid, dynamics and task settings "
-              "(harness/plants.py); its parameters by name through --set")
+              "(its C file, sim_host/src/plants/); its parameters by name through --set")
 SET_HELP = ("override a parameter (repeatable): NAME is group.field (policy.gain, ico.timing, critic.range, "
             "actor.noise_std, ...), a plant or run parameter (dt, integrator, max_trials, ...) or a flat "
             "alias (gain, ico_timing, noise_std, ...); reals must be finite and normal, integers must fit "

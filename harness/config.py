@@ -23,7 +23,8 @@ import numpy as np
 
 from . import _binding as B
 from . import geometry, literals, options
-from .plants import CART_POLE, spec as plant_spec
+from .options import CART_POLE
+from .plants import spec as plant_spec
 from .registry import CONDITIONS, REGISTRY
 from ._binding import ConfigError
 from .errors import UsageError
@@ -662,34 +663,42 @@ def check_prior(prior: B.Prior, n: int) -> None:
 # -- building and reading configurations ---------------------------------------------------------------
 def build_config(overrides: Mapping[str, Any] | None = None, condition: str | None = None,
                  prior: B.Prior | None = None, check: bool = True, plant: str = CART_POLE) -> RunConfig:
-    """C defaults, then the condition's overrides, then ``overrides`` by field name (canonical or
-    alias; a later name for the same field wins); validated by C. A registry plant other than the
+    """C defaults and the plant's task (its C file), then the condition's overrides and the plant's
+    settings of that learner, then ``overrides`` by field name (canonical or alias; a later name for
+    the same field wins); validated by C. A registry plant other than the
     cart-pole takes the overrides named after its parameters (and dt, integrator)."""
     if overrides is not None and not isinstance(overrides, Mapping):
         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"overrides must be a mapping name -> value, got {_short(overrides)}")
     if prior is not None and not isinstance(prior, B.Prior):
         raise ConfigError(B.ERR_BAD_PRIOR, f"prior must be an icoac_prior_t, got {type(prior).__name__}")
     cfg = RunConfig(prior=prior)
-    B.lib.icoac_config_default(ctypes.byref(cfg.controller))
+    spec = plant_spec(plant)
+    spec.task_config(cfg.controller)  # the C defaults, then the plant's task
     B.lib.icoac_sim_plant_default(ctypes.byref(cfg.plant))
     B.lib.icoac_sim_run_default(ctypes.byref(cfg.run))
-    items: list[tuple[Any, Any]] = list(plant_spec(plant).controller.items())  # the plant's task
+    condition_items: list[tuple[Any, Any]] = []
     if condition is not None:
         if not isinstance(condition, str) or condition not in CONDITION_OVERRIDES:
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
                               f"unknown condition {_short(condition)}; valid: {', '.join(CONDITIONS)}")
-        items += CONDITION_OVERRIDES[condition].items()
-        items += plant_spec(plant).learners.get(REGISTRY[condition].base, {}).items()
-    items += (overrides or {}).items()
+        condition_items = list(CONDITION_OVERRIDES[condition].items())
+    items = list((overrides or {}).items())
     if plant != CART_POLE:
         params = plant_params(plant)
         cfg.model = build_model(plant, {name: value for name, value in items if name in params})
         items = [(name, value) for name, value in items if name not in params]
-    for name, value in items:
-        name = canonical(name)
-        if cfg.model is not None and group_of(name) == "plant":
-            raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {plant} has no parameter {name}")
-        _set_field(cfg._struct(name), name, value)
+
+    def set_items(pairs: list[tuple[Any, Any]]) -> None:
+        for name, value in pairs:
+            name = canonical(name)
+            if cfg.model is not None and group_of(name) == "plant":
+                raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {plant} has no parameter {name}")
+            _set_field(cfg._struct(name), name, value)
+
+    set_items(condition_items)
+    if condition is not None:  # the plant's settings of the learner, over the condition's
+        spec.learner_config(REGISTRY[condition].base, cfg.controller)
+    set_items(items)
     if check:
         cfg.check()
     return cfg

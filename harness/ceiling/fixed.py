@@ -22,9 +22,8 @@ from .. import _binding as B
 from .. import geometry, grid, metrics, results
 from ..conditions import run_condition
 from ..config import RunConfig, build_config, make_prior, parse_sets
-from ..plants import CART_POLE
 from ..errors import LibraryError, UsageError
-from ..options import CEILING_MAX_TRIALS, CEILING_PROTOCOL_CHOICES, CEILING_PROTOCOLS
+from ..options import CART_POLE, CEILING_MAX_TRIALS, CEILING_PROTOCOL_CHOICES, CEILING_PROTOCOLS
 from .weights import as_weights, format_w, weights_key
 
 EVALS_DIR = "evals"   # OUT/evals/<w key>_<protocol>_h<steps>/: one results directory per evaluation

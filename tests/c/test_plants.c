@@ -369,6 +369,65 @@ static void test_energy_conserved(void)
 void setUp(void) {}
 void tearDown(void) {}
 
+/* 1 when word is one of the space-separated words of list. */
+static int listed(const char *list, const char *word)
+{
+    const size_t n = strlen(word);
+    while (*list != '\0') {
+        const size_t len = strcspn(list, " ");
+        if (len == n && strncmp(list, word, n) == 0) {
+            return 1;
+        }
+        list += len + (list[len] == ' ');
+    }
+    return 0;
+}
+
+/* Every plant's task is a configuration the controller accepts, with one input per state
+ * component; its learner settings keep it valid and apply to exactly the conditions they name. */
+static void test_task_presets(void)
+{
+    static const char *const conditions[] = {"ico", "ico-rl", "ico-mean-rl", "rl-ico-cov", "rl", "ico-search",
+                                             "search", "rl-ico"};
+    const int32_t n = icoac_sim_plant_count();
+    icoac_config_t cfg, before;
+    int32_t i, k;
+    size_t c;
+    for (i = 0; i < n; ++i) {
+        const icoac_sim_plant_desc_t *d = plant(i);
+        if (d->task == NULL) {
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_task(i, &cfg));
+            continue;
+        }
+        TEST_ASSERT_TRUE(strlen(d->task->source) > 0 && d->task->n_learners >= 0);
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(i, &cfg));
+        TEST_ASSERT_EQUAL_INT(d->n_state, cfg.task.n_inputs);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&cfg));
+        for (c = 0; c < sizeof conditions / sizeof conditions[0]; ++c) {
+            int named = 0;
+            for (k = 0; k < d->task->n_learners; ++k) {
+                named += listed(d->task->learners[k].conditions, conditions[c]);
+            }
+            before = cfg;
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_learner(i, conditions[c], &cfg));
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&cfg));
+            TEST_ASSERT_TRUE(named <= 1);
+            if (named == 0) { /* "ico" or "rl-ico" only inside another name: no match */
+                TEST_ASSERT_EQUAL_MEMORY(&before, &cfg, sizeof cfg);
+            }
+        }
+    }
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_task(n, &cfg));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_learner(-1, "rl", &cfg));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_task(0, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_learner(0, NULL, &cfg));
+    /* the cart-pole's task is the controller's defaults */
+    icoac_config_default(&before);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(ICOAC_SIM_CART_POLE, &cfg));
+    TEST_ASSERT_EQUAL_MEMORY(&before, &cfg, sizeof cfg);
+    TEST_ASSERT_EQUAL_INT(1, plant(ICOAC_SIM_CART_POLE)->task->paper);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -380,5 +439,6 @@ int main(void)
     RUN_TEST(test_grids);
     RUN_TEST(test_trial_start);
     RUN_TEST(test_energy_conserved);
+    RUN_TEST(test_task_presets);
     return UNITY_END();
 }

@@ -1,16 +1,18 @@
 # SPDX-License-Identifier: Apache-2.0
 """The benchmark on registry plants (harness --plant): configurations and records by plant, the
 plant's grid in every metric and map, the task settings and their sweep, refusals by name."""
+import ctypes
 import json
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from harness import _binding as B
-from harness import cli, geometry, grid, metrics, plants, results
+from harness import cli, config, geometry, grid, metrics, plants, results
 from harness import prior as P
 from harness.config import build_config, config_from_dict
 from harness.tools import plant_sweeps
@@ -47,16 +49,28 @@ def test_furuta_config_has_its_task_and_learner_settings():
     cfg = build_config(condition="ico-rl", plant="furuta", overrides={"pendulum_damping": 1e-4, "dt": 0.005})
     d = cfg.to_dict()
     assert d["plant"]["name"] == "furuta" and d["plant"]["pendulum_damping"] == 1e-4 and d["plant"]["dt"] == 0.005
-    task = plants.task_overrides("furuta", plants.FURUTA_SETTING)
-    assert np.allclose(d["controller"]["policy"]["input_range"][:4], task["policy.input_range"], rtol=1e-6)
-    assert math.isclose(d["controller"]["ico"]["rate"], plants.FURUTA_SETTING["ico.rate"], rel_tol=1e-6)
-    assert d["controller"]["actor"]["noise_std"] == plants.PLANTS["furuta"].learners["ico-rl"]["actor.noise_std"]
+    task = B.Config()
+    plants.spec("furuta").task_config(task)
+    assert bytes(task.policy) == bytes(cfg.controller.policy) and bytes(task.task) == bytes(cfg.controller.task)
+    assert B.plant_info("furuta")["task"]["learners"] == [["ico-rl", "ico-mean-rl"], ["rl", "rl-ico-cov"]]
+    assert cfg.controller.actor.noise_std == 1.0 and build_config(condition="ico-rl").controller.actor.noise_std != 1.0
     # the control takes its learner's noise; a user's --set wins over both
     ctrl = build_config(condition="ico-rl-control", plant="furuta", overrides={"policy.gain": 2})
     assert ctrl.to_dict()["controller"]["actor"]["noise_std"] == d["controller"]["actor"]["noise_std"]
     assert ctrl.controller.policy.gain == 2
     # the record reads back to the same configuration
     assert config_from_dict(d).to_dict() == d
+
+
+def test_a_plant_without_a_task_is_refused(monkeypatch):
+    bare = replace(plants.PLANTS["furuta"], task_source=None)
+    monkeypatch.setitem(plants.PLANTS, "furuta", bare)
+    with pytest.raises(B.ConfigError, match="plant furuta has no controller task"):
+        build_config(plant="furuta")
+    # C refuses it too: an index out of the registry has no task
+    cfg = B.Config()
+    assert B.lib.icoac_sim_plant_task(B.lib.icoac_sim_plant_count(), ctypes.byref(cfg)) == B.SIM_ERR_BAD_PLANT
+    assert B.lib.icoac_sim_plant_learner(-1, b"rl", ctypes.byref(cfg)) == B.SIM_ERR_BAD_PLANT
 
 
 @pytest.mark.parametrize("overrides, words", [
@@ -150,14 +164,22 @@ def test_sweep_ranking_and_the_furuta_choice():
             {"key": "b", "seed": "0", "success_rate": "0.295", "median_trials": "100"},
             {"key": "c", "seed": "0", "success_rate": "0.10", "median_trials": ""}]
     assert [r["key"] for r in plant_sweeps.ranked(rows)] == ["b", "a", "c"]  # within one point: fewer trials
-    # the settings in harness/plants.py are the choice its sweep's summary records
-    text = (REPO / "docs" / "sweeps-furuta.md").read_text()
-    choice = re.search(r"## Choice\s+`([^`]+)`", text).group(1)
-    assert plant_sweeps.setting_of(choice) == plants.FURUTA_SETTING
-    for learner, settings in plants.PLANTS["furuta"].learners.items():
-        if learner in plant_sweeps.LEARNER_SPACE:
-            picked = re.search(rf"## Learner {learner}: .*?Choice: `([^`]+)`", text, re.S).group(1)
-            assert json.loads(picked) == settings
+    # each swept plant's C task is the choice its sweep's summary records, and its learner settings
+    # the learner sweeps' choices
+    for plant in plant_sweeps.TASK_SPACES:
+        text = (REPO / "docs" / f"sweeps-{plant}.md").read_text()
+        choice = plant_sweeps.setting_of(re.search(r"## Choice\s+`([^`]+)`", text).group(1))
+        swept = B.Config()
+        B.lib.icoac_config_default(ctypes.byref(swept))
+        for name, value in plant_sweeps.task_overrides(plant, choice).items():
+            config._set_field(swept, config.canonical(name), value)
+        task = B.Config()
+        plants.spec(plant).task_config(task)
+        assert bytes(task) == bytes(swept), plant
+        for learner in set(plants.PLANTS[plant].learners) & set(plant_sweeps.LEARNER_SPACE):
+            picked = json.loads(re.search(rf"## Learner {learner}: .*?Choice: `([^`]+)`", text, re.S).group(1))
+            assert build_config(picked, condition=learner, plant=plant).to_dict() == \
+                build_config(condition=learner, plant=plant).to_dict()
 
 
 def test_figures_and_sweep_take_the_recorded_plant(capsys, tmp_path):
