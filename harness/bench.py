@@ -40,11 +40,8 @@ PAPER = {
 # The learners after ICO and its prior, in stage order.
 LEARNERS = PRIOR_CONDITIONS
 
-# Spread subset for smoke tests: rows (theta0 + 12 deg) x columns ((x0 + 2.4) / 0.1); includes
-# Fig. 1g's start (row 8, column 19) and enough central cells for a prior.
-QUICK_ROWS = (2, 8, 10, 12, 14, 22)
-QUICK_COLS = (4, 19, 22, 24, 26, 44)
-QUICK_CELLS = sorted(int(geometry.cell_index(r, c)) for r in QUICK_ROWS for c in QUICK_COLS)
+# The profiles' cells on a plant's grid: all (None), or a spread subset for smoke tests.
+QUICK_CELLS = geometry.PlantGrid.quick_cells
 
 PROFILES: dict[str, dict[str, Any]] = {
     # ICO at the paper's caps (1e5 trials, 1e5 steps), the learners' conditions with a 1000-trial
@@ -370,8 +367,8 @@ def stages(opt: BenchOptions) -> list[Stage]:
     ico_sets = command_overrides(opt.configuration, opt.sets, plant=opt.plant)
     rl_sets = command_overrides(opt.configuration, opt.sets, {"--rl-max-trials": ("max_trials", opt.rl_max_trials)},
                                 plant=opt.plant)
-    cells_spec = profile["cells"]
     plant_grid = geometry.of(opt.plant)
+    cells_spec = profile["cells"](plant_grid) if profile["cells"] else None
     frame = plant_grid.central_frame() if opt.frame == P.CENTRAL else opt.frame
 
     def overrides(condition):

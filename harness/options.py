@@ -28,7 +28,7 @@ DEFAULT_CHECKPOINT_EVERY = 2.0
 # (load balance, small loss when a worker dies) and a chunk is still seconds of C work.
 AUTO_CHUNKS_PER_THREAD = 8
 AUTO_CHUNK_MAX = 16
-MAX_CHUNK_CELLS = 1225           # at most the paper grid's cells per chunk
+MAX_CHUNK_CELLS = 1225           # at most this many cells per chunk (the paper grid's)
 MAX_WORKERS = 1024               # --workers N: 1 .. MAX_WORKERS local worker processes
 DASK_RETRIES = 3                 # retries of a chunk whose task raised (a dead worker is Dask's allowed-failures)
 DASK_CONNECT_TIMEOUT = 30.0      # s to reach a scheduler

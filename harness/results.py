@@ -154,7 +154,7 @@ def _widened(old: np.ndarray) -> np.ndarray:
 
 def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
     """The cell array of a cells.npz, read without trusting it: one member ``cells.npy`` whose
-    header says a 1-D CELL_DTYPE array of at most GRID_CELLS cells and whose size matches.
+    header says a 1-D CELL_DTYPE array of at most geometry.MAX_CELLS cells and whose size matches.
     Anything else (truncated, empty, not a zip, other dtype or shape) raises ResultsError, and
     so does a symbolic link unless ``follow``."""
     file = Path(file)
@@ -177,8 +177,8 @@ def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
                 if dtype != layout:
                     raise _err(f"{where} has a different cell layout than this library "
                                f"({_dtype_difference(dtype)}); it was written by another version")
-                if len(shape) != 1 or not 1 <= shape[0] <= B.GRID_CELLS:
-                    raise _err(f"{where}: expected 1 to {B.GRID_CELLS} cells, got shape {shape}")
+                if len(shape) != 1 or not 1 <= shape[0] <= geometry.MAX_CELLS:
+                    raise _err(f"{where}: expected 1 to {geometry.MAX_CELLS} cells, got shape {shape}")
                 nbytes = shape[0] * layout.itemsize
                 if info.file_size != fh.tell() + nbytes:
                     raise _err(f"{where}: size {info.file_size} does not match its header ({shape[0]} cells)")
@@ -274,7 +274,7 @@ def check_record(record: Any, where: str = RUN_FILE) -> dict[str, Any]:
         if not isinstance(cells, list):
             raise _err(f"{where}: cells must be null or a list of cell indices")
         try:
-            parsed = parse_cell_indices(cells)
+            parsed = parse_cell_indices(cells, geometry.MAX_CELLS)
         except B.ConfigError as exc:
             raise _err(f"{where}: cells: {exc}") from None
         if parsed != cells:

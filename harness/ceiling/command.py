@@ -68,7 +68,7 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
     max_trials = _positive("--max-trials", opt.max_trials)
     overrides = check_overrides(opt.sets, opt.plant)
     try:
-        indices = grid.parse_cell_indices(opt.cells)
+        indices = grid.parse_cell_indices(opt.cells, geometry.of(opt.plant).cells)
     except B.ConfigError as exc:
         raise UsageError(f"--cells: {exc}") from None
     n_inputs = geometry.of(opt.plant).n_inputs

@@ -100,7 +100,7 @@ def evaluate(w: Sequence[float], protocol: str = "first", *, seed: int = 0, cell
     one grid run of fixed_config. KeyboardInterrupt if cancelled."""
     cfg = fixed_config(w, protocol, max_trials=max_trials, success_steps=success_steps, overrides=overrides,
                        plant=plant)
-    arr = grid.make_cells(seed, grid.parse_cell_indices(cells), plant=plant)
+    arr = grid.make_cells(seed, grid.parse_cell_indices(cells, geometry.of(plant).cells), plant=plant)
     res = grid.run_grid(cfg, arr, threads=threads, progress=False)
     if res.cancelled:
         raise KeyboardInterrupt

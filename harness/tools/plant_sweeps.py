@@ -12,7 +12,7 @@ within one point of the best are ordered by fewer median trials to success.
 Stage 1 draws SAMPLES settings from the plant's space (TASK_SPACES; a seeded generator,
 so the same settings every time)
 and runs ICO on the 36 spread cells of the quick profile, seed 0. Stage 2 runs the best
-STAGE_2_TOP of stage 1 on 49 cells evenly over the grid, seeds 0 and 1; stage 3 varies one
+STAGE_2_TOP of stage 1 on the grid's spread cells (one per column; 49 on a 25 x 49 grid), seeds 0 and 1; stage 3 varies one
 parameter at a time over its values around stage 2's best, on the same cells and seeds. The
 choice is the best of stages 2 and 3. Every stage resumes (finished settings are skipped);
 --report writes summary.md (docs/sweeps-<plant>.md).
@@ -21,7 +21,7 @@ The learners (``--stage learners --prior-from ICO_DIR``, an ICO grid of the plan
 task settings): the scale of their exploration noise is in the plant's input unit (N, V), and the
 actor reading each took from the cart-pole's sweeps may not carry over. Each actor-critic learner
 (LEARNER_SPACE) runs its own reading at four noise scales and the other learner's reading at three,
-on at most LEARNER_FAILED cells the ICO grid failed (evenly thinned) and on the 49 spread cells,
+on at most LEARNER_FAILED cells the ICO grid failed (evenly thinned) and on the grid's spread cells,
 2 seeds, cap 1000 trials, as the cart-pole's learner sweeps; criterion fixed before the runs:
 success on the ICO-failed cells, ties within one point by the spread cells, then fewer median
 trials.
@@ -41,16 +41,14 @@ from typing import Any
 import numpy as np
 
 from .. import _binding as B
-from .. import grid, metrics, results, store
-from ..bench import QUICK_CELLS
+from .. import geometry, grid, metrics, results, store
 from ..config import build_config
-from ..sweep import DEFAULT_CELLS, SweepOptions, run_sweep
+from ..sweep import SweepOptions, run_sweep
 
 SAMPLES = 80
 STAGE_2_TOP = 5
 MAX_TRIALS = 20000
 SUCCESS_STEPS = 2000
-SPREAD_CELLS = DEFAULT_CELLS  # 49 cells evenly over a 25 x 49 grid
 FIELDS = ["key", "seed", "cells", "success_rate", "median_trials", "wall_time"]
 LEARNER_SPACE = {"ico-rl": ("actor.noise_std", (0.1, 0.3, 1.0, 3.0)),
                  "rl": ("actor.noise_std", (0.3, 1.0, 3.0, 12.0))}
@@ -234,6 +232,7 @@ def _trials(median: float) -> str:
 
 
 def report(plant: str, out: Path) -> Path:
+    plant_grid = geometry.of(plant)
     s1, s2, s3 = (ranked(read_rows(out / f"stage{i}.csv")) for i in (1, 2, 3))
     final = ranked(read_rows(out / "stage2.csv") + read_rows(out / "stage3.csv"))
     lines = [f"# The {plant}'s task settings: sweep", "",
@@ -243,9 +242,10 @@ def report(plant: str, out: Path) -> Path:
              f"Space: {', '.join(f'{n} in {list(v)}' for n, v in space(plant))}; the angles are scaled to their "
              "failure limits and the critic grid spans the same ranges (TASK_SPACES in harness/tools/plant_sweeps.py "
              "says how a setting becomes the controller's task). Stage 1: "
-             f"{SAMPLES} settings drawn from it (seeded), ICO on the quick profile's {len(QUICK_CELLS)} spread cells, "
+             f"{SAMPLES} settings drawn from it (seeded), ICO on the quick profile's "
+             f"{len(plant_grid.quick_cells())} spread cells, "
              f"seed 0, cap {MAX_TRIALS} trials, success {SUCCESS_STEPS} steps. Stage 2: the best {STAGE_2_TOP} "
-             f"on {len(SPREAD_CELLS)} cells evenly over the grid, seeds 0 and 1, same caps. Stage 3: one "
+             f"on {len(plant_grid.spread_cells())} cells evenly over the grid, seeds 0 and 1, same caps. Stage 3: one "
              "parameter at a time over its values around stage 2's best, same cells, seeds and caps. The choice "
              "is the best of stages 2 and 3 by the criterion.", ""]
     for title, rows in (("Stages 2 and 3, ranked together", final), ("Stage 3", s3), ("Stage 2", s2),
@@ -261,7 +261,7 @@ def report(plant: str, out: Path) -> Path:
                   f"On the plant's ICO grid of seed 0 at the chosen task settings (`--stage learners`): each "
                   "actor-critic learner at its own reading (from the cart-pole's sweeps) and four exploration "
                   f"noise scales, and at the other learner's reading and noise {list(OTHER_READING_NOISE)}, on at "
-                  f"most {LEARNER_FAILED} cells that grid failed (evenly thinned) and on the {len(SPREAD_CELLS)} "
+                  f"most {LEARNER_FAILED} cells that grid failed (evenly thinned) and on the {len(plant_grid.spread_cells())} "
                   f"spread cells, 2 seeds, cap {LEARNER_MAX_TRIALS} trials. Readings: "
                   + "; ".join(f"{r}: {', '.join(f'{k}={v}' for k, v in s.items())}" for r, s in READINGS.items())
                   + ". Criterion, fixed before the runs: success on the ICO-failed cells; within one point, the "
@@ -288,11 +288,11 @@ def report(plant: str, out: Path) -> Path:
 def learner_cells(ico_dir: Path) -> dict[str, list[int]]:
     """The learner sweeps' cell sets: the ICO-failed cells (at most LEARNER_FAILED, evenly thinned)
     and the spread cells."""
-    cells, _ = results.load(ico_dir, what="--prior-from")
+    cells, record = results.load(ico_dir, what="--prior-from")
     failed = np.flatnonzero(cells["outcome"] == B.FAILED)
     if failed.size > LEARNER_FAILED:
         failed = failed[np.round(np.linspace(0, failed.size - 1, LEARNER_FAILED)).astype(int)]
-    return {"ico-failed": [int(i) for i in failed], "spread": SPREAD_CELLS}
+    return {"ico-failed": [int(i) for i in failed], "spread": geometry.of(results.record_plant(record)).spread_cells()}
 
 
 def _other(condition: str) -> str:
@@ -349,18 +349,20 @@ def main(argv=None) -> int:
     p.add_argument("--report", action="store_true", help="only write summary.md")
     args = p.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
+    plant_grid = geometry.of(args.plant)
     if args.stage == "learners" and not args.report:
         if args.prior_from is None:
             p.error("--stage learners needs --prior-from ICO_DIR")
         run_learners(args.prior_from, args.out)
     elif not args.report:
         if args.stage in ("1", "all"):
-            run_stage(args.plant, args.out / "stage1.csv", samples(args.plant), [0], list(QUICK_CELLS))
+            run_stage(args.plant, args.out / "stage1.csv", samples(args.plant), [0], plant_grid.quick_cells())
         if args.stage in ("2", "all"):
             top = [setting_of(r["key"]) for r in ranked(read_rows(args.out / "stage1.csv"))[:STAGE_2_TOP]]
-            run_stage(args.plant, args.out / "stage2.csv", top, [0, 1], SPREAD_CELLS)
+            run_stage(args.plant, args.out / "stage2.csv", top, [0, 1], plant_grid.spread_cells())
         if args.stage in ("3", "all"):
-            run_stage(args.plant, args.out / "stage3.csv", one_at_a_time(args.plant, args.out), [0, 1], SPREAD_CELLS)
+            run_stage(args.plant, args.out / "stage3.csv", one_at_a_time(args.plant, args.out), [0, 1],
+                      plant_grid.spread_cells())
     print(report(args.plant, args.out))
     return 0
 

@@ -16,6 +16,8 @@ from gymnasium.utils.env_checker import check_env
 
 import harness.gym as hg
 from harness import _binding as B
+from harness import geometry
+from harness.gym import plants as gym_plants
 from harness.ceiling.fixed import fixed_config
 from harness.config import build_config
 from harness.grid import run_cell, trajectory
@@ -239,7 +241,9 @@ def test_readme_example_prints_what_the_readme_shows():
 
 
 # -- the registry plants served through the model API ----------------------------------------------------
-NEW_PLANTS = {"icoac/Furuta-v0": "furuta", "icoac/DoubleCartPole-v0": "double_cart_pole"}
+# Every registry plant but the cart-pole (tested above), by env id.
+NEW_PLANTS = {f"icoac/{gym_plants.gym_name(name)}-v0": name for name in
+              (B.plant_info(i)["name"] for i in range(B.lib.icoac_sim_plant_count())) if name != "cart_pole"}
 
 
 def c_model_start(model, plant, cell, grid_seed, noise):
@@ -275,7 +279,8 @@ def test_registry_plant_spaces_from_the_descriptor_and_check_env(env_id, plant):
 def test_zero_action_episode_equals_the_c_model(env_id, plant):
     """From a tilted grid cell, an episode under zero input = icoac_sim_model_step from the same
     start, bit for bit, and it terminates where icoac_sim_model_failed first says so."""
-    cell, grid_seed = 100, 7  # row 2: the pendulum 10 deg from upright
+    g = geometry.of(plant)
+    cell, grid_seed = int(g.cell_index(min(2, g.rows - 1), min(2, g.cols - 1))), 7  # row 2: 10 deg from upright
     env = gymnasium.make(env_id)
     obs, info = env.reset(options={"cell": cell, "grid_seed": grid_seed})
     model = B.model_default(plant)
@@ -349,11 +354,13 @@ def test_plant_episodes_equal_the_engine_trial_loop(env_id, plant):
     """IcoacPolicy with a plant's task settings on its env = the engine's cell run on the plant's
     model: same trial lengths, same learned weights (no initial velocity noise, so that every trial
     of the engine starts where the env's reset puts it)."""
-    trials, horizon, cell = 10, 300, 269  # the row component at -7 deg, the column's at 0
+    g = geometry.of(plant)
+    trials, horizon = 10, 300
+    cell = int(g.cell_index(min(5, g.rows - 1), g.cols // 2))  # the row component at -7 deg, the column's at 0
     cfg = build_config({"max_trials": trials, "success_steps": horizon, "init_velocity_noise": 0}, plant=plant)
     n = len(B.plant_info(plant)["state"])
     assert hg.IcoacPolicy(condition="ico", plant=plant).weights.shape == (n,)
-    cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
+    cells = np.zeros(g.cells, dtype=B.CELL_DTYPE)
     B.check_status(B.lib.icoac_sim_plant_grid(B.plant_index(plant), cells, cells.size, 0))
     seed = int(cells[cell]["seed"])
     engine = run_cell(cfg, cells[cell]["x0"], cells[cell]["theta0"], seed=seed)

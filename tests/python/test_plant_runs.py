@@ -121,6 +121,7 @@ def test_prior_frame_of_the_plant():
     col_deg, row_deg = np.degrees(cells["x0"]), np.degrees(cells["theta0"])
     inside = (np.abs(col_deg) <= 45.0 + 1e-9) & (np.abs(row_deg) <= 6.0 + 1e-9)
     assert info.n_cells == int(inside.sum()) and info.frame == (45.0, 6.0)
+    assert info.to_dict()["frame"] == {"theta0_abs_max_deg": 45.0, "alpha0_abs_max_deg": 6.0}
     assert np.allclose(info.mean, cells["weights"][inside][:, :4].mean(axis=0))
 
 
@@ -131,11 +132,11 @@ def test_grid_command_records_and_resumes_by_plant(capsys, tmp_path):
     cells, record = results.load(out)
     assert record["config"]["plant"]["name"] == "furuta" and results.record_plant(record) == "furuta"
     assert geometry.of("furuta").on_grid(cells).all()
-    expected = grid.make_cells(0, grid.parse_cell_indices(CELLS), plant="furuta")
+    expected = grid.make_cells(0, grid.parse_cell_indices(CELLS, geometry.of("furuta").cells), plant="furuta")
     assert np.array_equal(cells["x0"], expected["x0"]) and np.array_equal(cells["theta0"], expected["theta0"])
     # the engine through the harness is the C engine on the model
     cfg = config_from_dict(record["config"])
-    again = grid.make_cells(0, grid.parse_cell_indices(CELLS), plant="furuta")
+    again = grid.make_cells(0, grid.parse_cell_indices(CELLS, geometry.of("furuta").cells), plant="furuta")
     grid.run_grid(cfg, again, threads=1, progress=False)
     assert again.tobytes() == cells.tobytes()
     before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
@@ -226,3 +227,20 @@ def test_prior_of_finished_cells():
         P.compute(cells, None, grid=grid6, use="some")
     assert plants.PLANTS["double_cart_pole"].prior_cells == "finished"
     assert plants.PLANTS["furuta"].prior_cells == plants.PLANTS["cart_pole"].prior_cells == "successful"
+
+
+@pytest.mark.parametrize("plant", list(plants.PLANTS))
+def test_cell_subsets_follow_each_plant_grid(plant):
+    """The quick profile's, the sweep's spread and --subset cells lie on the plant's own grid; on
+    the cart-pole's they are the paper grid's historical cells."""
+    g = geometry.of(plant)
+    for cells in (g.quick_cells(), g.spread_cells(), g.subset(40)):
+        assert cells == sorted(set(cells)) and 0 <= cells[0] and cells[-1] < g.cells
+        assert grid.make_cells(0, cells, plant=plant).size == len(cells)
+    assert len(g.spread_cells()) == g.cols and g.subset(g.cells) == list(range(g.cells))
+    if plant == "cart_pole":
+        assert g.quick_cells() == sorted(r * 49 + c for r in (2, 8, 10, 12, 14, 22) for c in (4, 19, 22, 24, 26, 44))
+        assert g.spread_cells() == list(range(0, 1225, 25))
+    keys = g.frame_keys()
+    assert keys[0].startswith(g.col_start()) and keys[1].startswith(g.row_start())
+    assert [k.endswith("_deg") for k in keys] == [g.col_unit == "deg", g.row_unit == "deg"]

