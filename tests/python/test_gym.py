@@ -35,8 +35,20 @@ def make(steps=None, **kwargs):
     return gymnasium.make(ENV_ID, **({} if steps is None else {"max_episode_steps": steps}), **kwargs)
 
 
-def c_plant_step(plant, s, force):
-    B.check_status(B.lib.icoac_sim_plant_step(ctypes.byref(plant), s, force))
+def c_model_step(model, s, force):
+    """icoac_sim_model_step on a cart-pole state of 4 (in place)."""
+    full = np.zeros(B.MAX_STATE)
+    full[:4] = s
+    B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(model), full, force))
+    s[:] = full[:4]
+
+
+def c_model_failed(model, s):
+    full = np.zeros(B.MAX_STATE)
+    full[:4] = s
+    failed = ctypes.c_int32(-1)
+    B.check_status(B.lib.icoac_sim_model_failed(ctypes.byref(model), full, ctypes.byref(failed)))
+    return bool(failed.value)
 
 
 def test_registered_and_passes_check_env():
@@ -121,7 +133,7 @@ def test_reset_draws_and_options():
     obs, info = env.reset(options={"state": start})
     assert np.array_equal(obs, start) and info == {}
     obs, _, terminated, truncated, info = env.step(np.array([2.5]))
-    c_plant_step(env.unwrapped.parameters.plant, start, 2.5)
+    c_model_step(env.unwrapped.parameters.model, start, 2.5)
     assert np.array_equal(obs, start) and not terminated and not truncated and info["force"] == 2.5
     for bad in ({"state": [0, 0, np.nan, 0]}, {"state": [0, 0]}, {"state": "abc"}, {"cell": B.GRID_CELLS},
                 {"cell": 1.5}, {"grid_seed": -1}, {"state": [0, 0, 0, 0], "cell": 3}, {"theta0": 0.1}):
@@ -131,16 +143,17 @@ def test_reset_draws_and_options():
 
 def test_plant_parameters_reach_the_c_plant():
     env = make(dt=0.02, integrator="rk4", pole_mass=0.2)
-    plant = env.unwrapped.parameters.plant
-    assert (plant.dt, plant.integrator, plant.pole_mass) == (0.02, B.INTEGRATORS["rk4"], 0.2)
+    model = env.unwrapped.parameters.model
+    pole_mass = [p["name"] for p in B.plant_info("cart_pole")["params"]].index("pole_mass")
+    assert (model.dt, model.integrator, model.param[pole_mass]) == (0.02, B.INTEGRATORS["rk4"], 0.2)
     assert env.unwrapped.dt == 0.02
     s, _ = env.reset(seed=1)
     obs, *_ = env.step([-3.0])
-    c_plant_step(plant, s, -3.0)
+    c_model_step(model, s, -3.0)
     assert np.array_equal(obs, s)
-    with pytest.raises(B.ConfigError, match="gravity"):
+    with pytest.raises(B.ConfigError):
         make(gravity=-1.0)
-    with pytest.raises(ValueError, match="unknown cart-pole parameter 'gain'"):
+    with pytest.raises(ValueError, match="unknown cart_pole parameter 'gain'"):
         make(gain=3)
     with pytest.raises(ValueError, match="render_mode"):
         hg.IcoacPlantEnv(render_mode="human")
@@ -198,17 +211,17 @@ def test_continuous_cartpole_is_the_icoac_plant():
     parameters) does, to float64 rounding, under the same force from the same state: same
     equations, signs and units (the two round differently, so each step starts from Gymnasium's)."""
     env = hg.continuous_cartpole(dt=0.01)
-    plant = build_config().plant
+    model = build_config().engine_model()
     env.reset(seed=3)
     rng = np.random.default_rng(0)
     for k in range(200):
         s = np.array(env.unwrapped.state, dtype=np.float64)
         force = float(rng.uniform(-3, 3)) + 30.0 * s[2] + 5.0 * s[3]  # keeps the pole up
         obs, reward, terminated, truncated, info = env.step(np.array([force]))
-        c_plant_step(plant, s, force)
+        c_model_step(model, s, force)
         assert np.allclose(env.unwrapped.state, s, rtol=1e-13, atol=1e-16), k
         assert np.array_equal(obs, env.unwrapped.state.astype(np.float32)) and info["force"] == force
-        assert terminated == bool(B.lib.icoac_sim_failed(ctypes.byref(plant), s)) and not terminated
+        assert terminated == c_model_failed(model, s) and not terminated
     # a push to +x makes theta fall toward -x in both
     env.reset(options={"low": 0.0, "high": 0.0})
     assert env.step([10.0])[0][3] < 0
@@ -241,9 +254,9 @@ def test_readme_example_prints_what_the_readme_shows():
 
 
 # -- the registry plants served through the model API ----------------------------------------------------
-# Every registry plant but the cart-pole (tested above), by env id.
+# Every registry plant (the cart-pole's env also tested above), by env id.
 NEW_PLANTS = {f"icoac/{gym_plants.gym_name(name)}-v0": name for name in
-              (B.plant_info(i)["name"] for i in range(B.lib.icoac_sim_plant_count())) if name != "cart_pole"}
+              (B.plant_info(i)["name"] for i in range(B.lib.icoac_sim_plant_count()))}
 
 
 def c_model_start(model, plant, cell, grid_seed, noise):
