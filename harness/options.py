@@ -6,7 +6,7 @@ learning conditions are defined in harness.registry."""
 from __future__ import annotations
 
 PROFILE_NAMES = ("default", "paper", "quick")   # bench profiles (harness.bench.PROFILES)
-CART_POLE = "cart_pole"  # the default plant: the C registry's first, the one of the B.Plant struct
+CART_POLE = "cart_pole"  # the default plant: the C registry's first
 # Named configurations (harness.config.NAMED_CONFIGURATIONS): the defaults, or the paper's literal
 # reading of the actor-critic (method.md: A10, A14; L2, L3), one option away (--configuration literal).
 CONFIGURATION_NAMES = ("default", "literal")

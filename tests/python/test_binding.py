@@ -217,7 +217,7 @@ def test_config_defaults_match_spec():
     assert sea == {"batch": 8, "elite_fraction": 0.25, "step": 0.5, "floor": 1.0, "cov_scale": 64.0}
     assert p == {"gravity": 9.8, "cart_mass": 1.0, "pole_mass": 0.1, "half_length": 0.5, "dt": 0.01,
                  "x_limit": 2.4, "theta_limit": pytest.approx(math.radians(12)), "integrator": "euler",
-                 "reserved": 0}
+                 "name": "cart_pole"}
     assert r == {"max_trials": 100000, "success_steps": 100000, "init_velocity_noise": pytest.approx(1e-4)}
     assert d["prior"] is None
 
@@ -281,7 +281,7 @@ def test_overrides_by_name():
                         "noise_std": 2.0, "input_range": [2.4, 3.5, 0.2094384, 2.0], "clip_inputs": "false"})
     c = cfg.controller
     assert c.policy.reflex_mode == B.REFLEX_MODES["gain"] and c.ico.timing == B.ICO_TIMINGS["literal"]
-    assert cfg.plant.integrator == B.INTEGRATORS["rk4"] and cfg.run.max_trials == 2000
+    assert cfg.model.integrator == B.INTEGRATORS["rk4"] and cfg.run.max_trials == 2000
     assert c.actor.noise_std == 2.0 and c.policy.clip_inputs == 0
     d = cfg.to_dict()
     assert d["controller"]["policy"]["reflex_mode"] == "gain" and d["plant"]["integrator"] == "rk4"

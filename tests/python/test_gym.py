@@ -85,7 +85,7 @@ def test_fixed_w_episode_equals_the_engine_trajectory(w, cell, lasts):
     cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
     B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, grid_seed))
     assert episode.reset_info == {"cell": cell, "grid_seed": grid_seed, "cell_seed": int(cells[cell]["seed"])}
-    engine = trajectory(cfg, cells[cell]["x0"], cells[cell]["theta0"], duration=steps * cfg.plant.dt,
+    engine = trajectory(cfg, cells[cell]["x0"], cells[cell]["theta0"], duration=steps * cfg.model.dt,
                         seed=int(cells[cell]["seed"]))
     assert episode.steps == engine.n_steps == lasts
     assert np.array_equal(episode.forces, engine.forces)

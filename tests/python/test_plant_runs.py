@@ -40,9 +40,10 @@ def test_cart_pole_config_unchanged_by_the_plant_argument():
         assert build_config(condition=condition).to_dict() == \
             build_config(condition=condition, plant="cart_pole").to_dict()
     cfg = build_config()
-    assert cfg.model is None and cfg.plant_name == "cart_pole"
-    m = cfg.engine_model()
-    assert m.plant == 0 and m.param[0] == cfg.plant.gravity and m.dt == cfg.plant.dt
+    assert cfg.plant_name == "cart_pole" and cfg.model.plant == B.CART_POLE
+    # recorded as every plant: name, dt, integrator, its parameters by name
+    assert cfg.to_dict()["plant"] == {"name": "cart_pole", "dt": 0.01, "integrator": "euler",
+                                      **{p["name"]: p["value"] for p in B.plant_info("cart_pole")["params"]}}
 
 
 def test_furuta_config_has_its_task_and_learner_settings():
