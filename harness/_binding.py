@@ -108,7 +108,7 @@ def _stale(detail: str) -> LibraryError:
 # -- ABI versions and sizes first ---------------------------------------------------------------
 _SIZE_FUNCTIONS = ("icoac_abi_version", "icoac_sizeof_real", "icoac_sizeof_config", "icoac_sizeof_state",
                    "icoac_sizeof_input", "icoac_sizeof_output", "icoac_sizeof_prior",
-                   "icoac_sim_abi_version", "icoac_sim_sizeof_plant", "icoac_sim_sizeof_run",
+                   "icoac_sim_abi_version", "icoac_sim_sizeof_run",
                    "icoac_sim_sizeof_cell")
 for _name in _SIZE_FUNCTIONS:
     getattr(lib, _name).argtypes = []
@@ -388,21 +388,6 @@ class Output(ctypes.Structure):
     ]
 
 
-class Plant(ctypes.Structure):
-    """icoac_sim_plant_t."""
-    _fields_ = [
-        ("gravity", ctypes.c_double),
-        ("cart_mass", ctypes.c_double),
-        ("pole_mass", ctypes.c_double),
-        ("half_length", ctypes.c_double),
-        ("dt", ctypes.c_double),
-        ("x_limit", ctypes.c_double),
-        ("theta_limit", ctypes.c_double),
-        ("integrator", ctypes.c_int32),
-        ("reserved", ctypes.c_int32),
-    ]
-
-
 class Run(ctypes.Structure):
     """icoac_sim_run_t."""
     _fields_ = [
@@ -501,7 +486,6 @@ MIRRORS: dict[str, tuple[Mirror, str | None]] = {
     "icoac_counters_t": (Counters, None),
     "icoac_input_t": (Input, "icoac_sizeof_input"),
     "icoac_output_t": (Output, "icoac_sizeof_output"),
-    "icoac_sim_plant_t": (Plant, "icoac_sim_sizeof_plant"),
     "icoac_sim_run_t": (Run, "icoac_sim_sizeof_run"),
     "icoac_sim_cell_t": (CELL_DTYPE, "icoac_sim_sizeof_cell"),
     "icoac_sim_axis_t": (Axis, None),
@@ -629,23 +613,9 @@ _PROTOTYPES = {
     "icoac_prior_check": ([_P(Prior), ctypes.c_int32], ctypes.c_int),
     "icoac_mix_seed": ([ctypes.c_uint64, ctypes.c_uint64], ctypes.c_uint64),
     "icoac_sim_status_str": ([ctypes.c_int32], ctypes.c_char_p),
-    "icoac_sim_plant_default": ([_P(Plant)], None),
-    "icoac_sim_plant_check": ([_P(Plant)], ctypes.c_int32),
     "icoac_sim_run_default": ([_P(Run)], None),
     "icoac_sim_run_check": ([_P(Run)], ctypes.c_int32),
-    "icoac_sim_plant_step": ([_P(Plant), ndpointer(np.float64, ndim=1, shape=(N_INPUTS,),
-                                                   flags="C_CONTIGUOUS,WRITEABLE"), ctypes.c_double],
-                             ctypes.c_int32),
-    "icoac_sim_failed": ([_P(Plant), ndpointer(np.float64, ndim=1, shape=(N_INPUTS,), flags="C_CONTIGUOUS")],
-                         ctypes.c_int32),
     "icoac_sim_paper_grid": ([_cells_p, ctypes.c_int64, ctypes.c_uint64], ctypes.c_int32),
-    "icoac_sim_run_cell": ([_P(Config), _P(Plant), _P(Run), _P(Prior), _cells_p,
-                            _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)], ctypes.c_int32),
-    "icoac_sim_run_grid": ([_P(Config), _P(Plant), _P(Run), _P(Prior), _cells_p, ctypes.c_int64, ctypes.c_int32,
-                            _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)], ctypes.c_int32),
-    "icoac_sim_trajectory": ([_P(Config), _P(Plant), _P(Prior), ctypes.c_double, ctypes.c_double,
-                              ctypes.c_double, ctypes.c_uint64, ctypes.c_int64, _f64_w, _f64_w,
-                              _P(ctypes.c_int64)], ctypes.c_int32),
     "icoac_sim_plant_count": ([], ctypes.c_int32),
     "icoac_sim_plant_info": ([ctypes.c_int32], _P(PlantDesc)),
     "icoac_sim_plant_find": ([ctypes.c_char_p], ctypes.c_int32),
@@ -653,7 +623,6 @@ _PROTOTYPES = {
     "icoac_sim_plant_learner": ([ctypes.c_int32, ctypes.c_char_p, _P(Config)], ctypes.c_int32),
     "icoac_sim_model_default": ([_P(Model), ctypes.c_int32], ctypes.c_int32),
     "icoac_sim_model_check": ([_P(Model)], ctypes.c_int32),
-    "icoac_sim_model_from_plant": ([_P(Plant), _P(Model)], ctypes.c_int32),
     "icoac_sim_model_step": ([_P(Model), _state_w, ctypes.c_double], ctypes.c_int32),
     "icoac_sim_model_derivatives": ([_P(Model), _state_r, ctypes.c_double, _state_w], ctypes.c_int32),
     "icoac_sim_model_failed": ([_P(Model), _state_r, _P(ctypes.c_int32)], ctypes.c_int32),

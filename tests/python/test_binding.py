@@ -15,7 +15,6 @@ from harness.registry import CONDITIONS, REGISTRY
 def test_struct_sizes_match_c():
     assert ctypes.sizeof(B.Config) == B.lib.icoac_sizeof_config()
     assert ctypes.sizeof(B.Prior) == B.lib.icoac_sizeof_prior()
-    assert ctypes.sizeof(B.Plant) == B.lib.icoac_sim_sizeof_plant()
     assert ctypes.sizeof(B.Run) == B.lib.icoac_sim_sizeof_run()
     assert B.CELL_DTYPE.itemsize == B.lib.icoac_sim_sizeof_cell()
     assert ctypes.sizeof(B.c_real) == B.lib.icoac_sizeof_real()
@@ -127,9 +126,9 @@ def test_field_check_catches_missing_extra_size_and_dtype():
     with pytest.raises(LibraryError, match=r"icoac_sim_cell_t\.outcome: C offset 24 size 4, binding offset 24 size 8"):
         B.check_mirror("icoac_sim_cell_t", wrong)
     # a made-up table: the binding is checked against whatever C says
-    table = dict(B.FIELDS["icoac_sim_plant_t"], dt=(40, 8))
-    with pytest.raises(LibraryError, match=r"icoac_sim_plant_t\.dt: C offset 40"):
-        B.check_mirror("icoac_sim_plant_t", B.Plant, c_fields=table)
+    table = dict(B.FIELDS["icoac_sim_model_t"], dt=(40, 8))
+    with pytest.raises(LibraryError, match=r"icoac_sim_model_t\.dt: C offset 40"):
+        B.check_mirror("icoac_sim_model_t", B.Model, c_fields=table)
 
 
 def test_constants_from_c():

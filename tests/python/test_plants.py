@@ -6,8 +6,7 @@ energy density along it), the mass matrix is sum m J^T J with the Jacobians J ta
 step, the Coriolis terms come from finite differences of that matrix, gravity from the complex-
 step gradient of the potential. Checked: the state derivative at random states, inputs and
 parameters; the energy function; energy conservation over a long frictionless run; the
-linearisation of the C step at the upright against the one of these equations; the cart-pole
-through the interface against its old functions.
+linearisation of the C step at the upright against the one of these equations.
 """
 import ctypes
 
@@ -334,24 +333,6 @@ def test_linearisation_at_the_upright(name, integrator):
     assert np.allclose(fd_b, bd[:, 0], rtol=0, atol=1e-7 * np.max(np.abs(bd))), (fd_b, bd[:, 0])
     # the upright is unstable: A has an eigenvalue with a positive real part
     assert np.max(np.linalg.eigvals(a).real) > 1.0
-
-
-def test_cart_pole_interface_is_the_old_step_bit_for_bit():
-    rng = np.random.default_rng(3)
-    for integrator in ("euler", "rk4"):
-        plant = B.Plant()
-        B.lib.icoac_sim_plant_default(ctypes.byref(plant))
-        plant.integrator = B.INTEGRATORS[integrator]
-        model = B.Model()
-        B.check_status(B.lib.icoac_sim_model_from_plant(ctypes.byref(plant), ctypes.byref(model)))
-        for _ in range(500):
-            old = rng.uniform(-2, 2, B.N_INPUTS)
-            new = np.zeros(B.MAX_STATE)
-            new[:4] = old
-            force = rng.uniform(-20, 20)
-            B.check_status(B.lib.icoac_sim_plant_step(ctypes.byref(plant), old, force))
-            B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(model), new, force))
-            assert old.tobytes() == new[:4].tobytes()
 
 
 def test_bad_state_gets_a_named_status():
