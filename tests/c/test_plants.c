@@ -216,33 +216,44 @@ static void test_nonfinite_input(void)
     TEST_ASSERT_TRUE(strstr(icoac_sim_status_str(ICOAC_SIM_ERR_NONFINITE), "not finite") != NULL);
 }
 
-/* Each plant's failure test: inside on its limits, outside just beyond any of them. */
+/* 1 when the default model of plant i fails with component c at value v (the rest 0). */
+static int32_t fails_at(int32_t i, int32_t c, double v)
+{
+    icoac_sim_model_t model;
+    double s[ICOAC_SIM_MAX_STATE] = {0};
+    int32_t failed = -1;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_default(&model, i));
+    s[c] = v;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, s, &failed));
+    return failed;
+}
+
+/* Each plant's failure test: every parameter named a limit bounds at least one state component,
+ * inside on the limit, outside just beyond it on either side. */
 static void test_failure_limits(void)
 {
-    /* {plant, component, parameter of its limit} */
-    static const int32_t limits[][3] = {{0, 0, 4}, {0, 2, 5}, {1, 0, 10}, {1, 2, 11}, {2, 0, 6}, {2, 2, 7}, {2, 4, 7}};
-    size_t k;
-    for (k = 0; k < sizeof limits / sizeof limits[0]; ++k) {
-        icoac_sim_model_t model;
-        double s[ICOAC_SIM_MAX_STATE] = {0};
-        const int32_t c = limits[k][1];
-        double lim;
-        int32_t failed = -1;
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_default(&model, limits[k][0]));
-        lim = model.param[limits[k][2]];
-        TEST_ASSERT_TRUE(strstr(plant(limits[k][0])->params[limits[k][2]].name, "limit") != NULL);
-        s[c] = lim;
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, s, &failed));
-        TEST_ASSERT_EQUAL_INT(0, failed);
-        s[c] = -lim;
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, s, &failed));
-        TEST_ASSERT_EQUAL_INT(0, failed);
-        s[c] = nextafter(lim, 1e9);
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, s, &failed));
-        TEST_ASSERT_EQUAL_INT(1, failed);
-        s[c] = -nextafter(lim, 1e9);
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, s, &failed));
-        TEST_ASSERT_EQUAL_INT(1, failed);
+    int32_t i, j, c;
+    for (i = 0; i < icoac_sim_plant_count(); ++i) {
+        const icoac_sim_plant_desc_t *d = plant(i);
+        for (j = 0; j < d->n_params; ++j) {
+            const double lim = d->params[j].value;
+            int bounded = 0;
+            if (strstr(d->params[j].name, "limit") == NULL) {
+                continue;
+            }
+            for (c = 0; c < d->n_state; ++c) {
+                if (fails_at(i, c, lim) != 0 || fails_at(i, c, nextafter(lim, 1e9)) == 0) {
+                    continue; /* not bounded by this limit (inside beyond it, or outside another one) */
+                }
+                ++bounded;
+                TEST_ASSERT_EQUAL_INT(0, fails_at(i, c, -lim));
+                TEST_ASSERT_EQUAL_INT(1, fails_at(i, c, -nextafter(lim, 1e9)));
+            }
+            if (bounded == 0) {
+                TEST_PRINTF("%s: %s bounds no state component", d->name, d->params[j].name);
+                TEST_FAIL();
+            }
+        }
     }
 }
 
