@@ -552,7 +552,7 @@ def _culprits(struct: ctypes.Structure, check_fn, default_fn) -> str:
 
     ref = fresh()
     differ = [name for name, _ in struct._fields_
-              if name != "reserved" and not _same(_get(struct, name), _get(ref, name))]
+              if not _same(_get(struct, name), _get(ref, name))]
     alone = []
     for name in differ:
         probe = fresh()
@@ -704,16 +704,13 @@ def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
             continue
         if not isinstance(values, Mapping):
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"configuration group {group!r} must be a mapping, got {_short(values)}")
-        if group == "plant":  # by name; a record without one is the cart-pole's
+        if group == "plant":  # by name; a partial configuration without one is the cart-pole's
             plant = values.get("name", CART_POLE)
             if not isinstance(plant, str):
                 raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant name must be a string, got {_short(plant)}")
             own = plant_params(plant)
             for name, value in values.items():
-                if name == "reserved":  # the cart-pole struct's of records before ABI 4
-                    if not (isinstance(value, int) and not isinstance(value, bool) and value == 0):
-                        raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant parameter reserved must be 0, got {_short(value)}")
-                elif name != "name":
+                if name != "name":
                     if name not in own and group_of(canonical(name)) != "plant":
                         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"{_short(canonical(name))} is a "
                                           f"{group_of(canonical(name))} parameter, not a plant one")
