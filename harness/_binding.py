@@ -34,7 +34,7 @@ DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.s
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
 ABI_VERSION = 9
-SIM_ABI_VERSION = 3
+SIM_ABI_VERSION = 4
 
 
 class IcoacError(HarnessError):
@@ -110,7 +110,7 @@ def _stale(detail: str) -> LibraryError:
 # -- ABI versions and sizes first ---------------------------------------------------------------
 _SIZE_FUNCTIONS = ("icoac_abi_version", "icoac_sizeof_real", "icoac_sizeof_config", "icoac_sizeof_state",
                    "icoac_sizeof_input", "icoac_sizeof_output", "icoac_sizeof_prior",
-                   "icoac_sim_abi_version", "icoac_sim_sizeof_plant", "icoac_sim_sizeof_run",
+                   "icoac_sim_abi_version", "icoac_sim_sizeof_run",
                    "icoac_sim_sizeof_cell")
 for _name in _SIZE_FUNCTIONS:
     getattr(lib, _name).argtypes = []
@@ -396,21 +396,6 @@ class Output(ctypes.Structure):
     ]
 
 
-class Plant(ctypes.Structure):
-    """icoac_sim_plant_t."""
-    _fields_ = [
-        ("gravity", ctypes.c_double),
-        ("cart_mass", ctypes.c_double),
-        ("pole_mass", ctypes.c_double),
-        ("half_length", ctypes.c_double),
-        ("dt", ctypes.c_double),
-        ("x_limit", ctypes.c_double),
-        ("theta_limit", ctypes.c_double),
-        ("integrator", ctypes.c_int32),
-        ("reserved", ctypes.c_int32),
-    ]
-
-
 Run = _param_struct("Run", list(params_of("icoac_sim_run_t").values()),
                     "icoac_sim_run_t (its rows: ICOAC_SIM_RUN_PARAMS).")
 
@@ -430,6 +415,18 @@ class Sweep(ctypes.Structure):
     """icoac_sim_sweep_t: a swept start coordinate of a plant's grid."""
     _fields_ = [("component", ctypes.c_int32), ("count", ctypes.c_int32), ("first", ctypes.c_double),
                 ("step", ctypes.c_double), ("degrees", ctypes.c_int32), ("reserved", ctypes.c_int32)]
+
+
+class Learner(ctypes.Structure):
+    """icoac_sim_learner_t: a plant's settings of some learning conditions (applied by C)."""
+    _fields_ = [("conditions", ctypes.c_char_p), ("apply", ctypes.c_void_p)]
+
+
+class PlantTask(ctypes.Structure):
+    """icoac_sim_task_t: the controller task a plant is benchmarked with (applied by C)."""
+    _fields_ = [("source", ctypes.c_char_p), ("apply", ctypes.c_void_p), ("n_learners", ctypes.c_int32),
+                ("paper", ctypes.c_int32), ("learners", ctypes.POINTER(Learner)),
+                ("prior_all_finished", ctypes.c_char_p)]
 
 
 class PlantDesc(ctypes.Structure):
@@ -452,6 +449,7 @@ class PlantDesc(ctypes.Structure):
         ("derivatives", ctypes.c_void_p),
         ("failed", ctypes.c_void_p),
         ("energy", ctypes.c_void_p),
+        ("task", ctypes.POINTER(PlantTask)),
     ]
 
 
@@ -491,12 +489,13 @@ MIRRORS: dict[str, tuple[Mirror, str | None]] = {
     "icoac_counters_t": (Counters, None),
     "icoac_input_t": (Input, "icoac_sizeof_input"),
     "icoac_output_t": (Output, "icoac_sizeof_output"),
-    "icoac_sim_plant_t": (Plant, "icoac_sim_sizeof_plant"),
     "icoac_sim_run_t": (Run, "icoac_sim_sizeof_run"),
     "icoac_sim_cell_t": (CELL_DTYPE, "icoac_sim_sizeof_cell"),
     "icoac_sim_axis_t": (Axis, None),
     "icoac_sim_param_t": (Param, None),
     "icoac_sim_sweep_t": (Sweep, None),
+    "icoac_sim_learner_t": (Learner, None),
+    "icoac_sim_task_t": (PlantTask, None),
     "icoac_sim_plant_desc_t": (PlantDesc, None),
     "icoac_sim_model_t": (Model, None),
     "icoac_rng_t": (Rng, None),
@@ -617,29 +616,16 @@ _PROTOTYPES = {
     "icoac_prior_check": ([_P(Prior), ctypes.c_int32], ctypes.c_int),
     "icoac_mix_seed": ([ctypes.c_uint64, ctypes.c_uint64], ctypes.c_uint64),
     "icoac_sim_status_str": ([ctypes.c_int32], ctypes.c_char_p),
-    "icoac_sim_plant_default": ([_P(Plant)], None),
-    "icoac_sim_plant_check": ([_P(Plant)], ctypes.c_int32),
     "icoac_sim_run_default": ([_P(Run)], None),
     "icoac_sim_run_check": ([_P(Run)], ctypes.c_int32),
-    "icoac_sim_plant_step": ([_P(Plant), ndpointer(np.float64, ndim=1, shape=(N_INPUTS,),
-                                                   flags="C_CONTIGUOUS,WRITEABLE"), ctypes.c_double],
-                             ctypes.c_int32),
-    "icoac_sim_failed": ([_P(Plant), ndpointer(np.float64, ndim=1, shape=(N_INPUTS,), flags="C_CONTIGUOUS")],
-                         ctypes.c_int32),
     "icoac_sim_paper_grid": ([_cells_p, ctypes.c_int64, ctypes.c_uint64], ctypes.c_int32),
-    "icoac_sim_run_cell": ([_P(Config), _P(Plant), _P(Run), _P(Prior), _cells_p,
-                            _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)], ctypes.c_int32),
-    "icoac_sim_run_grid": ([_P(Config), _P(Plant), _P(Run), _P(Prior), _cells_p, ctypes.c_int64, ctypes.c_int32,
-                            _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)], ctypes.c_int32),
-    "icoac_sim_trajectory": ([_P(Config), _P(Plant), _P(Prior), ctypes.c_double, ctypes.c_double,
-                              ctypes.c_double, ctypes.c_uint64, ctypes.c_int64, _f64_w, _f64_w,
-                              _P(ctypes.c_int64)], ctypes.c_int32),
     "icoac_sim_plant_count": ([], ctypes.c_int32),
     "icoac_sim_plant_info": ([ctypes.c_int32], _P(PlantDesc)),
     "icoac_sim_plant_find": ([ctypes.c_char_p], ctypes.c_int32),
+    "icoac_sim_plant_task": ([ctypes.c_int32, _P(Config)], ctypes.c_int32),
+    "icoac_sim_plant_learner": ([ctypes.c_int32, ctypes.c_char_p, _P(Config)], ctypes.c_int32),
     "icoac_sim_model_default": ([_P(Model), ctypes.c_int32], ctypes.c_int32),
     "icoac_sim_model_check": ([_P(Model)], ctypes.c_int32),
-    "icoac_sim_model_from_plant": ([_P(Plant), _P(Model)], ctypes.c_int32),
     "icoac_sim_model_step": ([_P(Model), _state_w, ctypes.c_double], ctypes.c_int32),
     "icoac_sim_model_derivatives": ([_P(Model), _state_r, ctypes.c_double, _state_w], ctypes.c_int32),
     "icoac_sim_model_failed": ([_P(Model), _state_r, _P(ctypes.c_int32)], ctypes.c_int32),
@@ -742,7 +728,8 @@ def plant_index(name: str) -> int:
 def plant_info(plant: Union[int, str]) -> dict:
     """A registry plant's descriptor as plain data: name, title, source, input (name, unit),
     state [(name, unit)], params [{name, unit, value, min, max}], rows and cols of its grid
-    ({component, count, first, step, degrees}), start, drawn, observed, has_energy."""
+    ({component, count, first, step, degrees}), start, drawn, observed, has_energy, and its task
+    (None when it has none): {source, paper, learners (condition names), prior_all_finished}."""
     index = plant_index(plant) if isinstance(plant, str) else int(plant)
     ptr = lib.icoac_sim_plant_info(index)
     if not ptr:
@@ -761,7 +748,14 @@ def plant_info(plant: Union[int, str]) -> dict:
         "rows": sweep(d.rows), "cols": sweep(d.cols),
         "start": list(d.start[:n]), "drawn": [bool(v) for v in d.drawn[:n]], "observed": list(d.observed[:n]),
         "has_energy": bool(d.energy),
+        "task": _task_info(d.task.contents) if d.task else None,
     }
+
+
+def _task_info(t: PlantTask) -> dict:
+    return {"source": t.source.decode(), "paper": bool(t.paper),
+            "learners": [t.learners[i].conditions.decode().split() for i in range(t.n_learners)],
+            "prior_all_finished": t.prior_all_finished.decode() if t.prior_all_finished else None}
 
 
 def model_default(plant: Union[int, str], **params: float) -> Model:

@@ -101,25 +101,23 @@ def abi_of(B) -> dict[str, Any]:
     return {"abi_version": int(B.lib.icoac_abi_version()), "sim_abi_version": int(B.lib.icoac_sim_abi_version()),
             "sizeof_real": int(B.lib.icoac_sizeof_real()), "critic_dense": int(B.CONSTANTS["ICOAC_CRITIC_DENSE"]),
             "sizeof_config": int(B.lib.icoac_sizeof_config()),
-            "sizeof_prior": int(B.lib.icoac_sizeof_prior()), "sizeof_plant": int(B.lib.icoac_sim_sizeof_plant()),
+            "sizeof_prior": int(B.lib.icoac_sizeof_prior()), "sizeof_model": B.mirror_size(B.Model),
             "sizeof_run": int(B.lib.icoac_sim_sizeof_run()), "sizeof_cell": int(B.CELL_DTYPE.itemsize),
             "plants": [B.plant_info(i)["name"] for i in range(int(B.lib.icoac_sim_plant_count()))],
             "harness_version": __version__}
 
 
 def config_bytes(cfg) -> tuple:
-    """A RunConfig as the bytes of its C structs (controller, plant, run, prior or None, model or
-    None), which a worker turns back into the same configuration (config_from_bytes)."""
-    return (bytes(cfg.controller), bytes(cfg.plant), bytes(cfg.run),
-            None if cfg.prior is None else bytes(cfg.prior), None if cfg.model is None else bytes(cfg.model))
+    """A RunConfig as the bytes of its C structs (controller, model, run, prior or None), which a
+    worker turns back into the same configuration (config_from_bytes)."""
+    return (bytes(cfg.controller), bytes(cfg.model), bytes(cfg.run), None if cfg.prior is None else bytes(cfg.prior))
 
 
 def config_from_bytes(B, cfg_bytes: tuple):
     from .config import RunConfig
-    controller, plant, run, prior, model = cfg_bytes
-    return RunConfig(controller=B.Config.from_buffer_copy(controller), plant=B.Plant.from_buffer_copy(plant),
-                     run=B.Run.from_buffer_copy(run), prior=None if prior is None else B.Prior.from_buffer_copy(prior),
-                     model=None if model is None else B.Model.from_buffer_copy(model))
+    controller, model, run, prior = cfg_bytes
+    return RunConfig(controller=B.Config.from_buffer_copy(controller), model=B.Model.from_buffer_copy(model),
+                     run=B.Run.from_buffer_copy(run), prior=None if prior is None else B.Prior.from_buffer_copy(prior))
 
 
 def check_worker(expected: Mapping[str, Any], dask_worker=None) -> dict[str, Any]:

@@ -20,7 +20,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from . import geometry, grid, metrics, results, store, tables
+from . import geometry, grid, metrics, plants, results, store, tables
 from . import prior as P
 from .ceiling.records import bench_ceiling, load_ceiling, reference_lines
 from .ceiling.weights import format_w
@@ -28,8 +28,7 @@ from .conditions import run_condition
 from .config import build_config, command_overrides, named_sets
 from .errors import ResultsError
 from .metrics import percent
-from .options import PROFILE_NAMES
-from .plants import CART_POLE
+from .options import CART_POLE, PROFILE_NAMES
 from .registry import CONDITIONS, PRIOR_CONDITIONS, REGISTRY
 
 # Paper (Fig. 1b, 2b, 3a): ~68 % ICO, ~84 % ICO->RL; RL alone only "smaller" and "very slow" (Fig. 3 bars).
@@ -41,11 +40,8 @@ PAPER = {
 # The learners after ICO and its prior, in stage order.
 LEARNERS = PRIOR_CONDITIONS
 
-# Spread subset for smoke tests: rows (theta0 + 12 deg) x columns ((x0 + 2.4) / 0.1); includes
-# Fig. 1g's start (row 8, column 19) and enough central cells for a prior.
-QUICK_ROWS = (2, 8, 10, 12, 14, 22)
-QUICK_COLS = (4, 19, 22, 24, 26, 44)
-QUICK_CELLS = sorted(int(geometry.cell_index(r, c)) for r in QUICK_ROWS for c in QUICK_COLS)
+# The profiles' cells on a plant's grid: all (None), or a spread subset for smoke tests.
+QUICK_CELLS = geometry.PlantGrid.quick_cells
 
 PROFILES: dict[str, dict[str, Any]] = {
     # ICO at the paper's caps (1e5 trials, 1e5 steps), the learners' conditions with a 1000-trial
@@ -109,6 +105,11 @@ def _curves_and_quantiles(recs: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     return out
 
 
+def _paper_plant(plant: str) -> bool:
+    """Whether the paper's results apply to the plant's records (its C task says so)."""
+    return plants.PLANTS[plant].paper
+
+
 def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, Any]:
     """{condition: [run.json records over seeds]} -> mean/sd per statistic and condition."""
     out: dict[str, Any] = {}
@@ -120,7 +121,7 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, A
                                  "n_interior": recs[0]["summary"]["n_interior"],
                                  "max_trials": recs[0]["config"]["run"]["max_trials"],
                                  "success_steps": recs[0]["config"]["run"]["success_steps"],
-                                 "paper": PAPER.get(cond) if results.record_plant(recs[0]) == CART_POLE else None}
+                                 "paper": PAPER.get(cond) if _paper_plant(results.record_plant(recs[0])) else None}
         for key, _ in STATS:
             values = [r["summary"].get(key) for r in recs]
             mean, sd, n = _mean_sd(values)
@@ -213,10 +214,10 @@ def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None =
     lines += tables.curve_tables(agg, ceiling)
     lines += ["", f"Success rates use the cells run as denominator ({grid.cells} / {grid.n_interior} on "
               "the full grid)."]
-    if grid is geometry.CART_POLE:
+    if _paper_plant(grid.plant):
         lines[-1] += (f" The paper's ~{percent(PAPER['ico']['success_rate'], 0)} / "
                       f"~{percent(PAPER['ico-rl']['success_rate'], 0)} are read as fractions of all "
-                      f"{geometry.CELLS} cells.")
+                      f"{grid.cells} cells.")
     return "\n".join(lines) + "\n"
 
 
@@ -264,7 +265,7 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
         written.append(figures.plot_fig3a(figdir / "fig3a_success_rate.png", [REGISTRY[c].label for c in conds],
                                           [agg[c]["success_rate"] for c in conds],
                                           [agg[c]["success_rate_interior"] for c in conds],
-                                          [(PAPER.get(c) or {}).get("success_rate") for c in conds],
+                                          [(agg[c].get("paper") or {}).get("success_rate") for c in conds],
                                           ceiling=reference_lines(ceiling)))
         written.append(figures.plot_fig3b(figdir / "fig3b_elapsed_time.png", [REGISTRY[c].label for c in conds],
                                           [agg[c]["mean_elapsed_time_success"] for c in conds]))
@@ -349,7 +350,7 @@ class BenchOptions:
     prior_std: float = P.DEFAULT_STD
     ceiling: Path | None = None   # a ceiling.json (or its directory); default OUT/ceiling/ceiling.json
     dask: Any = None              # a harness.cluster.DaskSpec: every grid on that Dask cluster (None: threads)
-    plant: str = CART_POLE        # a plant of harness.plants: its grid, dynamics and task settings
+    plant: str = CART_POLE        # a registry plant (harness.plants): its grid, dynamics and task settings
 
     def seed_list(self) -> list[int]:
         n = self.seeds if self.seeds is not None else PROFILES[self.profile]["seeds"]
@@ -372,8 +373,8 @@ def stages(opt: BenchOptions) -> list[Stage]:
     ico_sets = command_overrides(opt.configuration, opt.sets, plant=opt.plant)
     rl_sets = command_overrides(opt.configuration, opt.sets, {"--rl-max-trials": ("max_trials", opt.rl_max_trials)},
                                 plant=opt.plant)
-    cells_spec = profile["cells"]
     plant_grid = geometry.of(opt.plant)
+    cells_spec = profile["cells"](plant_grid) if profile["cells"] else None
     frame = plant_grid.central_frame() if opt.frame == P.CENTRAL else opt.frame
 
     def overrides(condition):

@@ -111,7 +111,7 @@ _checkpoint_seconds = _positive_float(86400.0, "seconds in (0, 86400]")
 _duration = _positive_float(1e300, "a finite duration > 0 (s)")
 
 PLANT_HELP = ("registry plant (docs/plants.md; default cart_pole): its grid, dynamics and task settings "
-              "(harness/plants.py); its parameters by name through --set")
+              "(its C file, sim_host/src/plants/); its parameters by name through --set")
 SET_HELP = ("override a parameter (repeatable): NAME is group.field (policy.gain, ico.timing, critic.range, "
             "actor.noise_std, ...), a plant or run parameter (dt, integrator, max_trials, ...) or a flat "
             "alias (gain, ico_timing, noise_std, ...); reals must be finite and normal, integers must fit "
@@ -193,7 +193,7 @@ def build_parser() -> argparse.ArgumentParser:
     cells_, every = O.DEFAULT_CHECKPOINT_CELLS, O.DEFAULT_CHECKPOINT_EVERY
 
     g = sub.add_parser(
-        "grid", help="run (or resume) the paper grid (or some of its cells) for one condition",
+        "grid", help="run (or resume) the plant's grid (or some of its cells) for one condition",
         epilog=f"Checkpoints: cells.npz and run.json are rewritten atomically and fsynced (about 25 ms for "
                f"the full grid on a local disk, at most once per 0.2 s poll) whenever --checkpoint-cells N "
                f"cells (default {cells_}) finished since the last checkpoint, or --checkpoint-every SECONDS "
@@ -328,7 +328,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"trial cap of the retries protocol (default: --profile's, else {O.CEILING_MAX_TRIALS})")
     c.add_argument("--success-steps", type=_positive_int, default=None,
                    help="full horizon: steps of a successful trial (default 1e5)")
-    c.add_argument("--cells", default=None, help="subset of the paper grid's cell indices, e.g. 0,5,600-610")
+    c.add_argument("--cells", default=None, help="subset of the plant grid's cell indices (row-major, from 0), e.g. 0,5,600-610")
     c.add_argument("--candidates", type=_int_in(1, O.CEILING_MAX_CANDIDATES, f"an integer in [1, {O.CEILING_MAX_CANDIDATES}]"),
                    default=None, metavar="N", help=f"distinct w screened by the search (default {O.CEILING_CANDIDATES})")
     c.add_argument("--screen-steps", type=_positive_int, default=None, metavar="N",

@@ -87,7 +87,7 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     if resume and not (out.is_dir() and results.present(out)):
         raise nothing_to_resume(out)
     try:
-        indices = grid.parse_cell_indices(cell_spec)
+        indices = grid.parse_cell_indices(cell_spec, geometry.of(plant).cells)
     except B.ConfigError as exc:
         raise UsageError(f"--cells: {exc}") from None
     extra = prior_extra(info)

@@ -23,7 +23,8 @@ import numpy as np
 
 from . import _binding as B
 from . import geometry, literals, options
-from .plants import CART_POLE, spec as plant_spec
+from .options import CART_POLE
+from .plants import spec as plant_spec
 from .registry import CONDITIONS, REGISTRY
 from .signs import derive_input_signs
 from ._binding import ConfigError
@@ -32,10 +33,11 @@ from .errors import UsageError
 GROUPS = ("controller", "plant", "run")
 CONTROLLER_GROUPS = tuple(name for name, ctype in B.Config._fields_ if issubclass(ctype, ctypes.Structure))
 
-# Canonical names, in C order: the rows of the C parameter table (icoac_params.h, the run's rows);
-# the cart-pole plant struct's members.
+# Canonical names, in C order: the rows of the C parameter table (icoac_params.h, the run's rows).
 CONTROLLER_FIELDS = tuple(B.params_of("icoac_config_t"))
-PLANT_FIELDS = tuple(n for n in B.mirror_fields(B.Plant) if n != "reserved")
+# The default plant's parameters (its registry model's: its C descriptor's, then dt and integrator);
+# another plant's go by its own names (plant_params).
+PLANT_FIELDS = tuple(p["name"] for p in B.plant_info(CART_POLE)["params"]) + ("dt", "integrator")
 RUN_FIELDS = tuple(B.params_of("icoac_sim_run_t"))
 ALL_FIELDS = CONTROLLER_FIELDS + PLANT_FIELDS + RUN_FIELDS
 _GROUP_OF = {**{n: "controller" for n in CONTROLLER_FIELDS}, **{n: "plant" for n in PLANT_FIELDS},
@@ -204,8 +206,8 @@ def _struct_to_dict(struct: ctypes.Structure, prefix: str = "") -> dict[str, Any
 _INT_LIMITS = {ctypes.c_int32: (-2 ** 31, 2 ** 31 - 1), ctypes.c_int64: (-2 ** 63, 2 ** 63 - 1)}
 
 
-# The status C gives a bad value of each field: the parameter table's (the cart-pole plant struct,
-# which has none, refuses any field with ICOAC_SIM_ERR_BAD_PLANT).
+# The status C gives a bad value of each field: the parameter table's (a plant's parameters:
+# icoac_sim_model_check's ICOAC_SIM_ERR_BAD_PLANT).
 _FIELD_STATUS = {**{name: row["status"] for name, row in B.PARAMS.items()},
                  **{name: B.SIM_ERR_BAD_PLANT for name in PLANT_FIELDS}}
 
@@ -340,10 +342,7 @@ def given_twice(name: str, first: str, second: str) -> UsageError:
 
 
 def plant_params(plant: str) -> set[str]:
-    """The names --set takes for a registry plant's model (none for the cart-pole, whose fields
-    are canonical names)."""
-    if plant == CART_POLE:
-        return set()
+    """The names --set takes for a registry plant's model: its parameters, dt and integrator."""
     return {p["name"] for p in B.plant_info(B.plant_index(plant))["params"]} | {"dt", "integrator"}
 
 
@@ -383,19 +382,24 @@ def command_overrides(configuration: str, sets: Iterable[str] | None,
 
 
 # -- configurations ------------------------------------------------------------------------------------
+def _default_model() -> B.Model:
+    model = B.Model()
+    B.check_status(B.lib.icoac_sim_model_default(ctypes.byref(model), B.CART_POLE), "plant model")
+    return model
+
+
 @dataclass
 class RunConfig:
     """Controller, plant and run parameters of one benchmark, plus an optional prior. The plant is
-    the cart-pole of ``plant`` unless ``model`` holds another registry plant (docs/plants.md)."""
+    a registry plant's model (docs/plants.md), the cart-pole's by default."""
     controller: B.Config = field(default_factory=B.Config)
-    plant: B.Plant = field(default_factory=B.Plant)
+    model: B.Model = field(default_factory=_default_model)
     run: B.Run = field(default_factory=B.Run)
     prior: B.Prior | None = None
-    model: B.Model | None = None
 
     @property
     def plant_name(self) -> str:
-        return CART_POLE if self.model is None else B.plant_info(self.model.plant)["name"]
+        return B.plant_info(self.model.plant)["name"]
 
     @property
     def n_inputs(self) -> int:
@@ -403,25 +407,27 @@ class RunConfig:
         return int(self.controller.task.n_inputs)
 
     def engine_model(self) -> B.Model:
-        """The model the engine runs: ``model``, or the cart-pole's of ``plant``."""
-        if self.model is not None:
-            return self.model
-        model = B.Model()
-        B.check_status(B.lib.icoac_sim_model_from_plant(ctypes.byref(self.plant), ctypes.byref(model)), "plant")
-        return model
+        """The model the engine runs."""
+        return self.model
 
     def to_dict(self) -> dict[str, Any]:
-        """The record of run.json: canonical names, the controller nested by group; the plant of a
-        model by its name, dt, integrator and parameters."""
-        plant = _struct_to_dict(self.plant) if self.model is None else model_to_dict(self.model)
-        return {"controller": _struct_to_dict(self.controller), "plant": plant,
+        """The record of run.json: canonical names, the controller nested by group; the plant by
+        its name, dt, integrator and parameters."""
+        return {"controller": _struct_to_dict(self.controller), "plant": model_to_dict(self.model),
                 "run": _struct_to_dict(self.run),
                 "prior": prior_to_dict(self.prior, self.n_inputs) if self.prior is not None else None}
 
     def flat(self) -> dict[str, Any]:
-        """{canonical name: value as in to_dict} of every parameter (plant.reserved excluded)."""
-        return {name: _value_out(name, _ctype(self._struct(name), name), _get(self._struct(name), name))
-                for name in ALL_FIELDS}
+        """{name: value as in to_dict} of every parameter: the controller's and the run's by canonical
+        name, the plant's by its own (its parameters, dt, integrator), as build_config takes them."""
+        record = model_to_dict(self.model)
+        plant = {name: value for name, value in record.items() if name not in ("name", "dt", "integrator")}
+        plant.update(dt=record["dt"], integrator=record["integrator"])  # the order of PLANT_FIELDS
+        out = {name: _value_out(name, _ctype(self._struct(name), name), _get(self._struct(name), name))
+               for name in CONTROLLER_FIELDS}
+        out.update(plant)
+        out.update({name: _value_out(name, _ctype(self.run, name), _get(self.run, name)) for name in RUN_FIELDS})
+        return out
 
     def _struct(self, name: str) -> ctypes.Structure:
         return getattr(self, group_of(name))
@@ -438,16 +444,13 @@ class RunConfig:
             if status not in B.CONFIG_STATUSES:
                 B.check_status(status, "controller config")
             raise ConfigError(status, text, context="controller config")
-        if self.model is not None:
-            check_model(self.model)
+        check_model(self.model)
         n_state = geometry.of(self.plant_name).n_inputs
         if self.n_inputs != n_state:  # the engine's refusal, said before a run
             raise ConfigError(B.SIM_ERR_BAD_PLANT, f"task.n_inputs={self.n_inputs}: plant {self.plant_name} has "
                               f"{n_state} state components, one input each",
                               context="plant config")
-        checks = ((("plant config", self.plant, B.lib.icoac_sim_plant_check, B.lib.icoac_sim_plant_default),)
-                  if self.model is None else ())
-        for label, struct, check_fn, default_fn in checks + (
+        for label, struct, check_fn, default_fn in (
                 ("run config", self.run, B.lib.icoac_sim_run_check, B.lib.icoac_sim_run_default),):
             status = int(check_fn(ctypes.byref(struct)))
             if status != B.OK:
@@ -489,8 +492,8 @@ def check_model(model: B.Model) -> None:
                 rng = f" (valid: 0 or a normal number in [{info['params'][i]['min']:g}, " \
                       f"{info['params'][i]['max']:g}])" if i is not None else ""
                 bad.append(f"{key}={value!r}{rng}")
-        raise ConfigError(status, f"plant {info['name']}: {', '.join(bad) or 'parameters'} rejected",
-                          context="plant config")
+        raise ConfigError(status, f"{B.status_str(status)}; rejected: plant {info['name']}: "
+                                  f"{', '.join(bad) or 'parameters'}", context="plant config")
     n = len(info["state"])
     if n > B.MAX_INPUTS or info["observed"][:n] != list(range(n)):
         raise ConfigError(B.SIM_ERR_BAD_PLANT,
@@ -556,7 +559,7 @@ def _culprits(struct: ctypes.Structure, check_fn, default_fn) -> str:
 
     ref = fresh()
     differ = [name for name, _ in struct._fields_
-              if name != "reserved" and not _same(_get(struct, name), _get(ref, name))]
+              if not _same(_get(struct, name), _get(ref, name))]
     alone = []
     for name in differ:
         probe = fresh()
@@ -636,39 +639,47 @@ def check_prior(prior: B.Prior, n: int) -> None:
 def build_config(overrides: Mapping[str, Any] | None = None, condition: str | None = None,
                  prior: B.Prior | None = None, check: bool = True, plant: str = CART_POLE,
                  derive_signs: bool = True) -> RunConfig:
-    """C defaults, then the condition's overrides, then ``overrides`` by field name (canonical or
-    alias; a later name for the same field wins); validated by C. A registry plant other than the
+    """C defaults and the plant's task (its C file), then the condition's overrides and the plant's
+    settings of that learner, then ``overrides`` by field name (canonical or alias; a later name for
+    the same field wins); validated by C. A registry plant other than the
     cart-pole takes the overrides named after its parameters (and dt, integrator). With
-    derive_signs, task.input_sign comes from the plant's LQR gain (harness.signs) unless a layer
-    gives it (--set task.input_sign=1: the paper's signs)."""
+    derive_signs, task.input_sign comes from the plant's LQR gain (harness.signs) unless the plant's
+    task, the condition or ``overrides`` gives it (--set task.input_sign=1: the paper's signs)."""
     if overrides is not None and not isinstance(overrides, Mapping):
         raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"overrides must be a mapping name -> value, got {_short(overrides)}")
     if prior is not None and not isinstance(prior, B.Prior):
         raise ConfigError(B.ERR_BAD_PRIOR, f"prior must be an icoac_prior_t, got {type(prior).__name__}")
     cfg = RunConfig(prior=prior)
-    B.lib.icoac_config_default(ctypes.byref(cfg.controller))
-    B.lib.icoac_sim_plant_default(ctypes.byref(cfg.plant))
+    spec = plant_spec(plant)
+    spec.task_config(cfg.controller)  # the C defaults, then the plant's task
+    task_signs = list(cfg.controller.task.input_sign) != [1] * B.MAX_INPUTS  # the task gives its signs
     B.lib.icoac_sim_run_default(ctypes.byref(cfg.run))
-    items: list[tuple[Any, Any]] = list(plant_spec(plant).controller.items())  # the plant's task
+    condition_items: list[tuple[Any, Any]] = []
     if condition is not None:
         if not isinstance(condition, str) or condition not in CONDITION_OVERRIDES:
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
                               f"unknown condition {_short(condition)}; valid: {', '.join(CONDITIONS)}")
-        items += CONDITION_OVERRIDES[condition].items()
-        items += plant_spec(plant).learners.get(REGISTRY[condition].base, {}).items()
-    items += (overrides or {}).items()
-    if plant != CART_POLE:
-        params = plant_params(plant)
-        cfg.model = build_model(plant, {name: value for name, value in items if name in params})
-        items = [(name, value) for name, value in items if name not in params]
+        condition_items = list(CONDITION_OVERRIDES[condition].items())
+    items = list((overrides or {}).items())
+    params = plant_params(plant)
+    cfg.model = build_model(plant, {name: value for name, value in items if name in params})
+    items = [(name, value) for name, value in items if name not in params]
+
     given = set()
-    for name, value in items:
-        name = canonical(name)
-        if cfg.model is not None and group_of(name) == "plant":
-            raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {plant} has no parameter {name}")
-        _set_field(cfg._struct(name), name, value)
-        given.add(name)
-    if derive_signs and SIGN_FIELD not in given:
+
+    def set_items(pairs: list[tuple[Any, Any]]) -> None:
+        for name, value in pairs:
+            name = canonical(name)
+            if group_of(name) == "plant":
+                raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {plant} has no parameter {name}")
+            _set_field(cfg._struct(name), name, value)
+            given.add(name)
+
+    set_items(condition_items)
+    if condition is not None:  # the plant's settings of the learner, over the condition's
+        spec.learner_config(REGISTRY[condition].base, cfg.controller)
+    set_items(items)
+    if derive_signs and SIGN_FIELD not in given and not task_signs:
         _derive_signs(cfg)
     if check:
         cfg.check()
@@ -722,20 +733,20 @@ def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
             continue
         if not isinstance(values, Mapping):
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"configuration group {group!r} must be a mapping, got {_short(values)}")
-        if group == "plant" and "name" in values and values["name"] != CART_POLE:
-            plant = values["name"]
+        if group == "plant":  # by name; a partial configuration without one is the cart-pole's
+            plant = values.get("name", CART_POLE)
             if not isinstance(plant, str):
                 raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant name must be a string, got {_short(plant)}")
-            overrides += [(k, v) for k, v in values.items() if k != "name"]
+            own = plant_params(plant)
+            for name, value in values.items():
+                if name != "name":
+                    if name not in own and group_of(canonical(name)) != "plant":
+                        raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"{_short(canonical(name))} is a "
+                                          f"{group_of(canonical(name))} parameter, not a plant one")
+                    overrides.append((name, value))
             continue
         items = _controller_items(values) if group == "controller" else values.items()
         for name, value in items:
-            if group == "plant" and name == "name":  # the cart-pole, named
-                continue
-            if name == "reserved" and group == "plant":
-                if not (isinstance(value, int) and not isinstance(value, bool) and value == 0):
-                    raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant parameter reserved must be 0, got {_short(value)}")
-                continue
             name = canonical(name)
             if group_of(name) != group:
                 raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,

@@ -196,7 +196,8 @@ def plot_trajectory(traj, path: str | Path, *, title: str | None = None, cfg=Non
         ax.plot(x[:1], th[:1], "o", color="tab:green", markersize=5, label="start")
         ax.plot(x[-1:], th[-1:], "s", color="tab:red", markersize=4, label="end")
         if cfg is not None:
-            xl, tl = cfg.plant.x_limit, math.degrees(cfg.plant.theta_limit)
+            limits = {p["name"]: cfg.model.param[k] for k, p in enumerate(B.plant_info(cfg.model.plant)["params"])}
+            xl, tl = limits["x_limit"], math.degrees(limits["theta_limit"])
             ax.add_patch(Rectangle((-xl, -tl), 2 * xl, 2 * tl, fill=False, linestyle=":", edgecolor="grey"))
         ax.set_xlabel("x (m)")
         ax.set_ylabel(r"$\theta$ (deg)")

@@ -20,6 +20,13 @@ from .options import CART_POLE as CART_POLE_NAME
 
 TOL = 1e-6  # plant units (m, rad): a cell coordinate must be this close to a grid point
 
+# The quick profile's spread subset, rows x columns of the paper's 25 x 49 grid: Fig. 1g's start
+# (row 8, column 19) and enough central cells for a prior. Another grid takes the rows and columns
+# at the same fractions of its own (PlantGrid.quick_cells).
+QUICK_ROWS = (2, 8, 10, 12, 14, 22)
+QUICK_COLS = (4, 19, 22, 24, 26, 44)
+_QUICK_SHAPE = (int(B.constant("ICOAC_SIM_GRID_THETAS")), int(B.constant("ICOAC_SIM_GRID_XS")))
+
 
 def _start_name(component: str) -> str:
     return f"{component}_0" if component[-1:].isdigit() else f"{component}0"
@@ -132,6 +139,30 @@ class PlantGrid:
     def row_label(self) -> str:
         return f"{self.row_start()} ({self.row_unit})"
 
+    def quick_cells(self) -> list[int]:
+        """The quick profile's cells on this grid (QUICK_ROWS x QUICK_COLS at the same fractions)."""
+        def at(positions, n, paper_n):
+            return sorted({int(np.rint(p * (n - 1) / (paper_n - 1))) for p in positions})
+        rows, cols = at(QUICK_ROWS, self.rows, _QUICK_SHAPE[0]), at(QUICK_COLS, self.cols, _QUICK_SHAPE[1])
+        return [int(self.cell_index(r, c)) for r in rows for c in cols]
+
+    def spread_cells(self) -> list[int]:
+        """One cell per column, every rows-th cell in index order: spread over rows and columns
+        (the cart-pole's 49 cells 0, 25, ..., 1200)."""
+        return list(range(0, self.cells, self.rows))
+
+    def subset(self, n: int) -> list[int]:
+        """n cells (fewer when indices coincide) evenly spaced in index order; every cell for n = cells."""
+        if n >= self.cells:
+            return list(range(self.cells))
+        return sorted(set(int(round(v)) for v in np.linspace(0, self.cells - 1, n)))
+
+    def frame_keys(self) -> tuple[str, str]:
+        """The names a prior's frame is recorded by: the column's and the row's start, "_deg" for an
+        axis in degrees (else the value is in the component's unit): x0_abs_max, theta0_abs_max_deg."""
+        return tuple(f"{start}_abs_max" + ("_deg" if sweep["degrees"] else "")
+                     for start, sweep in ((self.col_start(), self._sweeps[1]), (self.row_start(), self._sweeps[0])))
+
     def central_frame(self) -> tuple[float, float]:
         """Half the grid's half-extent along each axis (display units): the default prior frame
         (|x0| <= 1.2 m, |theta0| <= 6 deg for the cart-pole)."""
@@ -144,6 +175,9 @@ def of(plant: str = CART_POLE_NAME) -> PlantGrid:
     """The grid of a registry plant."""
     return PlantGrid(plant)
 
+
+# The most cells of any registry plant's grid (a results file holds at most that many).
+MAX_CELLS = max(of(B.plant_info(i)["name"]).cells for i in range(int(B.lib.icoac_sim_plant_count())))
 
 # The cart-pole's, the paper's grid, under its historical names.
 CART_POLE = of(CART_POLE_NAME)

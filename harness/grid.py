@@ -70,8 +70,8 @@ _INDEX = re.compile(r"[0-9]{1,18}", re.ASCII)
 _RANGE = re.compile(r"([0-9]{1,18})\s*-\s*([0-9]{1,18})", re.ASCII)
 
 
-def parse_cell_indices(text: str | Sequence[int] | None, n_cells: int = B.GRID_CELLS) -> Optional[list[int]]:
-    """'i,j,k' or 'a-b' ranges -> sorted unique indices in [0, n_cells); None means every cell.
+def parse_cell_indices(text: str | Sequence[int] | None, n_cells: int) -> Optional[list[int]]:
+    """'i,j,k' or 'a-b' ranges -> sorted unique indices in [0, n_cells) (a grid's cells); None means every cell.
 
     Ranges are checked against n_cells before they are expanded; anything malformed raises ConfigError."""
     if text is None:
@@ -140,7 +140,7 @@ def make_cells(seed: int = 0, indices: Iterable[int] | None = None, plant: str =
     if indices is None:
         return cells
     indices = list(indices)
-    parse_cell_indices(indices)  # integers in range, else ConfigError
+    parse_cell_indices(indices, cells.size)  # integers in range, else ConfigError
     return np.ascontiguousarray(cells[np.asarray(indices, dtype=np.intp)])
 
 

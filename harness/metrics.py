@@ -78,8 +78,8 @@ def _rate(num: int, den: int) -> float:
 
 
 def summary(cells: np.ndarray, grid: geometry.PlantGrid = geometry.CART_POLE) -> dict[str, Any]:
-    """Aggregate metrics. Success rates use the cells given as denominator (the full grid's 1225
-    / 1081 when every cell is present); interior cells are those of the plant's grid."""
+    """Aggregate metrics. Success rates use the cells given as denominator (the full grid's
+    and its interior's when every cell is present); interior cells are those of the plant's grid."""
     ok = success_mask(cells)
     inner = grid.interior_mask(cells)
     trials = cells["trials"][ok]

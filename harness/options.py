@@ -6,7 +6,7 @@ learning conditions are defined in harness.registry."""
 from __future__ import annotations
 
 PROFILE_NAMES = ("default", "paper", "quick")   # bench profiles (harness.bench.PROFILES)
-CART_POLE = "cart_pole"  # the default plant: the C registry's first, the one of the B.Plant struct
+CART_POLE = "cart_pole"  # the default plant: the C registry's first
 # Named configurations (harness.config.NAMED_CONFIGURATIONS): the defaults, or the paper's literal
 # reading of the actor-critic (method.md: A10, A14; L2, L3), one option away (--configuration literal).
 CONFIGURATION_NAMES = ("default", "literal")
@@ -28,7 +28,7 @@ DEFAULT_CHECKPOINT_EVERY = 2.0
 # (load balance, small loss when a worker dies) and a chunk is still seconds of C work.
 AUTO_CHUNKS_PER_THREAD = 8
 AUTO_CHUNK_MAX = 16
-MAX_CHUNK_CELLS = 1225           # at most the paper grid's cells per chunk
+MAX_CHUNK_CELLS = 1225           # at most this many cells per chunk (the paper grid's)
 MAX_WORKERS = 1024               # --workers N: 1 .. MAX_WORKERS local worker processes
 DASK_RETRIES = 3                 # retries of a chunk whose task raised (a dead worker is Dask's allowed-failures)
 DASK_CONNECT_TIMEOUT = 30.0      # s to reach a scheduler

@@ -43,6 +43,7 @@ class PriorInfo:
     source_seed: int | None = None
     ico_phase_simulated_time: float | None = None  # A17: total simulated time of the ICO grid (s)
     extra: dict = field(default_factory=dict)
+    frame_keys: tuple[str, str] = geometry.CART_POLE.frame_keys()  # the grid's (PlantGrid.frame_keys)
 
     def to_dict(self) -> dict[str, Any]:
         out = {
@@ -50,8 +51,7 @@ class PriorInfo:
             "mean": [float(v) for v in self.mean],
             "cov": [[float(v) for v in row] for row in self.cov],
             "frame": None if self.source is None and self.n_cells == 0 else
-                     "all" if self.frame is None else {"x0_abs_max": self.frame[0],
-                                                        "theta0_abs_max_deg": self.frame[1]},
+                     "all" if self.frame is None else dict(zip(self.frame_keys, self.frame)),
             "n_cells": int(self.n_cells),
             "ridge": float(self.ridge),
             "source": self.source,
@@ -126,7 +126,7 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | str | None = DEFAULT
     # flushes subnormals, so the C prior check rejects them: store them as 0
     cov[np.abs(cov) < np.finfo(B.real_dtype).tiny] = 0.0
     return PriorInfo(mean=mean, cov=cov, frame=frame, n_cells=n, ridge=float(ridge),
-                     extra={} if use == PRIOR_CELLS[0] else {"prior_cells": use})
+                     extra={} if use == PRIOR_CELLS[0] else {"prior_cells": use}, frame_keys=grid.frame_keys())
 
 
 # The words of a prior rule (harness.registry) -> the mean (from the ICO prior) and covariance (from
@@ -187,7 +187,8 @@ def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_
     origin = {key: value for key, value in ico.extra.items() if key.startswith("source_")}
     return PriorInfo(mean=mean, cov=cov, frame=ico.frame, n_cells=ico.n_cells, ridge=ico.ridge, kind=condition,
                      source=ico.source, source_commit=ico.source_commit, source_seed=ico.source_seed,
-                     ico_phase_simulated_time=ico.ico_phase_simulated_time, extra={**origin, **extra})
+                     ico_phase_simulated_time=ico.ico_phase_simulated_time, extra={**origin, **extra},
+                     frame_keys=ico.frame_keys)
 
 
 def from_results(path: str | Path, frame: tuple[float, float] | str | None = DEFAULT_FRAME,

@@ -149,7 +149,7 @@ def open_file(file: Path, follow: bool = True):
 
 def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
     """The cell array of a cells.npz, read without trusting it: one member ``cells.npy`` whose
-    header says a 1-D CELL_DTYPE array of at most GRID_CELLS cells and whose size matches.
+    header says a 1-D CELL_DTYPE array of at most geometry.MAX_CELLS cells and whose size matches.
     Anything else (truncated, empty, not a zip, other dtype or shape) raises ResultsError, and
     so does a symbolic link unless ``follow``."""
     file = Path(file)
@@ -172,8 +172,8 @@ def read_cells(file: str | Path, follow: bool = True) -> np.ndarray:
                 if dtype != layout:
                     raise _err(f"{where} has a different cell layout than this library "
                                f"({_dtype_difference(dtype)}); it was written by another version")
-                if len(shape) != 1 or not 1 <= shape[0] <= B.GRID_CELLS:
-                    raise _err(f"{where}: expected 1 to {B.GRID_CELLS} cells, got shape {shape}")
+                if len(shape) != 1 or not 1 <= shape[0] <= geometry.MAX_CELLS:
+                    raise _err(f"{where}: expected 1 to {geometry.MAX_CELLS} cells, got shape {shape}")
                 nbytes = shape[0] * layout.itemsize
                 if info.file_size != fh.tell() + nbytes:
                     raise _err(f"{where}: size {info.file_size} does not match its header ({shape[0]} cells)")

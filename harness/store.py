@@ -43,7 +43,7 @@ import numpy as np
 
 from . import _binding as B
 from . import results
-from .config import CART_POLE, RunConfig, config_from_dict
+from .config import RunConfig, config_from_dict, plant_params
 from .errors import ResultsError, UsageError
 from .grid import make_cells
 
@@ -298,12 +298,12 @@ def check_resumable(record: Mapping[str, Any], *, condition: str, seed: int, cfg
     except B.ConfigError as exc:
         raise ResultsError(f"recorded configuration: {exc}") from None
     old = old_cfg.flat()
-    diffs += [f"{key} {old[key]!r} != {new[key]!r}" for key in new if old[key] != new[key]]
-    if old_cfg.model is not None or cfg.model is not None:  # a registry plant: its model's record
-        plants = [{"name": CART_POLE, **c.to_dict()["plant"]} for c in (old_cfg, cfg)]
-        keys = ["name"] if plants[0]["name"] != plants[1]["name"] else plants[0]
-        diffs += [f"plant {key} {plants[0][key]!r} != {plants[1][key]!r}" for key in keys
-                  if plants[0][key] != plants[1][key]]
+    if old_cfg.plant_name != cfg.plant_name:  # another plant: its name says it, not its parameters
+        diffs.append(f"plant name {old_cfg.plant_name!r} != {cfg.plant_name!r}")
+        old, new = ({k: v for k, v in d.items() if k not in plant_params(c.plant_name)}
+                    for d, c in ((old, old_cfg), (new, cfg)))
+    own = plant_params(cfg.plant_name)
+    diffs += [f"{'plant ' if key in own else ''}{key} {old[key]!r} != {new[key]!r}" for key in new if old[key] != new[key]]
     if old_cfg.to_dict()["prior"] != cfg.to_dict()["prior"]:
         diffs.append("prior differs")
     if diffs:

@@ -31,7 +31,6 @@ from .options import FRAME_NAMES, PRIOR_STD, SWEEP_MAX_TRIALS
 from .registry import REGISTRY
 
 PRIOR_PARAMS = ("prior_frame", "prior_ridge", "prior_std")
-DEFAULT_CELLS = list(range(0, geometry.CELLS, 25))  # 49 cells spread over the grid
 COLUMNS = ("key", "n_seeds", "n_cells", "success_rate_mean", "success_rate_sd", "success_rate_ico_failed",
            "n_ico_failed", "median_trials", "mean_elapsed_time", "wall_time")
 
@@ -102,13 +101,12 @@ def canonical_key(key: str) -> str:
         raise SweepError(f"bad setting key {key!r:.60} in sweep.csv ({exc}); use another --out") from None
 
 
-def subset_cells(n: int) -> list[int]:
-    """n cell indices evenly spread over the grid (1 <= n <= the grid's cells)."""
-    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= geometry.CELLS:
-        raise SweepError(f"--subset expects a number of cells in [1, {geometry.CELLS}], got {n!r:.40}")
-    if n == geometry.CELLS:
-        return list(range(geometry.CELLS))
-    return sorted(set(int(round(v)) for v in np.linspace(0, geometry.CELLS - 1, n)))
+def subset_cells(n: int, plant_grid: geometry.PlantGrid) -> list[int]:
+    """n cell indices evenly spread over the plant's grid (1 <= n <= its cells)."""
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= plant_grid.cells:
+        raise SweepError(f"--subset expects a number of cells in [1, {plant_grid.cells}] (the {plant_grid.plant}'s "
+                         f"grid), got {n!r:.40}")
+    return plant_grid.subset(n)
 
 
 def _write_md(path: Path, rows: list[dict[str, str]], names: list[str], meta: dict[str, Any], dir_fd: int) -> None:
@@ -213,15 +211,15 @@ def run_sweep(opt: SweepOptions) -> int:
     names = list(params)
     todo = settings(params, opt.one_at_a_time)
     seeds = grid.seed_range(opt.seed, opt.seeds)
-    if opt.cells is not None:
-        indices = grid.parse_cell_indices(opt.cells)
-    elif opt.subset is not None:
-        indices = subset_cells(opt.subset)
-    else:
-        indices = DEFAULT_CELLS
     ico_cells, ico_record = results.load(ico_dir, what="--prior-from")
     plant = results.record_plant(ico_record)  # the sweep runs on the plant of its ICO grid
     plant_grid = geometry.of(plant)
+    if opt.cells is not None:
+        indices = grid.parse_cell_indices(opt.cells, plant_grid.cells)
+    elif opt.subset is not None:
+        indices = subset_cells(opt.subset, plant_grid)
+    else:
+        indices = plant_grid.spread_cells()
     priors: dict = {}
 
     # ICO outcome on the sweep cells (matched by grid position).

@@ -25,7 +25,7 @@ import numpy as np
 
 from .. import _binding as B
 from .. import geometry, grid
-from ..config import RunConfig
+from ..config import CART_POLE, RunConfig
 from ..errors import LibraryError
 
 # Forces (N) of the first-step check: failure at step 1 must be the same under each.
@@ -82,9 +82,8 @@ def first_step_bound(cfg: RunConfig, cells: np.ndarray, threads: int = 0) -> dic
         raise LibraryError("failure at the first Euler step depends on the force; the first-step bound's "
                            "premise does not hold for this plant")
     # The engine itself: one trial of 1 step per cell; the lost cells are exactly its failures.
-    probe = RunConfig(controller=B.Config.from_buffer_copy(cfg.controller), plant=B.Plant.from_buffer_copy(cfg.plant),
-                      run=B.Run.from_buffer_copy(cfg.run), prior=cfg.prior,
-                      model=None if cfg.model is None else B.Model.from_buffer_copy(cfg.model))
+    probe = RunConfig(controller=B.Config.from_buffer_copy(cfg.controller), model=B.Model.from_buffer_copy(cfg.model),
+                      run=B.Run.from_buffer_copy(cfg.run), prior=cfg.prior)
     probe.run.max_trials, probe.run.success_steps = 1, 1
     eng = cells.copy()
     run = grid.run_grid(probe, eng, threads=threads, progress=False)
@@ -95,16 +94,19 @@ def first_step_bound(cfg: RunConfig, cells: np.ndarray, threads: int = 0) -> dic
         raise LibraryError(f"first-step bound: the engine loses {int(eng_lost.sum())} cells at step 1, the plant "
                            f"steps {int(lost.sum())}; the recomputed initial velocities do not match the engine's")
     rows, cols = plant_grid.grid_index(cells)
-    xl, tl = float(cfg.plant.x_limit), float(cfg.plant.theta_limit)
     lost_cells = []
     for i in np.flatnonzero(lost):
+        cell = int(plant_grid.cell_index(rows[i], cols[i]))
+        if cfg.plant_name != CART_POLE:
+            lost_cells.append({"cell": cell, "start": [float(v) for v in s0[i]], "exits": ["outside the plant's limits"]})
+            continue
+        limit = {p["name"]: cfg.model.param[k] for k, p in enumerate(B.plant_info(CART_POLE)["params"])}
+        xl, tl = float(limit["x_limit"]), float(limit["theta_limit"])
         x1, th1 = after[i, 0], after[i, 2]
         exits = [name for name, hit in (("x > x_limit", x1 > xl), ("x < -x_limit", x1 < -xl),
-                                        ("theta > theta_limit", th1 > tl), ("theta < -theta_limit", th1 < -tl))
-                 if hit] if cfg.model is None else ["outside the plant's limits"]
-        lost_cells.append({"cell": int(plant_grid.cell_index(rows[i], cols[i])), "x0": float(s0[i, 0]),
-                           "theta0_deg": float(np.degrees(s0[i, 2])), "x_dot0": float(s0[i, 1]),
-                           "theta_dot0": float(s0[i, 3]), "exits": exits})
+                                        ("theta > theta_limit", th1 > tl), ("theta < -theta_limit", th1 < -tl)) if hit]
+        lost_cells.append({"cell": cell, "x0": float(s0[i, 0]), "theta0_deg": float(np.degrees(s0[i, 2])),
+                           "x_dot0": float(s0[i, 1]), "theta_dot0": float(s0[i, 3]), "exits": exits})
     n_lost, n_lost_in = int(lost.sum()), int((lost & inner).sum())
     return {**base, "computed": True, "integrator": "euler", "forces_tested": list(BOUND_FORCES),
             "engine_agrees": True, "init_velocity_noise": float(cfg.run.init_velocity_noise),

@@ -15,8 +15,7 @@ from .. import _binding as B
 from .. import geometry, grid, results, store
 from .. import prior as P
 from ..errors import UsageError
-from ..plants import CART_POLE
-from ..options import (CEILING_CANDIDATES, CEILING_CONFIRM, CEILING_FILE, CEILING_MAX_CANDIDATES, CEILING_MAX_TRIALS,
+from ..options import (CART_POLE, CEILING_CANDIDATES, CEILING_CONFIRM, CEILING_FILE, CEILING_MAX_CANDIDATES, CEILING_MAX_TRIALS,
                        CEILING_PROTOCOLS, CEILING_SCREEN_STEPS, INT64_MAX)
 from .bound import first_step_bound
 from .fixed import check_overrides, eval_dir, evaluate_into, fixed_config, protocol_summary, protocols_of
@@ -69,7 +68,7 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
     max_trials = _positive("--max-trials", opt.max_trials)
     overrides = check_overrides(opt.sets, opt.plant)
     try:
-        indices = grid.parse_cell_indices(opt.cells)
+        indices = grid.parse_cell_indices(opt.cells, geometry.of(opt.plant).cells)
     except B.ConfigError as exc:
         raise UsageError(f"--cells: {exc}") from None
     n_inputs = geometry.of(opt.plant).n_inputs

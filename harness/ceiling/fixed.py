@@ -22,9 +22,8 @@ from .. import _binding as B
 from .. import geometry, grid, metrics, results
 from ..conditions import run_condition
 from ..config import RunConfig, build_config, make_prior, parse_sets
-from ..plants import CART_POLE
 from ..errors import LibraryError, UsageError
-from ..options import CEILING_MAX_TRIALS, CEILING_PROTOCOL_CHOICES, CEILING_PROTOCOLS
+from ..options import CART_POLE, CEILING_MAX_TRIALS, CEILING_PROTOCOL_CHOICES, CEILING_PROTOCOLS
 from .weights import as_weights, format_w, weights_key
 
 EVALS_DIR = "evals"   # OUT/evals/<w key>_<protocol>_h<steps>/: one results directory per evaluation
@@ -101,7 +100,7 @@ def evaluate(w: Sequence[float], protocol: str = "first", *, seed: int = 0, cell
     one grid run of fixed_config. KeyboardInterrupt if cancelled."""
     cfg = fixed_config(w, protocol, max_trials=max_trials, success_steps=success_steps, overrides=overrides,
                        plant=plant)
-    arr = grid.make_cells(seed, grid.parse_cell_indices(cells), plant=plant)
+    arr = grid.make_cells(seed, grid.parse_cell_indices(cells, geometry.of(plant).cells), plant=plant)
     res = grid.run_grid(cfg, arr, threads=threads, progress=False)
     if res.cancelled:
         raise KeyboardInterrupt

@@ -17,8 +17,7 @@ from .. import _binding as B
 from .. import results, store
 from ..errors import ResultsError, UsageError
 from ..metrics import percent
-from ..options import CEILING_DIR, CEILING_FILE, CEILING_PROTOCOLS
-from ..plants import CART_POLE
+from ..options import CART_POLE, CEILING_DIR, CEILING_FILE, CEILING_PROTOCOLS
 from .search import Screen
 from .weights import as_weights, format_w
 

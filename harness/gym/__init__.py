@@ -12,10 +12,10 @@ import gymnasium
 
 from .cartpole_v1 import ContinuousCartPole, continuous_cartpole
 from .env import IcoacPlantEnv
-from .plants import PLANTS, env_id
+from .plants import ENVS, env_id
 from .policy import Episode, IcoacPolicy
 
-for _spec in PLANTS.values():
+for _spec in ENVS.values():
     if env_id(_spec) not in gymnasium.registry:
         gymnasium.register(id=env_id(_spec), entry_point="harness.gym.env:IcoacPlantEnv",
                            kwargs={"plant": _spec.name}, max_episode_steps=_spec.max_episode_steps)

@@ -20,7 +20,7 @@ from gymnasium import spaces
 from gymnasium.envs.classic_control.cartpole import CartPoleEnv
 
 from .env import parse_force
-from .plants import CART_POLE
+from .plants import ENVS
 
 
 class ContinuousCartPole(gymnasium.Wrapper):
@@ -28,7 +28,7 @@ class ContinuousCartPole(gymnasium.Wrapper):
     ``force_limit`` (N) bounds the force (default the icoac env's; 10 keeps CartPole-v1's
     actuator); ``dt`` (s), when given, replaces the env's period tau (0.02 s)."""
 
-    def __init__(self, env: gymnasium.Env, force_limit: float = CART_POLE.action_limit, dt: float | None = None):
+    def __init__(self, env: gymnasium.Env, force_limit: float = ENVS["CartPole"].action_limit, dt: float | None = None):
         super().__init__(env)
         if not isinstance(env.unwrapped, CartPoleEnv):
             raise TypeError(f"ContinuousCartPole wraps Gymnasium's CartPoleEnv, got {type(env.unwrapped).__name__}")
@@ -49,7 +49,7 @@ class ContinuousCartPole(gymnasium.Wrapper):
         return obs, reward, terminated, truncated, {**info, "force": force}
 
 
-def continuous_cartpole(force_limit: float = CART_POLE.action_limit, dt: float | None = None,
+def continuous_cartpole(force_limit: float = ENVS["CartPole"].action_limit, dt: float | None = None,
                         **make_kwargs: Any) -> ContinuousCartPole:
     """gymnasium.make("CartPole-v1", **make_kwargs) with a continuous force."""
     return ContinuousCartPole(gymnasium.make("CartPole-v1", **make_kwargs), force_limit=force_limit, dt=dt)

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""IcoacPlantEnv: a plant of harness.gym.plants as a gymnasium.Env, stepped by the C simulator.
+"""IcoacPlantEnv: a plant of harness.gym.plants.ENVS as a gymnasium.Env, stepped by the C simulator.
 
 One env step is one control period: the input (a force, or the Furuta's voltage) is held for the
 plant's dt (0.01 s by default, the controller's 100 Hz tick) and the state advanced by the C step
@@ -18,7 +18,7 @@ from gymnasium import spaces
 from gymnasium.error import ResetNeeded
 
 from .. import _binding as B
-from .plants import PLANTS, PlantSpec
+from .plants import ENVS, EnvPlant
 
 
 def parse_force(action: Any, limit: float) -> float:
@@ -31,9 +31,9 @@ def parse_force(action: Any, limit: float) -> float:
 
 
 class IcoacPlantEnv(gymnasium.Env):
-    """A plant as an env. ``plant``: a name in harness.gym.plants.PLANTS; ``force_limit``: the
+    """A plant as an env. ``plant``: a name in harness.gym.plants.ENVS; ``force_limit``: the
     action bound (in the plant's input unit, default the plant's); every other keyword is a plant
-    parameter (its PlantSpec.parameter_names), checked by C. No rendering."""
+    parameter (its EnvPlant.parameter_names), checked by C. No rendering."""
 
     metadata = {"render_modes": []}
 
@@ -41,9 +41,9 @@ class IcoacPlantEnv(gymnasium.Env):
                  force_limit: float | None = None, **parameters: Any):
         if render_mode is not None:
             raise ValueError(f"render_mode must be None (this env does not render), got {render_mode!r:.40}")
-        if plant not in PLANTS:
-            raise ValueError(f"unknown plant {plant!r:.40}; valid: {', '.join(PLANTS)}")
-        self.plant: PlantSpec = PLANTS[plant]
+        if plant not in ENVS:
+            raise ValueError(f"unknown plant {plant!r:.40}; valid: {', '.join(ENVS)}")
+        self.plant: EnvPlant = ENVS[plant]
         self.render_mode = None
         self.parameters = self.plant.configure(parameters)
         limit = self.plant.action_limit if force_limit is None else force_limit

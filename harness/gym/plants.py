@@ -1,10 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The plants the Gymnasium envs serve, each described once: its state (names, units), its action,
-its parameters and the C functions that step it, test failure and draw start states.
-
-A plant is a PlantSpec in PLANTS; harness.gym registers ``icoac/<name>-v0`` for each. The
-cart-pole is stepped by its own C functions (bit for bit the engine's trial loop); every other
-plant of the C registry (docs/plants.md) by the model API, described from its C descriptor.
+"""The envs of the plants: every plant of the C registry (harness.plants.PLANTS, docs/plants.md)
+as an EnvPlant derived from its C descriptor: its state (names, units), its action, its parameters
+and the model API functions that step it (bit for bit the engine's trial loop), test failure and
+draw start states. harness.gym registers ``icoac/<name>-v0`` for each entry of ENVS.
 """
 from __future__ import annotations
 
@@ -17,21 +15,19 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from .. import _binding as B
-from ..config import PLANT_FIELDS, RunConfig, build_config
+from ..plants import PLANTS
 
 
 @dataclass(frozen=True)
 class Variable:
-    """One component of a plant's state or action; ``limit``: the parameter bounding it (the
-    failure test: |value| > that parameter), if any."""
+    """One component of a plant's state or action."""
     name: str
     unit: str
     meaning: str
-    limit: str | None = None
 
 
 @dataclass(frozen=True)
-class PlantSpec:
+class EnvPlant:
     """What an env needs to know about a plant. ``configure`` turns constructor keyword arguments
     into the plant's parameters (checked by C); ``step`` advances a float64 state in place by one
     control period under a force; ``failed`` is the termination test; ``start`` gives a start state
@@ -50,8 +46,6 @@ class PlantSpec:
     period: Callable[[Any], float]
 
 
-# -- the cart-pole: icoac_sim_plant_t, icoac_sim_plant_step, icoac_sim_failed, the paper grid ----------
-CART_POLE_PARAMETERS = PLANT_FIELDS + ("init_velocity_noise",)
 RESET_OPTIONS = ("state", "cell", "grid_seed")
 UINT64_LIMIT = 2 ** 64
 
@@ -62,36 +56,6 @@ def _run_default() -> B.Run:
     return run
 
 
-def cart_pole_configure(parameters: Mapping[str, Any]) -> RunConfig:
-    """Plant fields (gravity, cart_mass, pole_mass, half_length, dt, x_limit, theta_limit,
-    integrator) and init_velocity_noise over the C defaults; ConfigError (naming the field) for a
-    value C refuses, ValueError for another name."""
-    unknown = sorted(set(parameters) - set(CART_POLE_PARAMETERS))
-    if unknown:
-        raise ValueError(f"unknown cart-pole parameter {unknown[0]!r}; valid: {', '.join(CART_POLE_PARAMETERS)}")
-    return build_config(dict(parameters))
-
-
-def cart_pole_step(cfg: RunConfig, state: np.ndarray, force: float) -> None:
-    B.check_status(B.lib.icoac_sim_plant_step(ctypes.byref(cfg.plant), state, force), "plant step")
-
-
-def cart_pole_failed(cfg: RunConfig, state: np.ndarray) -> bool:
-    failed = B.lib.icoac_sim_failed(ctypes.byref(cfg.plant), state)
-    if failed not in (0, 1):  # a status: the plant or the arguments refused
-        B.check_status(failed, "failure test")
-    return failed == 1
-
-
-@functools.lru_cache(maxsize=1)
-def paper_grid(seed: int) -> np.ndarray:
-    """The paper grid's cells for a seed (icoac_sim_paper_grid), read-only; the last one is kept."""
-    cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
-    B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, seed), "paper grid")
-    cells.flags.writeable = False
-    return cells
-
-
 def _index(options: Mapping[str, Any], name: str, limit: int, rng: np.random.Generator) -> int:
     """An integer option in [0, limit), or a draw from rng when it is absent."""
     if name not in options:
@@ -100,22 +64,6 @@ def _index(options: Mapping[str, Any], name: str, limit: int, rng: np.random.Gen
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not 0 <= value < limit:
         raise ValueError(f"reset option {name!r} must be an integer in [0, {limit}), got {value!r:.40}")
     return int(value)
-
-
-def engine_start(cfg: RunConfig, x0: float, theta0: float, cell_seed: int) -> np.ndarray:
-    """The start state of the engine's first trial from (x0, theta0) with a cell seed: velocities
-    U(-a, a), a = init_velocity_noise, from the engine's own generator. icoac_sim_trajectory
-    records the start state first; its one controller tick (C default configuration) is discarded."""
-    controller = B.Config()
-    B.lib.icoac_config_default(ctypes.byref(controller))
-    states = np.zeros(2 * B.N_INPUTS)
-    forces = np.zeros(1)
-    n = ctypes.c_int64(0)
-    status = B.lib.icoac_sim_trajectory(ctypes.byref(controller), ctypes.byref(cfg.plant), None, float(x0),
-                                        float(theta0), float(cfg.run.init_velocity_noise), int(cell_seed), 1,
-                                        states, forces, ctypes.byref(n))
-    B.check_status(status, "start state")
-    return states[:B.N_INPUTS].copy()
 
 
 def _grid_start(options: Mapping[str, Any], names: tuple[str, ...], n_cells: int, rng: np.random.Generator,
@@ -146,34 +94,8 @@ def _grid_start(options: Mapping[str, Any], names: tuple[str, ...], n_cells: int
                            "cell_seed": np.uint64(row[0]["seed"])}
 
 
-def cart_pole_start(cfg: RunConfig, rng: np.random.Generator, options: Mapping[str, Any]) -> tuple[np.ndarray, dict]:
-    """The options of _grid_start on the paper grid; a cell starts where its first engine trial does."""
-    return _grid_start(options, tuple(v.name for v in CART_POLE.state), B.GRID_CELLS, rng, paper_grid,
-                       lambda row: engine_start(cfg, row[0]["x0"], row[0]["theta0"], int(row[0]["seed"])))
-
-
-CART_POLE = PlantSpec(
-    name="CartPole",
-    state=(Variable("x", "m", "cart position", "x_limit"), Variable("x_dot", "m/s", "cart velocity"),
-           Variable("theta", "rad", "pole angle, > 0 leaning toward +x", "theta_limit"),
-           Variable("theta_dot", "rad/s", "pole angular velocity")),
-    action=Variable("force", "N", "horizontal force on the cart, held for one period"),
-    action_limit=float(B.constant("ICOAC_FORCE_MAX")),
-    parameter_names=CART_POLE_PARAMETERS,
-    reset_options=RESET_OPTIONS,
-    max_episode_steps=int(_run_default().success_steps),
-    configure=cart_pole_configure,
-    step=cart_pole_step,
-    failed=cart_pole_failed,
-    start=cart_pole_start,
-    period=lambda cfg: float(cfg.plant.dt),
-)
-
-# -- any other registry plant: icoac_sim_model_t, icoac_sim_model_step / _failed / _start, its grid --
+# -- every registry plant: icoac_sim_model_t, icoac_sim_model_step / _failed / _start, its grid ----
 MODEL_OPTIONS = ("dt", "integrator", "init_velocity_noise")
-# Every plant of the C registry but the cart-pole (which has its own spec above).
-REGISTRY_PLANTS = tuple(B.plant_info(i)["name"] for i in range(int(B.lib.icoac_sim_plant_count()))
-                        if i != B.constant("ICOAC_SIM_CART_POLE"))
 
 
 @dataclass(frozen=True)
@@ -210,8 +132,8 @@ def model_start(parameters: ModelParameters, cell: np.ndarray) -> np.ndarray:
     return state
 
 
-def registry_spec(registry_name: str) -> PlantSpec:
-    """The PlantSpec of a C registry plant: state, action and parameter names and units from its
+def registry_spec(registry_name: str) -> EnvPlant:
+    """The EnvPlant of a C registry plant: state, action and parameter names and units from its
     descriptor; stepped, tested and started by icoac_sim_model_step / _failed / _start."""
     info = B.plant_info(registry_name)
     index, n = info["index"], len(info["state"])
@@ -251,7 +173,7 @@ def registry_spec(registry_name: str) -> PlantSpec:
         return _grid_start(options, tuple(name for name, _ in info["state"]), cells, rng,
                            lambda seed: plant_grid(index, seed), lambda cell: model_start(parameters, cell)[:n].copy())
 
-    return PlantSpec(
+    return EnvPlant(
         name=gym_name(info["name"]),
         state=tuple(Variable(name, unit, f"state component {i} of {info['title']}")
                     for i, (name, unit) in enumerate(info["state"])),
@@ -265,10 +187,10 @@ def registry_spec(registry_name: str) -> PlantSpec:
     )
 
 
-PLANTS: dict[str, PlantSpec] = {spec.name: spec for spec in
-                                (CART_POLE, *(registry_spec(name) for name in REGISTRY_PLANTS))}
-assert all(math.isfinite(spec.action_limit) and spec.action_limit > 0 for spec in PLANTS.values())
+# The env of every plant of the registry (harness.plants.PLANTS), by env name.
+ENVS: dict[str, EnvPlant] = {env.name: env for env in map(registry_spec, PLANTS)}
+assert all(math.isfinite(env.action_limit) and env.action_limit > 0 for env in ENVS.values())
 
 
-def env_id(spec: PlantSpec) -> str:
+def env_id(spec: EnvPlant) -> str:
     return f"icoac/{spec.name}-v0"

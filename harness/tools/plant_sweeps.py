@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The sweep that chose a plant's task settings (harness.plants), as one command:
+"""The sweep that chose a plant's task settings (its C file's task), as one command:
 
     python -m harness.tools.plant_sweeps --plant furuta --out results/sweeps-furuta
 
@@ -9,10 +9,10 @@ angle is scaled to its failure limit), the reflex zone's angle, ICO's rate and t
 The criterion, fixed before the runs: ICO's success rate (all cells, mean over seeds); settings
 within one point of the best are ordered by fewer median trials to success.
 
-Stage 1 draws SAMPLES settings from the plant's space (harness.plants.TASK_SPACES; a seeded generator,
+Stage 1 draws SAMPLES settings from the plant's space (TASK_SPACES; a seeded generator,
 so the same settings every time)
 and runs ICO on the 36 spread cells of the quick profile, seed 0. Stage 2 runs the best
-STAGE_2_TOP of stage 1 on 49 cells evenly over the grid, seeds 0 and 1; stage 3 varies one
+STAGE_2_TOP of stage 1 on the grid's spread cells (one per column; 49 on a 25 x 49 grid), seeds 0 and 1; stage 3 varies one
 parameter at a time over its values around stage 2's best, on the same cells and seeds. The
 choice is the best of stages 2 and 3. Every stage resumes (finished settings are skipped);
 --report writes summary.md (docs/sweeps-<plant>.md).
@@ -21,7 +21,7 @@ The learners (``--stage learners --prior-from ICO_DIR``, an ICO grid of the plan
 task settings): the scale of their exploration noise is in the plant's input unit (N, V), and the
 actor reading each took from the cart-pole's sweeps may not carry over. Each actor-critic learner
 (LEARNER_SPACE) runs its own reading at four noise scales and the other learner's reading at three,
-on at most LEARNER_FAILED cells the ICO grid failed (evenly thinned) and on the 49 spread cells,
+on at most LEARNER_FAILED cells the ICO grid failed (evenly thinned) and on the grid's spread cells,
 2 seeds, cap 1000 trials, as the cart-pole's learner sweeps; criterion fixed before the runs:
 success on the ICO-failed cells, ties within one point by the spread cells, then fewer median
 trials.
@@ -36,21 +36,19 @@ import math
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from .. import _binding as B
-from .. import grid, metrics, results, store
-from ..bench import QUICK_CELLS
+from .. import geometry, grid, metrics, results, store
 from ..config import build_config
-from ..plants import TASK_SPACES, task_overrides
-from ..sweep import DEFAULT_CELLS, SweepOptions, run_sweep
+from ..sweep import SweepOptions, run_sweep
 
 SAMPLES = 80
 STAGE_2_TOP = 5
 MAX_TRIALS = 20000
 SUCCESS_STEPS = 2000
-SPREAD_CELLS = DEFAULT_CELLS  # 49 cells evenly over a 25 x 49 grid
 FIELDS = ["key", "seed", "cells", "success_rate", "median_trials", "wall_time"]
 LEARNER_SPACE = {"ico-rl": ("actor.noise_std", (0.1, 0.3, 1.0, 3.0)),
                  "rl": ("actor.noise_std", (0.3, 1.0, 3.0, 12.0))}
@@ -64,9 +62,86 @@ OTHER_READING_NOISE = (0.3, 1.0, 3.0)
 LEARNER_FAILED = 200
 LEARNER_MAX_TRIALS = 1000
 
+# The cart-pole's reflex zone along its track as a fraction of its range (ICOAC_SIM_ZONE_FRACTION).
+ZONE_FRACTION = float(B.constant("ICOAC_SIM_ZONE_FRACTION"))
+
+
+def _param(plant: str, name: str) -> float:
+    return {p["name"]: p["value"] for p in B.plant_info(plant)["params"]}[name]
+
+
+def furuta_task(plant: str, setting: dict[str, float]) -> dict[str, Any]:
+    """The Furuta's controller settings of a task setting: input ranges (arm angle, arm velocity,
+    pendulum angle = its failure limit, pendulum velocity), the critic grid over the same ranges,
+    the reflex zone (ZONE_FRACTION of the arm range; the pendulum's at zone_deg), ICO's rate and
+    the policy gain. The cart-pole's rule table and critic units carry over."""
+    limit = _param(plant, "pendulum_limit")
+    ranges = [setting["arm_range"], setting["arm_velocity_range"], limit, setting["pendulum_velocity_range"]]
+    return {"policy.input_range": ranges, "critic.range": ranges,
+            "policy.zone_x": ZONE_FRACTION * setting["arm_range"],
+            "policy.zone_theta": math.radians(setting["zone_deg"]),
+            "ico.rate": setting["ico.rate"], "policy.gain": setting["policy.gain"]}
+
+
+# The double pendulum's critic units per input (x, x_dot, theta1, theta1_dot, theta2, theta2_dot):
+# the build's ICOAC_MAX_CRITIC_UNITS (216), three along both angles and the lower link's velocity.
+DOUBLE_CRITIC_UNITS = (2, 2, 3, 3, 3, 2)
+
+
+def double_task(plant: str, setting: dict[str, float]) -> dict[str, Any]:
+    """The double pendulum's controller settings of a task setting: six inputs, scaled to the
+    track and angle limits and to the swept velocity ranges (both links' alike); the critic grid
+    over the same ranges; six rules, first match wins: the lower link beyond +-zone_deg gives the
+    cart-pole's reflex (+1 when it leans toward +x), the cart beyond ZONE_FRACTION of the track
+    gives cart_reflex times the push back to the centre (+1: the cart-pole's; -1: away, the sign
+    of the plant's LQR gain on x), and the upper link beyond +-zone_deg gives upper_reflex times its sign (+1: push
+    under it as under the lower link; -1: tip the lower link under it, the sign of the plant's LQR
+    gain); ICO's rate and the policy gain."""
+    x_limit, limit = _param(plant, "x_limit"), _param(plant, "angle_limit")
+    v = setting["link_velocity_range"]
+    ranges = [x_limit, setting["cart_velocity_range"], limit, v, limit, v]
+    z, zx = math.radians(setting["zone_deg"]), ZONE_FRACTION * x_limit
+    up, cart = setting["upper_reflex"], setting["cart_reflex"]
+    above, below = B.RULE_SIDES["above"], B.RULE_SIDES["below"]
+    return {"task.n_inputs": 6, "task.n_rules": 6, "task.rule_input": [2, 0, 2, 0, 4, 4],
+            "task.rule_side": [above, below, below, above, above, below],
+            "task.rule_threshold": [z, -zx, -z, zx, z, -z], "task.rule_reflex": [1.0, cart, -1.0, -cart, up, -up],
+            "policy.input_range": ranges, "critic.range": ranges, "critic.units": list(DOUBLE_CRITIC_UNITS),
+            "ico.rate": setting["ico.rate"], "policy.gain": setting["policy.gain"]}
+
+
+# Each swept plant's task: the space its sweep draws settings from (harness.tools.plant_sweeps) and
+# the controller settings of a setting.
+TASK_SPACES: dict[str, tuple[tuple[tuple[str, tuple[float, ...]], ...], Any]] = {
+    "furuta": ((("arm_range", (0.5, 1.0, 1.5708, 3.0)),
+                ("arm_velocity_range", (1.0, 2.3, 6.4, 15.0, 40.0)),
+                ("pendulum_velocity_range", (0.3, 0.6, 1.0, 2.0, 5.6)),
+                ("zone_deg", (11.5, 10.0, 8.0, 6.0)),
+                ("ico.rate", (1e-4, 1e-3, 1e-2)),
+                ("policy.gain", (1.0, 3.0, 10.0))), furuta_task),
+    # Each space put its best at its edges, and the next extends those dimensions beyond it: the
+    # first (rate 0.01, gain 30 N, both velocity ranges and the zone at their largest), the second
+    # (cart velocity range 10 m/s, rate 0.1, gain 3 N).
+    "double_cart_pole": ((("cart_velocity_range", (1.0, 2.0, 3.5, 6.0, 10.0, 17.0, 30.0)),
+                          ("link_velocity_range", (0.5, 1.0, 2.0, 4.0, 8.0)),
+                          ("zone_deg", (11.0, 10.0, 8.0, 6.0, 4.0)),
+                          ("upper_reflex", (1.0, -1.0)),
+                          ("cart_reflex", (1.0, -1.0)),
+                          ("ico.rate", (1e-4, 1e-3, 1e-2, 1e-1, 0.3, 1.0)),
+                          ("policy.gain", (0.3, 1.0, 3.0, 10.0, 30.0, 100.0))), double_task),
+}
+
+
+def task_overrides(plant: str, setting: dict[str, float]) -> dict[str, Any]:
+    """The controller settings of a setting of the plant's task space (TASK_SPACES)."""
+    return TASK_SPACES[plant][1](plant, setting)
+
+
+# The Furuta's task setting, chosen by its sweep (docs/sweeps-furuta.md).
+
 
 def space(plant: str) -> tuple:
-    """The plant's task space: (name, values) pairs (harness.plants.TASK_SPACES)."""
+    """The plant's task space: (name, values) pairs (TASK_SPACES)."""
     return TASK_SPACES[plant][0]
 
 
@@ -157,6 +232,7 @@ def _trials(median: float) -> str:
 
 
 def report(plant: str, out: Path) -> Path:
+    plant_grid = geometry.of(plant)
     s1, s2, s3 = (ranked(read_rows(out / f"stage{i}.csv")) for i in (1, 2, 3))
     final = ranked(read_rows(out / "stage2.csv") + read_rows(out / "stage3.csv"))
     lines = [f"# The {plant}'s task settings: sweep", "",
@@ -164,11 +240,12 @@ def report(plant: str, out: Path) -> Path:
              "Criterion, fixed before the runs: ICO's success rate (all cells, mean over seeds); settings within "
              "one point of the best are ordered by fewer median trials to success.", "",
              f"Space: {', '.join(f'{n} in {list(v)}' for n, v in space(plant))}; the angles are scaled to their "
-             "failure limits and the critic grid spans the same ranges (harness/plants.py says how a setting "
-             "becomes the controller's task). Stage 1: "
-             f"{SAMPLES} settings drawn from it (seeded), ICO on the quick profile's {len(QUICK_CELLS)} spread cells, "
+             "failure limits and the critic grid spans the same ranges (TASK_SPACES in harness/tools/plant_sweeps.py "
+             "says how a setting becomes the controller's task). Stage 1: "
+             f"{SAMPLES} settings drawn from it (seeded), ICO on the quick profile's "
+             f"{len(plant_grid.quick_cells())} spread cells, "
              f"seed 0, cap {MAX_TRIALS} trials, success {SUCCESS_STEPS} steps. Stage 2: the best {STAGE_2_TOP} "
-             f"on {len(SPREAD_CELLS)} cells evenly over the grid, seeds 0 and 1, same caps. Stage 3: one "
+             f"on {len(plant_grid.spread_cells())} cells evenly over the grid, seeds 0 and 1, same caps. Stage 3: one "
              "parameter at a time over its values around stage 2's best, same cells, seeds and caps. The choice "
              "is the best of stages 2 and 3 by the criterion.", ""]
     for title, rows in (("Stages 2 and 3, ranked together", final), ("Stage 3", s3), ("Stage 2", s2),
@@ -178,13 +255,13 @@ def report(plant: str, out: Path) -> Path:
                   f"{_trials(r['median_trials'])} |" for i, r in enumerate(rows, 1)]
         lines.append("")
     if final:
-        lines += ["## Choice", "", f"`{final[0]['key']}` (harness/plants.py).", ""]
+        lines += ["## Choice", "", f"`{final[0]['key']}` (the task of sim_host/src/plants/{plant}.c).", ""]
     if any(learner_ranking(out, c) for c in LEARNER_SPACE):
         lines += ["## Learners", "",
                   f"On the plant's ICO grid of seed 0 at the chosen task settings (`--stage learners`): each "
                   "actor-critic learner at its own reading (from the cart-pole's sweeps) and four exploration "
                   f"noise scales, and at the other learner's reading and noise {list(OTHER_READING_NOISE)}, on at "
-                  f"most {LEARNER_FAILED} cells that grid failed (evenly thinned) and on the {len(SPREAD_CELLS)} "
+                  f"most {LEARNER_FAILED} cells that grid failed (evenly thinned) and on the {len(plant_grid.spread_cells())} "
                   f"spread cells, 2 seeds, cap {LEARNER_MAX_TRIALS} trials. Readings: "
                   + "; ".join(f"{r}: {', '.join(f'{k}={v}' for k, v in s.items())}" for r, s in READINGS.items())
                   + ". Criterion, fixed before the runs: success on the ICO-failed cells; within one point, the "
@@ -211,11 +288,11 @@ def report(plant: str, out: Path) -> Path:
 def learner_cells(ico_dir: Path) -> dict[str, list[int]]:
     """The learner sweeps' cell sets: the ICO-failed cells (at most LEARNER_FAILED, evenly thinned)
     and the spread cells."""
-    cells, _ = results.load(ico_dir, what="--prior-from")
+    cells, record = results.load(ico_dir, what="--prior-from")
     failed = np.flatnonzero(cells["outcome"] == B.FAILED)
     if failed.size > LEARNER_FAILED:
         failed = failed[np.round(np.linspace(0, failed.size - 1, LEARNER_FAILED)).astype(int)]
-    return {"ico-failed": [int(i) for i in failed], "spread": SPREAD_CELLS}
+    return {"ico-failed": [int(i) for i in failed], "spread": geometry.of(results.record_plant(record)).spread_cells()}
 
 
 def _other(condition: str) -> str:
@@ -272,18 +349,20 @@ def main(argv=None) -> int:
     p.add_argument("--report", action="store_true", help="only write summary.md")
     args = p.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
+    plant_grid = geometry.of(args.plant)
     if args.stage == "learners" and not args.report:
         if args.prior_from is None:
             p.error("--stage learners needs --prior-from ICO_DIR")
         run_learners(args.prior_from, args.out)
     elif not args.report:
         if args.stage in ("1", "all"):
-            run_stage(args.plant, args.out / "stage1.csv", samples(args.plant), [0], list(QUICK_CELLS))
+            run_stage(args.plant, args.out / "stage1.csv", samples(args.plant), [0], plant_grid.quick_cells())
         if args.stage in ("2", "all"):
             top = [setting_of(r["key"]) for r in ranked(read_rows(args.out / "stage1.csv"))[:STAGE_2_TOP]]
-            run_stage(args.plant, args.out / "stage2.csv", top, [0, 1], SPREAD_CELLS)
+            run_stage(args.plant, args.out / "stage2.csv", top, [0, 1], plant_grid.spread_cells())
         if args.stage in ("3", "all"):
-            run_stage(args.plant, args.out / "stage3.csv", one_at_a_time(args.plant, args.out), [0, 1], SPREAD_CELLS)
+            run_stage(args.plant, args.out / "stage3.csv", one_at_a_time(args.plant, args.out), [0, 1],
+                      plant_grid.spread_cells())
     print(report(args.plant, args.out))
     return 0
 

@@ -93,6 +93,7 @@ static const icoac_sim_constant_t constants[] = {
     CONSTANT(ICOAC_SIM_MAX_STATE),
     CONSTANT(ICOAC_SIM_MAX_PARAMS),
     CONSTANT(ICOAC_SIM_CART_POLE),
+    CONSTANT(ICOAC_SIM_ZONE_FRACTION),
     CONSTANT(ICOAC_SIM_START_STREAM),
 };
 
@@ -203,6 +204,15 @@ static const icoac_sim_field_t fields[] = {
     FIELD(icoac_sim_plant_desc_t, derivatives),
     FIELD(icoac_sim_plant_desc_t, failed),
     FIELD(icoac_sim_plant_desc_t, energy),
+    FIELD(icoac_sim_plant_desc_t, task),
+    FIELD(icoac_sim_learner_t, conditions),
+    FIELD(icoac_sim_learner_t, apply),
+    FIELD(icoac_sim_task_t, source),
+    FIELD(icoac_sim_task_t, apply),
+    FIELD(icoac_sim_task_t, n_learners),
+    FIELD(icoac_sim_task_t, paper),
+    FIELD(icoac_sim_task_t, learners),
+    FIELD(icoac_sim_task_t, prior_all_finished),
     FIELD(icoac_sim_model_t, plant),
     FIELD(icoac_sim_model_t, integrator),
     FIELD(icoac_sim_model_t, dt),

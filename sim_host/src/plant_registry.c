@@ -32,3 +32,52 @@ int32_t icoac_sim_plant_find(const char *name)
     }
     return -1;
 }
+
+int32_t icoac_sim_plant_task(int32_t index, icoac_config_t *cfg)
+{
+    const icoac_sim_plant_desc_t *desc = icoac_sim_plant_info(index);
+    if (cfg == 0) {
+        return ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
+    if (desc == 0 || desc->task == 0) {
+        return ICOAC_SIM_ERR_BAD_PLANT;
+    }
+    icoac_config_default(cfg);
+    if (desc->task->apply != 0) {
+        desc->task->apply(cfg);
+    }
+    return ICOAC_SIM_OK;
+}
+
+/* 1 when word is one of the space-separated words of list. */
+static int has_word(const char *list, const char *word)
+{
+    const size_t n = strlen(word);
+    const char *p = list;
+    while (n > 0 && (p = strstr(p, word)) != 0) {
+        if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0')) {
+            return 1;
+        }
+        p += n;
+    }
+    return 0;
+}
+
+int32_t icoac_sim_plant_learner(int32_t index, const char *condition, icoac_config_t *cfg)
+{
+    const icoac_sim_plant_desc_t *desc = icoac_sim_plant_info(index);
+    int32_t i;
+    if (cfg == 0 || condition == 0) {
+        return ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
+    if (desc == 0 || desc->task == 0) {
+        return ICOAC_SIM_ERR_BAD_PLANT;
+    }
+    for (i = 0; i < desc->task->n_learners; ++i) {
+        if (has_word(desc->task->learners[i].conditions, condition)) {
+            desc->task->learners[i].apply(cfg);
+            break;
+        }
+    }
+    return ICOAC_SIM_OK;
+}

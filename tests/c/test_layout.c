@@ -21,6 +21,7 @@ static const type_size_t types[] = {
     {"icoac_sim_run_t", sizeof(icoac_sim_run_t)},     {"icoac_sim_cell_t", sizeof(icoac_sim_cell_t)},
     {"icoac_sim_axis_t", sizeof(icoac_sim_axis_t)},   {"icoac_sim_param_t", sizeof(icoac_sim_param_t)},
     {"icoac_sim_sweep_t", sizeof(icoac_sim_sweep_t)}, {"icoac_sim_plant_desc_t", sizeof(icoac_sim_plant_desc_t)},
+    {"icoac_sim_learner_t", sizeof(icoac_sim_learner_t)}, {"icoac_sim_task_t", sizeof(icoac_sim_task_t)},
     {"icoac_sim_model_t", sizeof(icoac_sim_model_t)},       {"icoac_rng_t", sizeof(icoac_rng_t)},
 };
 
@@ -90,7 +91,7 @@ static void test_constants_table(void)
     TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == ICOAC_ABI_VERSION);
     TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == 9);
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == ICOAC_SIM_ABI_VERSION);
-    TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == 3);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == 4);
     TEST_ASSERT_TRUE(constant("ICOAC_CARTPOLE_INPUTS") == ICOAC_CARTPOLE_INPUTS);
     TEST_ASSERT_TRUE(constant("ICOAC_CARTPOLE_CRITIC_UNITS") == ICOAC_CARTPOLE_CRITIC_UNITS);
     TEST_ASSERT_TRUE(constant("ICOAC_STATE_SIZE") == ICOAC_STATE_SIZE);
@@ -248,6 +249,8 @@ static void test_fields_spot_checks(void)
     SPOT(icoac_sim_sweep_t, degrees);
     SPOT(icoac_sim_plant_desc_t, observed);
     SPOT(icoac_sim_plant_desc_t, energy);
+    SPOT(icoac_sim_plant_desc_t, task);
+    SPOT(icoac_sim_task_t, prior_all_finished);
     SPOT(icoac_sim_model_t, param);
     /* the nested layout, as the table names it */
     TEST_ASSERT_EQUAL_size_t(ICOAC_MAX_INPUTS * sizeof(icoac_real_t), find_field("icoac_config_t", "critic.range")->size);

@@ -216,33 +216,44 @@ static void test_nonfinite_input(void)
     TEST_ASSERT_TRUE(strstr(icoac_sim_status_str(ICOAC_SIM_ERR_NONFINITE), "not finite") != NULL);
 }
 
-/* Each plant's failure test: inside on its limits, outside just beyond any of them. */
+/* 1 when the default model of plant i fails with component c at value v (the rest 0). */
+static int32_t fails_at(int32_t i, int32_t c, double v)
+{
+    icoac_sim_model_t model;
+    double s[ICOAC_SIM_MAX_STATE] = {0};
+    int32_t failed = -1;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_default(&model, i));
+    s[c] = v;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, s, &failed));
+    return failed;
+}
+
+/* Each plant's failure test: every parameter named a limit bounds at least one state component,
+ * inside on the limit, outside just beyond it on either side. */
 static void test_failure_limits(void)
 {
-    /* {plant, component, parameter of its limit} */
-    static const int32_t limits[][3] = {{0, 0, 4}, {0, 2, 5}, {1, 0, 10}, {1, 2, 11}, {2, 0, 6}, {2, 2, 7}, {2, 4, 7}};
-    size_t k;
-    for (k = 0; k < sizeof limits / sizeof limits[0]; ++k) {
-        icoac_sim_model_t model;
-        double s[ICOAC_SIM_MAX_STATE] = {0};
-        const int32_t c = limits[k][1];
-        double lim;
-        int32_t failed = -1;
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_default(&model, limits[k][0]));
-        lim = model.param[limits[k][2]];
-        TEST_ASSERT_TRUE(strstr(plant(limits[k][0])->params[limits[k][2]].name, "limit") != NULL);
-        s[c] = lim;
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, s, &failed));
-        TEST_ASSERT_EQUAL_INT(0, failed);
-        s[c] = -lim;
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, s, &failed));
-        TEST_ASSERT_EQUAL_INT(0, failed);
-        s[c] = nextafter(lim, 1e9);
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, s, &failed));
-        TEST_ASSERT_EQUAL_INT(1, failed);
-        s[c] = -nextafter(lim, 1e9);
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, s, &failed));
-        TEST_ASSERT_EQUAL_INT(1, failed);
+    int32_t i, j, c;
+    for (i = 0; i < icoac_sim_plant_count(); ++i) {
+        const icoac_sim_plant_desc_t *d = plant(i);
+        for (j = 0; j < d->n_params; ++j) {
+            const double lim = d->params[j].value;
+            int bounded = 0;
+            if (strstr(d->params[j].name, "limit") == NULL) {
+                continue;
+            }
+            for (c = 0; c < d->n_state; ++c) {
+                if (fails_at(i, c, lim) != 0 || fails_at(i, c, nextafter(lim, 1e9)) == 0) {
+                    continue; /* not bounded by this limit (inside beyond it, or outside another one) */
+                }
+                ++bounded;
+                TEST_ASSERT_EQUAL_INT(0, fails_at(i, c, -lim));
+                TEST_ASSERT_EQUAL_INT(1, fails_at(i, c, -nextafter(lim, 1e9)));
+            }
+            if (bounded == 0) {
+                TEST_PRINTF("%s: %s bounds no state component", d->name, d->params[j].name);
+                TEST_FAIL();
+            }
+        }
     }
 }
 
@@ -342,11 +353,12 @@ static void test_energy_conserved(void)
             s[c] = 0.3 / (c + 1);
         }
         TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_energy(&model, s, &e0));
-        /* the potential energy of the upright at rest sets the scale */
+        /* the scale: the energy of the upright at rest, or the start's above it, whichever is the
+         * larger (a plant's potential may be 0 or negative at its upright) */
         {
             double up[ICOAC_SIM_MAX_STATE] = {0}, e_up = 0.0;
             TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_energy(&model, up, &e_up));
-            scale = fabs(e_up);
+            scale = fmax(fabs(e_up), fabs(e0 - e_up));
             TEST_ASSERT_TRUE(scale > 0.0);
         }
         for (k = 0; k < 20000; ++k) {
@@ -369,6 +381,65 @@ static void test_energy_conserved(void)
 void setUp(void) {}
 void tearDown(void) {}
 
+/* 1 when word is one of the space-separated words of list. */
+static int listed(const char *list, const char *word)
+{
+    const size_t n = strlen(word);
+    while (*list != '\0') {
+        const size_t len = strcspn(list, " ");
+        if (len == n && strncmp(list, word, n) == 0) {
+            return 1;
+        }
+        list += len + (list[len] == ' ');
+    }
+    return 0;
+}
+
+/* Every plant's task is a configuration the controller accepts, with one input per state
+ * component; its learner settings keep it valid and apply to exactly the conditions they name. */
+static void test_task_presets(void)
+{
+    static const char *const conditions[] = {"ico", "ico-rl", "ico-mean-rl", "rl-ico-cov", "rl", "ico-search",
+                                             "search", "rl-ico"};
+    const int32_t n = icoac_sim_plant_count();
+    icoac_config_t cfg, before;
+    int32_t i, k;
+    size_t c;
+    for (i = 0; i < n; ++i) {
+        const icoac_sim_plant_desc_t *d = plant(i);
+        if (d->task == NULL) {
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_task(i, &cfg));
+            continue;
+        }
+        TEST_ASSERT_TRUE(strlen(d->task->source) > 0 && d->task->n_learners >= 0);
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(i, &cfg));
+        TEST_ASSERT_EQUAL_INT(d->n_state, cfg.task.n_inputs);
+        TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&cfg));
+        for (c = 0; c < sizeof conditions / sizeof conditions[0]; ++c) {
+            int named = 0;
+            for (k = 0; k < d->task->n_learners; ++k) {
+                named += listed(d->task->learners[k].conditions, conditions[c]);
+            }
+            before = cfg;
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_learner(i, conditions[c], &cfg));
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&cfg));
+            TEST_ASSERT_TRUE(named <= 1);
+            if (named == 0) { /* "ico" or "rl-ico" only inside another name: no match */
+                TEST_ASSERT_EQUAL_MEMORY(&before, &cfg, sizeof cfg);
+            }
+        }
+    }
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_task(n, &cfg));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_learner(-1, "rl", &cfg));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_task(0, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_learner(0, NULL, &cfg));
+    /* the cart-pole's task is the controller's defaults */
+    icoac_config_default(&before);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(ICOAC_SIM_CART_POLE, &cfg));
+    TEST_ASSERT_EQUAL_MEMORY(&before, &cfg, sizeof cfg);
+    TEST_ASSERT_EQUAL_INT(1, plant(ICOAC_SIM_CART_POLE)->task->paper);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -380,5 +451,6 @@ int main(void)
     RUN_TEST(test_grids);
     RUN_TEST(test_trial_start);
     RUN_TEST(test_energy_conserved);
+    RUN_TEST(test_task_presets);
     return UNITY_END();
 }

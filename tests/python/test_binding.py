@@ -15,7 +15,6 @@ from harness.registry import CONDITIONS, REGISTRY
 def test_struct_sizes_match_c():
     assert ctypes.sizeof(B.Config) == B.lib.icoac_sizeof_config()
     assert ctypes.sizeof(B.Prior) == B.lib.icoac_sizeof_prior()
-    assert ctypes.sizeof(B.Plant) == B.lib.icoac_sim_sizeof_plant()
     assert ctypes.sizeof(B.Run) == B.lib.icoac_sim_sizeof_run()
     assert B.CELL_DTYPE.itemsize == B.lib.icoac_sim_sizeof_cell()
     assert ctypes.sizeof(B.c_real) == B.lib.icoac_sizeof_real()
@@ -61,7 +60,7 @@ def test_state_is_opaque_aligned_storage():
 
 def test_abi_versions():
     assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 9
-    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 3
+    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 4
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
     # the host build's defaults: the dense critic kernel, two lanes per engine thread
@@ -127,9 +126,9 @@ def test_field_check_catches_missing_extra_size_and_dtype():
     with pytest.raises(LibraryError, match=r"icoac_sim_cell_t\.outcome: C offset 24 size 4, binding offset 24 size 8"):
         B.check_mirror("icoac_sim_cell_t", wrong)
     # a made-up table: the binding is checked against whatever C says
-    table = dict(B.FIELDS["icoac_sim_plant_t"], dt=(40, 8))
-    with pytest.raises(LibraryError, match=r"icoac_sim_plant_t\.dt: C offset 40"):
-        B.check_mirror("icoac_sim_plant_t", B.Plant, c_fields=table)
+    table = dict(B.FIELDS["icoac_sim_model_t"], dt=(40, 8))
+    with pytest.raises(LibraryError, match=r"icoac_sim_model_t\.dt: C offset 40"):
+        B.check_mirror("icoac_sim_model_t", B.Model, c_fields=table)
 
 
 def test_constants_from_c():
@@ -217,7 +216,7 @@ def test_config_defaults_match_spec():
     assert sea == {"batch": 8, "elite_fraction": 0.25, "step": 0.5, "floor": 1.0, "cov_scale": 64.0}
     assert p == {"gravity": 9.8, "cart_mass": 1.0, "pole_mass": 0.1, "half_length": 0.5, "dt": 0.01,
                  "x_limit": 2.4, "theta_limit": pytest.approx(math.radians(12)), "integrator": "euler",
-                 "reserved": 0}
+                 "name": "cart_pole"}
     assert r == {"max_trials": 100000, "success_steps": 100000, "init_velocity_noise": pytest.approx(1e-4)}
     assert d["prior"] is None
 
@@ -281,7 +280,7 @@ def test_overrides_by_name():
                         "noise_std": 2.0, "input_range": [2.4, 3.5, 0.2094384, 2.0], "clip_inputs": "false"})
     c = cfg.controller
     assert c.policy.reflex_mode == B.REFLEX_MODES["gain"] and c.ico.timing == B.ICO_TIMINGS["literal"]
-    assert cfg.plant.integrator == B.INTEGRATORS["rk4"] and cfg.run.max_trials == 2000
+    assert cfg.model.integrator == B.INTEGRATORS["rk4"] and cfg.run.max_trials == 2000
     assert c.actor.noise_std == 2.0 and c.policy.clip_inputs == 0
     d = cfg.to_dict()
     assert d["controller"]["policy"]["reflex_mode"] == "gain" and d["plant"]["integrator"] == "rk4"

@@ -210,7 +210,8 @@ def test_first_step_bound_without_noise_and_with_rk4():
     cells = grid.make_cells(0)
     cfg = fixed.fixed_config(W, overrides={"init_velocity_noise": 0})
     bound = first_step_bound(cfg, cells)
-    beyond = (np.abs(cells["x0"]) > cfg.plant.x_limit) | (np.abs(cells["theta0"]) > cfg.plant.theta_limit)
+    limit = cfg.flat()
+    beyond = (np.abs(cells["x0"]) > limit["x_limit"]) | (np.abs(cells["theta0"]) > limit["theta_limit"])
     assert sorted(c["cell"] for c in bound["lost_cells"]) == np.flatnonzero(beyond).tolist()
     rk4 = first_step_bound(fixed.fixed_config(W, overrides={"integrator": "rk4"}), cells[:5])
     assert rk4["computed"] is False and "Euler" in rk4["reason"]

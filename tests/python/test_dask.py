@@ -41,7 +41,7 @@ CELL_SPEC = grid.format_cell_indices(CELLS)
 SLOW_CAPS = {"max_trials": 100000, "success_steps": 5000}  # about 3 s threaded (engine with lanes)
 SLOW_SEED = 5
 SLOW_SPEC = "560-679"
-SLOW_CELLS = grid.parse_cell_indices(SLOW_SPEC)
+SLOW_CELLS = grid.parse_cell_indices(SLOW_SPEC, B.GRID_CELLS)
 
 
 @pytest.fixture(scope="module")

@@ -86,12 +86,12 @@ def test_subset_seeds_match_full_grid():
 
 
 def test_parse_cell_indices():
-    assert grid.parse_cell_indices("3,1,5-7") == [1, 3, 5, 6, 7]
-    assert grid.parse_cell_indices(None) is None
+    assert grid.parse_cell_indices("3,1,5-7", 8) == [1, 3, 5, 6, 7]
+    assert grid.parse_cell_indices(None, 8) is None
+    with pytest.raises(B.ConfigError, match=r"out of range \[0, 8\)"):
+        grid.parse_cell_indices("8", 8)
     with pytest.raises(B.ConfigError):
-        grid.parse_cell_indices("1225")
-    with pytest.raises(B.ConfigError):
-        grid.parse_cell_indices("a,b")
+        grid.parse_cell_indices("a,b", 8)
 
 
 def test_run_cell_matches_grid(small_cfg, small_run):

@@ -16,6 +16,8 @@ from gymnasium.utils.env_checker import check_env
 
 import harness.gym as hg
 from harness import _binding as B
+from harness import geometry
+from harness.gym import plants as gym_plants
 from harness.ceiling.fixed import fixed_config
 from harness.config import build_config
 from harness.grid import run_cell, trajectory
@@ -33,8 +35,20 @@ def make(steps=None, **kwargs):
     return gymnasium.make(ENV_ID, **({} if steps is None else {"max_episode_steps": steps}), **kwargs)
 
 
-def c_plant_step(plant, s, force):
-    B.check_status(B.lib.icoac_sim_plant_step(ctypes.byref(plant), s, force))
+def c_model_step(model, s, force):
+    """icoac_sim_model_step on a cart-pole state of 4 (in place)."""
+    full = np.zeros(B.MAX_STATE)
+    full[:4] = s
+    B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(model), full, force))
+    s[:] = full[:4]
+
+
+def c_model_failed(model, s):
+    full = np.zeros(B.MAX_STATE)
+    full[:4] = s
+    failed = ctypes.c_int32(-1)
+    B.check_status(B.lib.icoac_sim_model_failed(ctypes.byref(model), full, ctypes.byref(failed)))
+    return bool(failed.value)
 
 
 def test_registered_and_passes_check_env():
@@ -71,7 +85,7 @@ def test_fixed_w_episode_equals_the_engine_trajectory(w, cell, lasts):
     cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
     B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, grid_seed))
     assert episode.reset_info == {"cell": cell, "grid_seed": grid_seed, "cell_seed": int(cells[cell]["seed"])}
-    engine = trajectory(cfg, cells[cell]["x0"], cells[cell]["theta0"], duration=steps * cfg.plant.dt,
+    engine = trajectory(cfg, cells[cell]["x0"], cells[cell]["theta0"], duration=steps * cfg.model.dt,
                         seed=int(cells[cell]["seed"]))
     assert episode.steps == engine.n_steps == lasts
     assert np.array_equal(episode.forces, engine.forces)
@@ -119,7 +133,7 @@ def test_reset_draws_and_options():
     obs, info = env.reset(options={"state": start})
     assert np.array_equal(obs, start) and info == {}
     obs, _, terminated, truncated, info = env.step(np.array([2.5]))
-    c_plant_step(env.unwrapped.parameters.plant, start, 2.5)
+    c_model_step(env.unwrapped.parameters.model, start, 2.5)
     assert np.array_equal(obs, start) and not terminated and not truncated and info["force"] == 2.5
     for bad in ({"state": [0, 0, np.nan, 0]}, {"state": [0, 0]}, {"state": "abc"}, {"cell": B.GRID_CELLS},
                 {"cell": 1.5}, {"grid_seed": -1}, {"state": [0, 0, 0, 0], "cell": 3}, {"theta0": 0.1}):
@@ -129,16 +143,17 @@ def test_reset_draws_and_options():
 
 def test_plant_parameters_reach_the_c_plant():
     env = make(dt=0.02, integrator="rk4", pole_mass=0.2)
-    plant = env.unwrapped.parameters.plant
-    assert (plant.dt, plant.integrator, plant.pole_mass) == (0.02, B.INTEGRATORS["rk4"], 0.2)
+    model = env.unwrapped.parameters.model
+    pole_mass = [p["name"] for p in B.plant_info("cart_pole")["params"]].index("pole_mass")
+    assert (model.dt, model.integrator, model.param[pole_mass]) == (0.02, B.INTEGRATORS["rk4"], 0.2)
     assert env.unwrapped.dt == 0.02
     s, _ = env.reset(seed=1)
     obs, *_ = env.step([-3.0])
-    c_plant_step(plant, s, -3.0)
+    c_model_step(model, s, -3.0)
     assert np.array_equal(obs, s)
-    with pytest.raises(B.ConfigError, match="gravity"):
+    with pytest.raises(B.ConfigError):
         make(gravity=-1.0)
-    with pytest.raises(ValueError, match="unknown cart-pole parameter 'gain'"):
+    with pytest.raises(ValueError, match="unknown cart_pole parameter 'gain'"):
         make(gain=3)
     with pytest.raises(ValueError, match="render_mode"):
         hg.IcoacPlantEnv(render_mode="human")
@@ -196,17 +211,17 @@ def test_continuous_cartpole_is_the_icoac_plant():
     parameters) does, to float64 rounding, under the same force from the same state: same
     equations, signs and units (the two round differently, so each step starts from Gymnasium's)."""
     env = hg.continuous_cartpole(dt=0.01)
-    plant = build_config().plant
+    model = build_config().engine_model()
     env.reset(seed=3)
     rng = np.random.default_rng(0)
     for k in range(200):
         s = np.array(env.unwrapped.state, dtype=np.float64)
         force = float(rng.uniform(-3, 3)) + 30.0 * s[2] + 5.0 * s[3]  # keeps the pole up
         obs, reward, terminated, truncated, info = env.step(np.array([force]))
-        c_plant_step(plant, s, force)
+        c_model_step(model, s, force)
         assert np.allclose(env.unwrapped.state, s, rtol=1e-13, atol=1e-16), k
         assert np.array_equal(obs, env.unwrapped.state.astype(np.float32)) and info["force"] == force
-        assert terminated == bool(B.lib.icoac_sim_failed(ctypes.byref(plant), s)) and not terminated
+        assert terminated == c_model_failed(model, s) and not terminated
     # a push to +x makes theta fall toward -x in both
     env.reset(options={"low": 0.0, "high": 0.0})
     assert env.step([10.0])[0][3] < 0
@@ -239,7 +254,9 @@ def test_readme_example_prints_what_the_readme_shows():
 
 
 # -- the registry plants served through the model API ----------------------------------------------------
-NEW_PLANTS = {"icoac/Furuta-v0": "furuta", "icoac/DoubleCartPole-v0": "double_cart_pole"}
+# Every registry plant (the cart-pole's env also tested above), by env id.
+NEW_PLANTS = {f"icoac/{gym_plants.gym_name(name)}-v0": name for name in
+              (B.plant_info(i)["name"] for i in range(B.lib.icoac_sim_plant_count()))}
 
 
 def c_model_start(model, plant, cell, grid_seed, noise):
@@ -275,7 +292,8 @@ def test_registry_plant_spaces_from_the_descriptor_and_check_env(env_id, plant):
 def test_zero_action_episode_equals_the_c_model(env_id, plant):
     """From a tilted grid cell, an episode under zero input = icoac_sim_model_step from the same
     start, bit for bit, and it terminates where icoac_sim_model_failed first says so."""
-    cell, grid_seed = 100, 7  # row 2: the pendulum 10 deg from upright
+    g = geometry.of(plant)
+    cell, grid_seed = int(g.cell_index(min(2, g.rows - 1), min(2, g.cols - 1))), 7  # row 2: 10 deg from upright
     env = gymnasium.make(env_id)
     obs, info = env.reset(options={"cell": cell, "grid_seed": grid_seed})
     model = B.model_default(plant)
@@ -356,11 +374,13 @@ def test_plant_episodes_equal_the_engine_trial_loop(env_id, plant):
     """IcoacPolicy with a plant's task settings on its env = the engine's cell run on the plant's
     model: same trial lengths, same learned weights (no initial velocity noise, so that every trial
     of the engine starts where the env's reset puts it)."""
-    trials, horizon, cell = 10, 300, 269  # the row component at -7 deg, the column's at 0
+    g = geometry.of(plant)
+    trials, horizon = 10, 300
+    cell = int(g.cell_index(min(5, g.rows - 1), g.cols // 2))  # the row component at -7 deg, the column's at 0
     cfg = build_config({"max_trials": trials, "success_steps": horizon, "init_velocity_noise": 0}, plant=plant)
     n = len(B.plant_info(plant)["state"])
     assert hg.IcoacPolicy(condition="ico", plant=plant).weights.shape == (n,)
-    cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
+    cells = np.zeros(g.cells, dtype=B.CELL_DTYPE)
     B.check_status(B.lib.icoac_sim_plant_grid(B.plant_index(plant), cells, cells.size, 0))
     seed = int(cells[cell]["seed"])
     engine = run_cell(cfg, cells[cell]["x0"], cells[cell]["theta0"], seed=seed)

@@ -10,6 +10,7 @@ import shutil
 import signal
 import sys
 import tempfile
+import traceback
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +26,7 @@ GRID_ARGS = ["--cells", "300,610-613,900", "--seed", "3", "--threads", "1", "--c
 # A bench of one seed on four central cells at small caps: every stage, priors included, in well under a second.
 TINY_PROFILE = {"seeds": 1, "ico": dict(SMALL),
                 "rl": {"max_trials": 300, "success_steps": 500},
-                "cells": [610, 611, 612, 613]}
+                "cells": lambda plant_grid: [610, 611, 612, 613]}
 MAX_WRITES = 400
 
 
@@ -70,6 +71,8 @@ def run_killed_at(k: int, argv: list[str], log: Path, refused: str | None = None
 
             store.write_bytes, store.remove = write_bytes, remove
             status = cli.main(argv)
+        except BaseException:
+            traceback.print_exc()
         finally:
             sys.stderr.flush()
             os._exit(status)

@@ -1,16 +1,18 @@
 # SPDX-License-Identifier: Apache-2.0
 """The benchmark on registry plants (harness --plant): configurations and records by plant, the
 plant's grid in every metric and map, the task settings and their sweep, refusals by name."""
+import ctypes
 import json
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from harness import _binding as B
-from harness import cli, geometry, grid, metrics, plants, results
+from harness import cli, config, geometry, grid, metrics, plants, results
 from harness import prior as P
 from harness.config import build_config, config_from_dict
 from harness.tools import plant_sweeps
@@ -38,25 +40,38 @@ def test_cart_pole_config_unchanged_by_the_plant_argument():
         assert build_config(condition=condition).to_dict() == \
             build_config(condition=condition, plant="cart_pole").to_dict()
     cfg = build_config()
-    assert cfg.model is None and cfg.plant_name == "cart_pole"
-    m = cfg.engine_model()
-    assert m.plant == 0 and m.param[0] == cfg.plant.gravity and m.dt == cfg.plant.dt
+    assert cfg.plant_name == "cart_pole" and cfg.model.plant == B.CART_POLE
+    # recorded as every plant: name, dt, integrator, its parameters by name
+    assert cfg.to_dict()["plant"] == {"name": "cart_pole", "dt": 0.01, "integrator": "euler",
+                                      **{p["name"]: p["value"] for p in B.plant_info("cart_pole")["params"]}}
 
 
 def test_furuta_config_has_its_task_and_learner_settings():
     cfg = build_config(condition="ico-rl", plant="furuta", overrides={"pendulum_damping": 1e-4, "dt": 0.005})
     d = cfg.to_dict()
     assert d["plant"]["name"] == "furuta" and d["plant"]["pendulum_damping"] == 1e-4 and d["plant"]["dt"] == 0.005
-    task = plants.task_overrides("furuta", plants.FURUTA_SETTING)
-    assert np.allclose(d["controller"]["policy"]["input_range"][:4], task["policy.input_range"], rtol=1e-6)
-    assert math.isclose(d["controller"]["ico"]["rate"], plants.FURUTA_SETTING["ico.rate"], rel_tol=1e-6)
-    assert d["controller"]["actor"]["noise_std"] == plants.PLANTS["furuta"].learners["ico-rl"]["actor.noise_std"]
+    task = B.Config()
+    plants.spec("furuta").task_config(task)
+    assert bytes(task.policy) == bytes(cfg.controller.policy) and bytes(task.task) == bytes(cfg.controller.task)
+    assert B.plant_info("furuta")["task"]["learners"] == [["ico-rl", "ico-mean-rl"], ["rl", "rl-ico-cov"]]
+    assert cfg.controller.actor.noise_std == 1.0 and build_config(condition="ico-rl").controller.actor.noise_std != 1.0
     # the control takes its learner's noise; a user's --set wins over both
     ctrl = build_config(condition="ico-rl-control", plant="furuta", overrides={"policy.gain": 2})
     assert ctrl.to_dict()["controller"]["actor"]["noise_std"] == d["controller"]["actor"]["noise_std"]
     assert ctrl.controller.policy.gain == 2
     # the record reads back to the same configuration
     assert config_from_dict(d).to_dict() == d
+
+
+def test_a_plant_without_a_task_is_refused(monkeypatch):
+    bare = replace(plants.PLANTS["furuta"], task_source=None)
+    monkeypatch.setitem(plants.PLANTS, "furuta", bare)
+    with pytest.raises(B.ConfigError, match="plant furuta has no controller task"):
+        build_config(plant="furuta")
+    # C refuses it too: an index out of the registry has no task
+    cfg = B.Config()
+    assert B.lib.icoac_sim_plant_task(B.lib.icoac_sim_plant_count(), ctypes.byref(cfg)) == B.SIM_ERR_BAD_PLANT
+    assert B.lib.icoac_sim_plant_learner(-1, b"rl", ctypes.byref(cfg)) == B.SIM_ERR_BAD_PLANT
 
 
 @pytest.mark.parametrize("overrides, words", [
@@ -107,6 +122,7 @@ def test_prior_frame_of_the_plant():
     col_deg, row_deg = np.degrees(cells["x0"]), np.degrees(cells["theta0"])
     inside = (np.abs(col_deg) <= 45.0 + 1e-9) & (np.abs(row_deg) <= 6.0 + 1e-9)
     assert info.n_cells == int(inside.sum()) and info.frame == (45.0, 6.0)
+    assert info.to_dict()["frame"] == {"theta0_abs_max_deg": 45.0, "alpha0_abs_max_deg": 6.0}
     assert np.allclose(info.mean, cells["weights"][inside][:, :4].mean(axis=0))
 
 
@@ -117,11 +133,11 @@ def test_grid_command_records_and_resumes_by_plant(capsys, tmp_path):
     cells, record = results.load(out)
     assert record["config"]["plant"]["name"] == "furuta" and results.record_plant(record) == "furuta"
     assert geometry.of("furuta").on_grid(cells).all()
-    expected = grid.make_cells(0, grid.parse_cell_indices(CELLS), plant="furuta")
+    expected = grid.make_cells(0, grid.parse_cell_indices(CELLS, geometry.of("furuta").cells), plant="furuta")
     assert np.array_equal(cells["x0"], expected["x0"]) and np.array_equal(cells["theta0"], expected["theta0"])
     # the engine through the harness is the C engine on the model
     cfg = config_from_dict(record["config"])
-    again = grid.make_cells(0, grid.parse_cell_indices(CELLS), plant="furuta")
+    again = grid.make_cells(0, grid.parse_cell_indices(CELLS, geometry.of("furuta").cells), plant="furuta")
     grid.run_grid(cfg, again, threads=1, progress=False)
     assert again.tobytes() == cells.tobytes()
     before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
@@ -150,14 +166,22 @@ def test_sweep_ranking_and_the_furuta_choice():
             {"key": "b", "seed": "0", "success_rate": "0.295", "median_trials": "100"},
             {"key": "c", "seed": "0", "success_rate": "0.10", "median_trials": ""}]
     assert [r["key"] for r in plant_sweeps.ranked(rows)] == ["b", "a", "c"]  # within one point: fewer trials
-    # the settings in harness/plants.py are the choice its sweep's summary records
-    text = (REPO / "docs" / "sweeps-furuta.md").read_text()
-    choice = re.search(r"## Choice\s+`([^`]+)`", text).group(1)
-    assert plant_sweeps.setting_of(choice) == plants.FURUTA_SETTING
-    for learner, settings in plants.PLANTS["furuta"].learners.items():
-        if learner in plant_sweeps.LEARNER_SPACE:
-            picked = re.search(rf"## Learner {learner}: .*?Choice: `([^`]+)`", text, re.S).group(1)
-            assert json.loads(picked) == settings
+    # each swept plant's C task is the choice its sweep's summary records, and its learner settings
+    # the learner sweeps' choices
+    for plant in plant_sweeps.TASK_SPACES:
+        text = (REPO / "docs" / f"sweeps-{plant}.md").read_text()
+        choice = plant_sweeps.setting_of(re.search(r"## Choice\s+`([^`]+)`", text).group(1))
+        swept = B.Config()
+        B.lib.icoac_config_default(ctypes.byref(swept))
+        for name, value in plant_sweeps.task_overrides(plant, choice).items():
+            config._set_field(swept, config.canonical(name), value)
+        task = B.Config()
+        plants.spec(plant).task_config(task)
+        assert bytes(task) == bytes(swept), plant
+        for learner in set(plants.PLANTS[plant].learners) & set(plant_sweeps.LEARNER_SPACE):
+            picked = json.loads(re.search(rf"## Learner {learner}: .*?Choice: `([^`]+)`", text, re.S).group(1))
+            assert build_config(picked, condition=learner, plant=plant).to_dict() == \
+                build_config(condition=learner, plant=plant).to_dict()
 
 
 def test_figures_and_sweep_take_the_recorded_plant(capsys, tmp_path):
@@ -204,3 +228,20 @@ def test_prior_of_finished_cells():
         P.compute(cells, None, grid=grid6, use="some")
     assert plants.PLANTS["double_cart_pole"].prior_cells == "finished"
     assert plants.PLANTS["furuta"].prior_cells == plants.PLANTS["cart_pole"].prior_cells == "successful"
+
+
+@pytest.mark.parametrize("plant", list(plants.PLANTS))
+def test_cell_subsets_follow_each_plant_grid(plant):
+    """The quick profile's, the sweep's spread and --subset cells lie on the plant's own grid; on
+    the cart-pole's they are the paper grid's historical cells."""
+    g = geometry.of(plant)
+    for cells in (g.quick_cells(), g.spread_cells(), g.subset(40)):
+        assert cells == sorted(set(cells)) and 0 <= cells[0] and cells[-1] < g.cells
+        assert grid.make_cells(0, cells, plant=plant).size == len(cells)
+    assert len(g.spread_cells()) == g.cols and g.subset(g.cells) == list(range(g.cells))
+    if plant == "cart_pole":
+        assert g.quick_cells() == sorted(r * 49 + c for r in (2, 8, 10, 12, 14, 22) for c in (4, 19, 22, 24, 26, 44))
+        assert g.spread_cells() == list(range(0, 1225, 25))
+    keys = g.frame_keys()
+    assert keys[0].startswith(g.col_start()) and keys[1].startswith(g.row_start())
+    assert [k.endswith("_deg") for k in keys] == [g.col_unit == "deg", g.row_unit == "deg"]

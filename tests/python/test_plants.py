@@ -6,8 +6,7 @@ energy density along it), the mass matrix is sum m J^T J with the Jacobians J ta
 step, the Coriolis terms come from finite differences of that matrix, gravity from the complex-
 step gradient of the potential. Checked: the state derivative at random states, inputs and
 parameters; the energy function; energy conservation over a long frictionless run; the
-linearisation of the C step at the upright against the one of these equations; the cart-pole
-through the interface against its old functions.
+linearisation of the C step at the upright against the one of these equations.
 """
 import ctypes
 
@@ -173,19 +172,19 @@ def random_state(rng, n_state, angle=1.2, rate=3.0):
 NAMES = list(PLANTS)
 
 
-def test_registry_lists_the_plants():
+def test_registry_holds_the_plants_derived_here():
+    """The plants derived here are in the registry (it may hold more: a plant added to it needs no
+    line here); their data sources' values."""
     names = [B.plant_info(i)["name"] for i in range(B.lib.icoac_sim_plant_count())]
-    assert names[:3] == NAMES and names[B.CART_POLE] == "cart_pole"
-    assert B.plant_index("furuta") == 1
+    assert set(NAMES) <= set(names) and names[B.CART_POLE] == "cart_pole"
     furuta = B.plant_info("furuta")
-    assert furuta["state"][2] == ("alpha", "rad") and furuta["input"] == ("voltage", "V")
+    assert furuta["input"] == ("voltage", "V")
     values = {pr["name"]: pr["value"] for pr in furuta["params"]}
     # QUBE-Servo 2: rotary pendulum module and motor (docs/plants.md)
     assert (values["arm_mass"], values["arm_length"], values["pendulum_mass"], values["pendulum_length"]) == \
         (0.095, 0.085, 0.024, 0.129)
     assert (values["resistance"], values["torque_constant"]) == (8.4, 0.042)
     dip = B.plant_info("double_cart_pole")
-    assert [s for s, _ in dip["state"]] == ["x", "x_dot", "theta1", "theta1_dot", "theta2", "theta2_dot"]
     values = {pr["name"]: pr["value"] for pr in dip["params"]}
     assert [values[k] for k in ("cart_mass", "mass1", "mass2", "length1", "length2")] == [1.5, 0.5, 0.75, 0.5, 0.75]
     with pytest.raises(B.ConfigError, match="unknown plant 'nope'"):
@@ -334,24 +333,6 @@ def test_linearisation_at_the_upright(name, integrator):
     assert np.allclose(fd_b, bd[:, 0], rtol=0, atol=1e-7 * np.max(np.abs(bd))), (fd_b, bd[:, 0])
     # the upright is unstable: A has an eigenvalue with a positive real part
     assert np.max(np.linalg.eigvals(a).real) > 1.0
-
-
-def test_cart_pole_interface_is_the_old_step_bit_for_bit():
-    rng = np.random.default_rng(3)
-    for integrator in ("euler", "rk4"):
-        plant = B.Plant()
-        B.lib.icoac_sim_plant_default(ctypes.byref(plant))
-        plant.integrator = B.INTEGRATORS[integrator]
-        model = B.Model()
-        B.check_status(B.lib.icoac_sim_model_from_plant(ctypes.byref(plant), ctypes.byref(model)))
-        for _ in range(500):
-            old = rng.uniform(-2, 2, B.N_INPUTS)
-            new = np.zeros(B.MAX_STATE)
-            new[:4] = old
-            force = rng.uniform(-20, 20)
-            B.check_status(B.lib.icoac_sim_plant_step(ctypes.byref(plant), old, force))
-            B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(model), new, force))
-            assert old.tobytes() == new[:4].tobytes()
 
 
 def test_bad_state_gets_a_named_status():

@@ -186,26 +186,26 @@ def test_config_from_dict_of_anything(data):
 @given(st.lists(st.integers(0, B.GRID_CELLS - 1), min_size=1, max_size=60), st.randoms(use_true_random=False))
 def test_cell_list_round_trip(indices, rnd):
     want = sorted(set(indices))
-    assert grid.parse_cell_indices(grid.format_cell_indices(indices)) == want
-    assert grid.parse_cell_indices(indices) == want
+    assert grid.parse_cell_indices(grid.format_cell_indices(indices), B.GRID_CELLS) == want
+    assert grid.parse_cell_indices(indices, B.GRID_CELLS) == want
     # the same cells written another way: shuffled parts, some ranges split, spaces, empty parts
     parts = grid.format_cell_indices(indices).split(",")
     rnd.shuffle(parts)
     text = " , ".join(p.replace("-", " - ") if rnd.random() < 0.5 else p for p in parts) + ("," if rnd.random() < .3 else "")
-    assert grid.parse_cell_indices(text) == want
+    assert grid.parse_cell_indices(text, B.GRID_CELLS) == want
 
 
 @given(st.text(alphabet="0123456789-, x+_.e", max_size=30) | st.text(max_size=30))
 def test_cell_text_accepted_or_config_error(text):
-    got = total(grid.parse_cell_indices, text)
+    got = total(lambda t: grid.parse_cell_indices(t, B.GRID_CELLS), text)
     if got is not None:
         assert got == sorted(set(got)) and all(0 <= i < B.GRID_CELLS for i in got)
-        assert grid.parse_cell_indices(grid.format_cell_indices(got)) == got
+        assert grid.parse_cell_indices(grid.format_cell_indices(got), B.GRID_CELLS) == got
 
 
 @given(st.lists(scalars | st.integers(-5, 1300), max_size=8))
 def test_cell_sequence_accepted_or_config_error(items):
-    got = total(grid.parse_cell_indices, items)
+    got = total(lambda t: grid.parse_cell_indices(t, B.GRID_CELLS), items)
     if got is not None:
         assert got == sorted({int(i) for i in items})
 

@@ -7,7 +7,7 @@ import pytest
 
 from harness import _binding as B
 from harness import config as C
-from harness import grid, results, signs
+from harness import grid, plants, results, signs
 from harness.ceiling import lqr
 from harness.errors import ResultsError
 
@@ -88,6 +88,21 @@ def test_given_signs_switch_the_derivation_off():
     del record["config"]["controller"]["task"]["input_sign"]
     with pytest.raises(ResultsError, match=r"config\.controller\.task: 'input_sign' is a required property"):
         results.check_record(record)
+
+
+def test_a_task_that_gives_signs_keeps_them(monkeypatch):
+    """A plant's C task that writes its own signs (a -1) is not derived over; the others are."""
+    plant = "double_cart_pole"
+    derived = list(C.build_config(plant=plant).controller.task.input_sign)
+    task_config = plants.PlantSpec.task_config
+
+    def with_signs(spec, cfg):
+        task_config(spec, cfg)
+        cfg.task.input_sign[0] = -1
+        cfg.task.input_sign[1] = 1
+    monkeypatch.setattr(plants.PlantSpec, "task_config", with_signs)
+    given = list(C.build_config(plant=plant).controller.task.input_sign)
+    assert given == [-1] + [1] * 5 != derived
 
 
 @pytest.mark.parametrize("bad", [0, 2, [1, 1, 0, 1, 1, 1]])

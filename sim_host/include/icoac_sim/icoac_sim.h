@@ -13,7 +13,7 @@
 extern "C" {
 #endif
 
-#define ICOAC_SIM_ABI_VERSION 3
+#define ICOAC_SIM_ABI_VERSION 4
 
 /* Status of sim functions: values below 100 are icoac_status_t, passed through. */
 typedef enum {
@@ -245,6 +245,30 @@ typedef int32_t (*icoac_sim_failed_fn)(const double *p, const double *s);
 /* Total mechanical energy (J) of s. */
 typedef double (*icoac_sim_energy_fn)(const double *p, const double *s);
 
+/* The cart-pole's penalty zone along its track, 2.35 of 2.4 m, as a fraction of that range: the
+ * shipped plants' tasks scale their own zone by it. */
+#define ICOAC_SIM_ZONE_FRACTION (2.35 / 2.4)
+
+/* Settings of some of the harness's learning conditions on a plant, over the condition's own
+ * (harness/registry.py names the conditions). */
+typedef struct {
+    const char *conditions;             /* their names, space-separated: "rl rl-ico-cov" */
+    void (*apply)(icoac_config_t *cfg); /* writes the settings */
+} icoac_sim_learner_t;
+
+/* The controller task a plant is benchmarked with (docs/plants.md): its inputs' ranges, rule
+ * table, critic grid and learner settings, chosen for this plant. */
+typedef struct {
+    const char *source;                 /* where the settings come from, one line */
+    void (*apply)(icoac_config_t *cfg); /* writes the task over icoac_config_default's; NULL: those are it */
+    int32_t n_learners;
+    int32_t paper; /* 1: the paper's plant and task, so that its published results apply */
+    const icoac_sim_learner_t *learners; /* n_learners entries; a condition in at most one */
+    /* NULL, or why the ICO prior averages every finished ICO cell of this plant, not only the
+     * successful ones (ICO balances too few of them for a prior) */
+    const char *prior_all_finished;
+} icoac_sim_task_t;
+
 typedef struct {
     const char *name;   /* registry key, e.g. "furuta" */
     const char *title;  /* one line for humans */
@@ -267,6 +291,7 @@ typedef struct {
     icoac_sim_derivatives_fn derivatives;
     icoac_sim_failed_fn failed;
     icoac_sim_energy_fn energy; /* NULL when the plant has none */
+    const icoac_sim_task_t *task; /* NULL: the plant has no task yet, and the harness refuses it */
 } icoac_sim_plant_desc_t;
 
 /* A registry plant with its parameter block and the engine's integration options. */
@@ -282,6 +307,13 @@ typedef struct {
 int32_t icoac_sim_plant_count(void);
 const icoac_sim_plant_desc_t *icoac_sim_plant_info(int32_t index);
 int32_t icoac_sim_plant_find(const char *name);
+
+/* icoac_config_default, then the task of plant index (icoac_sim_task_t); ICOAC_SIM_ERR_BAD_PLANT
+ * for an unknown plant or one without a task (cfg left as it was). */
+int32_t icoac_sim_plant_task(int32_t index, icoac_config_t *cfg);
+/* The plant's settings of the learning condition named condition over cfg, when its task has
+ * some (else cfg is left as it was); ICOAC_SIM_ERR_BAD_PLANT as icoac_sim_plant_task. */
+int32_t icoac_sim_plant_learner(int32_t index, const char *condition, icoac_config_t *cfg);
 
 /* Model of plant index with its default parameters, dt 0.01 s and Euler. */
 int32_t icoac_sim_model_default(icoac_sim_model_t *model, int32_t index);

@@ -54,6 +54,9 @@ static const icoac_sim_param_t params[N_PARAMS] = {
     {"theta_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX},
 };
 
+/* The paper's task: the controller's defaults. */
+static const icoac_sim_task_t task = {"the C defaults (the paper's task)", 0, 0, 1, 0, 0};
+
 const icoac_sim_plant_desc_t sim_cart_pole = {
     "cart_pole",
     "frictionless cart-pole, force on the cart",
@@ -73,6 +76,7 @@ const icoac_sim_plant_desc_t sim_cart_pole = {
     derivatives,
     failed,
     energy,
+    &task,
 };
 
 /* The icoac_sim_plant_t entry points: the descriptor's defaults, ranges and step on the

@@ -87,6 +87,48 @@ static const icoac_sim_param_t params[N_PARAMS] = {
     {"angle_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX},
 };
 
+/* Its task, chosen by its sweep (docs/sweeps-double_cart_pole.md): six inputs scaled to the track
+ * and angle limits, 30 m/s and 4 rad/s (both links); the critic over the same ranges, 216 units;
+ * six rules, first match wins: the lower link beyond 10 deg gives the cart-pole's reflex, the cart
+ * beyond ICOAC_SIM_ZONE_FRACTION of the track a push away from the centre (the sign of the plant's
+ * LQR gain on x), the upper link beyond 10 deg a push tipping the lower link under it; ICO rate 1,
+ * gain 10 N. */
+static void task_settings(icoac_config_t *cfg)
+{
+    const double limit = params[ANGLE_LIMIT].value, z = 10.0 * (ICOAC_SIM_PI / 180.0);
+    const double zx = ICOAC_SIM_ZONE_FRACTION * params[X_LIMIT].value;
+    const double range[6] = {params[X_LIMIT].value, 30.0, limit, 4.0, limit, 4.0};
+    const int32_t units[6] = {2, 2, 3, 3, 3, 2};
+    const int32_t input[6] = {2, 0, 2, 0, 4, 4};
+    const int32_t side[6] = {ICOAC_RULE_ABOVE, ICOAC_RULE_BELOW, ICOAC_RULE_BELOW,
+                             ICOAC_RULE_ABOVE, ICOAC_RULE_ABOVE, ICOAC_RULE_BELOW};
+    const double threshold[6] = {z, -zx, -z, zx, z, -z};
+    const double reflex[6] = {1.0, -1.0, -1.0, 1.0, -1.0, 1.0};
+    int i;
+    cfg->task.n_inputs = 6;
+    cfg->task.n_rules = 6;
+    for (i = 0; i < 6; ++i) {
+        cfg->task.rule_input[i] = input[i];
+        cfg->task.rule_side[i] = side[i];
+        cfg->task.rule_threshold[i] = (icoac_real_t)threshold[i];
+        cfg->task.rule_reflex[i] = (icoac_real_t)reflex[i];
+        cfg->policy.input_range[i] = (icoac_real_t)range[i];
+        cfg->critic.range[i] = (icoac_real_t)range[i];
+        cfg->critic.units[i] = units[i];
+    }
+    cfg->ico.rate = (icoac_real_t)1.0;
+    cfg->policy.gain = (icoac_real_t)10.0;
+}
+
+/* No setting of either actor-critic learner balances a cell (its learner sweeps), so both keep
+ * their defaults. */
+static const icoac_sim_task_t task = {
+    "its sweep (docs/sweeps-double_cart_pole.md): velocity scaling, reflex zone and the upper link's "
+    "reflex sign, ICO rate, gain",
+    task_settings, 0, 0, 0,
+    "ICO balances at most 1 of its cells at the default caps (no prior of 2 or more successful cells "
+    "in any frame), but it learns weights in every cell: the ICO prior averages them, balanced or not"};
+
 const icoac_sim_plant_desc_t sim_double_cart_pole = {
     "double_cart_pole",
     "double inverted pendulum on a cart, force on the cart",
@@ -107,4 +149,5 @@ const icoac_sim_plant_desc_t sim_double_cart_pole = {
     derivatives,
     failed,
     energy,
+    &task,
 };

@@ -93,6 +93,47 @@ static const icoac_sim_param_t params[N_PARAMS] = {
     {"pendulum_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX},
 };
 
+/* Its task, chosen by its sweep (docs/sweeps-furuta.md): inputs (arm angle, arm velocity,
+ * pendulum angle up to its limit, pendulum velocity) and critic over the same ranges, the
+ * cart-pole's rule table and critic units, the reflex zone at ICOAC_SIM_ZONE_FRACTION of the arm
+ * range and 8 deg of the pendulum, ICO rate 0.01, gain 1 V. */
+static void task_settings(icoac_config_t *cfg)
+{
+    const double range[4] = {1.0, 2.3, params[PENDULUM_LIMIT].value, 0.6};
+    const double zone_arm = ICOAC_SIM_ZONE_FRACTION * range[0], zone_pendulum = 8.0 * (ICOAC_SIM_PI / 180.0);
+    const double threshold[4] = {zone_pendulum, -zone_arm, -zone_pendulum, zone_arm}; /* the rules' order */
+    int i;
+    for (i = 0; i < 4; ++i) {
+        cfg->policy.input_range[i] = (icoac_real_t)range[i];
+        cfg->critic.range[i] = (icoac_real_t)range[i];
+        cfg->task.rule_threshold[i] = (icoac_real_t)threshold[i];
+    }
+    cfg->ico.rate = (icoac_real_t)0.01;
+    cfg->policy.gain = (icoac_real_t)1.0;
+}
+
+/* Learner settings by its learner sweeps (docs/sweeps-furuta.md): ICO->RL takes RL alone's
+ * (mean) reading; the prior's decomposition takes those of the learner whose prior mean it shares. */
+static void ico_mean_learners(icoac_config_t *cfg)
+{
+    cfg->actor.update = ICOAC_ACTOR_MEAN;
+    cfg->actor.likelihood_std = (icoac_real_t)0.1;
+    cfg->actor.scale = (icoac_real_t)0.1;
+    cfg->actor.noise_std = (icoac_real_t)1.0;
+}
+
+static void zero_mean_learners(icoac_config_t *cfg)
+{
+    cfg->actor.noise_std = (icoac_real_t)3.0; /* V */
+}
+
+static const icoac_sim_learner_t learners[2] = {{"ico-rl ico-mean-rl", ico_mean_learners},
+                                                {"rl rl-ico-cov", zero_mean_learners}};
+
+static const icoac_sim_task_t task = {
+    "its sweep (docs/sweeps-furuta.md): input scaling, reflex zone, ICO rate, gain", task_settings, 2, 0,
+    learners, 0};
+
 const icoac_sim_plant_desc_t sim_furuta = {
     "furuta",
     "Furuta pendulum (Quanser QUBE-Servo 2), motor voltage on the arm",
@@ -112,4 +153,5 @@ const icoac_sim_plant_desc_t sim_furuta = {
     derivatives,
     failed,
     energy,
+    &task,
 };
