@@ -93,6 +93,8 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
     extra = prior_extra(info)
     prior = info.prior() if info is not None else None
     cfg = None if resume and not explicit else build_config(overrides, condition=condition, prior=prior, plant=plant)
+    if cfg is not None and isinstance(info, P.PriorInfo):
+        P.check_origin_task(info, cfg)
     with store.ResultsStore(out, start_over=start_over) as st:
         have = st.present()
         if resume and not have:

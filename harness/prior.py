@@ -191,6 +191,20 @@ def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_
                      frame_keys=ico.frame_keys)
 
 
+def check_origin_task(info: PriorInfo, cfg) -> None:
+    """PriorError unless a prior taken from an ICO run (its ``source_task``) was learned on the
+    inputs of the task ``cfg`` runs, sign for sign (task.input_sign): weights learned on other
+    signs are in other coordinates."""
+    task = info.extra.get("source_task")
+    if not isinstance(task, dict):
+        return
+    n = cfg.n_inputs
+    source, target = list(task.get("input_sign", [])[:n]), [int(v) for v in cfg.controller.task.input_sign[:n]]
+    if source != target:
+        raise PriorError(f"--prior-from: the ICO run's input signs {source} are not this task's {target} "
+                         "(task.input_sign): its weights are in other coordinates")
+
+
 def from_results(path: str | Path, frame: tuple[float, float] | str | None = DEFAULT_FRAME,
                  ridge: float = DEFAULT_RIDGE, plant: str | None = None) -> PriorInfo:
     """ICO->RL prior from an ICO results directory, with its provenance (its plant, condition, task

@@ -461,3 +461,15 @@ def test_bench_quick_writes_comparison(tmp_path):
     assert json.loads((out / "summary.json").read_text()) == summary
     assert json.loads((tmp_path / "data.json").read_text())["aggregate"] == summary
     assert json.loads((out / "bench.json").read_text())["meta"]["resume"] is True  # the grids' log stays
+
+
+def test_prior_from_a_run_of_other_input_signs_is_refused(tmp_path, ico_dir):
+    """An ICO prior's weights are in its run's signed inputs (task.input_sign): a task of other
+    signs refuses it in one line, before any write."""
+    out = tmp_path / "icorl"
+    res = run_cli("grid", "--condition", "ico-rl", "--prior-from", str(ico_dir), "--out", str(out), "--cells", "611",
+              "--max-trials", "5", "--set", "task.input_sign=[-1,1,1,1]")
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "the ICO run's input signs [1, 1, 1, 1] are not this task's [-1, 1, 1, 1]" in lines[0]
+    assert not out.exists()
