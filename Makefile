@@ -21,9 +21,9 @@ BENCH_PROFILE ?= default
 BENCH_SUFFIX = $(if $(filter default,$(BENCH_PROFILE)),,/$(BENCH_PROFILE))
 BENCH_OUT ?= results/$(if $(BENCH_SUFFIX),$(BENCH_PROFILE),bench)
 BENCH_FIGURES ?= docs/figures$(BENCH_SUFFIX)
-# The summary docs/results.md's tables come from (python -m harness.tools.results_tables --update).
+# The summary docs/results.md's tables come from (python -m icoac.tools.results_tables --update).
 BENCH_DATA ?= docs/data/bench-$(BENCH_PROFILE).json
-# Plants the bench runs (harness/plants.py; `all`: every plant the controller build takes). The
+# Plants the bench runs (harness/icoac/core/plants.py; `all`: every plant the controller build takes). The
 # cart-pole writes the directories above, another plant P their names with -P (results, data) or
 # /P (figures) added.
 BENCH_PLANTS ?= cart_pole
@@ -58,7 +58,7 @@ deps:
 
 # Project venv; reinstalled when pyproject.toml changes. It gets the dependencies listed in
 # pyproject.toml (with the test extra) and this checkout on its path (a .pth file, behind the
-# current directory, so that a worktree's own harness/ wins) plus an `icoac-harness` script;
+# current directory, so that a worktree's own harness/ wins) plus an `icoac` script;
 # the library is the `make build` one. No wheel is built here (`pip install .` builds one: README).
 VENV_SITE = $$($(VPY) -c 'import sysconfig; print(sysconfig.get_path("purelib"))')
 venv: $(VENV)/.installed
@@ -66,13 +66,13 @@ $(VENV)/.installed: pyproject.toml | deps
 	@[ -x $(VPY) ] || $(PYTHON) -m venv $(VENV)
 	$(VPY) -m pip install -q --upgrade pip
 	@# the setuptools editable install of before, and its metadata in the checkout
-	@$(VPY) -m pip uninstall -q -y icoac-harness 2>/dev/null || true; rm -rf icoac_harness.egg-info
+	@$(VPY) -m pip uninstall -q -y icoac 2>/dev/null || true; rm -rf icoac.egg-info
 	$(VPY) -c 'import tomllib; p = tomllib.load(open("pyproject.toml", "rb"))["project"]; \
 	  print("\n".join(p["dependencies"] + p["optional-dependencies"]["test"]))' > $(VENV)/requirements.txt
 	$(VPY) -m pip install -q -r $(VENV)/requirements.txt
-	@echo "$(CURDIR)" > $(VENV_SITE)/icoac-harness-checkout.pth
-	@printf '#!%s\nfrom harness.cli import main\nraise SystemExit(main())\n' "$(CURDIR)/$(VPY)" > $(VENV)/bin/icoac-harness
-	@chmod +x $(VENV)/bin/icoac-harness
+	@echo "$(CURDIR)/harness" > $(VENV_SITE)/icoac-checkout.pth
+	@printf '#!%s\nfrom icoac.cli import main\nraise SystemExit(main())\n' "$(CURDIR)/$(VPY)" > $(VENV)/bin/icoac
+	@chmod +x $(VENV)/bin/icoac
 	@touch $@
 
 build: deps
@@ -145,7 +145,7 @@ bench-speed: build
 # summary.md and Fig. 3a.
 bench: build venv bench-speed
 	@plants="$(BENCH_PLANTS)"; \
-	if [ "$$plants" = all ]; then plants=$$($(VPY) -c 'from harness.plants import PLANTS; print(" ".join(PLANTS))'); fi; \
+	if [ "$$plants" = all ]; then plants=$$($(VPY) -c 'from icoac.core.plants import PLANTS; print(" ".join(PLANTS))'); fi; \
 	for p in $$plants; do $(MAKE) --no-print-directory bench-plant PLANT=$$p || exit 1; done
 
 PLANT ?= cart_pole
@@ -153,15 +153,15 @@ PLANT_OUT = $(if $(filter cart_pole,$(PLANT)),$(BENCH_OUT),$(BENCH_OUT)-$(PLANT)
 PLANT_FIGURES = $(if $(filter cart_pole,$(PLANT)),$(BENCH_FIGURES),$(BENCH_FIGURES)/$(PLANT))
 PLANT_DATA = $(if $(filter cart_pole,$(PLANT)),$(BENCH_DATA),$(basename $(BENCH_DATA))-$(PLANT).json)
 bench-plant:
-	$(VPY) -m harness ceiling --plant $(PLANT) --profile $(BENCH_PROFILE) --out $(PLANT_OUT)/ceiling --quiet
-	$(VPY) -m harness bench --plant $(PLANT) --profile $(BENCH_PROFILE) --out $(PLANT_OUT) \
+	$(VPY) -m icoac ceiling --plant $(PLANT) --profile $(BENCH_PROFILE) --out $(PLANT_OUT)/ceiling --quiet
+	$(VPY) -m icoac bench --plant $(PLANT) --profile $(BENCH_PROFILE) --out $(PLANT_OUT) \
 	  --figures $(PLANT_FIGURES) --data $(PLANT_DATA) $(BENCH_ARGS)
 
 # The learner sweeps that chose the defaults (docs/results.md), on the ICO grid of seed 0 of a
 # bench (make bench first); resumable, summary in $(SWEEP_OUT)/summary.md.
 SWEEP_OUT ?= results/sweeps
 SWEEP_ICO ?= $(BENCH_OUT)/ico/seed-0
-SWEEP = $(VPY) -m harness.tools.learner_sweeps --prior-from $(SWEEP_ICO) --out $(SWEEP_OUT)
+SWEEP = $(VPY) -m icoac.tools.learner_sweeps --prior-from $(SWEEP_ICO) --out $(SWEEP_OUT)
 sweeps: build venv
 	$(SWEEP)
 	$(SWEEP) --stage 2 --only ico-rl-stage2 --only ico-rl-schedule-grid --only ico-rl-schedule-grid2 \
@@ -178,7 +178,7 @@ sweeps: build venv
 RL_ALONE_OUT ?= results/sweeps-rl-alone
 RL_ALONE_BASE ?= --base actor.update=gradient --base actor.rate=0.03
 RL_ALONE_SCHEDULE ?= --base actor.update=gradient --base actor.explore_ticks=1000 --base actor.batch=0
-RL_ALONE_SWEEP = $(VPY) -m harness.tools.learner_sweeps --prior-from $(SWEEP_ICO) --out $(RL_ALONE_OUT)
+RL_ALONE_SWEEP = $(VPY) -m icoac.tools.learner_sweeps --prior-from $(SWEEP_ICO) --out $(RL_ALONE_OUT)
 sweeps-rl-alone: build venv
 	$(RL_ALONE_SWEEP) --stage rl-alone
 	$(RL_ALONE_SWEEP) --stage rl-alone-2 --only rl-alone-stage2 $(RL_ALONE_BASE)
@@ -188,11 +188,11 @@ sweeps-rl-alone: build venv
 	$(RL_ALONE_SWEEP) --report
 	cp $(RL_ALONE_OUT)/summary.md docs/sweeps-rl-alone.md
 
-# The task settings and learner noise of each plant but the cart-pole (harness/plants.py), by
-# their sweeps (harness.tools.plant_sweeps; resumable): the task on spread cells, then the
+# The task settings and learner noise of each plant but the cart-pole (harness/icoac/core/plants.py), by
+# their sweeps (icoac.tools.plant_sweeps; resumable): the task on spread cells, then the
 # learners on the plant's ICO grid of seed 0 (make bench BENCH_PLANTS=<plant> first).
-PLANT_SWEEPS = $(VPY) -m harness.tools.plant_sweeps --plant furuta --out results/sweeps-furuta
-DOUBLE_SWEEPS = $(VPY) -m harness.tools.plant_sweeps --plant double_cart_pole --out results/sweeps-double_cart_pole
+PLANT_SWEEPS = $(VPY) -m icoac.tools.plant_sweeps --plant furuta --out results/sweeps-furuta
+DOUBLE_SWEEPS = $(VPY) -m icoac.tools.plant_sweeps --plant double_cart_pole --out results/sweeps-double_cart_pole
 sweeps-plants: build venv
 	$(PLANT_SWEEPS)
 	$(PLANT_SWEEPS) --stage learners --prior-from $(BENCH_OUT)-furuta/ico/seed-0

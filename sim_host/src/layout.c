@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Constants, struct layouts and parameter rows exported for bindings (harness/_binding.py reads
+/* Constants, struct layouts and parameter rows exported for bindings (harness/icoac/core/binding.py reads
  * the tables at import), so that sizes, enum values, statuses, grid geometry, field offsets and
  * every parameter's description are defined once, in C. */
 #include <stddef.h>

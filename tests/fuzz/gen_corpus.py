@@ -439,7 +439,7 @@ def controller_seeds(fmt):
                                        + steps((-0.2,), 4))
         s[f"task-sensor-{name}"] = (config({"mode": mode, "task.late_source": 1, "search.batch": 2}) + NO_PRIOR
                                     + seed(66 + mode) + sensor_ops)
-        # the double pendulum's derived input signs (harness.signs): mixed, on six inputs
+        # the double pendulum's derived input signs (icoac.core.signs): mixed, on six inputs
         s[f"task-six-signs-{name}"] = (config_raw(fmt, {**six, **array("task.input_sign", [-1, -1, 1, 1, -1, -1]),
                                                         "mode": mode, "search.batch": 2}) + NO_PRIOR
                                        + seed(90 + mode) + six_exercise * 2)

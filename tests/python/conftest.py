@@ -37,13 +37,13 @@ SMALL_CELLS = [0, 48, 610, 611, 612, 613]
 
 @pytest.fixture(scope="session")
 def small_cfg():
-    from harness.config import build_config
+    from icoac.core.config import build_config
     return build_config(SMALL)
 
 
 @pytest.fixture(scope="session")
 def small_run(small_cfg):
-    from harness import grid
+    from icoac.core import grid
     cells = grid.make_cells(7, SMALL_CELLS)
     res = grid.run_grid(small_cfg, cells, threads=2, progress=False)
     assert not res.cancelled
@@ -56,8 +56,8 @@ ICO_CELLS = [0, 610, 611, 612, 613, 1224]
 
 @pytest.fixture(scope="session")
 def ico_dir(tmp_path_factory):
-    from harness import grid, store
-    from harness.config import build_config
+    from icoac.core import grid, store
+    from icoac.core.config import build_config
     out = tmp_path_factory.mktemp("ico")
     cfg = build_config(SMALL)
     cells = grid.make_cells(0, ICO_CELLS)

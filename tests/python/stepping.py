@@ -5,8 +5,8 @@ import ctypes
 
 import numpy as np
 
-from harness import _binding as B
-from harness.config import make_prior
+from icoac.core import binding as B
+from icoac.core.config import make_prior
 
 REAL = B.real_dtype.type  # np.float32 for the float library
 

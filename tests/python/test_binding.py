@@ -5,11 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import geometry, options
-from harness.config import CONDITION_OVERRIDES, NAMED_CONFIGURATIONS, build_config, named_sets, parse_sets
-from harness.errors import LibraryError
-from harness.registry import CONDITIONS, REGISTRY
+from icoac.core import binding as B
+from icoac.core import geometry, options
+from icoac.core.config import CONDITION_OVERRIDES, NAMED_CONFIGURATIONS, build_config, named_sets, parse_sets
+from icoac.core.errors import LibraryError
+from icoac.core.registry import CONDITIONS, REGISTRY
 
 
 def test_struct_sizes_match_c():
@@ -47,7 +47,7 @@ def test_library_lookup_order(monkeypatch, tmp_path):
 
 
 def test_checkout_is_not_an_installed_package():
-    # harness/lib/ exists only in an installed package (pyproject.toml, the wheel build).
+    # harness/icoac/lib/ exists only in an installed package (pyproject.toml, the wheel build).
     assert not B.PACKAGE_LIBRARY.exists() or B.LIBRARY_SOURCE == "package"
     assert B.abi_info()["library_source"] == B.LIBRARY_SOURCE in ("env", "package", "build")
 
@@ -287,7 +287,7 @@ def test_overrides_by_name():
 
 
 def test_paper_grid_layout():
-    from harness.grid import paper_grid
+    from icoac.core.grid import paper_grid
     cells = paper_grid(0)
     assert cells.size == geometry.CELLS == 1225
     assert np.all(cells["outcome"] == B.PENDING)

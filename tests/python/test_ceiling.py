@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The linear-policy ceiling (method.md, L5, harness.ceiling): fixed-w evaluation, the search, the
+"""The linear-policy ceiling (method.md, L5, icoac.studies.ceiling): fixed-w evaluation, the search, the
 first-step bound, the command and its files, the bench's reference lines."""
 import json
 import shutil
@@ -12,13 +12,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import bench, figures, geometry, grid, options, results
-from harness.ceiling import fixed, lqr, records, weights
-from harness.ceiling.bound import first_step_bound, initial_states
-from harness.ceiling import search as S
-from harness.config import build_config, make_prior
-from harness.errors import UsageError
+from icoac.core import binding as B
+from icoac.studies import bench, figures
+from icoac.core import geometry, grid, options, results
+from icoac.studies.ceiling import fixed, lqr, records, weights
+from icoac.studies.ceiling.bound import first_step_bound, initial_states
+from icoac.studies.ceiling import search as S
+from icoac.core.config import build_config, make_prior
+from icoac.core.errors import UsageError
 
 REPO = Path(__file__).resolve().parents[2]
 W = (0.3, 0.5, 0.8, 1.2)
@@ -29,7 +30,7 @@ SMALL = ["--cells", "600-624", "--candidates", "12", "--screen-steps", "200", "-
 
 
 def run(*args, timeout=120):
-    return subprocess.run([sys.executable, "-m", "harness", *args], cwd=REPO, capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "icoac", *args], cwd=REPO, capture_output=True, text=True,
                           timeout=timeout)
 
 
@@ -302,7 +303,7 @@ def test_profile_gives_the_retries_the_learners_caps(tmp_path, extra, cap, horiz
 
 
 def test_prior_from_starts_the_search_at_the_ico_mean(tmp_path, ico_dir):
-    from harness import prior as P
+    from icoac.studies import prior as P
     ico = Path(ico_dir)
     out = tmp_path / "p"
     res = run("ceiling", "--out", str(out), "--prior-from", str(ico), "--cells", "600-610", "--candidates", "3",
@@ -337,7 +338,7 @@ def test_user_errors_one_line_exit_2(tmp_path, args, words):
     assert res.returncode == 2, res.stderr
     assert "Traceback" not in res.stderr and "Traceback" not in res.stdout
     lines = res.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("icoac-harness: error: ") and words in lines[0]
+    assert len(lines) == 1 and lines[0].startswith("icoac: error: ") and words in lines[0]
     assert not out.exists()
 
 
@@ -358,7 +359,7 @@ def test_sigint_keeps_the_screens_and_the_rerun_finishes_identically(tmp_path):
     args = ["ceiling", "--candidates", "80", "--screen-steps", "1000",
             "--success-steps", "1000", "--confirm", "1", "--protocol", "first", "--threads", "1", "--quiet"]
     out = tmp_path / "i"
-    proc = subprocess.Popen([sys.executable, "-m", "harness", *args, "--out", str(out)], cwd=REPO,
+    proc = subprocess.Popen([sys.executable, "-m", "icoac", *args, "--out", str(out)], cwd=REPO,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(1.5)
     proc.send_signal(signal.SIGINT)

@@ -15,7 +15,7 @@ SMALL_ARGS = ["--max-trials", "6000", "--success-steps", "2000", "--quiet"]
 
 
 def run(*args, timeout=60):
-    return subprocess.run([sys.executable, "-m", "harness", *args], cwd=REPO, capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "icoac", *args], cwd=REPO, capture_output=True, text=True,
                           timeout=timeout)
 
 
@@ -51,7 +51,7 @@ def test_user_errors_one_line_exit_2(tmp_path, ico_dir, args, words):
     assert res.returncode == 2, res.stderr
     assert "Traceback" not in res.stderr and "Traceback" not in res.stdout
     lines = res.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("icoac-harness: error: ")
+    assert len(lines) == 1 and lines[0].startswith("icoac: error: ")
     assert words in lines[0]
     assert not any(tmp_path.iterdir())  # refused before anything was written
 
@@ -71,7 +71,7 @@ def test_grid_resume_and_mismatch(tmp_path):
 
 def test_sigint_then_resume(tmp_path):
     out = tmp_path / "s"
-    args = [sys.executable, "-m", "harness", "grid", "--out", str(out), "--cells", "590-640", "--threads", "1",
+    args = [sys.executable, "-m", "icoac", "grid", "--out", str(out), "--cells", "590-640", "--threads", "1",
             "--max-trials", "20000", "--success-steps", "5000", "--checkpoint-every", "0.2", "--quiet"]
     proc = subprocess.Popen(args, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 20
@@ -95,8 +95,8 @@ def test_sigint_then_resume(tmp_path):
     done = partial["outcome"] != 0
     assert np.array_equal(final[done], partial[done])
     # Same result as an uninterrupted run.
-    from harness import grid
-    from harness.config import build_config
+    from icoac.core import grid
+    from icoac.core.config import build_config
     ref = grid.make_cells(0, range(590, 641))
     grid.run_grid(build_config({"max_trials": 20000, "success_steps": 5000}), ref, progress=False)
     assert np.array_equal(ref, final)
@@ -104,11 +104,11 @@ def test_sigint_then_resume(tmp_path):
 
 def test_missing_library_is_one_line(tmp_path):
     env = dict(os.environ, ICOAC_SIM_LIBRARY=str(tmp_path / "libnone.so"))
-    res = subprocess.run([sys.executable, "-m", "harness", "grid", "--out", str(tmp_path / "x")], cwd=REPO,
+    res = subprocess.run([sys.executable, "-m", "icoac", "grid", "--out", str(tmp_path / "x")], cwd=REPO,
                          capture_output=True, text=True, env=env, timeout=60)
     assert res.returncode == 2 and "Traceback" not in res.stderr
     lines = res.stderr.strip().splitlines()
-    assert len(lines) == 1 and "make build" in lines[0] and lines[0].startswith("icoac-harness: error: ")
+    assert len(lines) == 1 and "make build" in lines[0] and lines[0].startswith("icoac: error: ")
 
 
 def test_help_exits_zero():
@@ -118,7 +118,7 @@ def test_help_exits_zero():
 
 @pytest.mark.parametrize("missing, args, words", [
     ("matplotlib", ["figures", "--results", "{ico}", "--out", "{tmp}/f"],
-     "drawing figures needs the 'plot' extra (matplotlib): pip install 'icoac-harness[plot]'"),
+     "drawing figures needs the 'plot' extra (matplotlib): pip install 'icoac[plot]'"),
     ("matplotlib", ["bench", "--profile", "quick", "--out", "{tmp}/b", "--figures", "{tmp}/bf"], "'plot' extra"),
     ("distributed", ["grid", "--out", "{tmp}/g", "--cells", "611", "--workers", "1"],
      "the Dask backend (--workers, --scheduler) needs the 'dask' extra (distributed): pip install"),
@@ -127,7 +127,7 @@ def test_a_missing_extra_is_one_line_before_any_work(tmp_path, ico_dir, missing,
     """Plotting and Dask are extras: without them, the commands that need them say which, in one
     line (exit 2), and write nothing; every other command runs without them."""
     code = (f"import sys; sys.modules[{missing!r}] = None\n"
-            "from harness.cli import main\nraise SystemExit(main(sys.argv[1:]))")
+            "from icoac.cli import main\nraise SystemExit(main(sys.argv[1:]))")
     argv = [a.format(tmp=tmp_path, ico=ico_dir) for a in args]
     res = subprocess.run([sys.executable, "-c", code, *argv], cwd=REPO, capture_output=True, text=True, timeout=120)
     assert res.returncode == 2, res.stderr

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The Dask backend (harness.cluster): a LocalCluster on loopback (2 worker processes, 1 thread
+"""The Dask backend (icoac.cluster.backend): a LocalCluster on loopback (2 worker processes, 1 thread
 each) gives the threaded engine's cells, bitwise, for every condition family, also when a worker
 is killed mid-chunk and through cancel and resume; workers that cannot load the library say so.
 
@@ -16,13 +16,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import _worker, cli, cluster, grid, results
-from harness import prior as P
-from harness.conditions import condition_prior, run_condition
-from harness.config import build_config
-from harness.errors import WorkerError
-from harness.registry import REGISTRY
+from icoac.core import binding as B
+from icoac.cluster import worker as _worker, backend as cluster
+from icoac import cli
+from icoac.core import grid, results
+from icoac.studies import prior as P
+from icoac.studies.conditions import condition_prior, run_condition
+from icoac.core.config import build_config
+from icoac.core.errors import WorkerError
+from icoac.core.registry import REGISTRY
 
 from conftest import SMALL
 
@@ -253,7 +255,7 @@ def test_c_error_on_a_worker_comes_back_as_the_same_exception(session):
 
 
 def test_sweep_on_the_cluster_equals_threads(session, ico_dir, tmp_path):
-    from harness import sweep
+    from icoac.studies import sweep
     common = dict(prior_from=ico_dir, params=["actor.noise_std=0.5,2"], cells="608-614", max_trials=20,
                   success_steps=500, quiet=True)
     assert sweep.run_sweep(sweep.SweepOptions(out=tmp_path / "t", threads=2, **common)) == 0
@@ -269,7 +271,7 @@ def test_sweep_on_the_cluster_equals_threads(session, ico_dir, tmp_path):
 
 # -- the command line --------------------------------------------------------------------------------
 def harness(*args):
-    return [sys.executable, "-m", "harness", *map(str, args)]
+    return [sys.executable, "-m", "icoac", *map(str, args)]
 
 
 @pytest.mark.parametrize("args, words", [
@@ -284,7 +286,7 @@ def harness(*args):
 def test_cli_backend_options_rejected(tmp_path, capsys, args, words):
     assert cli.main(["grid", "--out", str(tmp_path / "x"), *args]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("icoac-harness: error: ") and words in err[0], err
+    assert len(err) == 1 and err[0].startswith("icoac: error: ") and words in err[0], err
     assert not (tmp_path / "x").exists()
 
 
@@ -297,7 +299,7 @@ def test_cli_unreachable_scheduler_is_one_line(tmp_path, capsys, monkeypatch):
     assert cli.main(["grid", "--out", str(tmp_path / "x"), "--cells", "611", "--scheduler",
                      f"tcp://127.0.0.1:{port}", "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err[-1].startswith("icoac-harness: error: cannot reach the Dask scheduler at tcp://127.0.0.1:"), err
+    assert err[-1].startswith("icoac: error: cannot reach the Dask scheduler at tcp://127.0.0.1:"), err
 
 
 def test_cli_sigint_to_the_process_group_then_resume(tmp_path, slow_ref):
@@ -337,8 +339,8 @@ def test_cli_sigint_to_the_process_group_then_resume(tmp_path, slow_ref):
 def test_bench_on_the_cluster_equals_threads(session, tmp_path):
     """Every grid of a bench (one seed, the quick profile's cells, small caps) on the cluster:
     each results directory holds the threaded bench's cells; bench.json records the backend."""
-    from harness import bench
-    from harness.registry import CONDITIONS
+    from icoac.studies import bench
+    from icoac.core.registry import CONDITIONS
     common = dict(profile="quick", seeds=1, seed=1, rl_max_trials=10, sets=["success_steps=1000"], quiet=True)
     assert bench.run_bench(bench.BenchOptions(out=tmp_path / "t", threads=2, **common)) == 0
     assert bench.run_bench(bench.BenchOptions(out=tmp_path / "d", dask=cluster.DaskSpec(scheduler=session.address),

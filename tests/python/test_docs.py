@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Every `python -m harness ...` command in README.md, docs/*.md and the Makefile, and every
-`icoac-harness ...` command (the installed package's script), still parses, and its --set /
+"""Every `python -m icoac ...` command in README.md, docs/*.md and the Makefile, and every
+`icoac ...` command (the installed package's script), still parses, and its --set /
 --param names and values build a configuration (nothing is run)."""
 import re
 import shlex
@@ -8,8 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from harness import cli, sweep
-from harness.config import build_config, parse_sets
+from icoac import cli
+from icoac.studies import sweep
+from icoac.core.config import build_config, parse_sets
 
 REPO = Path(__file__).resolve().parents[2]
 # Placeholders the documents use, with a value each stands for.
@@ -20,10 +21,10 @@ PLACEHOLDERS = {"NAME": "variant", "SETTING": "integrator=rk4", "$(BENCH_PROFILE
 
 
 def _after(text: str):
-    """What follows 'python -m harness' in a command, or 'icoac-harness' at its start (None for
-    other commands, harness.tools, the package name alone and `icoac-harness: error: ...`)."""
-    m = (re.search(r"(?:python3?|\$\(VPY\)) -m harness(\s.*|$)", text, re.S)
-         or re.match(r"\s*(?:\S*/)?icoac-harness(\s+\S.*)", text, re.S))
+    """What follows 'python -m icoac' in a command, or 'icoac' at its start (None for
+    other commands, icoac.tools, the package name alone and `icoac: error: ...`)."""
+    m = (re.search(r"(?:python3?|\$\(VPY\)) -m icoac(\s.*|$)", text, re.S)
+         or re.match(r"\s*(?:\S*/)?icoac(\s+\S.*)", text, re.S))
     return " ".join(m.group(1).split()) if m else None
 
 
@@ -71,10 +72,10 @@ def test_documented_command_parses(where, command):
 
 
 def test_learner_sweep_plans_build():
-    """Every setting of the learner sweeps (harness.tools.learner_sweeps, method.md, L2-L4) builds a
+    """Every setting of the learner sweeps (icoac.tools.learner_sweeps, method.md, L2-L4) builds a
     configuration of its condition, in the mode of that condition."""
-    from harness import _binding as B
-    from harness.tools import learner_sweeps
+    from icoac.core import binding as B
+    from icoac.tools import learner_sweeps
 
     n = 0
     for name, condition, params, one_at_a_time in learner_sweeps.STAGE_1 + learner_sweeps.STAGE_2:

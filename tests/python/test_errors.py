@@ -4,8 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness.config import build_config, make_prior
+from icoac.core import binding as B
+from icoac.core.config import build_config, make_prior
 
 
 @pytest.mark.parametrize("overrides, condition, status, words", [

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Every harness fault is one line `icoac-harness: error: ...` on stderr, exit status 2, and nothing
-on disk is rewritten. The CLI runs in-process through harness.cli.main."""
+"""Every harness fault is one line `icoac: error: ...` on stderr, exit status 2, and nothing
+on disk is rewritten. The CLI runs in-process through icoac.cli.main."""
 import errno
 import json
 import shutil
@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import cli, grid, metrics, results, store
-from harness.config import build_config
+from icoac.core import binding as B
+from icoac import cli
+from icoac.core import grid, metrics, results, store
+from icoac.core.config import build_config
 
 CELLS = [610, 611, 612, 613]
 SEED = 3
@@ -32,7 +33,7 @@ def assert_one_line_error(rc, err, *words):
     assert rc == 2, err
     assert "Traceback" not in err
     lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("icoac-harness: error: "), err
+    assert len(lines) == 1 and lines[0].startswith("icoac: error: "), err
     for w in words:
         assert w in lines[0], lines[0]
     return lines[0]
@@ -485,7 +486,7 @@ def test_help_documents_bounds(capsys):
         cli.main(["grid", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "--overwrite" in text and f"max({grid.DEFAULT_CHECKPOINT_CELLS} cells" in text
-    assert cli.O.DEFAULT_CHECKPOINT_CELLS is grid.DEFAULT_CHECKPOINT_CELLS  # defined once, in harness.options
+    assert cli.O.DEFAULT_CHECKPOINT_CELLS is grid.DEFAULT_CHECKPOINT_CELLS  # defined once, in icoac.core.options
     assert cli.O.MAX_TRAJECTORY_STEPS is grid.MAX_TRAJECTORY_STEPS and cli.O.MAX_THREADS is grid.MAX_THREADS
     with pytest.raises(SystemExit):
         cli.main(["figures", "--help"])

@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
 import numpy as np
 
-from harness import figures, metrics, results, store
-from harness.config import build_config
-from harness.grid import make_cells, run_grid
+from icoac.studies import figures
+from icoac.core import metrics, results, store
+from icoac.core.config import build_config
+from icoac.core.grid import make_cells, run_grid
 
 PNG = b"\x89PNG\r\n\x1a\n"
 

@@ -4,9 +4,9 @@ import threading
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import grid
-from harness.config import build_config, make_prior
+from icoac.core import binding as B
+from icoac.core import grid
+from icoac.core.config import build_config, make_prior
 
 from conftest import SMALL, SMALL_CELLS
 

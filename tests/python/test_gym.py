@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The Gymnasium side (harness.gym): the registered cart-pole env against the engine it must
+"""The Gymnasium side (icoac.gym): the registered cart-pole env against the engine it must
 reproduce, the controller as a policy, Gymnasium's own CartPole-v1 under a continuous force."""
 import ctypes
 import re
@@ -14,14 +14,14 @@ import pytest
 from gymnasium.error import ResetNeeded
 from gymnasium.utils.env_checker import check_env
 
-import harness.gym as hg
-from harness import _binding as B
-from harness import geometry
-from harness.gym import plants as gym_plants
-from harness.ceiling.fixed import fixed_config
-from harness.config import build_config
-from harness.grid import run_cell, trajectory
-from harness.options import TYPICAL_ICO_WEIGHTS
+import icoac.gym as hg
+from icoac.core import binding as B
+from icoac.core import geometry
+from icoac.gym import plants as gym_plants
+from icoac.studies.ceiling.fixed import fixed_config
+from icoac.core.config import build_config
+from icoac.core.grid import run_cell, trajectory
+from icoac.core.options import TYPICAL_ICO_WEIGHTS
 
 REPO = Path(__file__).resolve().parents[2]
 ENV_ID = "icoac/CartPole-v0"
@@ -61,7 +61,7 @@ def test_registered_and_passes_check_env():
     unexpected = [str(w.message) for w in caught if not any(k in str(w.message) for k in KNOWN_WARNINGS)]
     assert unexpected == []
     # the "module:id" form imports the package first
-    assert gymnasium.make("harness.gym:" + ENV_ID).spec.id == ENV_ID
+    assert gymnasium.make("icoac.gym:" + ENV_ID).spec.id == ENV_ID
 
 
 def test_vector_env():

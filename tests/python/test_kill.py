@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Kill tests: a grid run as `python -m harness grid` is killed (SIGKILL) or interrupted (SIGINT) at
+"""Kill tests: a grid run as `python -m icoac grid` is killed (SIGKILL) or interrupted (SIGINT) at
 a random moment, resumed with --resume, and must equal an uninterrupted run bitwise, cell by cell.
 
 The delays come from a seeded RNG (ICOAC_KILL_SEED, default 8) as fractions of the measured
@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import grid, results
-from harness.config import build_config
+from icoac.core import binding as B
+from icoac.core import grid, results
+from icoac.core.config import build_config
 
 REPO = Path(__file__).resolve().parents[2]
 CELLS = "539-685"          # rows theta0 = -1, 0, +1 deg: 147 cells, about 4 s on 2 threads
@@ -40,7 +40,7 @@ def reference():
 
 
 def harness(*args):
-    return [sys.executable, "-m", "harness", "grid", *map(str, args)]
+    return [sys.executable, "-m", "icoac", "grid", *map(str, args)]
 
 
 def start_and_signal(out: Path, sig: int, delay: float, args):

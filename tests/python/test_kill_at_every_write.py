@@ -16,8 +16,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import bench, cli, geometry, metrics, results, store
-from harness.registry import CONDITIONS
+from icoac.studies import bench
+from icoac import cli
+from icoac.core import geometry, metrics, results, store
+from icoac.core.registry import CONDITIONS
 
 from conftest import SMALL
 

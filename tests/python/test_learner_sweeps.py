@@ -1,11 +1,11 @@
 # SPDX-License-Identifier: Apache-2.0
-"""RL alone's ranking by the sweeps' criterion (harness.tools.learner_sweeps.ranked_rows): the
+"""RL alone's ranking by the sweeps' criterion (icoac.tools.learner_sweeps.ranked_rows): the
 highest ICO-failed success; within one point of the best, the spread cells, then fewer median
 trials; controls and confirmations left out; rows with identical results counted once."""
 import csv
 import json
 
-from harness.tools import learner_sweeps as L
+from icoac.tools import learner_sweeps as L
 
 COLUMNS = ("key", "success_rate_mean", "success_rate_sd", "median_trials")
 

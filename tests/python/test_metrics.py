@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import metrics
-from harness.grid import paper_grid
+from icoac.core import binding as B
+from icoac.core import metrics
+from icoac.core.grid import paper_grid
 
 
 def hand_cells():

@@ -8,13 +8,14 @@ from pathlib import Path
 
 import pytest
 
-from harness import _binding as B
-from harness import config, figures, results, store
-from harness import prior as P
-from harness.config import (ALIASES, ALL_FIELDS, build_config, canonical, config_from_dict, named_sets,
+from icoac.core import binding as B
+from icoac.core import config, results, store
+from icoac.studies import figures
+from icoac.studies import prior as P
+from icoac.core.config import (ALIASES, ALL_FIELDS, build_config, canonical, config_from_dict, named_sets,
                             parse_sets)
-from harness.errors import UsageError
-from harness.tools import imports
+from icoac.core.errors import UsageError
+from icoac.tools import imports
 
 REPO = Path(__file__).resolve().parents[2]
 FIXTURES = Path(__file__).resolve().parent / "fixtures"
@@ -96,30 +97,45 @@ def test_rejection_names_the_c_field():
 # -- import graph -----------------------------------------------------------------------------------------
 def test_import_graph_has_no_cycle_and_nothing_imports_cli():
     g = imports.graph()
-    assert "harness.cli" in g and "harness.conditions" in g and "harness.errors" in g
+    assert "icoac.cli" in g and "icoac.studies.conditions" in g and "icoac.core.errors" in g
     assert imports.problems(g) == []
-    assert {m for m, deps in g.items() if "harness.cli" in deps} == {"harness.__main__"}
-    assert g["harness.errors"] == set() and g["harness.options"] == set()
-    assert g["harness._binding"] == {"harness.errors"}
+    assert {m for m, deps in g.items() if "icoac.cli" in deps} == {"icoac.__main__"}
+    assert g["icoac.core.errors"] == set() and g["icoac.core.options"] == set()
+    assert g["icoac.core.binding"] == {"icoac.core.errors"}
 
 
 def test_import_checker_finds_a_cycle_and_a_cli_import(tmp_path):
-    pkg = tmp_path / "harness"
+    pkg = tmp_path / "icoac"
     pkg.mkdir()
     (pkg / "__init__.py").write_text("")
     (pkg / "cli.py").write_text("from . import a\n")
     (pkg / "a.py").write_text("def f():\n    from .b import g\n")
-    (pkg / "b.py").write_text("import harness.a\nfrom .cli import main\n")
+    (pkg / "b.py").write_text("import icoac.a\nfrom .cli import main\n")
     g = imports.graph(pkg)
-    assert g["harness.a"] == {"harness.b"} and g["harness.b"] == {"harness.a", "harness.cli"}
+    assert g["icoac.a"] == {"icoac.b"} and g["icoac.b"] == {"icoac.a", "icoac.cli"}
     found = imports.problems(g)
-    assert any(p.startswith("cycle:") and "harness.a" in p and "harness.b" in p for p in found)
-    assert "harness.b imports harness.cli" in found
+    assert any(p.startswith("cycle:") and "icoac.a" in p and "icoac.b" in p for p in found)
+    assert "icoac.b imports icoac.cli" in found
+
+
+def test_import_checker_finds_a_layer_breach(tmp_path):
+    pkg = tmp_path / "icoac"
+    for folder in ("core", "studies", "gym"):
+        (pkg / folder).mkdir(parents=True)
+        (pkg / folder / "__init__.py").write_text("")
+    (pkg / "__init__.py").write_text("")
+    (pkg / "core" / "grid.py").write_text("from icoac.studies import bench\n")
+    (pkg / "studies" / "bench.py").write_text("from icoac.gym import env\n")
+    (pkg / "gym" / "env.py").write_text("from icoac.core import grid\n")
+    found = imports.problems(imports.graph(pkg))
+    assert "layer: icoac.core.grid (core) imports icoac.studies.bench (studies)" in found
+    assert "layer: icoac.studies.bench (studies) imports icoac.gym.env (gym)" in found
+    assert not any(p.startswith("layer: icoac.gym.env") for p in found)
 
 
 def test_import_graph_command():
-    res = subprocess.run([sys.executable, "-m", "harness.tools.imports"], cwd=REPO, capture_output=True,
+    res = subprocess.run([sys.executable, "-m", "icoac.tools.imports"], cwd=REPO / "harness", capture_output=True,
                          text=True, timeout=60, env={"PATH": "/usr/bin:/bin", "ICOAC_SIM_LIBRARY": "/nonexistent"})
     assert res.returncode == 0, res.stdout + res.stderr
-    assert "harness.cli" in res.stdout and res.stdout.strip().endswith(
-        "no cycle; nothing but harness.__main__ imports harness.cli")
+    assert "icoac.cli" in res.stdout and res.stdout.strip().endswith(
+        "no cycle; every layer imports only the layers it may; nothing but icoac.__main__ imports icoac.cli")

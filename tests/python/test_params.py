@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from harness import _binding as B
-from harness import params as P
-from harness.config import CONTROLLER_FIELDS, RUN_FIELDS
-from harness.tools import params_table as PT
+from icoac.core import binding as B
+from icoac.core import params as P
+from icoac.core.config import CONTROLLER_FIELDS, RUN_FIELDS
+from icoac.tools import params_table as PT
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGE = ROOT / "docs" / "design.md"
@@ -118,11 +118,11 @@ def test_a_changed_row_is_caught(tmp_path):
 
 
 def test_cli_lists_every_parameter():
-    out = subprocess.run([sys.executable, "-m", "harness", "params"], cwd=ROOT, check=True, capture_output=True,
+    out = subprocess.run([sys.executable, "-m", "icoac", "params"], cwd=ROOT, check=True, capture_output=True,
                          text=True).stdout
     names = [line.split()[0] for line in out.splitlines()[1:]]
     assert names == list(B.PARAMS)
-    essential = subprocess.run([sys.executable, "-m", "harness", "params", "--tier", "essential"], cwd=ROOT,
+    essential = subprocess.run([sys.executable, "-m", "icoac", "params", "--tier", "essential"], cwd=ROOT,
                                check=True, capture_output=True, text=True).stdout
     assert [line.split()[0] for line in essential.splitlines()[1:]] == [
         n for n, r in B.PARAMS.items() if r["tier"] == "essential"]

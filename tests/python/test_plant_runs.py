@@ -11,11 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import cli, config, geometry, grid, metrics, plants, results
-from harness import prior as P
-from harness.config import build_config, config_from_dict
-from harness.tools import plant_sweeps
+from icoac.core import binding as B
+from icoac import cli
+from icoac.core import config, geometry, grid, metrics, plants, results
+from icoac.studies import prior as P
+from icoac.core.config import build_config, config_from_dict
+from icoac.tools import plant_sweeps
 
 REPO = Path(__file__).resolve().parents[2]
 TINY_ARGS = ["--max-trials", "30", "--success-steps", "200", "--quiet"]
@@ -31,7 +32,7 @@ def main(capsys, *args):
 def one_line_error(rc, err):
     assert rc == 2 and "Traceback" not in err, err
     lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("icoac-harness: error: "), err
+    assert len(lines) == 1 and lines[0].startswith("icoac: error: "), err
     return lines[0]
 
 

@@ -13,7 +13,7 @@ import ctypes
 import numpy as np
 import pytest
 
-from harness import _binding as B
+from icoac.core import binding as B
 
 G_POINTS = (0.5 - 0.5 / np.sqrt(3.0), 0.5 + 0.5 / np.sqrt(3.0))  # Gauss-Legendre on [0, 1], weights 1/2
 

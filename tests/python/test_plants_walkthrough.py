@@ -62,12 +62,12 @@ def library(tmp_path_factory):
 
 def test_the_page_plant_runs_every_command(library, tmp_path):
     name, lib = library
-    env = {**os.environ, "ICOAC_SIM_LIBRARY": str(lib), "PYTHONPATH": str(REPO)}
-    harness = [sys.executable, "-m", "harness"]
+    env = {**os.environ, "ICOAC_SIM_LIBRARY": str(lib), "PYTHONPATH": str(REPO / "harness")}
+    harness = [sys.executable, "-m", "icoac"]
     out = run([*harness, "grid", "--plant", name, "--out", tmp_path / "grid", "--max-trials", "20",
                "--success-steps", "300", "--quiet"], env)
     assert "cells" in out
-    check = ("import json, sys; from harness import geometry, results; cells, rec = results.load(sys.argv[1]); "
+    check = ("import json, sys; from icoac.core import geometry, results; cells, rec = results.load(sys.argv[1]); "
              "g = geometry.of(sys.argv[2]); assert rec['config']['plant']['name'] == sys.argv[2]; "
              "assert cells.size == g.cells and g.on_grid(cells).all(); print(g.rows, g.cols)")
     shape = run([sys.executable, "-c", check, tmp_path / "grid", name], env).split()
@@ -77,9 +77,9 @@ def test_the_page_plant_runs_every_command(library, tmp_path):
     printed = run([*harness, "figures", "--results", tmp_path / "grid", "--out", tmp_path / "fig"], env)
     assert sorted(Path(p).name for p in printed.split()) == ["fig1b_success_map.png", "fig1cf_weights.png"]
     env_name = "".join(word.capitalize() for word in name.split("_"))
-    gym = ("import sys, gymnasium, harness.gym; from gymnasium.utils.env_checker import check_env; "
+    gym = ("import sys, gymnasium, icoac.gym; from gymnasium.utils.env_checker import check_env; "
            f"env = gymnasium.make('icoac/{env_name}-v0'); check_env(env.unwrapped); "
            "o, i = env.reset(options={'cell': int(sys.argv[1]) - 1}); "
-           f"print(len(o) == len(harness._binding.plant_info('{name}')['state']), i['cell'])")
+           f"print(len(o) == len(icoac.core.binding.plant_info('{name}')['state']), i['cell'])")
     cells = int(shape[0]) * int(shape[1])
     assert run([sys.executable, "-W", "ignore", "-c", gym, cells], env).split() == ["True", str(cells - 1)]

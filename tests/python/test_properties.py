@@ -15,12 +15,12 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from harness import _binding as B
-from harness import config, grid, metrics, results, store
-from harness.config import (ALIASES, ALL_FIELDS, BOOLS, ENUMS, RunConfig, build_config, canonical, config_from_dict,
+from icoac.core import binding as B
+from icoac.core import config, grid, metrics, results, store
+from icoac.core.config import (ALIASES, ALL_FIELDS, BOOLS, ENUMS, RunConfig, build_config, canonical, config_from_dict,
                             parse_sets, parse_value)
-from harness.errors import HarnessError
-from harness.registry import CONDITIONS
+from icoac.core.errors import HarnessError
+from icoac.core.registry import CONDITIONS
 
 HARNESS_ERRORS = (HarnessError,)  # ConfigError, ResultsError, UsageError, ... all derive from it
 

@@ -13,8 +13,8 @@ sigma_L = actor.likelihood_std, or sigma_u (actor.noise_std) when it is 0 (the d
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness.config import build_config
+from icoac.core import binding as B
+from icoac.core.config import build_config
 
 from stepping import (FAILED, REAL, controller, features, likelihood_var, posterior, random_prior, random_state, reset,
                       stored, tick)

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The condition registry (harness.registry): every condition defined once, its control generated
+"""The condition registry (icoac.core.registry): every condition defined once, its control generated
 from it, and the configurations and priors derived from it the same as before the registry."""
 import json
 import subprocess
@@ -9,12 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import bench, cli, tables
-from harness import prior as P
-from harness.conditions import condition_prior
-from harness.config import CONDITION_OVERRIDES, build_config
-from harness.errors import UsageError
-from harness.registry import CONDITIONS, PRIOR_CONDITIONS, REGISTRY, Condition, PriorRule
+from icoac.studies import bench, tables
+from icoac import cli
+from icoac.studies import prior as P
+from icoac.studies.conditions import condition_prior
+from icoac.core.config import CONDITION_OVERRIDES, build_config
+from icoac.core.errors import UsageError
+from icoac.core.registry import CONDITIONS, PRIOR_CONDITIONS, REGISTRY, Condition, PriorRule
 
 # The condition tables of the harness before the registry (captured from main at ad0bc3e). When a
 # condition's overrides change on purpose (registry.py), change them here too.
@@ -132,6 +133,6 @@ def test_command_line_choices_come_from_the_registry():
 
 
 def test_registry_imports_nothing_heavy():
-    code = ("import sys, harness.registry, harness.options; "
-            "assert not {'numpy', 'harness._binding', 'harness.config'} & set(sys.modules), sorted(sys.modules)")
+    code = ("import sys, icoac.core.registry, icoac.core.options; "
+            "assert not {'numpy', 'icoac.core.binding', 'icoac.core.config'} & set(sys.modules), sorted(sys.modules)")
     subprocess.run([sys.executable, "-c", code], check=True, cwd=Path(__file__).resolve().parents[2])

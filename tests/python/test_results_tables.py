@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """docs/results.md's tables are the committed summaries (docs/data/*.json) formatted by
-harness.tools.results_tables: the page must agree with them, and a changed number must be caught."""
+icoac.tools.results_tables: the page must agree with them, and a changed number must be caught."""
 import json
 import re
 import shutil
@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from harness.tools import results_tables as RT
+from icoac.tools import results_tables as RT
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGE = ROOT / "docs" / "results.md"

@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import grid, results
-from harness import prior as P
-from harness.config import build_config, make_prior, named_sets, parse_sets
-from harness.registry import CONDITIONS, REGISTRY
+from icoac.core import binding as B
+from icoac.core import grid, results
+from icoac.studies import prior as P
+from icoac.core.config import build_config, make_prior, named_sets, parse_sets
+from icoac.core.registry import CONDITIONS, REGISTRY
 
 REPO = Path(__file__).resolve().parents[2]
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -27,7 +27,7 @@ LITERAL = parse_sets(named_sets("literal"))
 
 
 def run_cli(*args, timeout=60):
-    return subprocess.run([sys.executable, "-m", "harness", *args], cwd=REPO, capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "icoac", *args], cwd=REPO, capture_output=True, text=True,
                           timeout=timeout)
 
 
@@ -35,7 +35,7 @@ def one_line_error(res, words):
     assert res.returncode == 2, res.stderr
     assert "Traceback" not in res.stderr
     lines = res.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("icoac-harness: error: "), res.stderr
+    assert len(lines) == 1 and lines[0].startswith("icoac: error: "), res.stderr
     assert words in lines[0], lines[0]
 
 

@@ -12,10 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import conditions, grid
-from harness import prior as P
-from harness.config import build_config
+from icoac.core import binding as B
+from icoac.studies import conditions
+from icoac.core import grid
+from icoac.studies import prior as P
+from icoac.core.config import build_config
 
 from stepping import FAILED, REAL, controller, posterior, random_prior, random_state, reset, retune, scaled, stored, tick
 

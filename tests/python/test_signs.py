@@ -1,15 +1,15 @@
 # SPDX-License-Identifier: Apache-2.0
-"""ICO's input signs from the plant (harness.signs, task.input_sign; docs/method.md, input signs)."""
+"""ICO's input signs from the plant (icoac.core.signs, task.input_sign; docs/method.md, input signs)."""
 import ctypes
 
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import config as C
-from harness import grid, plants, results, signs
-from harness.ceiling import lqr
-from harness.errors import ResultsError
+from icoac.core import binding as B
+from icoac.core import config as C
+from icoac.core import grid, plants, results, signs
+from icoac.studies.ceiling import lqr
+from icoac.core.errors import ResultsError
 
 PLANTS = [B.plant_info(i)["name"] for i in range(int(B.lib.icoac_sim_plant_count()))]
 

@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The results store (harness.store): writes that follow no planted link, one run per output
+"""The results store (icoac.core.store): writes that follow no planted link, one run per output
 directory (the lock, a stale one taken over), resume only of cells written by this ABI with the
 list of builds kept, write errors that name their file. Each fault is one line
-`icoac-harness: error: ...`, exit status 2, nothing on disk rewritten. (Strict parsing of the
+`icoac: error: ...`, exit status 2, nothing on disk rewritten. (Strict parsing of the
 command line: tests/python/test_faults.py.)"""
 import errno
 import json
@@ -16,10 +16,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness import conditions, grid, results, store
-from harness.config import build_config
-from harness.errors import ResultsError
+from icoac.core import binding as B
+from icoac.studies import conditions
+from icoac.core import grid, results, store
+from icoac.core.config import build_config
+from icoac.core.errors import ResultsError
 
 from test_faults import CELLS, SEED, TINY, TINY_ARGS, assert_one_line_error, main, snapshot, write_partial
 
@@ -134,7 +135,7 @@ def test_no_space_left_names_the_file(capsys, tmp_path, monkeypatch):
 
 # -- one run per directory ---------------------------------------------------------------------------------
 def start_slow(out: Path) -> subprocess.Popen:
-    proc = subprocess.Popen([sys.executable, "-m", "harness", "grid", "--out", str(out), *SLOW_ARGS], cwd=REPO,
+    proc = subprocess.Popen([sys.executable, "-m", "icoac", "grid", "--out", str(out), *SLOW_ARGS], cwd=REPO,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 30
     while not (out / "run.json").exists() and proc.poll() is None and time.monotonic() < deadline:

@@ -10,8 +10,8 @@ import random
 import numpy as np
 import pytest
 
-from harness import _binding as B
-from harness.config import build_config
+from icoac.core import binding as B
+from icoac.core.config import build_config
 
 REAL = B.real_dtype.type
 ABOVE, BELOW = B.RULE_SIDES["above"], B.RULE_SIDES["below"]

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The harness as a package (pyproject.toml, scikit-build-core): a wheel built from a clean copy of
 the checkout (its tracked and new, not ignored, files: no build/, no .venv), installed into a fresh
-venv, gives a working `icoac-harness` that runs a grid on the library inside the package - not
+venv, gives a working `icoac` that runs a grid on the library inside the package - not
 ICOAC_SIM_LIBRARY, not a build/ tree - with the cells of the development build, bit for bit.
 
 Slow (a fresh venv, numpy and matplotlib installed into it, the C library compiled): marked
@@ -23,7 +23,7 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 GRID = ["grid", "--condition", "ico", "--cells", "0-3,610-611", "--max-trials", "50", "--success-steps", "200",
         "--seed", "3", "--threads", "2", "--quiet"]
-LIBRARY = "harness/lib/libicoac_sim.so"
+LIBRARY = "icoac/lib/libicoac_sim.so"
 
 pytestmark = pytest.mark.slow
 
@@ -95,12 +95,12 @@ def test_wheel_holds_the_package_and_its_library(installed):
         names = set(zf.namelist())
         entry_points = next(zf.read(n).decode() for n in names if n.endswith(".dist-info/entry_points.txt"))
         tag = next(zf.read(n).decode() for n in names if n.endswith(".dist-info/WHEEL"))
-    assert LIBRARY in names and "harness/lib/build_info.json" in names
-    assert {"harness/__init__.py", "harness/cli.py", "harness/_binding.py", "harness/tools/imports.py"} <= names
+    assert LIBRARY in names and "icoac/lib/build_info.json" in names
+    assert {"icoac/__init__.py", "icoac/cli.py", "icoac/core/binding.py", "icoac/tools/imports.py"} <= names
     # Only the package: no tests, C sources, firmware or compiled Python files.
-    assert all(n.startswith(("harness/", "icoac_harness-")) for n in names), sorted(names)
+    assert all(n.startswith(("icoac/", "icoac-")) for n in names), sorted(names)
     assert not any(n.endswith((".pyc", ".c", ".h")) for n in names)
-    assert "icoac-harness = harness.cli:main" in entry_points
+    assert "icoac = icoac.cli:main" in entry_points
     assert "Tag: py3-none-" in tag
     print(f"\nwheel {wheel.name}: {wheel.stat().st_size} bytes, built in {seconds:.1f} s")
 
@@ -109,8 +109,8 @@ def test_installed_command_runs_a_grid_on_the_installed_library(installed, tmp_p
     venv, _, _ = installed
     cwd = tmp_path / "elsewhere"   # no harness/ or build/ here: neither can be picked up
     cwd.mkdir()
-    res = _run([venv / "bin" / "icoac-harness", *GRID, "--out", "out"], 600, env=_env(), cwd=cwd)
-    _check(res, "icoac-harness grid")
+    res = _run([venv / "bin" / "icoac", *GRID, "--out", "out"], 600, env=_env(), cwd=cwd)
+    _check(res, "icoac grid")
     out = cwd / "out"
     assert (out / "cells.npz").is_file() and (out / "run.json").is_file()
     record = json.loads((out / "run.json").read_text())
@@ -123,11 +123,11 @@ def test_installed_command_runs_a_grid_on_the_installed_library(installed, tmp_p
     assert record["git"] == {"commit": None, "dirty": None}
 
     # The same grid on the development library (the tests' one): the wheel is the reference build.
-    dev = _run([sys.executable, "-m", "harness", *GRID, "--out", tmp_path / "dev"], 600, cwd=REPO)
-    _check(dev, "python -m harness grid (development library)")
+    dev = _run([sys.executable, "-m", "icoac", *GRID, "--out", tmp_path / "dev"], 600, cwd=REPO)
+    _check(dev, "python -m icoac grid (development library)")
     with np.load(out / "cells.npz") as a, np.load(tmp_path / "dev" / "cells.npz") as b:
         wheel_cells, dev_cells = a["cells"], b["cells"]
-    from harness import _binding as B
+    from icoac.core import binding as B
     assert len(wheel_cells) == 6 and (wheel_cells["outcome"] != B.PENDING).all()
     for field in wheel_cells.dtype.names:
         if field != "elapsed_time":
@@ -138,7 +138,7 @@ def test_installed_package_ignores_a_checkout_and_honours_the_variable(installed
     """Run from a folder of the checkout (which has a build/ tree), the installed package still loads
     its own library; ICOAC_SIM_LIBRARY, when set, comes first; a missing one is a one-line error."""
     venv, _, _ = installed
-    code = "import harness._binding as B; print(B.LIBRARY_SOURCE, B.LIBRARY_PATH)"
+    code = "import icoac.core.binding as B; print(B.LIBRARY_SOURCE, B.LIBRARY_PATH)"
     res = _run([venv / "bin" / "python", "-c", code], 60, env=_env(), cwd=REPO / "tests")
     _check(res, "import from the checkout")
     source, path = res.stdout.split()
@@ -147,23 +147,23 @@ def test_installed_package_ignores_a_checkout_and_honours_the_variable(installed
     res = _run([venv / "bin" / "python", "-c", code], 60, env=_env(ICOAC_SIM_LIBRARY=dev_library), cwd=tmp_path)
     _check(res, "import with ICOAC_SIM_LIBRARY")
     assert res.stdout.split() == ["env", dev_library]
-    res = _run([venv / "bin" / "icoac-harness", *GRID, "--out", "x"], 60,
+    res = _run([venv / "bin" / "icoac", *GRID, "--out", "x"], 60,
                env=_env(ICOAC_SIM_LIBRARY=str(tmp_path / "libnone.so")), cwd=tmp_path)
     lines = res.stderr.strip().splitlines()
     assert res.returncode == 2 and len(lines) == 1 and "ICOAC_SIM_LIBRARY=" in lines[0], res.stderr
 
 
 def test_installed_version_is_the_cmake_project_version(installed, tmp_path):
-    """The wheel's metadata and harness/_version.py (generated by the build) carry the version of
+    """The wheel's metadata and icoac/_version.py (generated by the build) carry the version of
     CMakeLists.txt's project() line, and so does the library inside it (icoac_version)."""
     venv, wheel, _ = installed
     version = re.search(r"^project\(icoac VERSION ([0-9.]+)", (REPO / "CMakeLists.txt").read_text(), re.M).group(1)
     with zipfile.ZipFile(wheel) as zf:
         metadata = next(zf.read(n).decode() for n in zf.namelist() if n.endswith(".dist-info/METADATA"))
-        generated = zf.read("harness/_version.py").decode()
+        generated = zf.read("icoac/_version.py").decode()
     assert f"\nVersion: {version}\n" in metadata and f'__version__ = "{version}"' in generated
-    res = _run([venv / "bin" / "icoac-harness", "--version"], 60, env=_env(), cwd=tmp_path)
-    _check(res, "icoac-harness --version")
+    res = _run([venv / "bin" / "icoac", "--version"], 60, env=_env(), cwd=tmp_path)
+    _check(res, "icoac --version")
     lines = res.stdout.splitlines()
-    assert lines[0] == f"icoac-harness {version}" and lines[1].startswith(f"icoac library {version} (ABI "), lines
+    assert lines[0] == f"icoac {version}" and lines[1].startswith(f"icoac library {version} (ABI "), lines
     assert lines[1].endswith(LIBRARY), lines

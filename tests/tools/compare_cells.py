@@ -52,10 +52,10 @@ CART_POLE_INPUTS = 4
 
 
 def _run_condition(name: str, ico_prior) -> np.ndarray:
-    from harness import _binding as B
-    from harness import grid
-    from harness import prior as P
-    from harness.config import CONDITION_OVERRIDES, build_config, make_prior
+    from icoac.core import binding as B
+    from icoac.core import grid
+    from icoac.studies import prior as P
+    from icoac.core.config import CONDITION_OVERRIDES, build_config, make_prior
     condition, extra = VARIANTS.get(name, (name, {}))
     caps = ICO_CAPS if condition == "ico" else CAPS
     info = None
@@ -89,7 +89,7 @@ def _run_condition(name: str, ico_prior) -> np.ndarray:
 
 
 def _ico_prior_from_reference(data):
-    from harness import prior as P
+    from icoac.studies import prior as P
     return P.PriorInfo(mean=np.asarray(data["ico_prior_mean"]), cov=np.asarray(data["ico_prior_cov"]),
                        frame=None, n_cells=0, ridge=0.0)
 
@@ -103,8 +103,8 @@ def _commit() -> str:
 
 
 def generate(ico_prior_from: Path, reference: Path = REFERENCE) -> None:
-    from harness import options
-    from harness import prior as P
+    from icoac.core import options
+    from icoac.studies import prior as P
     ico = P.from_results(ico_prior_from)
     arrays = {"ico_prior_mean": ico.mean[:CART_POLE_INPUTS],
               "ico_prior_cov": ico.cov[:CART_POLE_INPUTS, :CART_POLE_INPUTS]}

@@ -14,9 +14,9 @@ import sys
 
 import numpy as np
 
-from harness import _binding as B
-from harness import grid, results
-from harness.config import config_from_dict
+from icoac.core import binding as B
+from icoac.core import grid, results
+from icoac.core.config import config_from_dict
 
 FIELDS = ("outcome", "status", "trials", "total_steps", "last_trial_steps", "elapsed_time", "weights", "cov")
 

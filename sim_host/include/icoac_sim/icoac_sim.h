@@ -250,7 +250,7 @@ typedef double (*icoac_sim_energy_fn)(const double *p, const double *s);
 #define ICOAC_SIM_ZONE_FRACTION (2.35 / 2.4)
 
 /* Settings of some of the harness's learning conditions on a plant, over the condition's own
- * (harness/registry.py names the conditions). */
+ * (harness/icoac/core/registry.py names the conditions). */
 typedef struct {
     const char *conditions;             /* their names, space-separated: "rl rl-ico-cov" */
     void (*apply)(icoac_config_t *cfg); /* writes the settings */

@@ -1,0 +1,87 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The parameters as the C table describes them (icoac_params.h and the run's rows, read by the
+binding as B.PARAMS): their valid ranges in words, the listing of `python -m icoac params`,
+and the table of docs/design.md (icoac.tools.params_table writes and checks it)."""
+from __future__ import annotations
+
+import ctypes
+from typing import Any, Mapping
+
+from icoac.core import binding as B
+
+COLUMNS = ("name", "unit", "default", "range", "modes", "tier", "description")
+
+
+def _num(value: float) -> str:
+    return f"{value:g}"
+
+
+def modes_text(row: Mapping[str, Any]) -> str:
+    names = [name for name, bit in B.PARAM_MODES.items() if row["modes"] & bit]
+    return "all" if len(names) == len(B.PARAM_MODES) else ", ".join(names)
+
+
+def _defaults() -> dict[str, Any]:
+    """Every parameter's C default as a record writes it (symbolic switches, booleans; the
+    arrays' entries the default task uses)."""
+    from icoac.core import config as C  # the value formatting of records
+    controller, run = B.Config(), B.Run()
+    B.lib.icoac_config_default(ctypes.byref(controller))
+    B.lib.icoac_sim_run_default(ctypes.byref(run))
+    sizes = {"inputs": controller.task.n_inputs, "rules": controller.task.n_rules}
+    out = {}
+    for name, row in B.PARAMS.items():
+        struct = controller if row["type"] == "icoac_config_t" else run
+        value = C._value_out(name, C._ctype(struct, name), C._get(struct, name))
+        out[name] = value[:sizes[row["dim"]]] if row["dim"] in sizes else value
+    return out
+
+
+def _value_text(value: Any) -> str:
+    if isinstance(value, list):
+        return ", ".join(_value_text(v) for v in value)
+    if isinstance(value, bool):
+        return str(value).lower()
+    return _num(value) if isinstance(value, float) else str(value)
+
+
+def rows(tier: str | None = None) -> list[dict[str, str]]:
+    """One dict of COLUMNS per parameter (tier "essential" or "advanced": those only), in C order."""
+    from icoac.core import config as C  # the symbolic names of the switches
+    defaults = _defaults()
+    out = []
+    for name, row in B.PARAMS.items():
+        if tier is not None and row["tier"] != tier:
+            continue
+        choices = tuple(C.ENUMS[name]) if name in C.ENUMS else None
+        out.append({"name": name, "unit": row["unit"], "default": _value_text(defaults[name]),
+                    "range": B.range_text(row, choices), "modes": modes_text(row), "tier": row["tier"],
+                    "description": row["doc"]})
+    return out
+
+
+def plant_rows(plant: str) -> list[dict[str, str]]:
+    """One dict of COLUMNS per parameter of a registry plant (its descriptor's table)."""
+    info = B.plant_info(plant)
+    return [{"name": p["name"], "unit": p["unit"], "default": _num(p["value"]),
+             "range": f"[{_num(p['min'])}, {_num(p['max'])}]", "modes": "all", "tier": "plant",
+             "description": f"{info['name']} parameter"} for p in info["params"]]
+
+
+def text_table(tier: str | None = None, plant: str | None = None) -> str:
+    """The listing of `python -m icoac params`: aligned columns, one line per parameter (the
+    controller's and the run's; with plant, that registry plant's after them)."""
+    table = [dict(zip(COLUMNS, COLUMNS))] + rows(tier) + (plant_rows(plant) if plant else [])
+    widths = {c: max(len(r[c]) for r in table) for c in COLUMNS[:-1]}
+    return "\n".join("  ".join(r[c].ljust(widths[c]) for c in COLUMNS[:-1]) + "  " + r["description"]
+                     for r in table).rstrip() + "\n"
+
+
+def markdown_table() -> list[str]:
+    """docs/design.md's parameter table."""
+    def cell(text: str) -> str:
+        return text.replace("|", "\\|")
+    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    for r in rows():
+        lines.append("| " + " | ".join([f"`{r['name']}`"] + [cell(r[c]) for c in COLUMNS[1:]]) + " |")
+    return lines

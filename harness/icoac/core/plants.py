@@ -1,0 +1,79 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The plants a benchmark runs, each described once, in its C file (sim_host/src/plants/,
+docs/plants.md): dynamics, parameters, failure test, grid, and the controller task it is
+benchmarked with (icoac_sim_task_t: input ranges, rule table, critic grid, learner settings). This
+module reads the C registry: PLANTS has every registry plant, and spec(name) refuses a plant whose
+file has no task, rather than run it on another plant's settings.
+
+The controller's task takes one input per state component, so a plant of n states runs with a
+task of n inputs (n up to the build's ICOAC_MAX_INPUTS; config.check_model refuses more).
+"""
+from __future__ import annotations
+
+import ctypes
+from dataclasses import dataclass
+
+from icoac.core import binding as B
+from icoac.core.registry import CONDITIONS
+
+# The cells of an ICO grid an ICO prior may average (PlantSpec.prior_cells): the paper's
+# "successful", or "finished" where ICO balances too few cells for a prior.
+PRIOR_CELLS = ("successful", "finished")
+
+
+@dataclass(frozen=True)
+class PlantSpec:
+    """A registry plant as the harness runs it, read from its C descriptor."""
+    name: str
+    index: int
+    title: str
+    task_source: str | None  # where its task's settings come from; None: it has no task
+    learners: tuple[str, ...] = ()  # the conditions its task has settings for
+    paper: bool = False  # the paper's plant and task: its published results apply
+    prior_cells: str = PRIOR_CELLS[0]
+    prior_why: str = ""
+
+    @property
+    def has_task(self) -> bool:
+        return self.task_source is not None
+
+    def task_config(self, cfg: B.Config) -> None:
+        """cfg = the C defaults, then the plant's task (icoac_sim_plant_task)."""
+        B.check_status(B.lib.icoac_sim_plant_task(self.index, ctypes.byref(cfg)), f"plant {self.name} task")
+
+    def learner_config(self, condition: str, cfg: B.Config) -> None:
+        """The plant's settings of a learning condition over cfg, if it has some."""
+        B.check_status(B.lib.icoac_sim_plant_learner(self.index, condition.encode(), ctypes.byref(cfg)),
+                       f"plant {self.name} learner settings")
+
+
+def _spec(index: int) -> PlantSpec:
+    info = B.plant_info(index)
+    task = info["task"]
+    if task is None:
+        return PlantSpec(info["name"], index, info["title"], None)
+    learners = tuple(c for group in task["learners"] for c in group)
+    unknown = sorted(set(learners) - set(CONDITIONS))
+    if unknown or len(set(learners)) != len(learners):
+        raise B.LibraryError(f"plant {info['name']}: its task's learner settings name "
+                             f"{', '.join(unknown) or 'a condition twice'}; conditions: {', '.join(CONDITIONS)}")
+    why = task["prior_all_finished"]
+    return PlantSpec(info["name"], index, info["title"], task["source"], learners, task["paper"],
+                     PRIOR_CELLS[1] if why else PRIOR_CELLS[0], why or "")
+
+
+# Every plant of the C registry, in its order.
+PLANTS: dict[str, PlantSpec] = {s.name: s for s in map(_spec, range(int(B.lib.icoac_sim_plant_count())))}
+
+
+def spec(name: str) -> PlantSpec:
+    """The plant called name, with its task; ConfigError when the registry has no such plant or
+    the plant's C file gives no task."""
+    B.plant_index(name)  # an unknown name: the registry's message
+    plant = PLANTS[name]
+    if not plant.has_task:
+        raise B.ConfigError(B.SIM_ERR_BAD_PLANT,
+                            f"plant {name} has no controller task: its C file (sim_host/src/plants/) must give "
+                            f"one (icoac_sim_task_t: input ranges, rule table, critic grid; docs/plants.md) "
+                            f"before it can run; no other plant's settings are used")
+    return plant

@@ -1,0 +1,116 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Markdown tables of a bench summary (the aggregate of icoac.studies.bench, as stored in summary.json
+and docs/data/*.json): the prior taken apart, success within k trials, and the distributions of
+trials and simulated time to success. Pure formatting: bench.py writes them into summary.md and
+icoac.tools.results_tables into docs/results.md, from the same numbers."""
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+from icoac.core.metrics import percent
+from icoac.core.registry import CONDITIONS, COV_RULES, MEAN_RULES, REGISTRY
+
+# The budgets k of the success-within-k table (those up to the largest cap of the summary).
+TABLE_BUDGETS = (1, 10, 100, 1000, 10_000, 100_000)
+# The actor-critic priors, ICO->RL first: (condition, what its mean and covariance are).
+PRIOR_WORDS = {"ico": "ICO", "zero": "0", "isotropic": "σ_w²·I", "identity": "I"}
+assert set(PRIOR_WORDS) == set(MEAN_RULES + COV_RULES)
+PRIOR_TABLE = tuple(c.name for c in REGISTRY.values() if c.mode == "rl" and c.learns)
+
+
+def _pct(stat: Mapping[str, Any] | None) -> str:
+    if not stat or stat.get("mean") is None:
+        return "n/a"
+    return f"{percent(stat['mean'])} ± {percent(stat['sd'])}"
+
+
+def _num(stat: Mapping[str, Any] | None) -> str:
+    if not stat or stat.get("mean") is None:
+        return "n/a"
+    return f"{stat['mean']:.4g} ± {stat['sd']:.2g}"
+
+
+def _at(series: Mapping[str, Sequence], i: int) -> dict[str, Any]:
+    return {"mean": series["mean"][i], "sd": series["sd"][i]}
+
+
+def prior_table(agg: Mapping[str, Any]) -> list[str]:
+    """The actor-critic from the four priors (mean ICO or 0, covariance ICO or σ_w²·I), each beside
+    its no-learning control: success (all cells, interior), median trials to success."""
+    rows = [c for c in PRIOR_TABLE if c in agg]
+    if not rows:
+        return []
+    lines = ["| condition | prior mean | prior covariance | success (all) | success (interior) | median trials | "
+             "control: success (all) | control: median trials | gain over control (points) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for cond in rows:
+        e = agg[cond]
+        mean, cov = REGISTRY[cond].prior
+        c = agg.get(REGISTRY[cond].control or "", {})
+        gain = (e.get("gain_over_control") or {}).get("points")
+        lines.append(f"| {REGISTRY[cond].label} | {PRIOR_WORDS[mean]} | {PRIOR_WORDS[cov]} | {_pct(e['success_rate'])} | "
+                     f"{_pct(e['success_rate_interior'])} | {_num(e['median_trials_to_success'])} | "
+                     f"{_pct(c.get('success_rate'))} | {_num(c.get('median_trials_to_success'))} | {_num(gain)} |")
+    return lines
+
+
+def budgets_of(agg: Mapping[str, Any]) -> list[int]:
+    """The table's budgets up to the largest trial cap of the summary."""
+    cap = max((e["max_trials"] for e in agg.values() if isinstance(e, Mapping) and "max_trials" in e), default=0)
+    return [k for k in TABLE_BUDGETS if k <= cap]
+
+
+def within_table(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> list[str]:
+    """Success (all cells) within k trials, mean ± sd over seeds, for every condition in the
+    summary, with the linear-policy ceiling's rows (its first trial is k = 1; its retries run to
+    their own cap)."""
+    ks = budgets_of(agg)
+    conds = [c for c in CONDITIONS if c in agg and agg[c].get("success_within")]
+    if not ks or not conds:
+        return []
+    lines = ["| condition | cap | " + " | ".join(f"k = {k:g}" for k in ks) + " |",
+             "|---|---|" + "---|" * len(ks)]
+    for cond in conds:
+        e = agg[cond]
+        curve = e["success_within"]
+        cells = []
+        for k in ks:
+            cells.append(_pct(_at(curve["all"], curve["k"].index(k))) if k <= e["max_trials"] else "")
+        lines.append(f"| {REGISTRY[cond].label} | {e['max_trials']:g} | " + " | ".join(cells) + " |")
+    for name, proto in ((ceiling or {}).get("best", {}).get("protocols", {}) or {}).items():
+        curve = proto.get("success_within")
+        cap = proto.get("max_trials", 1 if name == "first" else None)
+        if curve is None:
+            continue
+        cells = [percent(curve["all"][curve["k"].index(k)]) if cap is None or k <= cap else "" for k in ks]
+        lines.append(f"| linear-policy ceiling ({'first trial' if name == 'first' else name}) | "
+                     f"{'' if cap is None else f'{cap:g}'} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def quantile_table(agg: Mapping[str, Any], key: str = "trials_to_success_quantiles") -> list[str]:
+    """Quantiles of trials (or simulated time) to success over the successful cells, mean ± sd
+    over seeds, per condition."""
+    conds = [c for c in CONDITIONS if c in agg and agg[c].get(key)]
+    if not conds:
+        return []
+    qs = agg[conds[0]][key]["q"]
+    lines = ["| condition | " + " | ".join(f"{float(q) * 100:g} %" for q in qs) + " |", "|---|" + "---|" * len(qs)]
+    for cond in conds:
+        series = agg[cond][key]
+        lines.append(f"| {REGISTRY[cond].label} | " + " | ".join(_num(_at(series, i)) for i in range(len(qs))) + " |")
+    return lines
+
+
+def curve_tables(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> list[str]:
+    """The three tables with their headings, for summary.md."""
+    out: list[str] = []
+    for title, lines in (
+            ("The actor-critic from the four priors, each beside its no-learning control", prior_table(agg)),
+            ("Success within k trials (all cells), mean ± sd over seeds", within_table(agg, ceiling)),
+            ("Trials to success: quantiles over the successful cells, mean ± sd over seeds", quantile_table(agg)),
+            ("Simulated time to success (s): quantiles over the successful cells, mean ± sd over seeds",
+             quantile_table(agg, "elapsed_time_quantiles"))):
+        if lines:
+            out += ["", title + ":", ""] + lines
+    return out

@@ -1,0 +1,98 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The tables of docs/results.md, written from the committed bench summaries (docs/data/*.json,
+written by `bench --data`): every block
+
+    <!-- table: NAME FILE -->
+    ...
+    <!-- end table -->
+
+is replaced by the table NAME of icoac.studies.tables computed from docs/data/FILE. With --check it
+writes nothing and exits 1 when a block differs from its summary (tests/python/test_results_tables.py
+runs the check).
+
+    python -m icoac.tools.results_tables --update docs/results.md
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+from icoac.core import store
+from icoac.studies import tables
+from icoac.studies.bench import summary_markdown
+
+BLOCK = re.compile(r"(<!-- table: (?P<name>[a-z-]+) (?P<file>[\w.-]+\.json) -->\n)(?P<body>.*?)(<!-- end table -->)",
+                   re.S)
+
+
+def _summary(data: Mapping[str, Any]) -> list[str]:
+    """The bench's own comparison table (its first table of summary.md)."""
+    text = summary_markdown(data["aggregate"])
+    lines = text.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("| condition"))
+    end = next(i for i in range(start, len(lines)) if not lines[i].startswith("|"))
+    return lines[start:end]
+
+
+TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
+    "comparison": _summary,
+    "priors": lambda d: tables.prior_table(d["aggregate"]),
+    "within": lambda d: tables.within_table(d["aggregate"], d.get("ceiling")),
+    "trials-quantiles": lambda d: tables.quantile_table(d["aggregate"]),
+    "time-quantiles": lambda d: tables.quantile_table(d["aggregate"], "elapsed_time_quantiles"),
+}
+
+
+def provenance(data: Mapping[str, Any]) -> str:
+    git = data.get("git") or {}
+    commit = (git.get("commit") or "unknown")[:7] + ("+dirty" if git.get("dirty") else "")
+    plant = f"plant {data['plant']}, " if data.get("plant") else ""
+    return (f"*From docs/data: {plant}profile {data['profile']}, seeds {data['seeds']}, configuration "
+            f"{data['configuration']}{' ' + ' '.join(data['set']) if data.get('set') else ''}, commit {commit}.*")
+
+
+def render(text: str, data_dir: Path) -> str:
+    """text with every table block rewritten from its summary."""
+    cache: dict[str, Mapping[str, Any]] = {}
+
+    def block(m: re.Match) -> str:
+        name, file = m.group("name"), m.group("file")
+        if name not in TABLES:
+            raise SystemExit(f"unknown table {name!r} in a block; known: {', '.join(TABLES)}")
+        if file not in cache:
+            cache[file] = json.loads((data_dir / file).read_text())
+        lines = TABLES[name](cache[file])
+        return m.group(1) + "\n".join(lines + ["", provenance(cache[file])]) + "\n" + m.group(5)
+
+    return BLOCK.sub(block, text)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m icoac.tools.results_tables", description=__doc__.split("\n")[0])
+    ap.add_argument("page", type=Path, nargs="?", default=Path("docs/results.md"))
+    ap.add_argument("--data", type=Path, default=None, help="summaries directory (default: docs/data beside the page)")
+    mode = ap.add_mutually_exclusive_group(required=True)
+    mode.add_argument("--update", action="store_true", help="rewrite the page's tables")
+    mode.add_argument("--check", action="store_true", help="exit 1 when a table differs from its summary")
+    args = ap.parse_args(argv)
+    data_dir = args.data or args.page.parent / "data"
+    text = args.page.read_text()
+    new = render(text, data_dir)
+    if args.check:
+        if new != text:
+            print(f"{args.page}: a table differs from its summary in {data_dir}; "
+                  f"run python -m icoac.tools.results_tables --update {args.page}", file=sys.stderr)
+            return 1
+        return 0
+    if new != text:
+        store.write_text(args.page, new)
+    print(args.page)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
