@@ -20,10 +20,10 @@ def run(*args, timeout=60):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["grid", "--out", "{tmp}/a", "--set", "gain=-1"], "gain"),
+    (["grid", "--out", "{tmp}/a", "--set", "policy.gain=-1"], "gain"),
     (["grid", "--out", "{tmp}/a", "--set", "gian=1"], "unknown parameter 'gian'"),
     (["grid", "--out", "{tmp}/a", "--set", "gain"], "name=value"),
-    (["grid", "--out", "{tmp}/a", "--set", "reflex_mode=huge"], "unit, gain"),
+    (["grid", "--out", "{tmp}/a", "--set", "policy.reflex_mode=huge"], "unit, gain"),
     (["grid", "--out", "{tmp}/a", "--set", "dt=nan"], "plant"),
     (["grid", "--out", "{tmp}/a", "--max-trials", "0"], "max-trials"),
     (["grid", "--out", "{tmp}/a", "--cells", "5000"], "out of range"),
@@ -64,7 +64,7 @@ def test_grid_resume_and_mismatch(tmp_path):
     assert record["complete"] and record["cells"] == [610, 611] and record["seed"] == 4
     res = run("grid", "--out", str(out), "--resume", "--quiet")
     assert res.returncode == 0, res.stderr
-    res = run("grid", "--out", str(out), "--cells", "610,611", "--seed", "4", "--set", "gain=5", *SMALL_ARGS)
+    res = run("grid", "--out", str(out), "--cells", "610,611", "--seed", "4", "--set", "policy.gain=5", *SMALL_ARGS)
     assert res.returncode == 2 and "does not match" in res.stderr and "gain" in res.stderr
     assert "Traceback" not in res.stderr
 

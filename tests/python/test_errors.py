@@ -9,14 +9,14 @@ from icoac.core.config import build_config, make_prior
 
 
 @pytest.mark.parametrize("overrides, condition, status, words", [
-    ({"gain": -1.0}, "ico", B.ERR_BAD_GAIN, "rejected: policy.gain=-1.0"),
-    ({"reflex_force": -2.0}, "ico", B.ERR_BAD_GAIN, "rejected: policy.reflex_force=-2.0"),
-    ({"input_range": [2.4, 0.0, 0.2, 2.0]}, "ico", B.ERR_BAD_SCALE, "rejected: policy.input_range[1]=0.0"),
+    ({"policy.gain": -1.0}, "ico", B.ERR_BAD_GAIN, "rejected: policy.gain=-1.0"),
+    ({"policy.reflex_force": -2.0}, "ico", B.ERR_BAD_GAIN, "rejected: policy.reflex_force=-2.0"),
+    ({"policy.input_range": [2.4, 0.0, 0.2, 2.0]}, "ico", B.ERR_BAD_SCALE, "rejected: policy.input_range[1]=0.0"),
     ({"task.rule_threshold": [2e6]}, "ico", B.ERR_BAD_ZONE, "rejected: task.rule_threshold[0]=2000000.0"),
-    ({"ico_rate": -1e-4}, "ico", B.ERR_BAD_ICO_RATE, "rejected: ico.rate=-0.0001"),
-    ({"discount": 1.5}, "rl", B.ERR_BAD_CRITIC, "rejected: critic.discount=1.5"),
+    ({"ico.rate": -1e-4}, "ico", B.ERR_BAD_ICO_RATE, "rejected: ico.rate=-0.0001"),
+    ({"critic.discount": 1.5}, "rl", B.ERR_BAD_CRITIC, "rejected: critic.discount=1.5"),
     ({"critic.td_clip": 0.0}, "rl", B.ERR_BAD_CRITIC, "rejected: critic.td_clip=0.0"),
-    ({"noise_std": 0.0}, "rl", B.ERR_BAD_ACTOR, "rejected: actor.noise_std=0.0"),
+    ({"actor.noise_std": 0.0}, "rl", B.ERR_BAD_ACTOR, "rejected: actor.noise_std=0.0"),
     # 0 (sigma_L = sigma_u) or [1e-3, 1e3]
     ({"actor.likelihood_std": 5e-4}, "rl", B.ERR_BAD_ACTOR, "rejected: actor.likelihood_std=0.0005"),
     ({"actor.likelihood_std": -1.0}, "rl", B.ERR_BAD_ACTOR, "rejected: actor.likelihood_std=-1.0"),
@@ -45,18 +45,18 @@ def test_likelihood_std_zero_follows_the_noise():
 
 def test_mode_checks_only_its_groups():
     """icoac_config_check validates the groups the mode uses: a bad critic passes in ICO mode."""
-    build_config({"discount": 1.5}, condition="ico")
+    build_config({"critic.discount": 1.5}, condition="ico")
     with pytest.raises(B.ConfigError):
-        build_config({"discount": 1.5}, condition="rl")
-    build_config({"ico_rate": -1.0}, condition="rl")
+        build_config({"critic.discount": 1.5}, condition="rl")
+    build_config({"ico.rate": -1.0}, condition="rl")
     with pytest.raises(B.ConfigError):
-        build_config({"ico_rate": -1.0}, condition="ico")
+        build_config({"ico.rate": -1.0}, condition="ico")
 
 
 def test_python_side_rejection_carries_the_c_status():
     """A value rejected before C sees it (NaN, subnormal, overflow) has the status C gives that field."""
-    for name, status in [("gain", B.ERR_BAD_GAIN), ("critic.range", B.ERR_BAD_CRITIC),
-                         ("actor.forgetting", B.ERR_BAD_ACTOR), ("ico_rate", B.ERR_BAD_ICO_RATE),
+    for name, status in [("policy.gain", B.ERR_BAD_GAIN), ("critic.range", B.ERR_BAD_CRITIC),
+                         ("actor.forgetting", B.ERR_BAD_ACTOR), ("ico.rate", B.ERR_BAD_ICO_RATE),
                          ("gravity", B.SIM_ERR_BAD_PLANT), ("init_velocity_noise", B.SIM_ERR_BAD_RUN)]:
         value = [float("nan")] * 4 if name == "critic.range" else float("nan")
         with pytest.raises(B.ConfigError) as info:
@@ -64,7 +64,7 @@ def test_python_side_rejection_carries_the_c_status():
         assert info.value.status == status, name
 
 
-@pytest.mark.parametrize("name", ["gain", "ico_rate", "zone_theta", "gravity", "init_velocity_noise"])
+@pytest.mark.parametrize("name", ["policy.gain", "ico.rate", "gravity", "init_velocity_noise"])
 def test_nan_rejected(name):
     with pytest.raises(B.ConfigError) as info:
         build_config({name: float("nan")})
@@ -75,16 +75,16 @@ def test_unknown_name_lists_valid_names():
     with pytest.raises(B.ConfigError) as info:
         build_config({"gian": 10})
     text = str(info.value)
-    assert "gian" in text and "policy.gain" in text and "max_trials" in text and "did you mean gain" in text
+    assert "gian" in text and "policy.gain" in text and "max_trials" in text and "did you mean policy.gain" in text
 
 
 def test_bad_symbolic_value():
     with pytest.raises(B.ConfigError, match="unit, gain"):
-        build_config({"reflex_mode": "huge"})
+        build_config({"policy.reflex_mode": "huge"})
     with pytest.raises(B.ConfigError):
-        build_config({"input_range": [1, 2]})
+        build_config({"policy.input_range": [1, 2]})
     with pytest.raises(B.ConfigError):
-        build_config({"gain": "ten"})
+        build_config({"policy.gain": "ten"})
 
 
 def test_bad_prior():

@@ -217,7 +217,7 @@ def test_resume_checks_number_and_coordinates_of_cells(capsys, res, make, words)
 
 def test_resume_with_other_settings_writes_nothing(capsys, res):
     before = snapshot(res)
-    rc, _, err = main(capsys, "grid", "--out", res, "--cells", "610-613", "--seed", SEED, "--set", "gain=5",
+    rc, _, err = main(capsys, "grid", "--out", res, "--cells", "610-613", "--seed", SEED, "--set", "policy.gain=5",
                       *TINY_ARGS)
     assert_one_line_error(rc, err, "does not match", "gain")
     assert snapshot(res) == before
@@ -280,7 +280,7 @@ def test_lone_results_file_is_not_replaced(capsys, res, keep):
 
 def test_overwrite_replaces_complete_results_after_checks(capsys, res):
     before = snapshot(res)
-    rc, _, err = main(capsys, "grid", "--out", res, "--overwrite", "--set", "gain=-1", *TINY_ARGS)
+    rc, _, err = main(capsys, "grid", "--out", res, "--overwrite", "--set", "policy.gain=-1", *TINY_ARGS)
     assert_one_line_error(rc, err, "gain")
     assert snapshot(res) == before  # a bad configuration deletes nothing
     rc, _, err = main(capsys, "grid", "--out", res, "--cells", "612", "--overwrite", *TINY_ARGS)
@@ -324,20 +324,20 @@ BAD_GRID_ARGS = [
     (["--set", "gravity=-1"], "gravity=-1.0"),
     (["--set", "x_limit=0"], "x_limit=0.0"),
     (["--set", "dt=nan"], "dt"),
-    (["--set", "gain=Infinity"], "gain"),
-    (["--set", "gain=1e999"], "gain"),
-    (["--set", "gain=1e39"], "gain"),          # overflows float32
-    (["--set", "noise_std=1e-50"], "noise_std"),  # underflows float32
+    (["--set", "policy.gain=Infinity"], "gain"),
+    (["--set", "policy.gain=1e999"], "gain"),
+    (["--set", "policy.gain=1e39"], "gain"),          # overflows float32
+    (["--set", "actor.noise_std=1e-50"], "noise_std"),  # underflows float32
     (["--set", "init_velocity_noise=1e-320"], "init_velocity_noise"),
-    (["--set", "input_range=[1,2,3,NaN]"], "input_range"),
+    (["--set", "policy.input_range=[1,2,3,NaN]"], "input_range"),
     (["--set", "mode=4294967296"], "int32"),
     (["--set", "integrator=4294967297"], "int32"),
-    (["--set", "clip_inputs=4294967297"], "clip_inputs"),
+    (["--set", "policy.clip_inputs=4294967297"], "clip_inputs"),
     (["--set", "max_trials=1e30"], "int64"),
     (["--set", "max_trials=9223372036854775808"], "int64"),
     (["--set", "success_steps=inf"], "success_steps"),
     (["--set", "max_trials=" + "9" * 5000], "max_trials"),
-    (["--set", "gain=" + "[" * 5000], "gain"),
+    (["--set", "policy.gain=" + "[" * 5000], "gain"),
 ]
 
 
@@ -371,23 +371,23 @@ def test_figures_duration_bounded(capsys, res, tmp_path, duration, words):
 
 def test_sweep_and_bench_numbers(capsys, res, tmp_path):
     for args, words in [
-        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1", "--subset", "inf"],
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "actor.noise_std=1", "--subset", "inf"],
          "--subset"),
-        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1", "--subset", "5000"],
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "actor.noise_std=1", "--subset", "5000"],
          "--subset"),
-        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1",
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "actor.noise_std=1",
           "--seeds", "18446744073709551616"], "--seeds"),
-        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1",
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "actor.noise_std=1",
           "--seeds", "0,1"], "for the seeds 0,1 write --seed 0 --seeds 2"),
-        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1",
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "actor.noise_std=1",
           "--seed", "18446744073709551615", "--seeds", "2"], "2^64"),
         (["bench", "--out", tmp_path / "b", "--seeds", "0"], "--seeds"),
         (["bench", "--out", tmp_path / "b", "--seeds", "1,2,3"], "--seed 1 --seeds 3"),
         (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "prior_ridge=abc"], "prior_ridge"),
-        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "noise_std=1", "--threads", "1e10"],
+        (["sweep", "--prior-from", res, "--out", tmp_path / "w", "--param", "actor.noise_std=1", "--threads", "1e10"],
          "--threads"),
         (["bench", "--out", tmp_path / "b", "--seed", "18446744073709551615", "--seeds", "2"], "2^64"),
-        (["bench", "--out", tmp_path / "b", "--set", "gain=nan"], "gain"),
+        (["bench", "--out", tmp_path / "b", "--set", "policy.gain=nan"], "gain"),
         (["bench", "--out", tmp_path / "b", "--rl-max-trials", "inf"], "--rl-max-trials"),
     ]:
         rc, _, err = main(capsys, *args)
@@ -495,16 +495,16 @@ def test_help_documents_bounds(capsys):
 
 # -- strict parsing: numbers in ASCII digits that survive rounding, no parameter given twice ----------------
 STRICT = [
-    (["--set", "gain=1e-400"], ["policy.gain", "'1e-400'", "rounds to 0"]),
+    (["--set", "policy.gain=1e-400"], ["policy.gain", "'1e-400'", "rounds to 0"]),
     (["--set", "dt=1e-400"], ["dt", "rounds to 0"]),
-    (["--set", "input_range=[1e-400,3.5,0.2,2]"], ["input_range", "rounds to 0"]),
+    (["--set", "policy.input_range=[1e-400,3.5,0.2,2]"], ["input_range", "rounds to 0"]),
     (["--prior-ridge", "1e-400"], ["--prior-ridge", "rounds to 0"]),
     (["--max-trials", "50", "--set", "max_trials=true"], ["--max-trials 50", "--set max_trials", "both set"]),
     (["--max-trials", "50", "--set", "max_trials=-3"], ["--max-trials 50", "--set max_trials", "both set"]),
     (["--success-steps", "50", "--set", "success_steps=60"], ["--success-steps", "--set success_steps"]),
-    (["--set", "gain=3", "--set", "policy.gain=4"], ["gain=3", "policy.gain=4", "both set policy.gain"]),
+    (["--set", "policy.gain=3", "--set", "policy.gain=4"], ["policy.gain=3", "policy.gain=4", "both set policy.gain"]),
     (["--set", "max_trials=５０"], ["max_trials", "ASCII"]),
-    (["--set", "gain=１"], ["policy.gain", "ASCII"]),
+    (["--set", "policy.gain=１"], ["policy.gain", "ASCII"]),
     (["--cells", "６１１"], ["bad cell index", "ASCII"]),
     (["--max-trials", "５０"], ["--max-trials"]),
     (["--seed", "１"], ["--seed"]),
@@ -526,7 +526,7 @@ def test_strict_parsing(capsys, tmp_path, args, words):
 
 def test_zero_and_small_normal_values_pass(capsys, tmp_path):
     rc, _, err = main(capsys, "grid", "--out", tmp_path / "o", "--cells", "611", *TINY_ARGS,
-                      "--set", "critic.threshold=0.0e-400", "--set", "ico_rate=2.5e-38", "--set", "zone_x=2.35")
+                      "--set", "critic.threshold=0.0e-400", "--set", "ico.rate=2.5e-38")
     assert rc == 0, err
     controller = results.load(tmp_path / "o")[1]["config"]["controller"]
     assert controller["critic"]["threshold"] == 0.0 and controller["ico"]["rate"] == pytest.approx(2.5e-38)
@@ -536,13 +536,13 @@ SWEEP = ["sweep", "--out", "{tmp}/w", "--cells", "611"]
 BENCH = ["bench", "--profile", "quick", "--seeds", "1", "--out", "{tmp}/b"]
 CEILING = ["ceiling", "--out", "{tmp}/c", "--cells", "611", "--protocol", "first", "--success-steps", "200", "--quiet"]
 STRICT_COMMANDS = [
-    ([*SWEEP, "--param", "noise_std=1", "--max-trials", "50", "--set", "max_trials=60"],
+    ([*SWEEP, "--param", "actor.noise_std=1", "--max-trials", "50", "--set", "max_trials=60"],
      ["--max-trials 50", "--set max_trials"]),
-    ([*SWEEP, "--param", "noise_std=1,2", "--set", "noise_std=3"], ["--param actor.noise_std", "--set"]),
+    ([*SWEEP, "--param", "actor.noise_std=1,2", "--set", "actor.noise_std=3"], ["--param actor.noise_std", "--set"]),
     ([*SWEEP, "--param", "max_trials=10,20", "--max-trials", "50"], ["--param max_trials", "--max-trials"]),
-    ([*SWEEP, "--param", "noise_std=1", "--set", "gain=1e-400"], ["gain", "rounds to 0"]),
+    ([*SWEEP, "--param", "actor.noise_std=1", "--set", "policy.gain=1e-400"], ["gain", "rounds to 0"]),
     ([*BENCH, "--rl-max-trials", "5", "--set", "max_trials=6"], ["--rl-max-trials 5", "--set max_trials"]),
-    ([*BENCH, "--set", "max_trials=3", "--set", "noise_std=1", "--set", "actor.noise_std=2"],
+    ([*BENCH, "--set", "max_trials=3", "--set", "actor.noise_std=1", "--set", "actor.noise_std=2"],
      ["both set actor.noise_std"]),
     ([*CEILING, "--w", "1e-400,1,1,1"], ["--w", "rounds to 0"]),
     ([*CEILING, "--w", "１,1,1,1"], ["--w", "ASCII"]),

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Canonical names and their aliases, and the import graph."""
+"""Parameter names, and the import graph."""
 import json
 import shutil
 import subprocess
@@ -12,59 +12,33 @@ from icoac.core import binding as B
 from icoac.core import config, results, store
 from icoac.studies import figures
 from icoac.studies import prior as P
-from icoac.core.config import (ALIASES, ALL_FIELDS, build_config, canonical, config_from_dict, named_sets,
-                            parse_sets)
+from icoac.core.config import ALL_FIELDS, build_config, config_from_dict, parse_sets
 from icoac.core.errors import UsageError
 from icoac.tools import imports
 
 REPO = Path(__file__).resolve().parents[2]
 FIXTURES = Path(__file__).resolve().parent / "fixtures"
 
-# One non-default value per aliased field, valid in RL mode (every group the values touch is checked).
-VALUES = {
-    "input_range": [2.0, 3.0, 0.25, 2.5], "clip_inputs": False, "gain": 7.5, "reflex_mode": "gain",
-    "reflex_force": 2.0, "zone_theta": 0.19, "zone_x": 2.2, "ico_rate": 2e-4, "ico_timing": "literal",
-    "critic_rate": 0.3, "discount": 0.9, "td_clip": 0.5, "critic_range": [2.0, 3.0, 0.2, 1.5],
-    "critic_threshold": 0.0, "noise_std": 0.5, "actor_scale": 0.25, "forgetting": 0.999, "rl_reflex": False,
-    "act_with_sample": True,
-}
+def test_flat_names_of_earlier_versions_are_refused():
+    """Before 1.0 the flat names of earlier versions (gain, noise_std, zone_x, ...) went: a name is
+    its C member designator."""
+    for name in ("gain", "noise_std", "zone_x", "policy.zone_theta", "rl_reflex"):
+        with pytest.raises(B.ConfigError, match=rf"unknown parameter '{name}'"):
+            build_config({name: 1})
+        with pytest.raises((B.ConfigError, UsageError), match=rf"unknown parameter .{name}."):
+            parse_sets([f"{name}=1"])
 
 
-def test_zone_names_set_the_cartpole_rule_thresholds():
-    """zone_theta / zone_x (and policy.zone_*) of earlier versions: the preset's four thresholds."""
-    for name in ("zone_theta", "policy.zone_theta"):
-        t = list(build_config({name: 0.19, "zone_x": 2.2}).controller.task.rule_threshold)[:4]
-        assert t == pytest.approx([0.19, -2.2, -0.19, 2.2], rel=1e-6)
-    with pytest.raises(B.ConfigError, match="policy.zone_x") as info:
-        build_config({"zone_x": 0.0})
-    assert info.value.status == B.ERR_BAD_ZONE
-    assert "policy.zone_theta" not in build_config({"zone_theta": 0.19}).flat()  # recorded as the thresholds
-
-
-@pytest.mark.parametrize("alias", sorted(ALIASES))
-def test_alias_and_canonical_give_identical_configs(alias):
-    value = VALUES[alias]
-    a = build_config({alias: value}, condition="rl")
-    b = build_config({ALIASES[alias]: value}, condition="rl")
-    assert bytes(a.controller) == bytes(b.controller) != bytes(build_config(condition="rl").controller)
-    assert a.to_dict() == b.to_dict()
-    text = json.dumps(value)
-    assert parse_sets([f"{alias}={text}"]) == parse_sets([f"{ALIASES[alias]}={text}"])
-
-
-def test_all_aliases_at_once_and_a_field_given_twice():
-    a = build_config(VALUES, condition="rl")
-    b = build_config({{**ALIASES, **config.ZONE_ALIASES}[k]: v for k, v in VALUES.items()}, condition="rl")
-    assert bytes(a.controller) == bytes(b.controller)
-    for items in (["gain=3", "policy.gain=4"], ["policy.gain=4", "gain=3"], ["gain=3", "gain=3"]):
+def test_a_field_given_twice():
+    for items in (["policy.gain=3", "policy.gain=4"], ["policy.gain=3", "policy.gain=3"]):
         with pytest.raises(UsageError, match=f"--set {items[0]} and --set {items[1]} both set policy.gain"):
             parse_sets(items)
 
 
 def test_canonical_record_nested_and_flat_names():
-    d = build_config({"gain": 5}).to_dict()
+    d = build_config({"policy.gain": 5}).to_dict()
     assert d["controller"]["policy"]["gain"] == 5.0 and "gain" not in d["controller"]
-    flat = build_config({"gain": 5}).flat()
+    flat = build_config({"policy.gain": 5}).flat()
     assert list(flat) == list(ALL_FIELDS) and flat["policy.gain"] == 5.0 and flat["ico.timing"] == "code"
     # the same configuration from dotted names in the controller group
     dotted = {"controller": {k: v for k, v in flat.items() if config.group_of(k) == "controller"}}
@@ -81,12 +55,12 @@ def test_unknown_names_and_wrong_groups():
     with pytest.raises(B.ConfigError, match="'dt' is a plant parameter, not a controller one"):
         config_from_dict({"controller": {"dt": 0.01}})
     with pytest.raises(B.ConfigError, match="'policy.gain' is a controller parameter, not a plant one"):
-        config_from_dict({"plant": {"gain": 1}})
+        config_from_dict({"plant": {"policy.gain": 1}})
 
 
 def test_rejection_names_the_c_field():
     with pytest.raises(B.ConfigError) as info:
-        build_config({"critic_range": [2.4, 3.5, 0.2, 0.0]}, condition="rl")
+        build_config({"critic.range": [2.4, 3.5, 0.2, 0.0]}, condition="rl")
     assert info.value.status == B.ERR_BAD_CRITIC and "rejected: critic.range[3]=0.0" in str(info.value)
     with pytest.raises(B.ConfigError, match=r"rejected: actor.forgetting=0.25"):
         build_config({"actor.forgetting": 0.25}, condition="rl")

@@ -29,7 +29,7 @@ def test_save_load_round_trip(tmp_path, small_cfg, small_run):
     assert cfg.to_dict() == small_cfg.to_dict()
     store.check_resumable(record, condition="ico", seed=7, cfg=cfg, cell_indices=SMALL_CELLS)
     with pytest.raises(results.ResultsError, match="policy.gain 10.0 != 5.0"):
-        store.check_resumable(record, condition="ico", seed=7, cfg=build_config(dict(SMALL, gain=5)),
+        store.check_resumable(record, condition="ico", seed=7, cfg=build_config({**SMALL, "policy.gain": 5}),
                                 cell_indices=SMALL_CELLS)
     with pytest.raises(results.ResultsError, match="seed"):
         store.check_resumable(record, condition="ico", seed=8, cfg=cfg, cell_indices=SMALL_CELLS)

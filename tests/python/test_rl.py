@@ -253,7 +253,7 @@ def closed_form(cfg, mu, sigma, s_t, delta, eps):
                          [(1.0, 0.5, None), (2.0, 1.0, None), (2.0, 1.0, 2.0), (1.0, 0.5, 3.0), (0.5, 1.0, None)])
 def test_bayes_step_terminal_matches_closed_form(noise_std, actor_scale, likelihood_std):
     """The posterior reading (the literal configuration) after one transition into a failure."""
-    over = {**LITERAL, "noise_std": noise_std, "actor_scale": actor_scale}
+    over = {**LITERAL, "actor.noise_std": noise_std, "actor.scale": actor_scale}
     if likelihood_std is not None:
         over["actor.likelihood_std"] = likelihood_std
     cfg = build_config(over, condition="rl")
@@ -277,7 +277,7 @@ def test_bayes_step_terminal_matches_closed_form(noise_std, actor_scale, likelih
 
 def test_bayes_step_zero_td_error_keeps_mean():
     """Posterior reading: delta = 0 keeps mu_w, and Sigma_w still shrinks."""
-    cfg = build_config({**LITERAL, "discount": 0.95}, condition="rl")
+    cfg = build_config({**LITERAL, "critic.discount": 0.95}, condition="rl")
     state = controller(cfg, MU, SIGMA, seed=5)
     mu0, sig0 = posterior(state)
     out1 = tick(cfg, state, S_T)
@@ -328,11 +328,11 @@ def test_cli_configuration_literal(ico_dir, tmp_path):
     (["grid", "--condition", "ico-rl", "--out", "{tmp}/a"], "--prior-from"),
     (["grid", "--condition", "ico-rl", "--prior-from", "{ico}", "--prior-x", "0.01", "--prior-theta", "0.1",
       "--out", "{tmp}/a"], "ICO-successful cell in the prior frame"),
-    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "noise_std"], "--param"),
+    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "actor.noise_std"], "--param"),
     (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "nosie_std=1,2"], "unknown parameter"),
-    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "noise_std=1,-2"], "actor"),
+    (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "actor.noise_std=1,-2"], "actor"),
     (["sweep", "--prior-from", "{ico}", "--out", "{tmp}/w", "--param", "prior_frame=wide"], "prior_frame"),
-    (["sweep", "--prior-from", "{tmp}/none", "--out", "{tmp}/w", "--param", "noise_std=1"], "does not exist"),
+    (["sweep", "--prior-from", "{tmp}/none", "--out", "{tmp}/w", "--param", "actor.noise_std=1"], "does not exist"),
 ])
 def test_cli_rl_errors(ico_dir, tmp_path, args, words):
     res = run_cli(*[a.format(tmp=tmp_path, ico=ico_dir) for a in args])
@@ -341,7 +341,7 @@ def test_cli_rl_errors(ico_dir, tmp_path, args, words):
 
 def test_sweep_two_settings_resumable(ico_dir, tmp_path):
     out = tmp_path / "sweep"
-    args = ["sweep", "--prior-from", str(ico_dir), "--out", str(out), "--param", "noise_std=0.5,2",
+    args = ["sweep", "--prior-from", str(ico_dir), "--out", str(out), "--param", "actor.noise_std=0.5,2",
             "--cells", "0,611", "--max-trials", "20", "--success-steps", "500", "--quiet"]
     res = run_cli(*args)
     assert res.returncode == 0, res.stderr
@@ -354,14 +354,6 @@ def test_sweep_two_settings_resumable(ico_dir, tmp_path):
     assert json.loads((out / "sweep.json").read_text())["seeds"] == [0]
     res = run_cli(*args)  # resumed: nothing rerun, still two rows
     assert res.returncode == 0 and res.stderr.count("skipped") == 2
-    # the canonical name is the same parameter
-    res = run_cli(*[a.replace("noise_std=", "actor.noise_std=") for a in args])
-    assert res.returncode == 0 and res.stderr.count("skipped") == 2, res.stderr
-    # a sweep table written by the ABI-3 harness (flat names in the header and the keys) resumes too
-    text = (out / "sweep.csv").read_text().replace("actor.noise_std", "noise_std")
-    (out / "sweep.csv").write_text(text)
-    res = run_cli(*args)
-    assert res.returncode == 0 and res.stderr.count("skipped") == 2, res.stderr
     with open(out / "sweep.csv", newline="") as fh:
         assert len(list(csv.DictReader(fh))) == 2
 

@@ -202,7 +202,7 @@ def test_the_dask_path_holds_the_directory_too(capsys, tmp_path):
 @pytest.mark.parametrize("command", [
     ["grid", *GRID],
     ["bench", "--profile", "quick", "--seeds", "1", "--quiet"],
-    ["sweep", "--param", "noise_std=1", "--cells", "611", "--max-trials", "5", "--quiet"],
+    ["sweep", "--param", "actor.noise_std=1", "--cells", "611", "--max-trials", "5", "--quiet"],
     ["ceiling", "--w", "0.1,0.07,0.4,0.08", "--cells", "611", "--protocol", "first", "--success-steps", "200",
      "--quiet"],
 ], ids=lambda c: c[0])

@@ -1,13 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """Configurations: C defaults plus overrides by field name, validated by the C check functions.
 
-Names. The canonical name of a controller field is its member designator in icoac_config_t,
-"group.field" (``mode``, ``policy.gain``, ``ico.timing``, ``critic.range``, ``actor.noise_std``);
-plant and run fields keep their member names (``dt``, ``integrator``, ``max_trials``). The flat
-names of the ABI-3 configuration (``gain``, ``ico_timing``, ``noise_std``, ``actor_scale``,
-``rl_reflex``, ...) are aliases, defined once in ALIASES; ``--set``, ``sweep --param``, the Python
-API and old run.json files accept both, and every record is written with the canonical names,
-the controller nested by group.
+Names. The name of a controller field is its member designator in icoac_config_t, "group.field"
+(``mode``, ``policy.gain``, ``ico.timing``, ``critic.range``, ``actor.noise_std``); plant and run
+fields keep their member names (``dt``, ``integrator``, ``max_trials``). Every record is written
+with them, the controller nested by group.
 """
 from __future__ import annotations
 
@@ -42,36 +39,6 @@ RUN_FIELDS = tuple(B.params_of("icoac_sim_run_t"))
 ALL_FIELDS = CONTROLLER_FIELDS + PLANT_FIELDS + RUN_FIELDS
 _GROUP_OF = {**{n: "controller" for n in CONTROLLER_FIELDS}, **{n: "plant" for n in PLANT_FIELDS},
              **{n: "run" for n in RUN_FIELDS}}
-
-# The one alias table: flat ABI-3 name -> canonical name.
-ALIASES: dict[str, str] = {
-    "input_range": "policy.input_range",
-    "clip_inputs": "policy.clip_inputs",
-    "gain": "policy.gain",
-    "reflex_mode": "policy.reflex_mode",
-    "reflex_force": "policy.reflex_force",
-    "ico_rate": "ico.rate",
-    "ico_timing": "ico.timing",
-    "critic_rate": "critic.rate",
-    "discount": "critic.discount",
-    "td_clip": "critic.td_clip",
-    "critic_range": "critic.range",
-    "critic_threshold": "critic.threshold",
-    "noise_std": "actor.noise_std",
-    "actor_scale": "actor.scale",
-    "forgetting": "actor.forgetting",
-    "rl_reflex": "actor.reflex",
-    "act_with_sample": "actor.act_with_sample",
-}
-assert set(ALIASES.values()) <= set(CONTROLLER_FIELDS) and not set(ALIASES) & set(ALL_FIELDS), ALIASES
-
-# The cart-pole's penalty zone (method.md, Eq. 4) by the names of the versions before the task
-# description: each sets two thresholds of the cart-pole task's rule table (icoac_task_cartpole:
-# rules 0 and 2 on theta at +v and -v, rules 1 and 3 on x at -v and +v). Not recorded (the
-# record holds task.rule_threshold); accepted by --set, sweep --param and old run.json files.
-ZONE_RULES: dict[str, tuple[tuple[int, float], ...]] = {"policy.zone_theta": ((0, 1.0), (2, -1.0)),
-                                                        "policy.zone_x": ((1, -1.0), (3, 1.0))}
-ZONE_ALIASES = {"zone_theta": "policy.zone_theta", "zone_x": "policy.zone_x"}
 
 # ICO's input signs: derived from the plant (icoac.core.signs) unless a layer gives them; one number
 # sets every input's.
@@ -119,27 +86,22 @@ def _short(value: Any, limit: int = 60) -> str:
 
 
 def canonical(name: Any) -> str:
-    """The canonical name of a parameter given by its canonical name or an alias; ConfigError
-    (listing the valid names) for anything else."""
-    if isinstance(name, str):
-        if name in _GROUP_OF or name in ZONE_RULES:
-            return name
-        if name in ALIASES:
-            return ALIASES[name]
-        if name in ZONE_ALIASES:
-            return ZONE_ALIASES[name]
+    """``name`` if it names a parameter; ConfigError (listing the valid names) for anything else."""
+    if isinstance(name, str) and name in _GROUP_OF:
+        return name
     hint = ""
     if isinstance(name, str):
-        close = difflib.get_close_matches(name, list(ALL_FIELDS) + list(ALIASES), n=1)
-        hint = f" (did you mean {close[0]}?)" if close else ""
+        by_part = {**{n.rpartition(".")[2]: n for n in ALL_FIELDS}, **{n: n for n in ALL_FIELDS}}
+        close = difflib.get_close_matches(name, list(by_part), n=1)  # by full name or by field
+        hint = f" (did you mean {by_part[close[0]]}?)" if close else ""
     raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
                       f"unknown parameter {_short(name)}{hint}; valid names: {', '.join(ALL_FIELDS)} "
-                      f"(or the flat aliases {', '.join(ALIASES)})")
+                      "(python -m icoac params)")
 
 
 def group_of(name: str) -> str:
     """'controller', 'plant' or 'run' of a canonical name."""
-    return "controller" if name in ZONE_RULES else _GROUP_OF[name]
+    return _GROUP_OF[name]
 
 
 # -- fields of the ctypes structures, by canonical name ------------------------------------------------
@@ -213,8 +175,7 @@ _FIELD_STATUS = {**{name: row["status"] for name, row in B.PARAMS.items()},
 
 
 def _bad(name: str, message: str) -> ConfigError:
-    status = B.ERR_BAD_ZONE if name in ZONE_RULES else _FIELD_STATUS[name]
-    return ConfigError(status, f"{group_of(name)} parameter {name}: {message}")
+    return ConfigError(_FIELD_STATUS[name], f"{group_of(name)} parameter {name}: {message}")
 
 
 def _is_number(value: Any) -> bool:
@@ -294,13 +255,6 @@ def _parse_scalar(name: str, ctype, value: Any):
 
 def _set_field(struct: ctypes.Structure, name: str, value: Any) -> None:
     """Set a field by canonical name (relative to struct), parsing and range-checking the value."""
-    if name in ZONE_RULES:
-        half_width = _parse_real(name, B.c_real, value)
-        if not half_width > 0:
-            raise _bad(name, f"value {_short(value)} must be > 0 (a zone half-width)")
-        for rule, sign in ZONE_RULES[name]:
-            struct.task.rule_threshold[rule] = sign * half_width
-        return
     owner, leaf = _owner(struct, name)
     ctype = dict(owner._fields_)[leaf]
     if issubclass(ctype, ctypes.Array):
@@ -640,7 +594,7 @@ def build_config(overrides: Mapping[str, Any] | None = None, condition: str | No
                  prior: B.Prior | None = None, check: bool = True, plant: str = CART_POLE,
                  derive_signs: bool = True) -> RunConfig:
     """C defaults and the plant's task (its C file), then the condition's overrides and the plant's
-    settings of that learner, then ``overrides`` by field name (canonical or alias; a later name for
+    settings of that learner, then ``overrides`` by field name (a later name for
     the same field wins); validated by C. A registry plant other than the
     cart-pole takes the overrides named after its parameters (and dt, integrator). With
     derive_signs, task.input_sign comes from the plant's LQR gain (icoac.core.signs) unless the plant's
@@ -700,7 +654,7 @@ def _derive_signs(cfg: RunConfig) -> None:
 
 def _controller_items(values: Mapping[str, Any], prefix: str = ""):
     """(name, value) of a controller dict: nested groups ({"policy": {"gain": 10}}), dotted names
-    ("policy.gain") or flat aliases ("gain"); names not canonicalized yet."""
+    ("policy.gain"); names not checked yet."""
     for key, value in values.items():
         if not isinstance(key, str):
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT, f"configuration key {_short(key)} is not a name")

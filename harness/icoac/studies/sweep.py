@@ -41,8 +41,8 @@ def _name(name: str) -> str:
 
 
 def parse_params(items: Sequence[str]) -> dict[str, list[Any]]:
-    """['noise_std=0.5,1', ...] -> {'actor.noise_std': [0.5, 1.0]}: canonical names (aliases
-    accepted) of configuration fields, or prior_frame / prior_ridge / prior_std."""
+    """['actor.noise_std=0.5,1', ...] -> {'actor.noise_std': [0.5, 1.0]}: canonical names of
+    configuration fields, or prior_frame / prior_ridge / prior_std."""
     out: dict[str, list[Any]] = {}
     for item in items:
         if "=" not in item:
@@ -90,8 +90,7 @@ def key_of(setting: dict[str, Any]) -> str:
 
 
 def canonical_key(key: str) -> str:
-    """The key of a sweep.csv row with canonical names (rows written with ABI-3 flat names map
-    through the alias table); SweepError if it is not a setting."""
+    """The key of a sweep.csv row, its names checked; SweepError if it is not a setting."""
     try:
         setting = json.loads(key)
         if not isinstance(setting, dict):

@@ -77,9 +77,10 @@ def furuta_task(plant: str, setting: dict[str, float]) -> dict[str, Any]:
     the policy gain. The cart-pole's rule table and critic units carry over."""
     limit = _param(plant, "pendulum_limit")
     ranges = [setting["arm_range"], setting["arm_velocity_range"], limit, setting["pendulum_velocity_range"]]
+    z, zx = math.radians(setting["zone_deg"]), ZONE_FRACTION * setting["arm_range"]
     return {"policy.input_range": ranges, "critic.range": ranges,
-            "policy.zone_x": ZONE_FRACTION * setting["arm_range"],
-            "policy.zone_theta": math.radians(setting["zone_deg"]),
+            # the cart-pole's rules 0 and 2 on the pendulum at +-z, 1 and 3 on the arm at -+zx
+            "task.rule_threshold": [z, -zx, -z, zx] + [0.0] * (B.MAX_RULES - 4),
             "ico.rate": setting["ico.rate"], "policy.gain": setting["policy.gain"]}
 
 
