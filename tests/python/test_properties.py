@@ -17,8 +17,8 @@ from hypothesis import strategies as st
 
 from icoac.core import binding as B
 from icoac.core import config, grid, metrics, results, store
-from icoac.core.config import (ALIASES, ALL_FIELDS, BOOLS, ENUMS, RunConfig, build_config, canonical, config_from_dict,
-                            parse_sets, parse_value)
+from icoac.core.config import (ALL_FIELDS, BOOLS, ENUMS, RunConfig, build_config, canonical, config_from_dict,
+                               parse_sets, parse_value)
 from icoac.core.errors import HarnessError
 from icoac.core.registry import CONDITIONS
 
@@ -35,7 +35,7 @@ scalars = st.none() | st.booleans() | ints | floats | st.text(max_size=12) \
 json_values = st.recursive(scalars, lambda kids: st.lists(kids, max_size=5)
                            | st.dictionaries(st.text(max_size=8), kids, max_size=4), max_leaves=12)
 field_values = scalars | st.lists(floats | ints, min_size=3, max_size=5) | json_values
-names = st.sampled_from(ALL_FIELDS + tuple(ALIASES) + ("reserved", "gian", "", "Gain", "policy", "policy.")) \
+names = st.sampled_from(ALL_FIELDS + ("gain", "reserved", "gian", "", "Gain", "policy", "policy.")) \
     | st.text(max_size=10)
 
 
@@ -52,12 +52,9 @@ def assert_round_trip(cfg: RunConfig):
     assert json.loads(json.dumps(d)) == d           # JSON-clean: finite, plain types
     again = config_from_dict(d)
     assert again.to_dict() == d
-    # the same configuration from `--set` strings of the values, under canonical names and aliases
+    # the same configuration from `--set` strings of the values
     flat = cfg.flat()
     sets = [f"{name}={json.dumps(value)}" for name, value in flat.items()]
-    assert build_config(parse_sets(sets), prior=cfg.prior).to_dict() == d
-    alias_of = {v: k for k, v in ALIASES.items()}
-    sets = [f"{alias_of.get(name, name)}={json.dumps(value)}" for name, value in flat.items()]
     assert build_config(parse_sets(sets), prior=cfg.prior).to_dict() == d
 
 
@@ -69,7 +66,7 @@ def test_build_config_accepts_and_round_trips_or_rejects(overrides):
         assert_round_trip(cfg)
 
 
-@given(st.sampled_from(ALL_FIELDS + tuple(ALIASES)), field_values, st.sampled_from(CONDITIONS))
+@given(st.sampled_from(ALL_FIELDS), field_values, st.sampled_from(CONDITIONS))
 def test_single_field_override(given_name, value, condition):
     cfg = total(build_config, {given_name: value}, condition=condition)
     if cfg is None:
@@ -117,7 +114,7 @@ def test_integer_fields_are_range_checked_not_truncated(name, value):
     assert int(got) == number
 
 
-@given(st.sampled_from(ALL_FIELDS + tuple(ALIASES)),
+@given(st.sampled_from(ALL_FIELDS),
        st.text(max_size=20) | floats.map(repr) | ints.map(str) | json_values.map(json.dumps))
 def test_set_option_parsing(name, text):
     over = total(parse_sets, [f"{name}={text}"])
