@@ -276,8 +276,9 @@ def test_literal_configuration():
 
 
 def test_overrides_by_name():
-    cfg = build_config({"reflex_mode": "gain", "ico_timing": "literal", "integrator": "rk4", "max_trials": 2000,
-                        "noise_std": 2.0, "input_range": [2.4, 3.5, 0.2094384, 2.0], "clip_inputs": "false"})
+    cfg = build_config({"policy.reflex_mode": "gain", "ico.timing": "literal", "integrator": "rk4", "max_trials": 2000,
+                        "actor.noise_std": 2.0, "policy.input_range": [2.4, 3.5, 0.2094384, 2.0],
+                        "policy.clip_inputs": "false"})
     c = cfg.controller
     assert c.policy.reflex_mode == B.REFLEX_MODES["gain"] and c.ico.timing == B.ICO_TIMINGS["literal"]
     assert cfg.model.integrator == B.INTEGRATORS["rk4"] and cfg.run.max_trials == 2000

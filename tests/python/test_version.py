@@ -42,7 +42,7 @@ def test_wheel_metadata_reads_the_same_line():
     match = re.search(provider["regex"], (REPO / provider["input"]).read_text(encoding="utf-8"), re.MULTILINE)
     assert match is not None and match.group("value") == _cmake_version()
     generated = {g["path"]: g["template"] for g in pyproject["tool"]["scikit-build"]["generate"]}
-    assert '__version__ = "${version}"' in generated["harness/icoac/_version.py"]
+    assert '__version__ = "${version}"' in generated["icoac/_version.py"]
 
 
 def test_library_version_is_the_package_version():
