@@ -1,2 +1,3 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Developer tools of the harness that need neither the shared library nor the harness modules."""
+"""The maintainers' tools: the import checker, the generated tables of the docs, the sweeps behind
+the defaults, the Dask overhead measurement."""

@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import argparse
 import re
-import sys
 from pathlib import Path
 
-from icoac.core import params, store
+from icoac.core import params
+from icoac.tools.pages import update_or_check
 
 BLOCK = re.compile(r"(<!-- params:begin -->\n)(?P<body>.*?)(<!-- params:end -->)", re.S)
 
@@ -40,16 +40,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     text = args.page.read_text()
     new = render(text)
-    if args.check:
-        if new != text:
-            print(f"{args.page}: the parameter table differs from the C table; "
-                  f"run python -m icoac.tools.params_table --update {args.page}", file=sys.stderr)
-            return 1
-        return 0
-    if new != text:
-        store.write_text(args.page, new)
-    print(args.page)
-    return 0
+    return update_or_check(args.page, text, new, args.check, "the parameter table differs from the C table",
+                           "python -m icoac.tools.params_table")
 
 
 if __name__ == "__main__":

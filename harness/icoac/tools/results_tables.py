@@ -17,13 +17,12 @@ from __future__ import annotations
 import argparse
 import json
 import re
-import sys
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from icoac.core import store
 from icoac.studies import tables
 from icoac.studies.bench import summary_markdown
+from icoac.tools.pages import update_or_check
 
 BLOCK = re.compile(r"(<!-- table: (?P<name>[a-z-]+) (?P<file>[\w.-]+\.json) -->\n)(?P<body>.*?)(<!-- end table -->)",
                    re.S)
@@ -82,16 +81,8 @@ def main(argv: list[str] | None = None) -> int:
     data_dir = args.data or args.page.parent / "data"
     text = args.page.read_text()
     new = render(text, data_dir)
-    if args.check:
-        if new != text:
-            print(f"{args.page}: a table differs from its summary in {data_dir}; "
-                  f"run python -m icoac.tools.results_tables --update {args.page}", file=sys.stderr)
-            return 1
-        return 0
-    if new != text:
-        store.write_text(args.page, new)
-    print(args.page)
-    return 0
+    return update_or_check(args.page, text, new, args.check, f"a table differs from its summary in {data_dir}",
+                           "python -m icoac.tools.results_tables")
 
 
 if __name__ == "__main__":
