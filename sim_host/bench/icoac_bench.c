@@ -39,7 +39,7 @@ static void balanced_cell(icoac_sim_cell_t *cell, uint64_t seed)
 static double ns_per_tick(int mode, int64_t steps, int n_cells, int64_t *ticks_out)
 {
     icoac_config_t cfg;
-    icoac_sim_plant_t plant;
+    icoac_sim_model_t model;
     icoac_sim_run_t run;
     icoac_sim_cell_t cells[ICOAC_SIM_LANES];
     volatile int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
@@ -49,7 +49,7 @@ static double ns_per_tick(int mode, int64_t steps, int n_cells, int64_t *ticks_o
     int i;
     icoac_config_default(&cfg);
     cfg.mode = mode;
-    icoac_sim_plant_default(&plant);
+    (void)icoac_sim_model_default(&model, ICOAC_SIM_CART_POLE);
     icoac_sim_run_default(&run);
     run.success_steps = steps;
     run.max_trials = 1000;
@@ -57,8 +57,8 @@ static double ns_per_tick(int mode, int64_t steps, int n_cells, int64_t *ticks_o
         balanced_cell(&cells[i], 7u + (uint64_t)i);
     }
     t0 = now_seconds();
-    status = n_cells == 1 ? icoac_sim_run_cell(&cfg, &plant, &run, &balanced_prior, &cells[0], 0, progress)
-                          : icoac_sim_run_grid(&cfg, &plant, &run, &balanced_prior, cells, n_cells, 1, 0, progress);
+    status = n_cells == 1 ? icoac_sim_run_cell(&cfg, &model, &run, &balanced_prior, &cells[0], 0, progress)
+                          : icoac_sim_run_grid(&cfg, &model, &run, &balanced_prior, cells, n_cells, 1, 0, progress);
     elapsed = now_seconds() - t0;
     if (status != ICOAC_SIM_OK) {
         fprintf(stderr, "icoac_bench: %s\n", icoac_sim_status_str(status));
@@ -82,9 +82,11 @@ int main(int argc, char **argv)
 {
     const int quick = argc > 1 && strcmp(argv[1], "--quick") == 0;
     icoac_config_t cfg;
-    icoac_sim_plant_t plant;
+    icoac_sim_model_t model;
     icoac_sim_run_t run;
-    icoac_sim_cell_t *grid = calloc(ICOAC_SIM_GRID_CELLS, sizeof *grid);
+    const icoac_sim_plant_desc_t *cart_pole = icoac_sim_plant_info(ICOAC_SIM_CART_POLE);
+    const int64_t n_cells = (int64_t)cart_pole->rows.count * cart_pole->cols.count;
+    icoac_sim_cell_t *grid = calloc((size_t)n_cells, sizeof *grid);
     volatile int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
     double t0;
     double wall;
@@ -97,19 +99,18 @@ int main(int argc, char **argv)
     print_tick("RL ", ICOAC_MODE_RL, quick ? 50000 : 1000000, 150.0);
 
     icoac_config_default(&cfg);
-    icoac_sim_plant_default(&plant);
+    (void)icoac_sim_model_default(&model, ICOAC_SIM_CART_POLE);
     icoac_sim_run_default(&run);
     run.max_trials = quick ? 200 : 2000;
-    icoac_sim_paper_grid(grid, ICOAC_SIM_GRID_CELLS, 1u);
+    (void)icoac_sim_plant_grid(ICOAC_SIM_CART_POLE, grid, n_cells, 1u);
     t0 = now_seconds();
-    if (icoac_sim_run_grid(&cfg, &plant, &run, 0, grid, ICOAC_SIM_GRID_CELLS, 0, 0, progress) !=
-        ICOAC_SIM_OK) {
+    if (icoac_sim_run_grid(&cfg, &model, &run, 0, grid, n_cells, 0, 0, progress) != ICOAC_SIM_OK) {
         fprintf(stderr, "icoac_bench: run_grid failed\n");
         return 1;
     }
     wall = now_seconds() - t0;
-    printf("ICO grid, 1225 cells, max_trials %lld, all cores: %.2f s, %.3g ticks/s, %.3g trials/s\n",
-           (long long)run.max_trials, wall, (double)progress[ICOAC_SIM_PROGRESS_STEPS] / wall,
+    printf("ICO grid, %lld cells, max_trials %lld, all cores: %.2f s, %.3g ticks/s, %.3g trials/s\n",
+           (long long)n_cells, (long long)run.max_trials, wall, (double)progress[ICOAC_SIM_PROGRESS_STEPS] / wall,
            (double)progress[ICOAC_SIM_PROGRESS_TRIALS] / wall);
     free(grid);
     return 0;

@@ -99,10 +99,10 @@ static int32_t thread_count(int32_t requested, int64_t n_cells)
     return (int32_t)n;
 }
 
-int32_t icoac_sim_run_grid_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
-                                 const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                                 icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
-                                 const volatile int32_t *cancel, volatile int64_t *progress)
+int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                           icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
+                           const volatile int32_t *cancel, volatile int64_t *progress)
 {
     pthread_t threads[SIM_MAX_THREADS];
     grid_job_t job;
@@ -155,14 +155,4 @@ int32_t icoac_sim_run_grid_model(const icoac_config_t *cfg, const icoac_sim_mode
         (void)pthread_join(threads[t], 0);
     }
     return job.cancelled ? ICOAC_SIM_CANCELLED : ICOAC_SIM_OK;
-}
-
-int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                           icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
-                           const volatile int32_t *cancel, volatile int64_t *progress)
-{
-    icoac_sim_model_t model;
-    return icoac_sim_run_grid_model(cfg, sim_model_of(plant, &model), run, prior, cells, n_cells, n_threads,
-                                    cancel, progress);
 }

@@ -75,7 +75,3 @@ int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_model_t *model,
     return status;
 }
 
-const icoac_sim_model_t *sim_model_of(const icoac_sim_plant_t *plant, icoac_sim_model_t *model)
-{
-    return icoac_sim_model_from_plant(plant, model) == ICOAC_SIM_OK ? model : 0;
-}

@@ -32,9 +32,6 @@ void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *
 int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_model_t *model,
                       const icoac_sim_run_t *run);
 
-/* The model of a plant struct, or NULL when plant is NULL (the check then refuses it). */
-const icoac_sim_model_t *sim_model_of(const icoac_sim_plant_t *plant, icoac_sim_model_t *model);
-
 /* Initial velocity noise a: 0, or in [ICOAC_SIM_NOISE_MIN, ICOAC_SIM_NOISE_MAX] (params.c). */
 int sim_velocity_noise_valid(double a);
 

@@ -6,10 +6,10 @@
 #include "icoac_sim/icoac_sim.h"
 #include "sim_internal.h"
 
-int32_t icoac_sim_trajectory_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
-                                   const icoac_prior_t *prior, double x0, double theta0,
-                                   double init_velocity_noise, uint64_t seed, int64_t max_steps,
-                                   double *states, double *forces, int64_t *n_steps)
+int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                             const icoac_prior_t *prior, double x0, double theta0,
+                             double init_velocity_noise, uint64_t seed, int64_t max_steps,
+                             double *states, double *forces, int64_t *n_steps)
 {
     const icoac_sim_plant_desc_t *desc;
     icoac_state_t ctrl;
@@ -59,14 +59,4 @@ int32_t icoac_sim_trajectory_model(const icoac_config_t *cfg, const icoac_sim_mo
     }
     sim_fpu_restore(fpu_mode);
     return status;
-}
-
-int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                             const icoac_prior_t *prior, double x0, double theta0,
-                             double init_velocity_noise, uint64_t seed, int64_t max_steps,
-                             double *states, double *forces, int64_t *n_steps)
-{
-    icoac_sim_model_t model;
-    return icoac_sim_trajectory_model(cfg, sim_model_of(plant, &model), prior, x0, theta0, init_velocity_noise,
-                                      seed, max_steps, states, forces, n_steps);
 }

@@ -172,10 +172,10 @@ int sim_lane_tick(const sim_job_t *job, sim_lane_t *lane)
     return lane->steps >= job->run->success_steps ? end_trial(job, lane, 1) : SIM_LANE_RUNNING;
 }
 
-int32_t icoac_sim_run_cell_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
-                                 const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                                 icoac_sim_cell_t *cell, const volatile int32_t *cancel,
-                                 volatile int64_t *progress)
+int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                           icoac_sim_cell_t *cell, const volatile int32_t *cancel,
+                           volatile int64_t *progress)
 {
     sim_lane_t lane;
     uint32_t fpu_mode;
@@ -200,13 +200,4 @@ int32_t icoac_sim_run_cell_model(const icoac_config_t *cfg, const icoac_sim_mode
         sim_fpu_restore(fpu_mode);
     }
     return state == SIM_LANE_CANCELLED ? ICOAC_SIM_CANCELLED : status;
-}
-
-int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                           icoac_sim_cell_t *cell, const volatile int32_t *cancel,
-                           volatile int64_t *progress)
-{
-    icoac_sim_model_t model;
-    return icoac_sim_run_cell_model(cfg, sim_model_of(plant, &model), run, prior, cell, cancel, progress);
 }

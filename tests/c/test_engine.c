@@ -9,13 +9,6 @@
 
 #include "test_sim_common.h"
 
-static icoac_sim_plant_t default_plant(void)
-{
-    icoac_sim_plant_t p;
-    icoac_sim_plant_default(&p);
-    return p;
-}
-
 static icoac_sim_cell_t make_cell(double x0, double theta0, uint64_t seed)
 {
     icoac_sim_cell_t c;
@@ -45,7 +38,7 @@ static void check_accounting(const icoac_sim_cell_t *c, const icoac_sim_run_t *r
 
 static void test_run_cell_deterministic(void)
 {
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     const icoac_sim_run_t run = test_small_run(15, 1500);
     int mode;
     for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
@@ -54,25 +47,25 @@ static void test_run_cell_deterministic(void)
         icoac_sim_cell_t b = a;
         icoac_sim_cell_t c = make_cell(-1.5, DEG(-7.0), 124u);
         cfg.mode = mode;
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &a, NULL, NULL));
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &b, NULL, NULL));
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, NULL, &a, NULL, NULL));
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, NULL, &b, NULL, NULL));
         TEST_ASSERT_EQUAL_MEMORY(&b, &a, sizeof a);
         check_accounting(&a, &run);
         /* a different seed changes the run (velocities, exploration noise) */
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL));
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, NULL, &c, NULL, NULL));
         TEST_ASSERT_TRUE(memcmp(a.weights, c.weights, sizeof a.weights) != 0 || a.total_steps != c.total_steps);
     }
 }
 
 static void test_run_cell_outcomes(void)
 {
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     icoac_config_t cfg = test_default_config();
     icoac_sim_run_t run = test_small_run(5, 1);
     icoac_sim_cell_t c = make_cell(0.0, 0.0, 1u);
     int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
     /* one step from the upright cannot fail: success in the first trial */
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, progress));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, NULL, &c, NULL, progress));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_SUCCESS, c.outcome);
     TEST_ASSERT_EQUAL_INT64(1, c.trials);
     TEST_ASSERT_EQUAL_INT64(1, c.total_steps);
@@ -83,7 +76,7 @@ static void test_run_cell_outcomes(void)
     /* leaning 11.9 deg with w = 0 and the 1 N reflex: every trial falls */
     run = test_small_run(4, 100000);
     c = make_cell(0.0, DEG(11.9), 1u);
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, NULL, &c, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_FAILED, c.outcome);
     TEST_ASSERT_EQUAL_INT64(4, c.trials);
     check_accounting(&c, &run);
@@ -98,7 +91,7 @@ static void test_run_cell_outcomes(void)
  * FAILED with NaN weights. */
 static void test_numeric_fault_marks_cell_error(void)
 {
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     icoac_config_t cfg = test_default_config();
     icoac_sim_run_t run = test_small_run(50, 5000);
     icoac_sim_cell_t cells[2];
@@ -109,7 +102,7 @@ static void test_numeric_fault_marks_cell_error(void)
     cfg.actor.forgetting = ICOAC_FORGETTING_MIN;
     cells[0] = make_cell(0.0, 0.0, 1u);
     cells[1] = make_cell(0.5, DEG(1.0), 2u);
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &plant, &run, &prior, cells, 2, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &model, &run, &prior, cells, 2, 1, NULL, NULL));
     for (k = 0; k < 2; ++k) {
         TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERROR, cells[k].outcome);
         TEST_ASSERT_EQUAL_INT(ICOAC_ERR_NUMERIC, cells[k].status);
@@ -127,27 +120,27 @@ static void test_numeric_fault_marks_cell_error(void)
  * initial-velocity noise make every trial the same, falling at step n. */
 static void test_failure_at_the_last_step(void)
 {
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     icoac_config_t cfg = test_default_config();
     icoac_sim_run_t run = test_small_run(1, 100000);
     icoac_sim_cell_t c = make_cell(0.0, DEG(11.9), 1u);
     int64_t n;
     cfg.learn = 0;
     run.init_velocity_noise = 0.0;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, NULL, &c, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_FAILED, c.outcome);
     n = c.last_trial_steps;
     TEST_ASSERT_TRUE(n > 1 && n < 1000);
     run = test_small_run(2, n);
     c = make_cell(0.0, DEG(11.9), 1u);
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, NULL, &c, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_FAILED, c.outcome);
     TEST_ASSERT_EQUAL_INT64(2, c.trials);
     TEST_ASSERT_EQUAL_INT64(n, c.last_trial_steps);
     check_accounting(&c, &run);
     run = test_small_run(2, n - 1);
     c = make_cell(0.0, DEG(11.9), 1u);
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, NULL, &c, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_SUCCESS, c.outcome);
     TEST_ASSERT_EQUAL_INT64(1, c.trials);
     check_accounting(&c, &run);
@@ -156,19 +149,19 @@ static void test_failure_at_the_last_step(void)
 static void run_grid_ok(const icoac_config_t *cfg, icoac_sim_cell_t *cells, int64_t n, int32_t threads,
                         int64_t progress[ICOAC_SIM_PROGRESS_LEN])
 {
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     const icoac_sim_run_t run = test_small_run(10, 1000);
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(cfg, &plant, &run, NULL, cells, n, threads, NULL, progress));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(cfg, &model, &run, NULL, cells, n, threads, NULL, progress));
 }
 
 #define NSUB 8
 
 static void subset(icoac_sim_cell_t out[NSUB])
 {
-    static icoac_sim_cell_t grid[ICOAC_SIM_GRID_CELLS];
+    static icoac_sim_cell_t grid[TEST_PAPER_CELLS];
     static const int pick[NSUB] = {0, 100, 333, 600, 612, 777, 1000, 1224};
     int i;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_paper_grid(grid, ICOAC_SIM_GRID_CELLS, 2010u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_grid(ICOAC_SIM_CART_POLE, grid, TEST_PAPER_CELLS, 2010u));
     for (i = 0; i < NSUB; ++i) {
         out[i] = grid[pick[i]];
     }
@@ -178,7 +171,7 @@ static void test_grid_thread_independent(void)
 {
     icoac_sim_cell_t one[NSUB], two[NSUB], solo[NSUB];
     int64_t p1[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0}, p2[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     const icoac_sim_run_t run = test_small_run(10, 1000);
     int mode, i;
     for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_RL; ++mode) {
@@ -196,7 +189,7 @@ static void test_grid_thread_independent(void)
         TEST_ASSERT_EQUAL_MEMORY(p2, p1, sizeof p1);
         for (i = 0; i < NSUB; ++i) {
             /* a grid cell is the same independent run as icoac_sim_run_cell */
-            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &solo[i], NULL, NULL));
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, NULL, &solo[i], NULL, NULL));
             check_accounting(&one[i], &run);
             trials += one[i].trials;
             steps += one[i].total_steps;
@@ -216,13 +209,13 @@ static void test_lanes_match_single_cells(void)
 {
 #define NLANE 11
     static const int pick[NLANE] = {612, 0, 1224, 600, 24, 611, 613, 100, 1000, 587, 637};
-    static icoac_sim_cell_t grid[ICOAC_SIM_GRID_CELLS];
-    const icoac_sim_plant_t plant = default_plant();
+    static icoac_sim_cell_t grid[TEST_PAPER_CELLS];
+    const icoac_sim_model_t model = test_cart_pole();
     const icoac_sim_run_t run = test_small_run(40, 600);
     const icoac_prior_t prior = test_prior(0.094, 0.066, 0.365, 0.080, 1e-3);
     icoac_sim_cell_t solo[NLANE], cells[NLANE];
     int mode, threads, i;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_paper_grid(grid, ICOAC_SIM_GRID_CELLS, 99u));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_grid(ICOAC_SIM_CART_POLE, grid, TEST_PAPER_CELLS, 99u));
     for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_SEARCH; ++mode) {
         icoac_config_t cfg = test_default_config();
         int64_t short_cells = 0, long_cells = 0; /* <= 10 trials, all max_trials */
@@ -234,7 +227,7 @@ static void test_lanes_match_single_cells(void)
                 solo[i].trials = -3;
                 continue;
             }
-            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, &prior, &solo[i], NULL, NULL));
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, &prior, &solo[i], NULL, NULL));
             short_cells += solo[i].trials <= 10;
             long_cells += solo[i].trials == run.max_trials;
         }
@@ -248,7 +241,7 @@ static void test_lanes_match_single_cells(void)
                 }
             }
             TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                                  icoac_sim_run_grid(&cfg, &plant, &run, &prior, cells, NLANE, threads, NULL, progress));
+                                  icoac_sim_run_grid(&cfg, &model, &run, &prior, cells, NLANE, threads, NULL, progress));
             TEST_ASSERT_EQUAL_MEMORY(solo, cells, sizeof cells);
             TEST_ASSERT_EQUAL_INT64(NLANE - 1, progress[ICOAC_SIM_PROGRESS_CELLS]);
         }
@@ -278,7 +271,7 @@ static void *cancel_later(void *arg)
 static void test_cancel_mid_run(void)
 {
     icoac_config_t cfg = test_default_config();
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     const icoac_sim_run_t run = test_small_run(300, 1000);
     icoac_sim_cell_t cells[NSUB], reference[NSUB], before[NSUB];
     volatile int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
@@ -288,7 +281,7 @@ static void test_cancel_mid_run(void)
     int i, pending = 0;
     cfg.mode = ICOAC_MODE_RL;
     subset(reference);
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &plant, &run, NULL, reference, NSUB, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &model, &run, NULL, reference, NSUB, 1, NULL, NULL));
     subset(cells);
     memcpy(before, cells, sizeof cells);
     canceller.cancel = &cancel;
@@ -296,7 +289,7 @@ static void test_cancel_mid_run(void)
     canceller.after_trials = 200;
     TEST_ASSERT_EQUAL_INT(0, pthread_create(&thread, NULL, cancel_later, &canceller));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_CANCELLED,
-                          icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, NSUB, 1, &cancel, progress));
+                          icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, NSUB, 1, &cancel, progress));
     TEST_ASSERT_EQUAL_INT(0, pthread_join(thread, NULL));
     for (i = 0; i < NSUB; ++i) {
         if (cells[i].outcome == ICOAC_SIM_PENDING) {
@@ -308,14 +301,14 @@ static void test_cancel_mid_run(void)
     }
     TEST_ASSERT_TRUE(pending > 0);
     cancel = 0;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, NSUB, 1, &cancel, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, NSUB, 1, &cancel, NULL));
     TEST_ASSERT_EQUAL_MEMORY(reference, cells, sizeof cells);
 }
 
 static void test_cancel_and_resume(void)
 {
     icoac_config_t cfg = test_default_config();
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     const icoac_sim_run_t run = test_small_run(10, 1000);
     icoac_sim_cell_t cells[NSUB], reference[NSUB], before[NSUB];
     int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
@@ -326,23 +319,23 @@ static void test_cancel_and_resume(void)
     subset(cells);
     memcpy(before, cells, sizeof cells);
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_CANCELLED,
-                          icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, NSUB, 2, &cancel, progress));
+                          icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, NSUB, 2, &cancel, progress));
     for (i = 0; i < NSUB; ++i) {
         TEST_ASSERT_EQUAL_INT(ICOAC_SIM_PENDING, cells[i].outcome);
     }
     TEST_ASSERT_EQUAL_MEMORY(before, cells, sizeof cells);
     TEST_ASSERT_EQUAL_INT64(0, progress[ICOAC_SIM_PROGRESS_CELLS]);
     /* single cell too */
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_CANCELLED, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &cells[0], &cancel, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_CANCELLED, icoac_sim_run_cell(&cfg, &model, &run, NULL, &cells[0], &cancel, NULL));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_PENDING, cells[0].outcome);
     /* resume: lower the flag, call again */
     cancel = 0;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, NSUB, 2, &cancel, progress));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, NSUB, 2, &cancel, progress));
     TEST_ASSERT_EQUAL_MEMORY(reference, cells, sizeof cells);
     TEST_ASSERT_EQUAL_INT64(NSUB, progress[ICOAC_SIM_PROGRESS_CELLS]);
     /* finished cells are final: a further call changes nothing */
     cells[3].trials = -7; /* marker */
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, NSUB, 2, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, NSUB, 2, NULL, NULL));
     TEST_ASSERT_EQUAL_INT64(-7, cells[3].trials);
     cells[3].trials = reference[3].trials;
     TEST_ASSERT_EQUAL_MEMORY(reference, cells, sizeof cells);
@@ -351,10 +344,10 @@ static void test_cancel_and_resume(void)
 static void test_bad_parameters(void)
 {
     const icoac_config_t good_cfg = test_default_config();
-    const icoac_sim_plant_t good_plant = default_plant();
+    const icoac_sim_model_t good_model = test_cart_pole();
     const icoac_sim_run_t good_run = test_small_run(3, 100);
     icoac_config_t cfg = good_cfg;
-    icoac_sim_plant_t plant = good_plant;
+    icoac_sim_model_t model = good_model;
     icoac_sim_run_t run = good_run;
     icoac_sim_cell_t cells[2], copy[2];
     icoac_prior_t bad_prior = test_prior(0, 0, 0, 0, 1.0);
@@ -362,51 +355,51 @@ static void test_bad_parameters(void)
     cells[1] = make_cell(-0.1, -0.01, 2u);
     memcpy(copy, cells, sizeof cells);
 
-    plant.dt = 0.0;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &cells[0], NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL));
-    plant = good_plant;
-    plant.integrator = 7;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL));
-    plant = good_plant;
+    model.dt = 0.0;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_cell(&cfg, &model, &run, NULL, &cells[0], NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
+    model = good_model;
+    model.integrator = 7;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
+    model = good_model;
 
     run.max_trials = 0;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &cells[0], NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL));
-    plant.dt = 1e-310; /* subnormal: flushed to 0 by the workers, the plant would never move */
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL));
-    plant = good_plant;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_cell(&cfg, &model, &run, NULL, &cells[0], NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
+    model.dt = 1e-310; /* subnormal: flushed to 0 by the workers, the plant would never move */
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
+    model = good_model;
     run = good_run;
     run.init_velocity_noise = -1.0;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
     run = good_run;
 
     cfg.policy.gain = (icoac_real_t)NAN;
-    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_GAIN, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &cells[0], NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_GAIN, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_GAIN, icoac_sim_run_cell(&cfg, &model, &run, NULL, &cells[0], NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_GAIN, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
     cfg = good_cfg;
 
     bad_prior.cov[0][1] = (icoac_real_t)0.5; /* not symmetric */
-    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_PRIOR, icoac_sim_run_grid(&cfg, &plant, &run, &bad_prior, cells, 2, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_ERR_BAD_PRIOR, icoac_sim_run_grid(&cfg, &model, &run, &bad_prior, cells, 2, 1, NULL, NULL));
 
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, &plant, &run, NULL, NULL, 2, 1, NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 0, 1, NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, -1, NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell(&cfg, &plant, NULL, NULL, &cells[0], NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell(&cfg, &plant, &run, NULL, NULL, NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell(NULL, &plant, &run, NULL, &cells[0], NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, &model, &run, NULL, NULL, 2, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 0, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, -1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell(&cfg, &model, NULL, NULL, &cells[0], NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell(&cfg, &model, &run, NULL, NULL, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell(NULL, &model, &run, NULL, &cells[0], NULL, NULL));
     /* the rejected calls left the cells untouched */
     TEST_ASSERT_EQUAL_MEMORY(copy, cells, sizeof cells);
     cells[1].x0 = (double)NAN;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &cells[1], NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, &plant, &run, NULL, cells, 2, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell(&cfg, &model, &run, NULL, &cells[1], NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_PENDING, cells[0].outcome);
 }
 
 static void test_trajectory_recorder(void)
 {
     icoac_config_t cfg = test_default_config();
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     const icoac_prior_t prior = test_prior(0.075, 0.049, 0.318, 0.085, 1.0);
     enum { MAX = 300 };
     static double states[(MAX + 1) * 4], forces[MAX], states2[(MAX + 1) * 4], forces2[MAX];
@@ -414,7 +407,7 @@ static void test_trajectory_recorder(void)
     int i;
     cfg.ico.rate = 0; /* fixed w: the recorded force can be recomputed */
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                          icoac_sim_trajectory(&cfg, &plant, &prior, -0.5, DEG(-4.0), 1e-4, 9u, MAX, states, forces, &n));
+                          icoac_sim_trajectory(&cfg, &model, &prior, -0.5, DEG(-4.0), 1e-4, 9u, MAX, states, forces, &n));
     TEST_ASSERT_TRUE(n >= 1 && n <= MAX);
     /* start state: (x0, small v, theta0, small v) */
     TEST_ASSERT_TRUE(states[0] == -0.5);
@@ -426,7 +419,7 @@ static void test_trajectory_recorder(void)
         const double *cur = states + 4 * k;
         memcpy(s, cur, sizeof s);
         /* each recorded state is one plant step from the previous under the recorded force */
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_step(&plant, s, forces[k]));
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, test_cart_pole_step(&model, s, forces[k]));
         TEST_ASSERT_EQUAL_MEMORY(states + 4 * (k + 1), s, sizeof s);
         /* and the force is G w^T x~ + U (1 N) of the previous state */
         for (i = 0; i < 4; ++i) {
@@ -439,19 +432,19 @@ static void test_trajectory_recorder(void)
         }
         assert_close(forces[k], 10.0 * z + u, 1e-4);
         if (k + 1 < n) {
-            TEST_ASSERT_EQUAL_INT(0, icoac_sim_failed(&plant, states + 4 * (k + 1)));
+            TEST_ASSERT_EQUAL_INT(0, test_cart_pole_failed(&model, states + 4 * (k + 1)));
         }
     }
     if (n < MAX) {
-        TEST_ASSERT_EQUAL_INT(1, icoac_sim_failed(&plant, states + 4 * n));
+        TEST_ASSERT_EQUAL_INT(1, test_cart_pole_failed(&model, states + 4 * n));
     }
     /* same seed: identical; other seed: other initial velocities */
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                          icoac_sim_trajectory(&cfg, &plant, &prior, -0.5, DEG(-4.0), 1e-4, 9u, MAX, states2, forces2, &n2));
+                          icoac_sim_trajectory(&cfg, &model, &prior, -0.5, DEG(-4.0), 1e-4, 9u, MAX, states2, forces2, &n2));
     TEST_ASSERT_EQUAL_INT64(n, n2);
     TEST_ASSERT_EQUAL_MEMORY(states, states2, sizeof(double) * 4 * (size_t)(n + 1));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                          icoac_sim_trajectory(&cfg, &plant, &prior, -0.5, DEG(-4.0), 1e-4, 10u, MAX, states2, forces2, &n2));
+                          icoac_sim_trajectory(&cfg, &model, &prior, -0.5, DEG(-4.0), 1e-4, 10u, MAX, states2, forces2, &n2));
     TEST_ASSERT_TRUE(states2[1] != states[1] && states2[3] != states[3]);
     TEST_ASSERT_TRUE(states2[0] == states[0] && states2[2] == states[2]);
     TEST_ASSERT_TRUE(fabs(states2[1]) <= 1e-4 && fabs(states2[3]) <= 1e-4);
@@ -460,40 +453,40 @@ static void test_trajectory_recorder(void)
 static void test_trajectory_falls(void)
 {
     const icoac_config_t cfg = test_default_config();
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     enum { MAX = 500 };
     static double states[(MAX + 1) * 4], forces[MAX];
     int64_t n = -1;
     /* w = 0: only the 1 N reflex, which cannot hold 11.9 deg */
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                          icoac_sim_trajectory(&cfg, &plant, NULL, 0.0, DEG(11.9), 0.0, 1u, MAX, states, forces, &n));
+                          icoac_sim_trajectory(&cfg, &model, NULL, 0.0, DEG(11.9), 0.0, 1u, MAX, states, forces, &n));
     TEST_ASSERT_TRUE(n >= 1 && n < MAX);
     TEST_ASSERT_TRUE(states[1] == 0.0 && states[3] == 0.0); /* zero noise: zero velocities */
-    TEST_ASSERT_EQUAL_INT(1, icoac_sim_failed(&plant, states + 4 * n));
+    TEST_ASSERT_EQUAL_INT(1, test_cart_pole_failed(&model, states + 4 * n));
     TEST_ASSERT_TRUE(states[4 * n + 2] > DEG(12.0));
     assert_close(forces[0], 1.0, 0.0); /* reflex only */
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT,
-                          icoac_sim_trajectory(&cfg, &plant, NULL, 0.0, 0.0, 0.0, 1u, 0, states, forces, &n));
+                          icoac_sim_trajectory(&cfg, &model, NULL, 0.0, 0.0, 0.0, 1u, 0, states, forces, &n));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT,
-                          icoac_sim_trajectory(&cfg, &plant, NULL, 0.0, 0.0, 0.0, 1u, MAX, NULL, forces, &n));
+                          icoac_sim_trajectory(&cfg, &model, NULL, 0.0, 0.0, 0.0, 1u, MAX, NULL, forces, &n));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT,
-                          icoac_sim_trajectory(&cfg, &plant, NULL, 0.0, 0.0, -1.0, 1u, MAX, states, forces, &n));
+                          icoac_sim_trajectory(&cfg, &model, NULL, 0.0, 0.0, -1.0, 1u, MAX, states, forces, &n));
 }
 
 /* The engine may flush subnormals on its threads, but restores the caller's FPU mode. */
 static void test_fpu_mode_restored(void)
 {
     const icoac_config_t cfg = test_default_config();
-    const icoac_sim_plant_t plant = default_plant();
+    const icoac_sim_model_t model = test_cart_pole();
     const icoac_sim_run_t run = test_small_run(2, 50);
     icoac_sim_cell_t c = make_cell(0.0, 0.0, 5u);
     double states[(50 + 1) * 4], forces[50];
     int64_t n;
     volatile double tiny = 1e-300, big = 1e10;
     TEST_ASSERT_TRUE(tiny / big > 0.0); /* subnormal, not flushed */
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &c, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &model, &run, NULL, &c, NULL, NULL));
     TEST_ASSERT_TRUE(tiny / big > 0.0);
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_trajectory(&cfg, &plant, NULL, 0.0, 0.0, 1e-4, 1u, 50, states, forces, &n));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_trajectory(&cfg, &model, NULL, 0.0, 0.0, 1e-4, 1u, 50, states, forces, &n));
     TEST_ASSERT_TRUE(tiny / big > 0.0);
 }
 

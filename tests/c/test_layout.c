@@ -17,7 +17,7 @@ typedef struct {
 static const type_size_t types[] = {
     {"icoac_config_t", sizeof(icoac_config_t)},       {"icoac_prior_t", sizeof(icoac_prior_t)},
     {"icoac_counters_t", sizeof(icoac_counters_t)},   {"icoac_input_t", sizeof(icoac_input_t)},
-    {"icoac_output_t", sizeof(icoac_output_t)},       {"icoac_sim_plant_t", sizeof(icoac_sim_plant_t)},
+    {"icoac_output_t", sizeof(icoac_output_t)},
     {"icoac_sim_run_t", sizeof(icoac_sim_run_t)},     {"icoac_sim_cell_t", sizeof(icoac_sim_cell_t)},
     {"icoac_sim_axis_t", sizeof(icoac_sim_axis_t)},   {"icoac_sim_param_t", sizeof(icoac_sim_param_t)},
     {"icoac_sim_sweep_t", sizeof(icoac_sim_sweep_t)}, {"icoac_sim_plant_desc_t", sizeof(icoac_sim_plant_desc_t)},
@@ -91,7 +91,7 @@ static void test_constants_table(void)
     TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == ICOAC_ABI_VERSION);
     TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == 9);
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == ICOAC_SIM_ABI_VERSION);
-    TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == 4);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == 5);
     TEST_ASSERT_TRUE(constant("ICOAC_CARTPOLE_INPUTS") == ICOAC_CARTPOLE_INPUTS);
     TEST_ASSERT_TRUE(constant("ICOAC_CARTPOLE_CRITIC_UNITS") == ICOAC_CARTPOLE_CRITIC_UNITS);
     TEST_ASSERT_TRUE(constant("ICOAC_STATE_SIZE") == ICOAC_STATE_SIZE);
@@ -117,11 +117,6 @@ static void test_constants_table(void)
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_CANCELLED") == ICOAC_SIM_CANCELLED);
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_ERROR") == ICOAC_SIM_ERROR);
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_PROGRESS_LEN") == ICOAC_SIM_PROGRESS_LEN);
-    TEST_ASSERT_TRUE(constant("ICOAC_SIM_GRID_CELLS") == ICOAC_SIM_GRID_CELLS);
-    TEST_ASSERT_TRUE(constant("ICOAC_SIM_GRID_CELLS") == 1225);
-    TEST_ASSERT_TRUE(constant("ICOAC_SIM_GRID_X_FIRST") == ICOAC_SIM_GRID_X_FIRST);
-    TEST_ASSERT_TRUE(constant("ICOAC_SIM_GRID_X_STEP") == ICOAC_SIM_GRID_X_STEP);
-    TEST_ASSERT_TRUE(constant("ICOAC_SIM_GRID_THETA_FIRST_DEG") == ICOAC_SIM_GRID_THETA_FIRST_DEG);
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_PI") == ICOAC_SIM_PI);
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_MAX_STATE") == ICOAC_SIM_MAX_STATE);
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_MAX_PARAMS") == ICOAC_SIM_MAX_PARAMS);
@@ -242,10 +237,10 @@ static void test_fields_spot_checks(void)
     SPOT(icoac_input_t, flags);
     SPOT(icoac_output_t, weight_norm);
     SPOT(icoac_output_t, status);
-    SPOT(icoac_sim_plant_t, integrator);
     SPOT(icoac_sim_run_t, init_velocity_noise);
     SPOT(icoac_sim_cell_t, cov);
     SPOT(icoac_sim_param_t, max);
+    SPOT(icoac_sim_param_t, doc);
     SPOT(icoac_sim_sweep_t, degrees);
     SPOT(icoac_sim_plant_desc_t, observed);
     SPOT(icoac_sim_plant_desc_t, energy);

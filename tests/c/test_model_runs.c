@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The benchmark on registry plants (icoac_sim_run_cell_model, icoac_sim_run_grid_model,
- * icoac_sim_trajectory_model): the cart-pole's model runs bit for bit as its plant struct, a
- * Furuta pendulum grid runs its own dynamics and failure test, the 6-state double pendulum runs
- * with a task of 6 inputs, and a task of another size is refused. */
+/* The benchmark on registry plants other than the cart-pole (icoac_sim_run_cell,
+ * icoac_sim_run_grid, icoac_sim_trajectory; the cart-pole's runs are in test_engine.c): a Furuta
+ * pendulum grid runs its own dynamics and failure test, the 6-state double pendulum runs with a
+ * task of 6 inputs, and a task of another size is refused. */
 #include "test_common.h"
 
 #include "test_sim_common.h"
@@ -12,53 +12,6 @@ static icoac_sim_model_t model_of(int32_t index)
     icoac_sim_model_t model;
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_default(&model, index));
     return model;
-}
-
-/* ICO and RL cells, a grid on two threads and a trajectory, through the plant struct and through
- * its model: the same bytes. */
-static void test_cart_pole_model_bit_for_bit(void)
-{
-    static icoac_sim_cell_t by_plant[12], by_model[12];
-    const icoac_sim_run_t run = test_small_run(40, 400);
-    icoac_sim_plant_t plant;
-    icoac_sim_model_t model;
-    double states_p[101 * 4], states_m[101 * 4], forces_p[100], forces_m[100];
-    int64_t steps_p = -1, steps_m = -2;
-    int mode;
-    icoac_sim_plant_default(&plant);
-    plant.integrator = ICOAC_SIM_RK4;
-    plant.pole_mass = 0.2;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_from_plant(&plant, &model));
-    for (mode = 0; mode < 2; ++mode) {
-        icoac_config_t cfg = test_default_config();
-        int i;
-        cfg.mode = mode == 0 ? ICOAC_MODE_ICO : ICOAC_MODE_RL;
-        for (i = 0; i < 12; ++i) {
-            memset(&by_plant[i], 0, sizeof by_plant[i]);
-            by_plant[i].x0 = -1.1 + 0.2 * i;
-            by_plant[i].theta0 = 0.01 * (i - 6);
-            by_plant[i].seed = 1000u + (uint64_t)i;
-        }
-        memcpy(by_model, by_plant, sizeof by_model);
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &plant, &run, NULL, by_plant, 12, 2, NULL, NULL));
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                              icoac_sim_run_grid_model(&cfg, &model, &run, NULL, by_model, 12, 2, NULL, NULL));
-        TEST_ASSERT_EQUAL_MEMORY(by_model, by_plant, sizeof by_model);
-        by_plant[0].outcome = by_model[0].outcome = ICOAC_SIM_PENDING;
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_cell(&cfg, &plant, &run, NULL, &by_plant[0], NULL, NULL));
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                              icoac_sim_run_cell_model(&cfg, &model, &run, NULL, &by_model[0], NULL, NULL));
-        TEST_ASSERT_EQUAL_MEMORY(&by_model[0], &by_plant[0], sizeof by_model[0]);
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                              icoac_sim_trajectory(&cfg, &plant, NULL, 0.3, 0.05, 0.01, 9u, 100, states_p, forces_p,
-                                                   &steps_p));
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                              icoac_sim_trajectory_model(&cfg, &model, NULL, 0.3, 0.05, 0.01, 9u, 100, states_m,
-                                                         forces_m, &steps_m));
-        TEST_ASSERT_EQUAL_INT64(steps_m, steps_p);
-        TEST_ASSERT_EQUAL_MEMORY(states_m, states_p, (size_t)(steps_p + 1) * 4 * sizeof states_p[0]);
-        TEST_ASSERT_EQUAL_MEMORY(forces_m, forces_p, (size_t)steps_p * sizeof forces_p[0]);
-    }
 }
 
 /* A Furuta grid with the controller's zero policy and no learning: every trial follows the
@@ -81,8 +34,8 @@ static void test_furuta_grid(void)
     cfg.policy.reflex_mode = ICOAC_REFLEX_GAIN; /* F = G (z + U) = 0 */
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_grid(furuta, cells, n, 3u));
     memcpy(again, cells, sizeof cells);
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid_model(&cfg, &model, &run, NULL, cells, n, 2, NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid_model(&cfg, &model, &run, NULL, again, n, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, n, 2, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &model, &run, NULL, again, n, 1, NULL, NULL));
     TEST_ASSERT_EQUAL_MEMORY(again, cells, (size_t)n * sizeof cells[0]);
     for (p = 0; p < 3; ++p) {
         const icoac_sim_cell_t *cell = &cells[picks[p]];
@@ -121,7 +74,7 @@ static void test_furuta_trajectory(void)
     int64_t steps = -1;
     int64_t k;
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                          icoac_sim_trajectory_model(&cfg, &model, NULL, 0.4, -0.05, 0.0, 1u, 50, states, forces, &steps));
+                          icoac_sim_trajectory(&cfg, &model, NULL, 0.4, -0.05, 0.0, 1u, 50, states, forces, &steps));
     TEST_ASSERT_TRUE(steps >= 1 && steps <= 50);
     TEST_ASSERT_TRUE(states[0] == 0.4 && states[1] == 0.0 && states[2] == -0.05 && states[3] == 0.0);
     for (k = 0; k < steps; ++k) {
@@ -153,7 +106,7 @@ static void test_double_pendulum_six_inputs(void)
     }
     TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&cfg));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                          icoac_sim_trajectory_model(&cfg, &model, NULL, 0.2, 0.1, 0.0, 3u, 30, states, forces, &steps));
+                          icoac_sim_trajectory(&cfg, &model, NULL, 0.2, 0.1, 0.0, 3u, 30, states, forces, &steps));
     TEST_ASSERT_TRUE(steps >= 1 && steps <= 30);
     TEST_ASSERT_TRUE(states[0] == 0.2 && states[2] == 0.1 && states[4] == 0.0);
     for (k = 0; k < steps; ++k) {
@@ -167,7 +120,7 @@ static void test_double_pendulum_six_inputs(void)
     cells[1].theta0 = -0.05;
     cells[0].seed = 1u;
     cells[1].seed = 2u;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid_model(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
     for (i = 0; i < 2; ++i) {
         TEST_ASSERT_EQUAL_INT(ICOAC_OK, cells[i].status);
         TEST_ASSERT_TRUE(cells[i].outcome == ICOAC_SIM_SUCCESS || cells[i].outcome == ICOAC_SIM_FAILED);
@@ -189,20 +142,20 @@ static void test_refused(void)
     cells[1].x0 = 0.1;
     memcpy(before, cells, sizeof cells);
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT,
-                          icoac_sim_run_grid_model(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_cell_model(&cfg, &model, &run, NULL, cells, NULL, NULL));
+                          icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_cell(&cfg, &model, &run, NULL, cells, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT,
-                          icoac_sim_trajectory_model(&cfg, &model, NULL, 0.0, 0.0, 0.0, 1u, 1, states, forces, &steps));
+                          icoac_sim_trajectory(&cfg, &model, NULL, 0.0, 0.0, 0.0, 1u, 1, states, forces, &steps));
     model = model_of(icoac_sim_plant_find("furuta"));
     model.param[0] = -1.0;
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT,
-                          icoac_sim_run_grid_model(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
+                          icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
     model.param[0] = 9.81;
     model.dt = 0.0;
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_cell_model(&cfg, &model, &run, NULL, cells, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_run_cell(&cfg, &model, &run, NULL, cells, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT,
-                          icoac_sim_run_grid_model(&cfg, NULL, &run, NULL, cells, 2, 1, NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell_model(NULL, &model, &run, NULL, cells, NULL, NULL));
+                          icoac_sim_run_grid(&cfg, NULL, &run, NULL, cells, 2, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell(NULL, &model, &run, NULL, cells, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, NULL, &run, NULL, cells, 2, 1, NULL, NULL));
     TEST_ASSERT_EQUAL_MEMORY(before, cells, sizeof cells);
 }
@@ -214,16 +167,15 @@ static void test_grid_null_run(void)
 {
     icoac_config_t cfg = test_default_config();
     const icoac_sim_model_t model = model_of(icoac_sim_plant_find("furuta"));
-    icoac_sim_plant_t plant;
+    const icoac_sim_model_t cart_pole = model_of(ICOAC_SIM_CART_POLE);
     icoac_sim_cell_t cells[2], before[2];
-    icoac_sim_plant_default(&plant);
     memset(cells, 0, sizeof cells);
     cells[1].x0 = 0.1;
     memcpy(before, cells, sizeof cells);
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT,
-                          icoac_sim_run_grid_model(&cfg, &model, NULL, NULL, cells, 2, 1, NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, &plant, NULL, NULL, cells, 2, 2, NULL, NULL));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell_model(&cfg, &model, NULL, NULL, cells, NULL, NULL));
+                          icoac_sim_run_grid(&cfg, &model, NULL, NULL, cells, 2, 1, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_grid(&cfg, &cart_pole, NULL, NULL, cells, 2, 2, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_cell(&cfg, &model, NULL, NULL, cells, NULL, NULL));
     TEST_ASSERT_EQUAL_MEMORY(before, cells, sizeof cells);
 }
 
@@ -233,7 +185,6 @@ void tearDown(void) {}
 int main(void)
 {
     UNITY_BEGIN();
-    RUN_TEST(test_cart_pole_model_bit_for_bit);
     RUN_TEST(test_furuta_grid);
     RUN_TEST(test_furuta_trajectory);
     RUN_TEST(test_double_pendulum_six_inputs);

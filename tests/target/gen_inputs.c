@@ -34,10 +34,11 @@ static int emit(const char *name, const char *upper, int32_t mode, uint64_t seed
 {
     icoac_config_t cfg;
     icoac_state_t st;
-    icoac_sim_plant_t plant;
+    icoac_sim_model_t model;
     icoac_input_t in;
     icoac_output_t out;
-    double s[ICOAC_CARTPOLE_INPUTS];
+    double s[ICOAC_SIM_MAX_STATE] = {0};
+    int32_t failed = 0;
     unsigned flags = 2u; /* reset before the first tick */
     int i, k;
     int trials = 0;
@@ -45,7 +46,7 @@ static int emit(const char *name, const char *upper, int32_t mode, uint64_t seed
     icoac_config_default(&cfg);
     cfg.mode = mode;
     cfg.search.batch = SEARCH_BATCH; /* used by ICOAC_MODE_SEARCH only */
-    icoac_sim_plant_default(&plant);
+    (void)icoac_sim_model_default(&model, ICOAC_SIM_CART_POLE);
     if (icoac_init(&cfg, &st, NULL, seed) != ICOAC_OK) {
         return 1;
     }
@@ -75,8 +76,9 @@ static int emit(const char *name, const char *upper, int32_t mode, uint64_t seed
             s[3] = uniform(-1e-4, 1e-4);
             flags = 2u;
         } else {
-            icoac_sim_plant_step(&plant, s, (double)out.force);
-            flags = icoac_sim_failed(&plant, s) == 1 ? 1u : 0u;
+            (void)icoac_sim_model_step(&model, s, (double)out.force);
+            (void)icoac_sim_model_failed(&model, s, &failed);
+            flags = failed == 1 ? 1u : 0u;
         }
     }
     printf("};\n\n");

@@ -1,7 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* icoac_sim: plants (the cart-pole and a registry of others), benchmark trial loop and grid
- * runner for the icoac controller. Host-only C11; exported as a shared library for the Python
- * harness. */
+/* icoac_sim: a registry of plants, the benchmark trial loop and the grid runner for the icoac
+ * controller. Host-only C11; exported as a shared library for the Python harness. */
 #ifndef ICOAC_SIM_H
 #define ICOAC_SIM_H
 
@@ -13,7 +12,7 @@
 extern "C" {
 #endif
 
-#define ICOAC_SIM_ABI_VERSION 4
+#define ICOAC_SIM_ABI_VERSION 5
 
 /* Status of sim functions: values below 100 are icoac_status_t, passed through. */
 typedef enum {
@@ -39,26 +38,13 @@ typedef enum {
 
 /* Valid plant and run ranges (closed): no subnormal or absurd value reaches the integrator,
  * whose worker threads flush subnormals to zero. */
-#define ICOAC_SIM_PHYS_MIN 1.0e-6   /* gravity (m/s^2), masses (kg), half_length, x_limit (m) */
+#define ICOAC_SIM_PHYS_MIN 1.0e-6   /* the shipped plants' physical parameters: gravity, masses, lengths */
 #define ICOAC_SIM_PHYS_MAX 1.0e6
 #define ICOAC_SIM_DT_MIN 1.0e-6     /* dt (s) */
 #define ICOAC_SIM_DT_MAX 1.0
-#define ICOAC_SIM_THETA_LIMIT_MAX ICOAC_SIM_PI /* theta_limit (rad), >= 1e-6 */
+#define ICOAC_SIM_THETA_LIMIT_MAX ICOAC_SIM_PI /* an angle limit (rad), >= 1e-6 */
 #define ICOAC_SIM_NOISE_MIN 1.0e-12 /* init_velocity_noise: 0 or in [1e-12, 1e3] (m/s, rad/s) */
 #define ICOAC_SIM_NOISE_MAX 1.0e3
-
-/* Frictionless cart-pole (Barto, Sutton & Anderson 1983 without friction). */
-typedef struct {
-    double gravity;     /* m/s^2, [1e-6, 1e6]. 9.8 */
-    double cart_mass;   /* kg, [1e-6, 1e6]. 1.0 */
-    double pole_mass;   /* kg, [1e-6, 1e6]. 0.1 */
-    double half_length; /* m, [1e-6, 1e6]. 0.5 */
-    double dt;          /* s, [1e-6, 1]. 0.01 */
-    double x_limit;     /* m, [1e-6, 1e6]: failure when |x| > x_limit. 2.4 */
-    double theta_limit; /* rad, [1e-6, pi]: failure when |theta| > theta_limit. 12 deg */
-    int32_t integrator; /* icoac_sim_integrator_t */
-    int32_t reserved;   /* 0 */
-} icoac_sim_plant_t;
 
 /* Benchmark protocol of one cell (method.md): one row per field, as the controller's
  * (icoac_params.h, the same columns); its members, default, check and exported rows come from it. */
@@ -83,9 +69,9 @@ typedef enum {
     ICOAC_SIM_ERROR = 3    /* the controller reported an error (e.g. ICOAC_ERR_NUMERIC); see status */
 } icoac_sim_outcome_t;
 
-/* One cell: the caller fills x0, theta0, seed; the run fills the rest. For a registry plant
- * (icoac_sim_plant_grid), x0 is the start of the grid's column component and theta0 that of its
- * row component, in the plant's units. */
+/* One cell: the caller fills x0, theta0, seed; the run fills the rest. x0 is the start of the
+ * plant grid's column component and theta0 that of its row component, in the plant's units
+ * (icoac_sim_plant_grid; the cart-pole's x and theta). */
 typedef struct {
     double x0;                  /* m (the cart-pole's x; a plant's column component) */
     double theta0;              /* rad (the cart-pole's theta; a plant's row component) */
@@ -106,39 +92,13 @@ typedef struct {
 #define ICOAC_SIM_PROGRESS_STEPS 2  /* plant steps finished (updated per trial) */
 #define ICOAC_SIM_PROGRESS_LEN 3
 
-/* Paper grid: 25 angles (-12..12 deg) x 49 positions (-2.4..2.4 m). */
-#define ICOAC_SIM_GRID_THETAS 25
-#define ICOAC_SIM_GRID_XS 49
-#define ICOAC_SIM_GRID_CELLS (ICOAC_SIM_GRID_THETAS * ICOAC_SIM_GRID_XS)
-#define ICOAC_SIM_GRID_THETA_FIRST_DEG (-12) /* row i: theta0 = (-12 + i) deg */
-#define ICOAC_SIM_GRID_X_FIRST (-2.4)        /* column j: x0 = -2.4 + 0.1 j m */
-#define ICOAC_SIM_GRID_X_STEP 0.1
-
 const char *icoac_sim_status_str(int32_t status);
 uint32_t icoac_sim_abi_version(void);
-uint32_t icoac_sim_sizeof_plant(void);
 uint32_t icoac_sim_sizeof_run(void);
 uint32_t icoac_sim_sizeof_cell(void);
 
-void icoac_sim_plant_default(icoac_sim_plant_t *plant);
-int32_t icoac_sim_plant_check(const icoac_sim_plant_t *plant);
 void icoac_sim_run_default(icoac_sim_run_t *run);
 int32_t icoac_sim_run_check(const icoac_sim_run_t *run);
-
-/* Advance state (x, x_dot, theta, theta_dot) by one dt under force (N). Checked as
- * icoac_sim_model_step checks, the state left as it was on an error: ICOAC_SIM_ERR_BAD_ARGUMENT
- * (NULL), ICOAC_SIM_ERR_BAD_PLANT (a plant icoac_sim_plant_check refuses: a parameter, dt or
- * integrator), ICOAC_SIM_ERR_NONFINITE (state or force not finite, or made so by the step). */
-int32_t icoac_sim_plant_step(const icoac_sim_plant_t *plant, double state[ICOAC_CARTPOLE_INPUTS], double force);
-
-/* 1 when state is outside the strict limits (or not finite), else 0; a status for bad arguments:
- * ICOAC_SIM_ERR_BAD_ARGUMENT (NULL), ICOAC_SIM_ERR_BAD_PLANT (a plant icoac_sim_plant_check
- * refuses). */
-int32_t icoac_sim_failed(const icoac_sim_plant_t *plant, const double state[ICOAC_CARTPOLE_INPUTS]);
-
-/* Fill the paper's grid, row-major over theta (row i: theta0 = (-12 + i) deg) then x
- * (column j: x0 = -2.4 + 0.1 j m); cell seeds derive from seed; outcomes set PENDING. */
-int32_t icoac_sim_paper_grid(icoac_sim_cell_t *cells, int64_t n_cells, uint64_t seed);
 
 /* Constants and struct layouts for bindings, so that C is their single source. */
 typedef struct {
@@ -179,32 +139,9 @@ const icoac_sim_constant_t *icoac_sim_constants(int32_t *count);
 const icoac_sim_field_t *icoac_sim_fields(int32_t *count);
 const icoac_sim_param_row_t *icoac_sim_param_table(int32_t *count);
 
-/* One independent run of a cell from a fresh controller (prior NULL: icoac_init default). */
-int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                           icoac_sim_cell_t *cell, const volatile int32_t *cancel,
-                           volatile int64_t *progress);
-
-/* Run every PENDING cell on n_threads threads (0: all cores). Finished cells are final,
- * so a cancelled grid resumes by calling again. cancel and progress may be NULL;
- * progress has ICOAC_SIM_PROGRESS_LEN counters, updated atomically. */
-int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                           icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
-                           const volatile int32_t *cancel, volatile int64_t *progress);
-
-/* One trial from (x0, theta0) with the controller initialised from prior (learning on),
- * recording up to max_steps ticks: states[(max_steps + 1) * 4] (the start included),
- * forces[max_steps]. *n_steps receives the ticks run (fewer if the pole fell). */
-int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_plant_t *plant,
-                             const icoac_prior_t *prior, double x0, double theta0,
-                             double init_velocity_noise, uint64_t seed, int64_t max_steps,
-                             double *states, double *forces, int64_t *n_steps);
-
 /* ---- Plant registry (docs/plants.md) -------------------------------------------------------
- * Every plant is a descriptor: its state, parameters, dynamics, failure test and grid of initial
- * conditions. The cart-pole above is the registry's first plant, ICOAC_SIM_CART_POLE; its
- * icoac_sim_plant_t maps onto a model with icoac_sim_model_from_plant. */
+ * Every plant is a descriptor: its state, parameters, dynamics, failure test, grid of initial
+ * conditions and controller task. The cart-pole is the registry's first plant. */
 #define ICOAC_SIM_MAX_STATE 6   /* state components of any plant */
 #define ICOAC_SIM_MAX_PARAMS 16 /* parameters of any plant */
 #define ICOAC_SIM_CART_POLE 0   /* registry index of the cart-pole */
@@ -215,13 +152,16 @@ typedef struct {
     const char *unit; /* "m", "rad/s", "V" */
 } icoac_sim_axis_t;
 
-/* One plant parameter: valid values are 0 or normal numbers in [min, max]. */
+/* One plant parameter: valid values are 0 or normal numbers in [min, max]. What bindings, the
+ * command line and the docs know of it (as of a controller parameter, icoac_params.h). */
 typedef struct {
     const char *name;
     const char *unit;
     double value; /* default */
     double min;
     double max;
+    const char *tier; /* "essential" (the physics) or "advanced" (the failure limits) */
+    const char *doc;  /* one line */
 } icoac_sim_param_t;
 
 /* A swept start coordinate: value i (0 <= i < count) is first + step * i, converted by
@@ -320,8 +260,6 @@ int32_t icoac_sim_model_default(icoac_sim_model_t *model, int32_t index);
 /* ICOAC_SIM_ERR_BAD_PLANT for an unknown plant, a parameter outside its range, a bad dt or
  * integrator, or a nonzero unused parameter. */
 int32_t icoac_sim_model_check(const icoac_sim_model_t *model);
-/* The cart-pole model of a cart-pole plant struct (same dynamics, limits and options). */
-int32_t icoac_sim_model_from_plant(const icoac_sim_plant_t *plant, icoac_sim_model_t *model);
 
 /* State arrays hold ICOAC_SIM_MAX_STATE values, of which the plant's n_state are read/written.
  * Bad input gets a status, the state left as it was: ICOAC_SIM_ERR_BAD_PLANT (model),
@@ -337,33 +275,43 @@ int32_t icoac_sim_model_energy(const icoac_sim_model_t *model, const double stat
                                double *energy);
 
 /* The plant's grid (rows.count * cols.count cells, row-major): theta0 = the row value, x0 = the
- * column value; seeds and outcomes as icoac_sim_paper_grid (the cart-pole's is that grid). */
+ * column value, seed = icoac_mix_seed(seed, cell index), outcome PENDING. The cart-pole's is the
+ * paper's grid: row i is theta0 = (-12 + i) deg, column j is x0 = -2.4 + 0.1 j m. */
 int32_t icoac_sim_plant_grid(int32_t index, icoac_sim_cell_t *cells, int64_t n_cells, uint64_t seed);
 /* Start state of a trial from cell: start[], the swept components from the cell, the drawn ones
- * U(-noise, noise) from rng (for the cart-pole, the trial loop's start). The engine seeds that rng
+ * U(-noise, noise) from rng (the trial loop's start). The engine seeds that rng
  * with icoac_rng_seed(&rng, cell seed, ICOAC_SIM_START_STREAM). */
 #define ICOAC_SIM_START_STREAM 2u
 int32_t icoac_sim_model_start(const icoac_sim_model_t *model, const icoac_sim_cell_t *cell, double noise,
                               icoac_rng_t *rng, double state[ICOAC_SIM_MAX_STATE]);
 
-/* The benchmark on any registry plant: icoac_sim_run_cell, icoac_sim_run_grid and
- * icoac_sim_trajectory with a model in place of the cart-pole struct (those three are these with
- * the model of their plant, bit for bit). Trials start by icoac_sim_model_start; the controller's
- * task reads all the plant's n_state components (task.n_inputs = n_state; the plant observes its
- * state in order), and a task of another size is refused with ICOAC_SIM_ERR_BAD_PLANT. The trajectory's states hold
- * (max_steps + 1) rows of the plant's n_state values. */
-int32_t icoac_sim_run_cell_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
-                                 const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                                 icoac_sim_cell_t *cell, const volatile int32_t *cancel,
-                                 volatile int64_t *progress);
-int32_t icoac_sim_run_grid_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
-                                 const icoac_sim_run_t *run, const icoac_prior_t *prior,
-                                 icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
-                                 const volatile int32_t *cancel, volatile int64_t *progress);
-int32_t icoac_sim_trajectory_model(const icoac_config_t *cfg, const icoac_sim_model_t *model,
-                                   const icoac_prior_t *prior, double x0, double theta0,
-                                   double init_velocity_noise, uint64_t seed, int64_t max_steps,
-                                   double *states, double *forces, int64_t *n_steps);
+/* The benchmark (method.md) on a registry plant. Trials start by icoac_sim_model_start; the
+ * controller's task reads all the plant's n_state components (task.n_inputs = n_state; the plant
+ * observes its state in order), and a task of another size is refused with
+ * ICOAC_SIM_ERR_BAD_PLANT. */
+
+/* One independent run of a cell from a fresh controller (prior NULL: icoac_init default). */
+int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                           icoac_sim_cell_t *cell, const volatile int32_t *cancel,
+                           volatile int64_t *progress);
+
+/* Run every PENDING cell on n_threads threads (0: all cores). Finished cells are final,
+ * so a cancelled grid resumes by calling again. cancel and progress may be NULL;
+ * progress has ICOAC_SIM_PROGRESS_LEN counters, updated atomically. */
+int32_t icoac_sim_run_grid(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                           const icoac_sim_run_t *run, const icoac_prior_t *prior,
+                           icoac_sim_cell_t *cells, int64_t n_cells, int32_t n_threads,
+                           const volatile int32_t *cancel, volatile int64_t *progress);
+
+/* One trial from (x0, theta0) with the controller initialised from prior (learning on),
+ * recording up to max_steps ticks: states holds (max_steps + 1) rows of the plant's n_state
+ * values (the start included), forces max_steps inputs. *n_steps receives the ticks run (fewer
+ * if the plant failed). */
+int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_model_t *model,
+                             const icoac_prior_t *prior, double x0, double theta0,
+                             double init_velocity_noise, uint64_t seed, int64_t max_steps,
+                             double *states, double *forces, int64_t *n_steps);
 
 #ifdef __cplusplus
 }

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Frictionless cart-pole (Barto, Sutton & Anderson 1983, with g = +9.8; method.md, plant): the
- * registry's first plant, and the icoac_sim_plant_t entry points of the trial loop. */
+ * registry's first plant, the paper's. */
 #include <math.h>
 
 #include "icoac_sim/icoac_sim.h"
@@ -46,12 +46,18 @@ static double energy(const double *p, const double *s)
 }
 
 static const icoac_sim_param_t params[N_PARAMS] = {
-    {"gravity", "m/s^2", 9.8, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"cart_mass", "kg", 1.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"pole_mass", "kg", 0.1, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"half_length", "m", 0.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"x_limit", "m", 2.4, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"theta_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX},
+    {"gravity", "m/s^2", 9.8, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
+     "gravitational acceleration"},
+    {"cart_mass", "kg", 1.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
+     "mass of the cart"},
+    {"pole_mass", "kg", 0.1, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
+     "mass of the pole, a uniform rod"},
+    {"half_length", "m", 0.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
+     "half the pole's length (pivot to centre of mass)"},
+    {"x_limit", "m", 2.4, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+     "failure when |x| exceeds it"},
+    {"theta_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX, "advanced",
+     "failure when |theta| exceeds it"},
 };
 
 /* The paper's task: the controller's defaults. */
@@ -67,8 +73,8 @@ const icoac_sim_plant_desc_t sim_cart_pole = {
     N_PARAMS,
     {{"x", "m"}, {"x_dot", "m/s"}, {"theta", "rad"}, {"theta_dot", "rad/s"}},
     params,
-    {2, ICOAC_SIM_GRID_THETAS, ICOAC_SIM_GRID_THETA_FIRST_DEG, 1.0, 1, 0},
-    {0, ICOAC_SIM_GRID_XS, ICOAC_SIM_GRID_X_FIRST, ICOAC_SIM_GRID_X_STEP, 0, 0},
+    {2, 25, -12.0, 1.0, 1, 0}, /* the paper's grid: theta0 = -12, -11, ..., 12 deg */
+    {0, 49, -2.4, 0.1, 0, 0},  /* x0 = -2.4, -2.3, ..., 2.4 m */
     {0.0, 0.0, 0.0, 0.0},
     {0, 1, 0, 1},
     {0, 1, 2, 3},
@@ -78,95 +84,3 @@ const icoac_sim_plant_desc_t sim_cart_pole = {
     energy,
     &task,
 };
-
-/* The icoac_sim_plant_t entry points: the descriptor's defaults, ranges and step on the
- * struct's parameters. */
-void icoac_sim_plant_default(icoac_sim_plant_t *plant)
-{
-    if (plant == 0) {
-        return;
-    }
-    plant->gravity = params[GRAVITY].value;
-    plant->cart_mass = params[CART_MASS].value;
-    plant->pole_mass = params[POLE_MASS].value;
-    plant->half_length = params[HALF_LENGTH].value;
-    plant->dt = SIM_DT_DEFAULT;
-    plant->x_limit = params[X_LIMIT].value;
-    plant->theta_limit = params[THETA_LIMIT].value;
-    plant->integrator = ICOAC_SIM_EULER;
-    plant->reserved = 0;
-}
-
-int32_t icoac_sim_plant_check(const icoac_sim_plant_t *plant)
-{
-    icoac_sim_model_t model;
-    if (plant == 0) {
-        return ICOAC_SIM_ERR_BAD_ARGUMENT;
-    }
-    (void)icoac_sim_model_from_plant(plant, &model);
-    return icoac_sim_model_check(&model);
-}
-
-/* The plant's model and the first 4 entries of a model state (the rest 0): the model API checks
- * the plant's parameters, dt, integrator and state as it does for every plant. */
-static void as_model(const icoac_sim_plant_t *plant, const double state[4], icoac_sim_model_t *model,
-                     double s[ICOAC_SIM_MAX_STATE])
-{
-    int i;
-    (void)icoac_sim_model_from_plant(plant, model);
-    for (i = 0; i < ICOAC_SIM_MAX_STATE; ++i) {
-        s[i] = i < 4 ? state[i] : 0.0;
-    }
-}
-
-int32_t icoac_sim_plant_step(const icoac_sim_plant_t *plant, double state[4], double force)
-{
-    icoac_sim_model_t model;
-    double s[ICOAC_SIM_MAX_STATE];
-    int32_t status;
-    int i;
-    if (plant == 0 || state == 0) {
-        return ICOAC_SIM_ERR_BAD_ARGUMENT;
-    }
-    as_model(plant, state, &model, s);
-    status = icoac_sim_model_step(&model, s, force);
-    if (status == ICOAC_SIM_OK) {
-        for (i = 0; i < 4; ++i) {
-            state[i] = s[i];
-        }
-    }
-    return status;
-}
-
-int32_t icoac_sim_failed(const icoac_sim_plant_t *plant, const double state[4])
-{
-    icoac_sim_model_t model;
-    double s[ICOAC_SIM_MAX_STATE];
-    int32_t failed = 1;
-    int32_t status;
-    if (plant == 0 || state == 0) {
-        return ICOAC_SIM_ERR_BAD_ARGUMENT;
-    }
-    as_model(plant, state, &model, s);
-    status = icoac_sim_model_failed(&model, s, &failed);
-    return status == ICOAC_SIM_OK ? failed : status;
-}
-
-int32_t icoac_sim_model_from_plant(const icoac_sim_plant_t *plant, icoac_sim_model_t *model)
-{
-    int i;
-    if (plant == 0 || model == 0) {
-        return ICOAC_SIM_ERR_BAD_ARGUMENT;
-    }
-    model->plant = ICOAC_SIM_CART_POLE;
-    model->integrator = plant->integrator;
-    model->dt = plant->dt;
-    for (i = 0; i < ICOAC_SIM_MAX_PARAMS; ++i) model->param[i] = 0.0;
-    model->param[GRAVITY] = plant->gravity;
-    model->param[CART_MASS] = plant->cart_mass;
-    model->param[POLE_MASS] = plant->pole_mass;
-    model->param[HALF_LENGTH] = plant->half_length;
-    model->param[X_LIMIT] = plant->x_limit;
-    model->param[THETA_LIMIT] = plant->theta_limit;
-    return ICOAC_SIM_OK;
-}

@@ -77,14 +77,22 @@ static double energy(const double *p, const double *s)
 }
 
 static const icoac_sim_param_t params[N_PARAMS] = {
-    {"gravity", "m/s^2", 9.8, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"cart_mass", "kg", 1.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"mass1", "kg", 0.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"mass2", "kg", 0.75, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"length1", "m", 0.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"length2", "m", 0.75, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"x_limit", "m", 2.4, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX},
-    {"angle_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX},
+    {"gravity", "m/s^2", 9.8, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
+     "gravitational acceleration"},
+    {"cart_mass", "kg", 1.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
+     "mass of the cart"},
+    {"mass1", "kg", 0.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
+     "mass of the lower link, a uniform rod"},
+    {"mass2", "kg", 0.75, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
+     "mass of the upper link, a uniform rod"},
+    {"length1", "m", 0.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
+     "length of the lower link"},
+    {"length2", "m", 0.75, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
+     "length of the upper link"},
+    {"x_limit", "m", 2.4, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+     "failure when |x| exceeds it"},
+    {"angle_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX, "advanced",
+     "failure when |theta1| or |theta2| exceeds it"},
 };
 
 /* Its task, chosen by its sweep (docs/sweeps-double_cart_pole.md): six inputs scaled to the track
