@@ -60,7 +60,7 @@ def test_state_is_opaque_aligned_storage():
 
 def test_abi_versions():
     assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 9
-    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 4
+    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 5
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
     # the host build's defaults: the dense critic kernel, two lanes per engine thread
@@ -146,7 +146,7 @@ def test_constants_from_c():
     assert B.OUTCOME_NAMES == {c["ICOAC_SIM_PENDING"]: "pending", c["ICOAC_SIM_SUCCESS"]: "success",
                                c["ICOAC_SIM_FAILED"]: "failed", c["ICOAC_SIM_ERROR"]: "error"}
     assert B.CONFIG_STATUSES == {v for k, v in c.items() if k.startswith(("ICOAC_ERR_BAD_", "ICOAC_SIM_ERR_BAD_"))}
-    assert geometry.CELLS == geometry.THETAS * geometry.XS == c["ICOAC_SIM_GRID_CELLS"]
+    assert geometry.CELLS == geometry.THETAS * geometry.XS == 1225
     assert geometry.N_INTERIOR == (geometry.THETAS - 2) * (geometry.XS - 2)
     assert B.PI == math.pi
     with pytest.raises(LibraryError, match="ICOAC_NO_SUCH"):
@@ -288,15 +288,15 @@ def test_overrides_by_name():
 
 
 def test_paper_grid_layout():
-    from icoac.core.grid import paper_grid
-    cells = paper_grid(0)
+    from icoac.core.grid import plant_grid
+    cells = plant_grid("cart_pole", 0)
     assert cells.size == geometry.CELLS == 1225
     assert np.all(cells["outcome"] == B.PENDING)
     assert cells["x0"][0] == pytest.approx(-2.4) and cells["x0"][48] == pytest.approx(2.4)
     assert np.degrees(cells["theta0"][0]) == pytest.approx(-12) and np.degrees(cells["theta0"][-1]) == pytest.approx(12)
     assert np.degrees(cells["theta0"][49]) == pytest.approx(-11)
     assert len(set(cells["seed"].tolist())) == 1225
-    assert not np.array_equal(paper_grid(1)["seed"], cells["seed"])
+    assert not np.array_equal(plant_grid("cart_pole", 1)["seed"], cells["seed"])
     rows, cols = geometry.grid_index(cells)
     assert np.array_equal(geometry.cell_index(rows, cols), np.arange(cells.size))
     assert geometry.THETA_STEP_DEG == 1.0 and geometry.map_extent() == (-2.45, 2.45, -12.5, 12.5)

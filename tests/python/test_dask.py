@@ -19,7 +19,7 @@ import pytest
 from icoac.core import binding as B
 from icoac.cluster import worker as _worker, backend as cluster
 from icoac import cli
-from icoac.core import grid, results
+from icoac.core import geometry, grid, results
 from icoac.studies import prior as P
 from icoac.studies.conditions import condition_prior, run_condition
 from icoac.core.config import build_config
@@ -43,7 +43,7 @@ CELL_SPEC = grid.format_cell_indices(CELLS)
 SLOW_CAPS = {"max_trials": 100000, "success_steps": 5000}  # about 3 s threaded (engine with lanes)
 SLOW_SEED = 5
 SLOW_SPEC = "560-679"
-SLOW_CELLS = grid.parse_cell_indices(SLOW_SPEC, B.GRID_CELLS)
+SLOW_CELLS = grid.parse_cell_indices(SLOW_SPEC, geometry.CELLS)
 
 
 @pytest.fixture(scope="module")

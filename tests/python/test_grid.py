@@ -80,7 +80,7 @@ def test_cancel_event_before_start_keeps_all_pending(small_cfg):
 
 
 def test_subset_seeds_match_full_grid():
-    full = grid.paper_grid(5)
+    full = grid.plant_grid("cart_pole", 5)
     sub = grid.make_cells(5, [3, 700])
     assert np.array_equal(sub["seed"], full["seed"][[3, 700]])
 

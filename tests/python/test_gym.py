@@ -20,7 +20,7 @@ from icoac.core import geometry
 from icoac.gym import plants as gym_plants
 from icoac.studies.ceiling.fixed import fixed_config
 from icoac.core.config import build_config
-from icoac.core.grid import run_cell, trajectory
+from icoac.core.grid import plant_grid, run_cell, trajectory
 from icoac.core.options import TYPICAL_ICO_WEIGHTS
 
 REPO = Path(__file__).resolve().parents[2]
@@ -82,8 +82,7 @@ def test_fixed_w_episode_equals_the_engine_trajectory(w, cell, lasts):
     cfg = fixed_config(w)
     policy = hg.IcoacPolicy(cfg)
     episode = policy.run_episode(make(steps), options={"cell": cell, "grid_seed": grid_seed}, trace=True)
-    cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
-    B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, grid_seed))
+    cells = plant_grid("cart_pole", grid_seed)
     assert episode.reset_info == {"cell": cell, "grid_seed": grid_seed, "cell_seed": int(cells[cell]["seed"])}
     engine = trajectory(cfg, cells[cell]["x0"], cells[cell]["theta0"], duration=steps * cfg.model.dt,
                         seed=int(cells[cell]["seed"]))
@@ -114,8 +113,7 @@ def test_learning_episodes_equal_the_engine_trial_loop(condition, cell):
     trials, horizon = 12, 400  # cells: theta0 = 3 deg, x0 = 0; theta0 = 8 deg, x0 = 0.6 m
     cfg = build_config({"max_trials": trials, "success_steps": horizon, "init_velocity_noise": 0},
                        condition=condition)
-    cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
-    B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, 0))
+    cells = plant_grid("cart_pole", 0)
     seed = int(cells[cell]["seed"])
     engine = run_cell(cfg, cells[cell]["x0"], cells[cell]["theta0"], seed=seed)
     policy = hg.IcoacPolicy(cfg, seed=int(B.lib.icoac_mix_seed(seed, 1)))
@@ -128,14 +126,14 @@ def test_reset_draws_and_options():
     env = make()
     a, info_a = env.reset(seed=5)
     b, info_b = env.reset(seed=5)
-    assert np.array_equal(a, b) and info_a == info_b and 0 <= info_a["cell"] < B.GRID_CELLS
+    assert np.array_equal(a, b) and info_a == info_b and 0 <= info_a["cell"] < geometry.CELLS
     start = np.array([0.1, -0.2, 0.05, 0.3])
     obs, info = env.reset(options={"state": start})
     assert np.array_equal(obs, start) and info == {}
     obs, _, terminated, truncated, info = env.step(np.array([2.5]))
     c_model_step(env.unwrapped.parameters.model, start, 2.5)
     assert np.array_equal(obs, start) and not terminated and not truncated and info["force"] == 2.5
-    for bad in ({"state": [0, 0, np.nan, 0]}, {"state": [0, 0]}, {"state": "abc"}, {"cell": B.GRID_CELLS},
+    for bad in ({"state": [0, 0, np.nan, 0]}, {"state": [0, 0]}, {"state": "abc"}, {"cell": geometry.CELLS},
                 {"cell": 1.5}, {"grid_seed": -1}, {"state": [0, 0, 0, 0], "cell": 3}, {"theta0": 0.1}):
         with pytest.raises(ValueError, match="reset option|unknown reset option"):
             env.reset(options=bad)

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from icoac.core import binding as B
-from icoac.core import grid, results
+from icoac.core import geometry, grid, results
 from icoac.core.config import build_config
 
 REPO = Path(__file__).resolve().parents[2]
@@ -32,7 +32,7 @@ KILL_SEED = int(os.environ.get("ICOAC_KILL_SEED", "8"))
 @pytest.fixture(scope="module")
 def reference():
     """The uninterrupted run (in-process, same C runner) and its wall time."""
-    cells = grid.make_cells(5, grid.parse_cell_indices(CELLS, B.GRID_CELLS))
+    cells = grid.make_cells(5, grid.parse_cell_indices(CELLS, geometry.CELLS))
     t0 = time.monotonic()
     res = grid.run_grid(build_config(CAPS), cells, threads=2, progress=False)
     assert res.complete

@@ -4,11 +4,11 @@ import pytest
 
 from icoac.core import binding as B
 from icoac.core import metrics
-from icoac.core.grid import paper_grid
+from icoac.core.grid import plant_grid
 
 
 def hand_cells():
-    cells = paper_grid(0)
+    cells = plant_grid("cart_pole", 0)
     cells["outcome"] = B.FAILED
     cells["trials"] = 100
     cells["total_steps"] = 1000
@@ -37,7 +37,7 @@ def test_summary_exact():
 
 
 def test_interior_mask():
-    cells = paper_grid(0)
+    cells = plant_grid("cart_pole", 0)
     m = metrics.interior_mask(cells)
     grid = m.reshape(25, 49)
     assert m.sum() == 1081
@@ -58,7 +58,7 @@ def test_trials_and_grid_maps():
 
 
 def test_empty_success():
-    cells = paper_grid(0)
+    cells = plant_grid("cart_pole", 0)
     cells["outcome"] = B.FAILED
     s = metrics.summary(cells)
     assert s["success_rate"] == 0.0 and s["median_trials_to_success"] is None

@@ -357,7 +357,3 @@ def test_plant_grid(name):
     cols = np.arange(n) % info["cols"]["count"]
     assert np.allclose(cells["theta0"], to_si(info["rows"], rows), rtol=0, atol=1e-12)
     assert np.allclose(cells["x0"], to_si(info["cols"], cols), rtol=0, atol=1e-12)
-    if name == "cart_pole":
-        paper = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
-        B.check_status(B.lib.icoac_sim_paper_grid(paper, B.GRID_CELLS, 5))
-        assert paper.tobytes() == cells.tobytes()

@@ -16,7 +16,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from icoac.core import binding as B
-from icoac.core import config, grid, metrics, results, store
+from icoac.core import config, geometry, grid, metrics, results, store
 from icoac.core.config import (ALL_FIELDS, BOOLS, ENUMS, RunConfig, build_config, canonical, config_from_dict,
                                parse_sets, parse_value)
 from icoac.core.errors import HarnessError
@@ -180,29 +180,29 @@ def test_config_from_dict_of_anything(data):
 
 
 # -- cell lists ------------------------------------------------------------------------------------------
-@given(st.lists(st.integers(0, B.GRID_CELLS - 1), min_size=1, max_size=60), st.randoms(use_true_random=False))
+@given(st.lists(st.integers(0, geometry.CELLS - 1), min_size=1, max_size=60), st.randoms(use_true_random=False))
 def test_cell_list_round_trip(indices, rnd):
     want = sorted(set(indices))
-    assert grid.parse_cell_indices(grid.format_cell_indices(indices), B.GRID_CELLS) == want
-    assert grid.parse_cell_indices(indices, B.GRID_CELLS) == want
+    assert grid.parse_cell_indices(grid.format_cell_indices(indices), geometry.CELLS) == want
+    assert grid.parse_cell_indices(indices, geometry.CELLS) == want
     # the same cells written another way: shuffled parts, some ranges split, spaces, empty parts
     parts = grid.format_cell_indices(indices).split(",")
     rnd.shuffle(parts)
     text = " , ".join(p.replace("-", " - ") if rnd.random() < 0.5 else p for p in parts) + ("," if rnd.random() < .3 else "")
-    assert grid.parse_cell_indices(text, B.GRID_CELLS) == want
+    assert grid.parse_cell_indices(text, geometry.CELLS) == want
 
 
 @given(st.text(alphabet="0123456789-, x+_.e", max_size=30) | st.text(max_size=30))
 def test_cell_text_accepted_or_config_error(text):
-    got = total(lambda t: grid.parse_cell_indices(t, B.GRID_CELLS), text)
+    got = total(lambda t: grid.parse_cell_indices(t, geometry.CELLS), text)
     if got is not None:
-        assert got == sorted(set(got)) and all(0 <= i < B.GRID_CELLS for i in got)
-        assert grid.parse_cell_indices(grid.format_cell_indices(got), B.GRID_CELLS) == got
+        assert got == sorted(set(got)) and all(0 <= i < geometry.CELLS for i in got)
+        assert grid.parse_cell_indices(grid.format_cell_indices(got), geometry.CELLS) == got
 
 
 @given(st.lists(scalars | st.integers(-5, 1300), max_size=8))
 def test_cell_sequence_accepted_or_config_error(items):
-    got = total(lambda t: grid.parse_cell_indices(t, B.GRID_CELLS), items)
+    got = total(lambda t: grid.parse_cell_indices(t, geometry.CELLS), items)
     if got is not None:
         assert got == sorted({int(i) for i in items})
 
@@ -226,11 +226,11 @@ def _load_with(valid_dir, name, data: bytes):
         got = total(results.load, d)
     if got is not None:
         cells, record = got
-        assert cells.dtype == B.CELL_DTYPE and cells.ndim == 1 and 1 <= cells.size <= B.GRID_CELLS
+        assert cells.dtype == B.CELL_DTYPE and cells.ndim == 1 and 1 <= cells.size <= geometry.CELLS
         assert np.isin(cells["outcome"], list(B.OUTCOME_NAMES)).all()
         assert np.isfinite(cells["x0"]).all() and np.isfinite(cells["theta0"]).all()
         rows, cols = metrics.grid_index(cells)
-        assert ((rows >= 0) & (rows < B.GRID_THETAS) & (cols >= 0) & (cols < B.GRID_XS)).all()
+        assert ((rows >= 0) & (rows < geometry.THETAS) & (cols >= 0) & (cols < geometry.XS)).all()
         assert isinstance(record, dict) and isinstance(record["config"], dict)
         config_from_dict(record["config"])
     return got

@@ -35,7 +35,7 @@ DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.s
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
 ABI_VERSION = 9
-SIM_ABI_VERSION = 4
+SIM_ABI_VERSION = 5
 
 
 class IcoacError(HarnessError):
@@ -296,16 +296,8 @@ PROGRESS_TRIALS = int(constant("ICOAC_SIM_PROGRESS_TRIALS"))
 PROGRESS_STEPS = int(constant("ICOAC_SIM_PROGRESS_STEPS"))
 PROGRESS_LEN = int(constant("ICOAC_SIM_PROGRESS_LEN"))
 
-# The paper grid (icoac.core.geometry derives the rest and checks it against icoac_sim_paper_grid).
-GRID_THETAS = int(constant("ICOAC_SIM_GRID_THETAS"))
-GRID_XS = int(constant("ICOAC_SIM_GRID_XS"))
-GRID_CELLS = int(constant("ICOAC_SIM_GRID_CELLS"))
-GRID_THETA_FIRST_DEG = float(constant("ICOAC_SIM_GRID_THETA_FIRST_DEG"))
-GRID_X_FIRST = float(constant("ICOAC_SIM_GRID_X_FIRST"))
-GRID_X_STEP = float(constant("ICOAC_SIM_GRID_X_STEP"))
-PI = float(constant("ICOAC_SIM_PI"))
-
 # The plant registry (docs/plants.md).
+PI = float(constant("ICOAC_SIM_PI"))
 MAX_STATE = int(constant("ICOAC_SIM_MAX_STATE"))
 MAX_PARAMS = int(constant("ICOAC_SIM_MAX_PARAMS"))
 CART_POLE = int(constant("ICOAC_SIM_CART_POLE"))
@@ -407,9 +399,10 @@ class Axis(ctypes.Structure):
 
 
 class Param(ctypes.Structure):
-    """icoac_sim_param_t: one plant parameter, its default and valid range."""
+    """icoac_sim_param_t: one plant parameter, its default, valid range, tier and description."""
     _fields_ = [("name", ctypes.c_char_p), ("unit", ctypes.c_char_p), ("value", ctypes.c_double),
-                ("min", ctypes.c_double), ("max", ctypes.c_double)]
+                ("min", ctypes.c_double), ("max", ctypes.c_double), ("tier", ctypes.c_char_p),
+                ("doc", ctypes.c_char_p)]
 
 
 class Sweep(ctypes.Structure):
@@ -619,7 +612,6 @@ _PROTOTYPES = {
     "icoac_sim_status_str": ([ctypes.c_int32], ctypes.c_char_p),
     "icoac_sim_run_default": ([_P(Run)], None),
     "icoac_sim_run_check": ([_P(Run)], ctypes.c_int32),
-    "icoac_sim_paper_grid": ([_cells_p, ctypes.c_int64, ctypes.c_uint64], ctypes.c_int32),
     "icoac_sim_plant_count": ([], ctypes.c_int32),
     "icoac_sim_plant_info": ([ctypes.c_int32], _P(PlantDesc)),
     "icoac_sim_plant_find": ([ctypes.c_char_p], ctypes.c_int32),
@@ -634,14 +626,14 @@ _PROTOTYPES = {
     "icoac_sim_plant_grid": ([ctypes.c_int32, _cells_p, ctypes.c_int64, ctypes.c_uint64], ctypes.c_int32),
     "icoac_rng_seed": ([_P(Rng), ctypes.c_uint64, ctypes.c_uint64], None),
     "icoac_sim_model_start": ([_P(Model), ndpointer(CELL_DTYPE, shape=(1,), flags="C_CONTIGUOUS"), ctypes.c_double, _P(Rng), _state_w], ctypes.c_int32),
-    "icoac_sim_run_cell_model": ([_P(Config), _P(Model), _P(Run), _P(Prior), _cells_p,
-                                  _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)], ctypes.c_int32),
-    "icoac_sim_run_grid_model": ([_P(Config), _P(Model), _P(Run), _P(Prior), _cells_p, ctypes.c_int64,
-                                  ctypes.c_int32, _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)],
-                                 ctypes.c_int32),
-    "icoac_sim_trajectory_model": ([_P(Config), _P(Model), _P(Prior), ctypes.c_double, ctypes.c_double,
-                                    ctypes.c_double, ctypes.c_uint64, ctypes.c_int64, _f64_w, _f64_w,
-                                    _P(ctypes.c_int64)], ctypes.c_int32),
+    "icoac_sim_run_cell": ([_P(Config), _P(Model), _P(Run), _P(Prior), _cells_p,
+                            _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)], ctypes.c_int32),
+    "icoac_sim_run_grid": ([_P(Config), _P(Model), _P(Run), _P(Prior), _cells_p, ctypes.c_int64,
+                            ctypes.c_int32, _NullableNdpointer(_cancel_p), _NullableNdpointer(_progress_p)],
+                           ctypes.c_int32),
+    "icoac_sim_trajectory": ([_P(Config), _P(Model), _P(Prior), ctypes.c_double, ctypes.c_double,
+                              ctypes.c_double, ctypes.c_uint64, ctypes.c_int64, _f64_w, _f64_w,
+                              _P(ctypes.c_int64)], ctypes.c_int32),
 }
 for _name, (_args, _res) in _PROTOTYPES.items():
     _fn = getattr(lib, _name)
@@ -728,7 +720,7 @@ def plant_index(name: str) -> int:
 
 def plant_info(plant: Union[int, str]) -> dict:
     """A registry plant's descriptor as plain data: name, title, source, input (name, unit),
-    state [(name, unit)], params [{name, unit, value, min, max}], rows and cols of its grid
+    state [(name, unit)], params [{name, unit, value, min, max, tier, doc}], rows and cols of its grid
     ({component, count, first, step, degrees}), start, drawn, observed, has_energy, and its task
     (None when it has none): {source, paper, learners (condition names), prior_all_finished}."""
     index = plant_index(plant) if isinstance(plant, str) else int(plant)
@@ -744,13 +736,22 @@ def plant_info(plant: Union[int, str]) -> dict:
         "name": d.name.decode(), "title": d.title.decode(), "source": d.source.decode(),
         "input": (d.input.name.decode(), d.input.unit.decode()),
         "state": [(d.state[i].name.decode(), d.state[i].unit.decode()) for i in range(n)],
-        "params": [{"name": p.name.decode(), "unit": p.unit.decode(), "value": p.value, "min": p.min,
-                    "max": p.max} for p in (d.params[i] for i in range(d.n_params))],
+        "params": [_param_info(d.name.decode(), p) for p in (d.params[i] for i in range(d.n_params))],
         "rows": sweep(d.rows), "cols": sweep(d.cols),
         "start": list(d.start[:n]), "drawn": [bool(v) for v in d.drawn[:n]], "observed": list(d.observed[:n]),
         "has_energy": bool(d.energy),
         "task": _task_info(d.task.contents) if d.task else None,
     }
+
+
+def _param_info(plant: str, p: Param) -> dict:
+    name = p.name.decode()
+    tier, doc = (p.tier or b"").decode(), (p.doc or b"").decode()
+    if tier not in ("essential", "advanced") or not doc:
+        raise LibraryError(f"plant {plant}: parameter {name} needs a tier (\"essential\" or \"advanced\") and a "
+                           "one-line doc in its C table (docs/plants.md)")
+    return {"name": name, "unit": p.unit.decode(), "value": p.value, "min": p.min, "max": p.max,
+            "tier": tier, "doc": doc}
 
 
 def _task_info(t: PlantTask) -> dict:

@@ -6,11 +6,9 @@ column value as x0 and the row value as theta0, in the plant's units (radians fo
 
 PlantGrid(name) is that geometry for any registry plant; the module-level names are the
 cart-pole's, the paper's grid: row i is theta0 = -12 + i deg, column j is x0 = -2.4 + 0.1 j m.
-At import the cart-pole's geometry is checked against the C paper grid cell by cell.
 """
 from __future__ import annotations
 
-import math
 from functools import lru_cache
 
 import numpy as np
@@ -20,12 +18,11 @@ from icoac.core.options import CART_POLE as CART_POLE_NAME
 
 TOL = 1e-6  # plant units (m, rad): a cell coordinate must be this close to a grid point
 
-# The quick profile's spread subset, rows x columns of the paper's 25 x 49 grid: Fig. 1g's start
-# (row 8, column 19) and enough central cells for a prior. Another grid takes the rows and columns
-# at the same fractions of its own (PlantGrid.quick_cells).
+# The quick profile's spread subset, rows x columns of the cart-pole's 25 x 49 grid: Fig. 1g's
+# start (row 8, column 19) and enough central cells for a prior. Another grid takes the rows and
+# columns at the same fractions of its own (PlantGrid.quick_cells).
 QUICK_ROWS = (2, 8, 10, 12, 14, 22)
 QUICK_COLS = (4, 19, 22, 24, 26, 44)
-_QUICK_SHAPE = (int(B.constant("ICOAC_SIM_GRID_THETAS")), int(B.constant("ICOAC_SIM_GRID_XS")))
 
 
 def _start_name(component: str) -> str:
@@ -143,7 +140,8 @@ class PlantGrid:
         """The quick profile's cells on this grid (QUICK_ROWS x QUICK_COLS at the same fractions)."""
         def at(positions, n, paper_n):
             return sorted({int(np.rint(p * (n - 1) / (paper_n - 1))) for p in positions})
-        rows, cols = at(QUICK_ROWS, self.rows, _QUICK_SHAPE[0]), at(QUICK_COLS, self.cols, _QUICK_SHAPE[1])
+        paper = of(CART_POLE_NAME)
+        rows, cols = at(QUICK_ROWS, self.rows, paper.rows), at(QUICK_COLS, self.cols, paper.cols)
         return [int(self.cell_index(r, c)) for r in rows for c in cols]
 
     def spread_cells(self) -> list[int]:
@@ -203,19 +201,3 @@ on_grid = CART_POLE.on_grid
 to_grid = CART_POLE.to_grid
 map_extent = CART_POLE.map_extent
 
-
-def _check() -> None:
-    """The cart-pole's geometry reproduces every cell of the C paper grid, and its constants are
-    the C table's."""
-    cells = np.zeros(CELLS, dtype=B.CELL_DTYPE)
-    B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, 0), "paper grid")
-    rows, cols = grid_index(cells)
-    k = np.arange(CELLS)
-    if not ((THETAS, XS, CELLS) == (B.GRID_THETAS, B.GRID_XS, B.GRID_CELLS) and THETA_FIRST_DEG == B.GRID_THETA_FIRST_DEG
-            and X_FIRST == B.GRID_X_FIRST and X_STEP == B.GRID_X_STEP and math.isclose(THETA_STEP_DEG, 1.0)
-            and np.array_equal(rows, k // XS) and np.array_equal(cols, k % XS) and on_grid(cells).all()):
-        raise B.LibraryError("icoac_sim_paper_grid does not follow the grid constants "
-                             "(ICOAC_SIM_GRID_*); rebuild the library")
-
-
-_check()

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Run grids of cells through icoac_sim_run_grid_model (any registry plant) with progress, Ctrl-C cancellation and checkpoints."""
+"""Run grids of cells through icoac_sim_run_grid (any registry plant) with progress, Ctrl-C cancellation and checkpoints."""
 from __future__ import annotations
 
 import ctypes
@@ -18,7 +18,7 @@ from icoac.core import binding as B
 from icoac.core.config import RunConfig
 from icoac.core.options import CART_POLE, DEFAULT_CHECKPOINT_CELLS, DEFAULT_CHECKPOINT_EVERY, MAX_THREADS, MAX_TRAJECTORY_STEPS, SEED_LIMIT, TRAJECTORY_DURATION
 
-# What icoac_sim_run_grid_model fills in; the caller sets the others (icoac_sim_cell_t).
+# What icoac_sim_run_grid fills in; the caller sets the others (icoac_sim_cell_t).
 INPUT_FIELDS = ("x0", "theta0", "seed")
 RESULT_FIELDS = tuple(n for n in B.CELL_DTYPE.names if n not in INPUT_FIELDS)
 
@@ -54,14 +54,6 @@ def check_threads(threads) -> int:
     if not _is_int(threads) or not 0 <= int(threads) <= MAX_THREADS:
         raise _bad_arg(f"threads must be an integer in [0, {MAX_THREADS}] (0: all cores), got {threads!r:.60}")
     return int(threads)
-
-
-def paper_grid(seed: int = 0) -> np.ndarray:
-    """The paper's grid (row-major over theta0, then x0; icoac.core.geometry), every cell PENDING."""
-    seed = check_seed(seed)
-    cells = np.zeros(B.GRID_CELLS, dtype=B.CELL_DTYPE)
-    B.check_status(B.lib.icoac_sim_paper_grid(cells, cells.size, seed), "paper grid")
-    return cells
 
 
 # ASCII digits, as every number of the harness (icoac.core.literals)
@@ -291,7 +283,7 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
 
     def worker() -> None:
         try:
-            result["status"] = B.lib.icoac_sim_run_grid_model(
+            result["status"] = B.lib.icoac_sim_run_grid(
                 ctypes.byref(cfg.controller), ctypes.byref(model), ctypes.byref(cfg.run), prior,
                 cells, cells.size, int(threads), cancel, counters)
         except BaseException as exc:  # pragma: no cover - ctypes argument errors
@@ -346,13 +338,13 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
 
 
 def run_cell(cfg: RunConfig, x0: float, theta0: float, seed: int = 0) -> np.ndarray:
-    """One independent run of one cell (icoac_sim_run_cell_model); returns a 0-d CELL_DTYPE record."""
+    """One independent run of one cell (icoac_sim_run_cell); returns a 0-d CELL_DTYPE record."""
     cfg.check()
     cell = np.zeros(1, dtype=B.CELL_DTYPE)
     cell["x0"], cell["theta0"], cell["seed"] = x0, theta0, check_seed(seed)
     prior = ctypes.byref(cfg.prior) if cfg.prior is not None else None
-    status = B.lib.icoac_sim_run_cell_model(ctypes.byref(cfg.controller), ctypes.byref(cfg.engine_model()),
-                                            ctypes.byref(cfg.run), prior, cell, None, None)
+    status = B.lib.icoac_sim_run_cell(ctypes.byref(cfg.controller), ctypes.byref(cfg.engine_model()),
+                                      ctypes.byref(cfg.run), prior, cell, None, None)
     B.check_status(status, "run cell")
     return cell[0]
 
@@ -390,7 +382,7 @@ def trajectory_steps(duration: float, dt: float) -> int:
 def trajectory(cfg: RunConfig, x0: float, theta0: float, duration: float = TRAJECTORY_DURATION,
                seed: int = 0, init_velocity_noise: float | None = None) -> Trajectory:
     """One trial from (x0, theta0) with the controller initialised from cfg.prior (learning on),
-    recorded for up to ``duration`` simulated seconds (icoac_sim_trajectory_model)."""
+    recorded for up to ``duration`` simulated seconds (icoac_sim_trajectory)."""
     cfg.check()
     model = cfg.engine_model()
     max_steps = trajectory_steps(duration, model.dt)
@@ -400,9 +392,9 @@ def trajectory(cfg: RunConfig, x0: float, theta0: float, duration: float = TRAJE
     forces = np.zeros(max_steps)
     n = ctypes.c_int64(0)
     prior = ctypes.byref(cfg.prior) if cfg.prior is not None else None
-    status = B.lib.icoac_sim_trajectory_model(ctypes.byref(cfg.controller), ctypes.byref(model), prior,
-                                              float(x0), float(theta0), noise, check_seed(seed), max_steps,
-                                              states, forces, ctypes.byref(n))
+    status = B.lib.icoac_sim_trajectory(ctypes.byref(cfg.controller), ctypes.byref(model), prior,
+                                        float(x0), float(theta0), noise, check_seed(seed), max_steps,
+                                        states, forces, ctypes.byref(n))
     B.check_status(status, "trajectory")
     k = int(n.value)
     return Trajectory(states.reshape(-1, n_state)[: k + 1].copy(), forces[:k].copy(), model.dt)

@@ -4,7 +4,7 @@ dt times the initial velocities only (x1 = x0 + dt x_dot0, theta1 = theta0 + dt 
 force changes only the velocities, which stay finite. So a cell on a failure threshold
 (|x0| = 2.4 m or |theta0| = 12 deg; the grid's last x0 is 2.400000000000001 in double) whose
 first draw points outward fails at step 1 whatever any controller does. The engine's first
-draws are recomputed through the C API (``icoac_sim_trajectory_model`` with one step gives the
+draws are recomputed through the C API (``icoac_sim_trajectory`` with one step gives the
 start state of the cell's first trial), stepped once by ``icoac_sim_model_step`` under several
 forces from -1e4 N to 1e4 N and tested with ``icoac_sim_model_failed``; the cells failing under
 every force
@@ -43,10 +43,10 @@ def initial_states(cfg: RunConfig, cells: np.ndarray) -> np.ndarray:
     prior = ctypes.byref(cfg.prior) if cfg.prior is not None else None
     model = cfg.engine_model()
     for i, cell in enumerate(cells):
-        status = B.lib.icoac_sim_trajectory_model(ctypes.byref(cfg.controller), ctypes.byref(model), prior,
-                                                  float(cell["x0"]), float(cell["theta0"]),
-                                                  float(cfg.run.init_velocity_noise), int(cell["seed"]), 1,
-                                                  states, forces, ctypes.byref(n))
+        status = B.lib.icoac_sim_trajectory(ctypes.byref(cfg.controller), ctypes.byref(model), prior,
+                                            float(cell["x0"]), float(cell["theta0"]),
+                                            float(cfg.run.init_velocity_noise), int(cell["seed"]), 1,
+                                            states, forces, ctypes.byref(n))
         B.check_status(status, "trajectory")
         out[i] = states[:n_state]
     return out
