@@ -83,6 +83,8 @@ static const icoac_sim_constant_t constants[] = {
     CONSTANT(ICOAC_SIM_PROGRESS_LEN),
     /* the plant registry */
     CONSTANT(ICOAC_SIM_PI),
+    CONSTANT(ICOAC_SIM_DT_MIN),
+    CONSTANT(ICOAC_SIM_DT_MAX),
     CONSTANT(ICOAC_SIM_MAX_STATE),
     CONSTANT(ICOAC_SIM_MAX_PARAMS),
     CONSTANT(ICOAC_SIM_CART_POLE),

@@ -108,6 +108,24 @@ def test_design_page_agrees_with_the_c_table():
     assert PT.main([str(PAGE), "--check"]) == 0
 
 
+def test_plants_page_has_every_plant_table_from_c(tmp_path):
+    """docs/plants.md holds one generated table per registry plant, each row a descriptor
+    parameter (then dt and the integrator) with its tier and description."""
+    page = ROOT / "docs" / "plants.md"
+    assert PT.main([str(page), "--check"]) == 0
+    text = page.read_text()
+    for index in range(int(B.lib.icoac_sim_plant_count())):
+        info = B.plant_info(index)
+        assert f"<!-- plant-params {info['name']}:begin -->" in text
+        rows = P.plant_rows(info["name"])
+        assert [r["name"] for r in rows] == [p["name"] for p in info["params"]] + ["dt", "integrator"]
+        assert all(r["tier"] in ("essential", "advanced") and r["description"] for r in rows)
+    stale = text.replace("| essential | gravitational acceleration |", "| advanced | gravitational acceleration |", 1)
+    copy = tmp_path / "plants.md"
+    copy.write_text(stale)
+    assert PT.main([str(copy), "--check"]) == 1
+
+
 def test_a_changed_row_is_caught(tmp_path):
     page = tmp_path / "design.md"
     shutil.copy(PAGE, page)

@@ -176,7 +176,7 @@ typedef struct {
  * (ICOAC_SEARCH_BATCH_MAX n-vectors), the critic weights (ICOAC_MAX_CRITIC_UNITS) and two
  * kept-unit lists (ICOAC_STATE_LIST reals and bytes each: a critic block's rows and cells).
  * Default maxima: 2,880 bytes with float, 5,440 with double; cart-pole maxima (4 inputs, 4 rules,
- * 162 units): 2,112 / 3,840. */
+ * 162 units): 2,112 / 3,904. */
 #define ICOAC_STATE_LIST_BOUND (32 + ICOAC_MAX_CRITIC_UNITS / 31)
 #define ICOAC_STATE_LIST (ICOAC_STATE_LIST_BOUND < 63 ? ICOAC_STATE_LIST_BOUND : 63)
 #define ICOAC_STATE_REALS                                                                                \

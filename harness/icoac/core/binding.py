@@ -298,6 +298,7 @@ PROGRESS_LEN = int(constant("ICOAC_SIM_PROGRESS_LEN"))
 
 # The plant registry (docs/plants.md).
 PI = float(constant("ICOAC_SIM_PI"))
+DT_MIN, DT_MAX = float(constant("ICOAC_SIM_DT_MIN")), float(constant("ICOAC_SIM_DT_MAX"))  # a model's dt (s)
 MAX_STATE = int(constant("ICOAC_SIM_MAX_STATE"))
 MAX_PARAMS = int(constant("ICOAC_SIM_MAX_PARAMS"))
 CART_POLE = int(constant("ICOAC_SIM_CART_POLE"))

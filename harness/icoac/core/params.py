@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The parameters as the C table describes them (icoac_params.h and the run's rows, read by the
-binding as B.PARAMS): their valid ranges in words, the listing of `python -m icoac params`,
-and the table of docs/design.md (icoac.tools.params_table writes and checks it)."""
+"""The parameters as the C tables describe them (icoac_params.h and the run's rows, read by the
+binding as B.PARAMS; each plant's own in its descriptor): their valid ranges in words, the listing
+of `python -m icoac params`, and the tables of docs/design.md and docs/plants.md
+(icoac.tools.params_table writes and checks them)."""
 from __future__ import annotations
 
 import ctypes
@@ -60,28 +61,48 @@ def rows(tier: str | None = None) -> list[dict[str, str]]:
     return out
 
 
-def plant_rows(plant: str) -> list[dict[str, str]]:
-    """One dict of COLUMNS per parameter of a registry plant (its descriptor's table)."""
-    info = B.plant_info(plant)
-    return [{"name": p["name"], "unit": p["unit"], "default": _num(p["value"]),
-             "range": f"[{_num(p['min'])}, {_num(p['max'])}]", "modes": "all", "tier": "plant",
-             "description": f"{info['name']} parameter"} for p in info["params"]]
+def _integrator(value: int) -> str:
+    return next(name for name, v in B.INTEGRATORS.items() if v == value)
+
+
+def plant_rows(plant: str, tier: str | None = None) -> list[dict[str, str]]:
+    """One dict of COLUMNS per parameter of a registry plant (its descriptor's table; tier: those
+    only), then its model's dt and integrator."""
+    model = B.model_default(plant)
+    table = [{"name": p["name"], "unit": p["unit"], "default": _num(p["value"]),
+              "range": f"[{_num(p['min'])}, {_num(p['max'])}]", "tier": p["tier"], "description": p["doc"]}
+             for p in B.plant_info(plant)["params"]]
+    table += [{"name": "dt", "unit": "s", "default": _num(model.dt), "range": f"[{_num(B.DT_MIN)}, {_num(B.DT_MAX)}]",
+               "tier": "advanced", "description": "integration step, one controller tick"},
+              {"name": "integrator", "unit": "", "default": _integrator(model.integrator),
+               "range": ", ".join(B.INTEGRATORS), "tier": "advanced",
+               "description": "explicit Euler (Sutton's update order) or classical RK4"}]
+    return [dict(r, modes="all") for r in table if tier is None or r["tier"] == tier]
 
 
 def text_table(tier: str | None = None, plant: str | None = None) -> str:
     """The listing of `python -m icoac params`: aligned columns, one line per parameter (the
     controller's and the run's; with plant, that registry plant's after them)."""
-    table = [dict(zip(COLUMNS, COLUMNS))] + rows(tier) + (plant_rows(plant) if plant else [])
+    table = [dict(zip(COLUMNS, COLUMNS))] + rows(tier) + (plant_rows(plant, tier) if plant else [])
     widths = {c: max(len(r[c]) for r in table) for c in COLUMNS[:-1]}
     return "\n".join("  ".join(r[c].ljust(widths[c]) for c in COLUMNS[:-1]) + "  " + r["description"]
                      for r in table).rstrip() + "\n"
 
 
-def markdown_table() -> list[str]:
-    """docs/design.md's parameter table."""
+def _markdown(table: list[dict[str, str]], columns: tuple[str, ...]) -> list[str]:
     def cell(text: str) -> str:
         return text.replace("|", "\\|")
-    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
-    for r in rows():
-        lines.append("| " + " | ".join([f"`{r['name']}`"] + [cell(r[c]) for c in COLUMNS[1:]]) + " |")
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    for r in table:
+        lines.append("| " + " | ".join([f"`{r['name']}`"] + [cell(r[c]) for c in columns[1:]]) + " |")
     return lines
+
+
+def markdown_table() -> list[str]:
+    """docs/design.md's parameter table."""
+    return _markdown(rows(), COLUMNS)
+
+
+def plant_markdown(plant: str) -> list[str]:
+    """A registry plant's parameter table in docs/plants.md."""
+    return _markdown(plant_rows(plant), tuple(c for c in COLUMNS if c != "modes"))

@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """IcoacPolicy: an icoac controller (any mode, learning as it acts) driving a Gymnasium env whose
-observation is four numbers, (x m, x_dot m/s, theta rad, theta_dot rad/s) for the cart-pole or
-another plant's state in the same places (``plant``: its task settings, icoac.core.plants), and whose
-action is one number, a force (N) or the plant's input.
+observation is the plant's state, one controller input per component in the descriptor's order
+((x m, x_dot m/s, theta rad, theta_dot rad/s) for the cart-pole; ``plant``: its task settings,
+icoac.core.plants), and whose action is one number, a force (N) or the plant's input.
 
 Per episode, as the engine per trial: icoac_reset, then per env step one icoac_step on the
 observation, its force the action; the observation of a terminating step (terminated=True) goes

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Priors of the RL conditions (method.md, A15-A17) from the final weights of an ICO grid.
 
-ICO->RL: mean and 4x4 sample covariance (ddof 1) of the final ICO weights of the ICO-successful cells
+ICO->RL: mean and n x n sample covariance (ddof 1) of the final ICO weights of the ICO-successful cells
 inside a frame (default |x0| <= 1.2 m, |theta0| <= 6 deg; or every successful cell), plus ridge * I.
 The other actor-critic priors take the ICO mean, the ICO covariance, both or neither
 (each condition's rule: icoac.core.registry; method.md, A16 and L6); the search's is N(0, I) or the

@@ -78,21 +78,21 @@ static double energy(const double *p, const double *s)
 
 static const icoac_sim_param_t params[N_PARAMS] = {
     {"gravity", "m/s^2", 9.8, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
-     "gravitational acceleration"},
+     "gravitational acceleration (Bogdanov 2004)"},
     {"cart_mass", "kg", 1.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
-     "mass of the cart"},
+     "m0, mass of the cart (Bogdanov 2004)"},
     {"mass1", "kg", 0.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
-     "mass of the lower link, a uniform rod"},
+     "mass of the lower link, a uniform rod (Bogdanov 2004)"},
     {"mass2", "kg", 0.75, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
-     "mass of the upper link, a uniform rod"},
+     "mass of the upper link, a uniform rod (Bogdanov 2004)"},
     {"length1", "m", 0.5, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
-     "length of the lower link"},
+     "length of the lower link (Bogdanov 2004)"},
     {"length2", "m", 0.75, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "essential",
-     "length of the upper link"},
+     "length of the upper link (Bogdanov 2004)"},
     {"x_limit", "m", 2.4, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
-     "failure when |x| exceeds it"},
+     "failure when |x| exceeds it (our choice, as the cart-pole's)"},
     {"angle_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX, "advanced",
-     "failure when |theta1| or |theta2| exceeds it"},
+     "failure when |theta1| or |theta2| exceeds it (our choice, as the cart-pole's)"},
 };
 
 /* Its task, chosen by its sweep (docs/sweeps-double_cart_pole.md): six inputs scaled to the track
