@@ -58,7 +58,7 @@ const icoac_prior_t *fz_prior(fz_reader_t *r, icoac_prior_t *prior);
 #if defined(ICOAC_FUZZ_SIM) && ICOAC_FUZZ_SIM
 #include "icoac_sim/icoac_sim.h"
 
-/* Run section (fuzz_sim.c, fuzz_model.c): a mode byte b; b odd: the raw bytes of
+/* Run section (fuzz_model.c): a mode byte b; b odd: the raw bytes of
  * icoac_sim_run_t over icoac_sim_run_default; b even: (b >> 1) % 4 mutations, each a field byte
  * (% 3: 0 max_trials, 1 success_steps as int64; 2 init_velocity_noise as double) and a value. */
 void fz_run(fz_reader_t *r, icoac_sim_run_t *run);

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* libFuzzer target of the plant registry and model API (icoac_sim.h, "Plant registry"), linked
- * with libicoac_sim.so.
+/* libFuzzer target of the sim API (icoac_sim.h): the plant registry, the model functions and the
+ * benchmark runs on a model; linked with libicoac_sim.so.
  *
  * Input format, read front to back (a byte past the end reads as 0):
  *   model   mode byte m, plant byte p (registry plant p % icoac_sim_plant_count). m % 4: 1: the
@@ -11,7 +11,7 @@
  *           the double below min, the double above max; past n_params: -0, 0, DBL_TRUE_MIN,
  *           -DBL_TRUE_MIN).
  *   ops     at most FZ_MODEL_OPS, until the input ends. Op byte o; o in [0x80, 0xC0): a run op
- *           (below); else o & 7:
+ *           (below); else (o & 7) % 7 (7 reads as 0):
  *           0 step      6 doubles state, 1 double u: icoac_sim_model_step.
  *           1 deriv     6 doubles state, 1 double u: icoac_sim_model_derivatives.
  *           2 failed    6 doubles state: icoac_sim_model_failed.
@@ -19,42 +19,46 @@
  *           4 start     cell x0, theta0 (doubles), cell seed byte, noise (double), rng seed byte
  *                       (icoac_rng_seed with ICOAC_SIM_START_STREAM): icoac_sim_model_start.
  *           5 grid      index (int32), size byte c (c % 8: the plant's rows.count * cols.count
- *                       (1225 for a bad index), 0, -1, that - 1, that + 1, INT64_MAX,
+ *                       (the cart-pole's for a bad index), 0, -1, that - 1, that + 1, INT64_MAX,
  *                       INT64_MIN, 1; c & 128: NULL cells), seed byte: icoac_sim_plant_grid.
  *           6 registry  index (int32): icoac_sim_plant_info, icoac_sim_model_default; name
  *                       selector byte k % 4: 0 NULL, 1 the name of plant (byte % count),
  *                       2 that name less its last character, 3 a length byte (% 24) and that
  *                       many bytes: icoac_sim_plant_find.
- *           7 plant     4 doubles state, 1 double force: the icoac_sim_plant_t of the model
- *                       (dt, integrator, the cart-pole parameters by name; the default plant
- *                       for a NULL model), reserved (int32): icoac_sim_model_from_plant, then
- *                       the plant and model functions side by side.
- *           o >= 0xC0: NULL pointers, bit 3 the state array (plant op: the plant), bit 4 the
- *           output (ds, failed, energy; start: the cell; plant op: the model), bit 5 the rng.
+ *           o >= 0xC0: NULL pointers, bit 3 the state array, bit 4 the output (ds, failed,
+ *           energy; start: the cell), bit 5 the rng.
  *           A state's entries past the plant's n_state are replaced by a canary.
  *   run ops o & 3, on the model; o & 0x20: NULL pointers, bit 2 the configuration, bit 3 the
  *           cell / cells / trajectory states, bit 4 the run / trajectory forces.
- *           0 cell      run, config, prior sections, cell spec: icoac_sim_run_cell_model.
+ *           0 cell      run, config, prior sections, cell spec: icoac_sim_run_cell.
  *           1 grid      run, config, prior sections, count byte (1 + n % 4 cells; n % 32 == 31:
  *                       0 cells), threads byte (% 16: 13-14 two threads, 15 -1, else 1), a cell
- *                       spec per cell: icoac_sim_run_grid_model.
+ *                       spec per cell: icoac_sim_run_grid.
  *           2 traj      config, prior sections, cell spec (x0, theta0, seed), noise (double),
  *                       steps byte b (max_steps = (b & 127) % 66 - 1; b & 128: NULL n_steps):
- *                       icoac_sim_trajectory_model.
+ *                       icoac_sim_trajectory.
  *           3 cancel    as grid, with the cancel flag raised.
- *           run section as in fuzz_sim.c (fz_run), then max_trials clamped to <= 3 and
- *           success_steps to <= 300; config and prior as in fuzz_controller.c. Cell spec: kind
- *           byte k; k & 1 == 0: seed byte and 2 bytes i (little endian), cell i % size of
- *           icoac_sim_plant_grid of plant p with that seed; k & 1 == 1: x0, theta0 (doubles),
- *           seed byte. (k >> 1) & 3 (grid ops): 0 PENDING, else a finished cell preset with
- *           outcome SUCCESS, FAILED, ERROR (recognisable fields) that the grid must keep. The run
- *           ops of one input run at most FZ_SIM_TICK_BUDGET controller ticks in cells and grids
- *           (a cart-pole model's twice); refused calls are not charged.
- *   value   double and int32 as in fuzz_sim.c (tables in fuzz_input.c).
+ *           run section: a mode byte b; b odd: the raw bytes of icoac_sim_run_t over
+ *           icoac_sim_run_default; b even: (b >> 1) % 4 mutations, each a field byte (% 3:
+ *           0 max_trials, 1 success_steps as int64; 2 init_velocity_noise as double) and a value
+ *           (fz_run); then max_trials clamped to <= 3 and success_steps to <= 300. Config and
+ *           prior as in fuzz_controller.c (float controller). Cell spec: kind byte k; k & 1 == 0:
+ *           seed byte and 2 bytes i (little endian), cell i % size of icoac_sim_plant_grid of
+ *           plant p with that seed; k & 1 == 1: x0, theta0 (doubles), seed byte. (k >> 1) & 3
+ *           (grid ops): 0 PENDING, else a finished cell preset with outcome SUCCESS, FAILED, ERROR
+ *           (recognisable fields) that the grid must keep. The run ops of one input run at most
+ *           FZ_SIM_TICK_BUDGET controller ticks in cells and grids; refused calls are not charged.
+ *   value   double: selector byte k % 40. k < 28: special value (table in fuzz_input.c: 0, -0,
+ *           1e-310, DBL_TRUE_MIN, DBL_MIN, DBL_MAX, 1e300, 1e30, NaN, +Inf, -Inf, -1, 1, 0.5,
+ *           -1e30, 1e-20, -DBL_MAX, 2, 0.25, 2.4, -2.4, 9.8, 0.01, 1e-6, 1e6, 0.1, 1e-39, 3.2);
+ *           28-35: int16 (2 bytes) / 32768 * {1e-3, ..., 1e4}[k - 28]; 36-39: 8 raw bytes.
+ *           int64: selector % 12: 0, 1, 2, 3, -1, 300, 1000, 100000, INT64_MAX, INT64_MIN, 10,
+ *           11 = 8 raw bytes. int32: selector % 8: 0, 1, 2, -1, INT32_MAX, INT32_MIN, 3, 7 = 4 raw bytes.
  *
  * Contract (abort on violation): statuses are known (icoac_sim_status_str not "unknown");
  * icoac_sim_model_check accepts exactly the documented models (registry plant, Euler or RK4, dt
- * in [1e-6, 1], each parameter 0 or normal inside its range, unused ones 0). A refused model is
+ * in [1e-6, 1], each parameter 0 or normal inside its range, unused ones 0), and
+ * icoac_sim_run_check refuses a NULL run with ICOAC_SIM_ERR_BAD_ARGUMENT. A refused model is
  * refused by step, derivatives, failed, energy and start with the check's status. Every call
  * that does not return OK leaves its state and outputs bitwise untouched; the state-taking
  * calls read and write only the plant's n_state entries (each runs twice, with a NaN and with a
@@ -62,39 +66,35 @@
  * without energy is ICOAC_SIM_ERR_BAD_ARGUMENT (or NONFINITE when the input is not finite too);
  * a non-finite state or u is NONFINITE; step and derivatives return OK with finite values or
  * NONFINITE, and an OK Euler step is s + dt * derivatives (within a rounding); failed is OK
- * with 0 or 1, 1 for a non-finite state; energy is OK and finite or NONFINITE; start refuses a
- * non-finite cell or a negative or non-finite noise, accepts the documented noises (0, [1e-12,
- * 1e3]), and gives the swept components from the cell, start[] elsewhere and drawn components
- * with |v| <= noise. The grid is OK exactly for a registry plant, non-NULL cells and n_cells =
- * rows.count * cols.count, then fills them with the sweeps' values, PENDING outcomes and
- * icoac_sim_paper_grid's seeds (the cart-pole's is that grid bitwise); info is NULL exactly out
- * of range; model_default gives the documented default; find returns the plant of that name or
- * -1; from_plant copies the plant into a cart-pole model that the model check judges as
- * icoac_sim_plant_check does, and that steps and fails as icoac_sim_plant_step and
- * icoac_sim_failed do.
+ * with 0 or 1, 1 for a non-finite state, and the cart-pole's is its definition (outside |x| <=
+ * x_limit and |theta| <= theta_limit, or not finite); energy is OK and finite or NONFINITE; start
+ * refuses a non-finite cell or a negative or non-finite noise, accepts the documented noises (0,
+ * [1e-12, 1e3]), and gives the swept components from the cell, start[] elsewhere and drawn
+ * components with |v| <= noise. The grid is OK exactly for a registry plant, non-NULL cells and
+ * n_cells = rows.count * cols.count, then fills them with the sweeps' values, PENDING outcomes
+ * and the seeds icoac_mix_seed(seed, i), the other fields 0; the cart-pole's is the paper's grid
+ * (theta0 = -12 ... 12 deg, x0 = -2.4 ... 2.4 m); info is NULL exactly out of range;
+ * model_default gives the documented default; every plant parameter has the tier "essential" or
+ * "advanced" and a one-line doc; find returns the plant of that name or -1.
  *
  * Run ops: a call refused returns the status of the first failing check, in order: a NULL
- * configuration or model (ICOAC_SIM_ERR_BAD_ARGUMENT, as the plant-struct functions refuse a NULL
- * plant), the configuration check, the model check, the observation fit (a plant whose n_state
- * is not the task's n_inputs is ICOAC_SIM_ERR_BAD_PLANT), the run check (cells and grids; a NULL run
- * is BAD_ARGUMENT), then the arguments (NULL cell(s) or outputs, no cells, negative threads, a
- * non-finite x0 or theta0 in any cell, max_steps < 1, a noise not 0 or in [1e-12, 1e3]: all
- * BAD_ARGUMENT), then icoac_prior_check of the prior; and it leaves the cells, states, forces
- * and n_steps bitwise untouched. An accepted cell or grid returns OK (a grid also
- * ICOAC_SIM_ERR_THREAD, its cells untouched), every run cell ends SUCCESS, FAILED or ERROR with
- * its inputs kept and counts that fit the outcome (fz_check_finished_cell: trials in [1,
- * max_trials] unless ERROR, total_steps >= last_trial_steps, elapsed_time == dt * total_steps
- * exactly), and a non-ERROR cell has status OK and finite weights and cov; a finished cell given
- * to the grid is kept bitwise. With the cancel flag raised an accepted grid returns
- * ICOAC_SIM_CANCELLED (OK when no cell is pending), finished cells kept and the others PENDING.
- * An accepted trajectory returns OK or a controller status (< 100) with n_steps in [0,
- * max_steps]; its first row is icoac_sim_model_start of the cell (rng seeded with
- * icoac_rng_seed(seed, ICOAC_SIM_START_STREAM)), rows of n_state values; no row before the last
- * is failed or non-finite, an OK trajectory shorter than max_steps ends failed, forces are
- * finite, and nothing past n_steps is written (exact heap blocks for ASan). When a plant struct
- * represents the model (a cart-pole model that icoac_sim_model_from_plant gives back bitwise;
- * NULL for a NULL model), icoac_sim_run_cell, icoac_sim_run_grid and icoac_sim_trajectory on it
- * return the same status and the same bytes.
+ * configuration or model (ICOAC_SIM_ERR_BAD_ARGUMENT), the configuration check, the model check,
+ * the observation fit (a plant whose n_state is not the task's n_inputs is
+ * ICOAC_SIM_ERR_BAD_PLANT), the run check (cells and grids; a NULL run is BAD_ARGUMENT), then the
+ * arguments (NULL cell(s) or outputs, no cells, negative threads, a non-finite x0 or theta0 in
+ * any cell, max_steps < 1, a noise not 0 or in [1e-12, 1e3]: all BAD_ARGUMENT), then
+ * icoac_prior_check of the prior; and it leaves the cells, states, forces and n_steps bitwise
+ * untouched. An accepted cell or grid returns OK (a grid also ICOAC_SIM_ERR_THREAD, its cells
+ * untouched), every run cell ends SUCCESS, FAILED or ERROR with its inputs kept and counts that
+ * fit the outcome (fz_check_finished_cell: trials in [1, max_trials] unless ERROR, total_steps >=
+ * last_trial_steps, elapsed_time == dt * total_steps exactly), and a non-ERROR cell has status OK
+ * and finite weights and cov; a finished cell given to the grid is kept bitwise. With the cancel
+ * flag raised an accepted grid returns ICOAC_SIM_CANCELLED (OK when no cell is pending), finished
+ * cells kept and the others PENDING. An accepted trajectory returns OK or a controller status
+ * (< 100) with n_steps in [0, max_steps]; its first row is icoac_sim_model_start of the cell (rng
+ * seeded with icoac_rng_seed(seed, ICOAC_SIM_START_STREAM)), rows of n_state values; no row
+ * before the last is failed or non-finite, an OK trajectory shorter than max_steps ends failed,
+ * forces are finite, and nothing past n_steps is written (exact heap blocks for ASan).
  */
 #include <float.h>
 #include <math.h>
@@ -111,8 +111,8 @@
 #define FZ_MODEL_FIELDS (3 + 2 * ICOAC_SIM_MAX_PARAMS)
 #define FZ_NAME_MAX 24
 
-/* Op kinds and NULL-pointer bits of the op byte. */
-enum { OP_STEP, OP_DERIVATIVES, OP_FAILED, OP_ENERGY, OP_START, OP_GRID, OP_REGISTRY, OP_PLANT };
+/* Op kinds (op byte (o & 7) % OP_KINDS) and NULL-pointer bits of the op byte. */
+enum { OP_STEP, OP_DERIVATIVES, OP_FAILED, OP_ENERGY, OP_START, OP_GRID, OP_REGISTRY, OP_KINDS };
 #define NULL_STATE 0x08u
 #define NULL_OUT 0x10u
 #define NULL_RNG 0x20u
@@ -285,6 +285,25 @@ static void decode_model(fz_reader_t *r, setup_t *su)
     }
 }
 
+/* Parameter name of the model's plant (abort when it has none). */
+static double param_named(const icoac_sim_model_t *m, const char *name)
+{
+    const icoac_sim_plant_desc_t *d = icoac_sim_plant_info(m->plant);
+    int i;
+    for (i = 0; i < d->n_params && strcmp(d->params[i].name, name) != 0; ++i) {
+    }
+    FZ_CHECK(i < d->n_params, "plant %s has no parameter %s", d->name, name);
+    return m->param[i];
+}
+
+/* The cart-pole's failure test, as defined: outside the closed limits, or not finite. */
+static int cart_pole_failed(const icoac_sim_model_t *m, const double s[4])
+{
+    const double x_limit = param_named(m, "x_limit");
+    const double theta_limit = param_named(m, "theta_limit");
+    return !(fabs(s[0]) <= x_limit && fabs(s[2]) <= theta_limit && isfinite(s[1]) && isfinite(s[3]));
+}
+
 /* A state-taking call (step, derivatives, failed, energy) on s0's first n entries, fill past
  * them and in the outputs. */
 static void call_state(int op, const setup_t *su, const double *s0, double u, double fill, unsigned nulls,
@@ -373,6 +392,8 @@ static void op_state(fz_reader_t *r, const setup_t *su, int op, unsigned nulls)
         FZ_CHECK(a.status == ICOAC_SIM_OK && (a.failed == 0 || a.failed == 1) && (a.failed == 1 || !nonfinite),
                  "failed returned %d, *failed %d (state finite: %d)", (int)a.status, (int)a.failed, !nonfinite);
         FZ_CHECK(same(a.s, s0, su->n), "failed changed the state");
+        FZ_CHECK(su->model->plant != ICOAC_SIM_CART_POLE || a.failed == cart_pole_failed(su->model, s0),
+                 "the cart-pole's failed(%g, %g, %g, %g) is %d", s0[0], s0[1], s0[2], s0[3], (int)a.failed);
         return;
     }
     if (nonfinite) {
@@ -481,16 +502,23 @@ static int close_to(double a, double b)
     return fabs(a - b) <= 1e-12 * (1.0 + fabs(b));
 }
 
+/* The paper's grid (method.md), the cart-pole's: row i is theta0 = (-12 + i) deg, column j is
+ * x0 = -2.4 + 0.1 j m. */
+#define PAPER_ROWS 25
+#define PAPER_COLS 49
+
+static int64_t grid_size(const icoac_sim_plant_desc_t *d)
+{
+    return (int64_t)d->rows.count * d->cols.count;
+}
+
 static void op_grid(fz_reader_t *r)
 {
-    static icoac_sim_cell_t paper[ICOAC_SIM_GRID_CELLS];
-    static uint64_t paper_seed;
-    static int paper_ready;
     const int32_t index = fz_i32(r);
     const uint8_t c = fz_u8(r);
     const uint64_t seed = fz_u8(r);
     const icoac_sim_plant_desc_t *d = icoac_sim_plant_info(index);
-    const int64_t exact = d != 0 ? (int64_t)d->rows.count * d->cols.count : ICOAC_SIM_GRID_CELLS;
+    const int64_t exact = grid_size(d != 0 ? d : icoac_sim_plant_info(ICOAC_SIM_CART_POLE));
     const int64_t sizes[8] = {exact, 0, -1, exact - 1, exact + 1, INT64_MAX, INT64_MIN, 1};
     const int64_t n = sizes[c % 8];
     const int null_cells = (c & 0x80u) != 0u;
@@ -518,21 +546,29 @@ static void op_grid(fz_reader_t *r)
     } else {
         FZ_CHECK(status == ICOAC_SIM_OK, "plant_grid(%d, %lld cells) returned %d", (int)index, (long long)n,
                  (int)status);
-        if (!paper_ready || paper_seed != seed) { /* the paper grid of the last seed is kept */
-            FZ_CHECK(icoac_sim_paper_grid(paper, ICOAC_SIM_GRID_CELLS, seed) == ICOAC_SIM_OK, "paper_grid refused");
-            paper_seed = seed;
-            paper_ready = 1;
-        }
-        FZ_CHECK(index != ICOAC_SIM_CART_POLE || memcmp(cells, paper, sizeof paper) == 0,
-                 "the cart-pole's grid is not the paper grid");
+        FZ_CHECK(index != ICOAC_SIM_CART_POLE || (d->rows.count == PAPER_ROWS && d->cols.count == PAPER_COLS),
+                 "the cart-pole's grid has %d x %d cells, the paper's %d x %d", (int)d->rows.count,
+                 (int)d->cols.count, PAPER_ROWS, PAPER_COLS);
         for (i = 0; i < n; ++i) {
             const icoac_sim_cell_t *cell = &cells[i];
-            FZ_CHECK(close_to(cell->theta0, sweep_value(&d->rows, i / d->cols.count)) &&
-                         close_to(cell->x0, sweep_value(&d->cols, i % d->cols.count)) &&
-                         cell->outcome == ICOAC_SIM_PENDING &&
-                         (i >= ICOAC_SIM_GRID_CELLS || cell->seed == paper[i].seed),
-                     "plant_grid(%d) cell %lld: theta0 %g x0 %g outcome %d", (int)index, (long long)i, cell->theta0,
-                     cell->x0, (int)cell->outcome);
+            const int64_t row = i / d->cols.count;
+            const int64_t col = i % d->cols.count;
+            icoac_sim_cell_t want;
+            /* the documented fields, the rest 0 */
+            memset(&want, 0, sizeof want);
+            want.x0 = cell->x0;
+            want.theta0 = cell->theta0;
+            want.seed = icoac_mix_seed(seed, (uint64_t)i);
+            want.outcome = ICOAC_SIM_PENDING;
+            FZ_CHECK(close_to(cell->theta0, sweep_value(&d->rows, row)) &&
+                         close_to(cell->x0, sweep_value(&d->cols, col)) && memcmp(cell, &want, sizeof want) == 0,
+                     "plant_grid(%d) cell %lld: theta0 %g x0 %g seed %llu outcome %d", (int)index, (long long)i,
+                     cell->theta0, cell->x0, (unsigned long long)cell->seed, (int)cell->outcome);
+            FZ_CHECK(index != ICOAC_SIM_CART_POLE ||
+                         (close_to(cell->theta0, (double)(row - 12) * ICOAC_SIM_PI / 180.0) &&
+                          close_to(cell->x0, -2.4 + 0.1 * (double)col)),
+                     "the cart-pole's grid cell %lld (theta0 %g, x0 %g) is not the paper's", (long long)i,
+                     cell->theta0, cell->x0);
         }
     }
     free(cells);
@@ -570,6 +606,15 @@ static void op_registry(fz_reader_t *r)
             FZ_CHECK(memcmp(&m.param[i], &want, sizeof want) == 0, "model_default(%d): param[%d] %g", (int)index, i,
                      m.param[i]);
         }
+        for (i = 0; i < d->n_params; ++i) {
+            const icoac_sim_param_t *p = &d->params[i];
+            FZ_CHECK(p->name != 0 && p->unit != 0 && p->tier != 0 &&
+                         (strcmp(p->tier, "essential") == 0 || strcmp(p->tier, "advanced") == 0) && p->doc != 0 &&
+                         p->doc[0] != '\0' && strchr(p->doc, '\n') == 0,
+                     "plant %s: parameter %d (%s) has tier %s, doc \"%s\"", d->name, i,
+                     p->name != 0 ? p->name : "(null)", p->tier != 0 ? p->tier : "(null)",
+                     p->doc != 0 ? p->doc : "(null)");
+        }
     }
     {
         const uint8_t k = fz_u8(r) % 4;
@@ -601,118 +646,7 @@ static void op_registry(fz_reader_t *r)
     FZ_CHECK(found == (i < count ? i : -1), "plant_find(\"%s\") returned %d", query, (int)found);
 }
 
-/* The cart-pole parameter of each double field of icoac_sim_plant_t but dt. */
-static const char *const plant_fields[6] = {"gravity", "cart_mass", "pole_mass", "half_length", "x_limit",
-                                            "theta_limit"};
-
-static double *plant_field(icoac_sim_plant_t *p, int k)
-{
-    double *fields[6];
-    fields[0] = &p->gravity;
-    fields[1] = &p->cart_mass;
-    fields[2] = &p->pole_mass;
-    fields[3] = &p->half_length;
-    fields[4] = &p->x_limit;
-    fields[5] = &p->theta_limit;
-    return fields[k];
-}
-
-/* Index of the cart-pole parameter named name (abort when none is). */
-static int cart_pole_param(const char *name)
-{
-    const icoac_sim_plant_desc_t *d = icoac_sim_plant_info(ICOAC_SIM_CART_POLE);
-    int i;
-    for (i = 0; i < d->n_params && strcmp(d->params[i].name, name) != 0; ++i) {
-    }
-    FZ_CHECK(i < d->n_params, "the cart-pole has no parameter %s", name);
-    return i;
-}
-
-/* The icoac_sim_plant_t of a model: its dt, integrator and the cart-pole parameters by name (the
- * default plant for a NULL model). */
-static void plant_of_model(const icoac_sim_model_t *model, icoac_sim_plant_t *plant)
-{
-    int i;
-    icoac_sim_plant_default(plant);
-    if (model != 0) {
-        plant->dt = model->dt;
-        plant->integrator = model->integrator;
-        for (i = 0; i < 6; ++i) {
-            *plant_field(plant, i) = model->param[cart_pole_param(plant_fields[i])];
-        }
-    }
-}
-
-static void op_plant(fz_reader_t *r, const setup_t *su, unsigned nulls)
-{
-    icoac_sim_plant_t plant;
-    icoac_sim_model_t m;
-    icoac_sim_model_t given;
-    double s0[4];
-    double ps[4];
-    double ms[MAXS];
-    double force;
-    int32_t status;
-    int32_t plant_failed;
-    int32_t plant_status;
-    int32_t model_failed = FAILED_CANARY;
-    int mapped[ICOAC_SIM_MAX_PARAMS] = {0};
-    int i;
-    for (i = 0; i < 4; ++i) {
-        s0[i] = fz_double(r);
-    }
-    force = fz_double(r);
-    plant_of_model(su->model, &plant);
-    plant.reserved = fz_i32(r);
-    memset(&m, 0xA5, sizeof m);
-    given = m;
-    status = icoac_sim_model_from_plant((nulls & NULL_STATE) ? 0 : &plant, (nulls & NULL_OUT) ? 0 : &m);
-    if (nulls & (NULL_STATE | NULL_OUT)) {
-        FZ_CHECK(status == ICOAC_SIM_ERR_BAD_ARGUMENT && memcmp(&m, &given, sizeof m) == 0,
-                 "model_from_plant with a NULL pointer returned %d or wrote the model", (int)status);
-        return;
-    }
-    FZ_CHECK(status == ICOAC_SIM_OK, "model_from_plant returned %d", (int)status);
-    FZ_CHECK(m.plant == ICOAC_SIM_CART_POLE && m.integrator == plant.integrator &&
-                 memcmp(&m.dt, &plant.dt, sizeof m.dt) == 0,
-             "model_from_plant: plant %d integrator %d dt %g", (int)m.plant, (int)m.integrator, m.dt);
-    for (i = 0; i < 6; ++i) {
-        const int k = cart_pole_param(plant_fields[i]);
-        mapped[k] = 1;
-        FZ_CHECK(memcmp(&m.param[k], plant_field(&plant, i), sizeof m.param[k]) == 0, "model_from_plant: %s %g",
-                 plant_fields[i], m.param[k]);
-    }
-    for (i = 0; i < ICOAC_SIM_MAX_PARAMS; ++i) {
-        FZ_CHECK(mapped[i] || m.param[i] == 0.0, "model_from_plant: unused param[%d] %g", i, m.param[i]);
-    }
-    status = icoac_sim_model_check(&m);
-    FZ_CHECK(status == icoac_sim_plant_check(&plant), "model_check %d of the plant's model, plant_check %d",
-             (int)status, (int)icoac_sim_plant_check(&plant));
-    if (status != ICOAC_SIM_OK) {
-        return;
-    }
-    /* same dynamics and failure test */
-    memcpy(ps, s0, sizeof ps);
-    for (i = 0; i < MAXS; ++i) {
-        ms[i] = i < 4 ? s0[i] : canary(0);
-    }
-    plant_failed = icoac_sim_failed(&plant, s0);
-    status = icoac_sim_model_failed(&m, ms, &model_failed);
-    FZ_CHECK(status == ICOAC_SIM_OK && model_failed == plant_failed, "model_failed %d (status %d), icoac_sim_failed %d",
-             (int)model_failed, (int)status, (int)plant_failed);
-    plant_status = icoac_sim_plant_step(&plant, ps, force);
-    status = icoac_sim_model_step(&m, ms, force);
-    FZ_CHECK(plant_status == status, "plant_step returned %d, model_step %d", (int)plant_status, (int)status);
-    if (status == ICOAC_SIM_OK) {
-        FZ_CHECK(same(ms, ps, 4), "model_step and plant_step differ: (%g %g %g %g) vs (%g %g %g %g)", ms[0], ms[1],
-                 ms[2], ms[3], ps[0], ps[1], ps[2], ps[3]);
-    } else {
-        FZ_CHECK(status == ICOAC_SIM_ERR_NONFINITE && memcmp(ps, s0, sizeof ps) == 0,
-                 "a refused plant_step (%d) changed the state", (int)status);
-    }
-}
-
-/* ---- Run ops: icoac_sim_run_cell_model, icoac_sim_run_grid_model, icoac_sim_trajectory_model */
+/* ---- Run ops: icoac_sim_run_cell, icoac_sim_run_grid, icoac_sim_trajectory ---------------- */
 
 /* What a run op decodes: the controller configuration and prior and, for cells and grids, the
  * run (clamped) with the verdicts of their checks. */
@@ -738,9 +672,9 @@ static void decode_control(fz_reader_t *r, int with_run, control_t *c)
 }
 
 /* The status of the documented checks in their order: a NULL configuration or model is refused
- * first (as the plant-struct functions refuse a NULL plant), then the configuration check, the
- * model check, the observation fit (the task reads the plant's n_state components),
- * and last run_status (the run check, BAD_ARGUMENT for a NULL run, OK for a trajectory). */
+ * first, then the configuration check, the model check, the observation fit (the task reads the
+ * plant's n_state components), and last run_status (the run check, BAD_ARGUMENT for a NULL run,
+ * OK for a trajectory). */
 static int32_t checks_status(const setup_t *su, const icoac_config_t *cfg, int32_t run_status)
 {
     int32_t status;
@@ -758,23 +692,6 @@ static int32_t checks_status(const setup_t *su, const icoac_config_t *cfg, int32
         return ICOAC_SIM_ERR_BAD_PLANT;
     }
     return run_status;
-}
-
-/* The plant struct equivalent to the model, when one can represent it: &storage for a cart-pole
- * model that icoac_sim_model_from_plant gives back bitwise, NULL for a NULL model (*ok = 1 in
- * both cases), else *ok = 0. */
-static const icoac_sim_plant_t *equivalent_plant(const setup_t *su, icoac_sim_plant_t *storage, int *ok)
-{
-    icoac_sim_model_t back;
-    *ok = 1;
-    if (su->model == 0) {
-        return 0;
-    }
-    plant_of_model(su->model, storage);
-    storage->reserved = 0;
-    *ok = su->model->plant == ICOAC_SIM_CART_POLE && icoac_sim_model_from_plant(storage, &back) == ICOAC_SIM_OK &&
-          memcmp(&back, su->model, sizeof back) == 0;
-    return storage;
 }
 
 /* Cell i of the grid of plant index with seed; the grid of the last (index, seed) is kept. */
@@ -833,19 +750,14 @@ static int cell_inputs_kept(const icoac_sim_cell_t *a, const icoac_sim_cell_t *b
 static void op_run_cell(fz_reader_t *r, setup_t *su, unsigned nulls)
 {
     control_t c;
-    icoac_sim_plant_t plant_storage;
     icoac_sim_cell_t cell;
     icoac_sim_cell_t given;
-    icoac_sim_cell_t by_plant;
     const icoac_config_t *cfg;
     const icoac_sim_run_t *run;
-    const icoac_sim_plant_t *plant;
-    int representable;
     int32_t expected;
     int32_t status;
     decode_control(r, 1, &c);
     (void)decode_cell(r, su, &cell);
-    plant = equivalent_plant(su, &plant_storage, &representable);
     cfg = (nulls & NULL_CFG) ? 0 : &c.cfg;
     run = (nulls & NULL_RUN) ? 0 : &c.run;
     expected = checks_status(su, cfg, run != 0 ? c.run_status : ICOAC_SIM_ERR_BAD_ARGUMENT);
@@ -856,30 +768,22 @@ static void op_run_cell(fz_reader_t *r, setup_t *su, unsigned nulls)
         expected = c.prior_status;
     }
     /* refused calls run nothing: only runs are charged */
-    if (expected == ICOAC_SIM_OK && !fz_charge(&su->budget, &c.run, representable ? 2 : 1)) {
+    if (expected == ICOAC_SIM_OK && !fz_charge(&su->budget, &c.run, 1)) {
         return;
     }
     given = cell;
-    by_plant = cell;
-    status = icoac_sim_run_cell_model(cfg, su->model, run, c.prior, (nulls & NULL_CELLS) ? 0 : &cell, 0, 0);
-    FZ_CHECK(fz_sim_status_known(status), "run_cell_model returned unknown status %d", (int)status);
+    status = icoac_sim_run_cell(cfg, su->model, run, c.prior, (nulls & NULL_CELLS) ? 0 : &cell, 0, 0);
+    FZ_CHECK(fz_sim_status_known(status), "run_cell returned unknown status %d", (int)status);
     if (expected != ICOAC_SIM_OK) {
-        FZ_CHECK(status == expected, "run_cell_model returned %d (%s), the first failing check %d (%s)", (int)status,
+        FZ_CHECK(status == expected, "run_cell returned %d (%s), the first failing check %d (%s)", (int)status,
                  icoac_sim_status_str(status), (int)expected, icoac_sim_status_str(expected));
-        FZ_CHECK(memcmp(&cell, &given, sizeof cell) == 0, "run_cell_model refused with %d but wrote the cell",
+        FZ_CHECK(memcmp(&cell, &given, sizeof cell) == 0, "run_cell refused with %d but wrote the cell",
                  (int)status);
     } else {
-        FZ_CHECK(status == ICOAC_SIM_OK, "run_cell_model returned %d (%s) for a valid setup", (int)status,
+        FZ_CHECK(status == ICOAC_SIM_OK, "run_cell returned %d (%s) for a valid setup", (int)status,
                  icoac_sim_status_str(status));
-        FZ_CHECK(cell_inputs_kept(&cell, &given), "run_cell_model changed the cell's inputs");
-        fz_check_finished_cell(&c.run, su->model->dt, &cell, "run_cell_model");
-    }
-    if (representable) {
-        const int32_t plant_status =
-            icoac_sim_run_cell(cfg, plant, run, c.prior, (nulls & NULL_CELLS) ? 0 : &by_plant, 0, 0);
-        FZ_CHECK(plant_status == status && memcmp(&by_plant, &cell, sizeof cell) == 0,
-                 "run_cell returned %d, run_cell_model %d on its model, or the cells differ", (int)plant_status,
-                 (int)status);
+        FZ_CHECK(cell_inputs_kept(&cell, &given), "run_cell changed the cell's inputs");
+        fz_check_finished_cell(&c.run, su->model->dt, &cell, "run_cell");
     }
 }
 
@@ -888,20 +792,16 @@ static void op_run_grid(fz_reader_t *r, setup_t *su, unsigned nulls, int cancel)
 {
     static const int32_t preset_outcomes[4] = {ICOAC_SIM_PENDING, ICOAC_SIM_SUCCESS, ICOAC_SIM_FAILED, ICOAC_SIM_ERROR};
     control_t c;
-    icoac_sim_plant_t plant_storage;
     icoac_sim_cell_t *cells;
     icoac_sim_cell_t *given;
-    icoac_sim_cell_t *by_plant;
     const icoac_config_t *cfg;
     const icoac_sim_run_t *run;
-    const icoac_sim_plant_t *plant;
     const volatile int32_t raised = 1;
     const volatile int32_t *flag = cancel ? &raised : 0;
     uint8_t count;
     int n;
     int32_t threads;
     int preset[FZ_MODEL_MAX_CELLS] = {0};
-    int representable;
     int all_finite = 1;
     int pending = 0;
     int32_t expected;
@@ -916,8 +816,7 @@ static void op_run_grid(fz_reader_t *r, setup_t *su, unsigned nulls, int cancel)
     bytes = (size_t)(n > 0 ? n : 1) * sizeof *cells;
     cells = (icoac_sim_cell_t *)malloc(bytes);
     given = (icoac_sim_cell_t *)malloc(bytes);
-    by_plant = (icoac_sim_cell_t *)malloc(bytes);
-    FZ_CHECK(cells != 0 && given != 0 && by_plant != 0, "out of memory");
+    FZ_CHECK(cells != 0 && given != 0, "out of memory");
     memset(cells, 0, bytes);
     for (i = 0; i < n; ++i) {
         const int32_t outcome = preset_outcomes[decode_cell(r, su, &cells[i])];
@@ -933,7 +832,6 @@ static void op_run_grid(fz_reader_t *r, setup_t *su, unsigned nulls, int cancel)
         }
         all_finite = all_finite && isfinite(cells[i].x0) && isfinite(cells[i].theta0);
     }
-    plant = equivalent_plant(su, &plant_storage, &representable);
     cfg = (nulls & NULL_CFG) ? 0 : &c.cfg;
     run = (nulls & NULL_RUN) ? 0 : &c.run;
     expected = checks_status(su, cfg, run != 0 ? c.run_status : ICOAC_SIM_ERR_BAD_ARGUMENT);
@@ -943,55 +841,43 @@ static void op_run_grid(fz_reader_t *r, setup_t *su, unsigned nulls, int cancel)
     if (expected == ICOAC_SIM_OK) {
         expected = c.prior_status;
     }
-    if (expected != ICOAC_SIM_OK || cancel ||
-        fz_charge(&su->budget, &c.run, (int64_t)pending * (representable ? 2 : 1))) {
+    if (expected != ICOAC_SIM_OK || cancel || fz_charge(&su->budget, &c.run, pending)) {
         memcpy(given, cells, bytes);
-        memcpy(by_plant, cells, bytes);
-        status = icoac_sim_run_grid_model(cfg, su->model, run, c.prior, (nulls & NULL_CELLS) ? 0 : cells, n, threads,
-                                          flag, 0);
-        FZ_CHECK(fz_sim_status_known(status), "run_grid_model returned unknown status %d", (int)status);
+        status = icoac_sim_run_grid(cfg, su->model, run, c.prior, (nulls & NULL_CELLS) ? 0 : cells, n, threads, flag,
+                                    0);
+        FZ_CHECK(fz_sim_status_known(status), "run_grid returned unknown status %d", (int)status);
         if (expected != ICOAC_SIM_OK || status == ICOAC_SIM_ERR_THREAD) {
             FZ_CHECK(status == expected || (expected == ICOAC_SIM_OK && status == ICOAC_SIM_ERR_THREAD),
-                     "run_grid_model(%d cells, %d threads) returned %d (%s), the first failing check %d (%s)", n,
+                     "run_grid(%d cells, %d threads) returned %d (%s), the first failing check %d (%s)", n,
                      (int)threads, (int)status, icoac_sim_status_str(status), (int)expected,
                      icoac_sim_status_str(expected));
-            FZ_CHECK(memcmp(cells, given, bytes) == 0, "run_grid_model returned %d but changed cells", (int)status);
+            FZ_CHECK(memcmp(cells, given, bytes) == 0, "run_grid returned %d but changed cells", (int)status);
         } else if (cancel) {
             /* nothing starts: every trial start sees the flag */
             FZ_CHECK(status == ICOAC_SIM_CANCELLED || (pending == 0 && status == ICOAC_SIM_OK),
-                     "run_grid_model with the cancel flag raised returned %d (%d pending cells)", (int)status, pending);
+                     "run_grid with the cancel flag raised returned %d (%d pending cells)", (int)status, pending);
             for (i = 0; i < n; ++i) {
                 FZ_CHECK(preset[i] ? memcmp(&cells[i], &given[i], sizeof cells[i]) == 0
                                    : cells[i].outcome == ICOAC_SIM_PENDING,
-                         "run_grid_model cancelled: cell %d (preset %d) has outcome %d", i, preset[i],
+                         "run_grid cancelled: cell %d (preset %d) has outcome %d", i, preset[i],
                          (int)cells[i].outcome);
             }
         } else {
-            FZ_CHECK(status == ICOAC_SIM_OK, "run_grid_model returned %d (%s) for a valid setup", (int)status,
+            FZ_CHECK(status == ICOAC_SIM_OK, "run_grid returned %d (%s) for a valid setup", (int)status,
                      icoac_sim_status_str(status));
             for (i = 0; i < n; ++i) {
                 if (preset[i]) {
                     FZ_CHECK(memcmp(&cells[i], &given[i], sizeof cells[i]) == 0,
-                             "run_grid_model reran finished cell %d (outcome %d)", i, (int)given[i].outcome);
+                             "run_grid reran finished cell %d (outcome %d)", i, (int)given[i].outcome);
                 } else {
-                    FZ_CHECK(cell_inputs_kept(&cells[i], &given[i]), "run_grid_model changed cell %d's inputs", i);
-                    fz_check_finished_cell(&c.run, su->model->dt, &cells[i], "run_grid_model");
+                    FZ_CHECK(cell_inputs_kept(&cells[i], &given[i]), "run_grid changed cell %d's inputs", i);
+                    fz_check_finished_cell(&c.run, su->model->dt, &cells[i], "run_grid");
                 }
             }
-        }
-        if (representable && !cancel) {
-            const int32_t plant_status = icoac_sim_run_grid(cfg, plant, run, c.prior,
-                                                            (nulls & NULL_CELLS) ? 0 : by_plant, n, threads, 0, 0);
-            FZ_CHECK((plant_status == status || plant_status == ICOAC_SIM_ERR_THREAD ||
-                      status == ICOAC_SIM_ERR_THREAD) &&
-                         (plant_status != status || memcmp(by_plant, cells, bytes) == 0),
-                     "run_grid returned %d, run_grid_model %d on its model, or the cells differ", (int)plant_status,
-                     (int)status);
         }
     }
     free(cells);
     free(given);
-    free(by_plant);
 }
 
 /* The recorded trajectory of an accepted call: the first row is the model's start of the cell,
@@ -1004,33 +890,33 @@ static void check_trajectory(const setup_t *su, const icoac_sim_cell_t *cell, do
     double start[MAXS];
     icoac_rng_t rng;
     int64_t k;
-    FZ_CHECK(status < 100, "trajectory_model returned %d (%s) for a valid setup", (int)status,
+    FZ_CHECK(status < 100, "trajectory returned %d (%s) for a valid setup", (int)status,
              icoac_sim_status_str(status));
-    FZ_CHECK(n_steps >= 0 && n_steps <= max_steps, "trajectory_model: n_steps %lld of max_steps %lld",
+    FZ_CHECK(n_steps >= 0 && n_steps <= max_steps, "trajectory: n_steps %lld of max_steps %lld",
              (long long)n_steps, (long long)max_steps);
     icoac_rng_seed(&rng, cell->seed, ICOAC_SIM_START_STREAM);
     FZ_CHECK(icoac_sim_model_start(su->model, cell, noise, &rng, start) == ICOAC_SIM_OK,
-             "model_start refused what trajectory_model accepted");
-    FZ_CHECK(same(states, start, n), "trajectory_model: the first row is not the model's start");
+             "model_start refused what trajectory accepted");
+    FZ_CHECK(same(states, start, n), "trajectory: the first row is not the model's start");
     for (k = 1; k <= n_steps; ++k) {
         const double *s = states + (size_t)n * (size_t)k;
         int32_t failed = FAILED_CANARY;
         FZ_CHECK(icoac_sim_model_failed(su->model, s, &failed) == ICOAC_SIM_OK, "model_failed refused a row");
         if (k < n_steps) {
-            FZ_CHECK(fz_all_finite_double(s, n) && !failed, "trajectory_model ran on past row %lld (failed %d)",
+            FZ_CHECK(fz_all_finite_double(s, n) && !failed, "trajectory ran on past row %lld (failed %d)",
                      (long long)k, (int)failed);
         } else if (status == ICOAC_SIM_OK && n_steps < max_steps) {
-            FZ_CHECK(failed, "trajectory_model stopped at %lld of %lld without a failure", (long long)n_steps,
+            FZ_CHECK(failed, "trajectory stopped at %lld of %lld without a failure", (long long)n_steps,
                      (long long)max_steps);
         }
     }
-    FZ_CHECK(fz_all_finite_double(forces, (int)n_steps), "trajectory_model recorded a non-finite force");
+    FZ_CHECK(fz_all_finite_double(forces, (int)n_steps), "trajectory recorded a non-finite force");
     for (k = (n_steps + 1) * n; k < (max_steps + 1) * n; ++k) {
-        FZ_CHECK(isnan(states[k]), "trajectory_model wrote state entry %lld past its %lld steps", (long long)k,
+        FZ_CHECK(isnan(states[k]), "trajectory wrote state entry %lld past its %lld steps", (long long)k,
                  (long long)n_steps);
     }
     for (k = n_steps; k < max_steps; ++k) {
-        FZ_CHECK(isnan(forces[k]), "trajectory_model wrote force %lld past its %lld steps", (long long)k,
+        FZ_CHECK(isnan(forces[k]), "trajectory wrote force %lld past its %lld steps", (long long)k,
                  (long long)n_steps);
     }
 }
@@ -1050,10 +936,8 @@ static double *nan_block(int64_t count)
 static void op_run_trajectory(fz_reader_t *r, const setup_t *su, unsigned nulls)
 {
     control_t c;
-    icoac_sim_plant_t plant_storage;
     icoac_sim_cell_t cell;
     const icoac_config_t *cfg;
-    const icoac_sim_plant_t *plant;
     double noise;
     uint8_t steps_byte;
     int64_t max_steps;
@@ -1065,7 +949,6 @@ static void op_run_trajectory(fz_reader_t *r, const setup_t *su, unsigned nulls)
     double *given_forces;
     int64_t n_steps = -7;
     int64_t *n_steps_out;
-    int representable;
     int32_t expected;
     int32_t status;
     decode_control(r, 0, &c);
@@ -1081,10 +964,9 @@ static void op_run_trajectory(fz_reader_t *r, const setup_t *su, unsigned nulls)
     given_states = nan_block(rows * row);
     given_forces = nan_block(rows - 1 > 0 ? rows - 1 : 1);
     cfg = (nulls & NULL_CFG) ? 0 : &c.cfg;
-    status = icoac_sim_trajectory_model(cfg, su->model, c.prior, cell.x0, cell.theta0, noise, cell.seed, max_steps,
-                                        (nulls & NULL_CELLS) ? 0 : states, (nulls & NULL_RUN) ? 0 : forces,
-                                        n_steps_out);
-    FZ_CHECK(fz_sim_status_known(status), "trajectory_model returned unknown status %d", (int)status);
+    status = icoac_sim_trajectory(cfg, su->model, c.prior, cell.x0, cell.theta0, noise, cell.seed, max_steps,
+                                  (nulls & NULL_CELLS) ? 0 : states, (nulls & NULL_RUN) ? 0 : forces, n_steps_out);
+    FZ_CHECK(fz_sim_status_known(status), "trajectory returned unknown status %d", (int)status);
     expected = checks_status(su, cfg, ICOAC_SIM_OK);
     if (expected == ICOAC_SIM_OK &&
         ((nulls & (NULL_CELLS | NULL_RUN)) || n_steps_out == 0 || max_steps < 1 || !isfinite(cell.x0) ||
@@ -1095,27 +977,13 @@ static void op_run_trajectory(fz_reader_t *r, const setup_t *su, unsigned nulls)
         expected = c.prior_status;
     }
     if (expected != ICOAC_SIM_OK) {
-        FZ_CHECK(status == expected, "trajectory_model returned %d (%s), the first failing check %d (%s)",
+        FZ_CHECK(status == expected, "trajectory returned %d (%s), the first failing check %d (%s)",
                  (int)status, icoac_sim_status_str(status), (int)expected, icoac_sim_status_str(expected));
         FZ_CHECK(n_steps == -7 && memcmp(states, given_states, (size_t)(rows * row) * sizeof *states) == 0 &&
                      memcmp(forces, given_forces, (size_t)(rows > 1 ? rows - 1 : 1) * sizeof *forces) == 0,
-                 "trajectory_model refused with %d but wrote its outputs", (int)status);
+                 "trajectory refused with %d but wrote its outputs", (int)status);
     } else {
         check_trajectory(su, &cell, noise, max_steps, status, states, forces, n_steps);
-    }
-    plant = equivalent_plant(su, &plant_storage, &representable);
-    if (representable) {
-        int64_t plant_steps = -7;
-        const int32_t plant_status = icoac_sim_trajectory(
-            cfg, plant, c.prior, cell.x0, cell.theta0, noise, cell.seed, max_steps,
-            (nulls & NULL_CELLS) ? 0 : given_states, (nulls & NULL_RUN) ? 0 : given_forces,
-            n_steps_out != 0 ? &plant_steps : 0);
-        FZ_CHECK(plant_status == status && plant_steps == n_steps &&
-                     memcmp(states, given_states, (size_t)(rows * row) * sizeof *states) == 0 &&
-                     memcmp(forces, given_forces, (size_t)(rows > 1 ? rows - 1 : 1) * sizeof *forces) == 0,
-                 "trajectory returned %d (%lld steps), trajectory_model %d (%lld steps) on its model, or the "
-                 "recordings differ",
-                 (int)plant_status, (long long)plant_steps, (int)status, (long long)n_steps);
     }
     free(states);
     free(forces);
@@ -1130,6 +998,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     int ops;
     fz_reader_init(&r, data, size);
     FZ_CHECK(icoac_sim_plant_count() >= 1, "empty registry");
+    FZ_CHECK(icoac_sim_run_check(0) == ICOAC_SIM_ERR_BAD_ARGUMENT, "run_check(NULL) was not refused");
     decode_model(&r, &su);
     for (ops = 0; ops < FZ_MODEL_OPS && !fz_done(&r); ++ops) {
         const uint8_t op = fz_u8(&r);
@@ -1144,15 +1013,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             }
             continue;
         }
-        switch (op & 7) {
-        case OP_STEP:
-        case OP_DERIVATIVES:
-        case OP_FAILED:
-        case OP_ENERGY: op_state(&r, &su, op & 7, nulls); break;
+        switch ((op & 7) % OP_KINDS) {
         case OP_START: op_start(&r, &su, nulls); break;
         case OP_GRID: op_grid(&r); break;
         case OP_REGISTRY: op_registry(&r); break;
-        default: op_plant(&r, &su, nulls); break;
+        default: op_state(&r, &su, (op & 7) % OP_KINDS, nulls); break;
         }
     }
     return 0;

@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Write the committed seed corpus of the fuzz targets, tests/fuzz/corpus/<target>/.
 
-Inputs follow the formats documented at the top of fuzz_controller.c, fuzz_state.c,
-fuzz_sim.c and fuzz_model.c; the value tables below mirror fuzz_input.c, the state fields
+Inputs follow the formats documented at the top of fuzz_controller.c, fuzz_state.c and
+fuzz_model.c; the value tables below mirror fuzz_input.c, the state fields
 fuzz_state.c. Files named repro-* are known reproducers.
 
     python3 tests/fuzz/gen_corpus.py          # (re)write the corpus
@@ -138,8 +138,6 @@ def config_offsets(fmt):
     return size, fields
 
 
-PLANT_FIELDS = ["gravity", "cart_mass", "pole_mass", "half_length", "dt", "x_limit",
-                "theta_limit", "integrator", "reserved"]
 RUN_FIELDS = ["max_trials", "success_steps", "init_velocity_noise"]
 
 
@@ -755,95 +753,12 @@ def state_seeds(fmt):
     return s
 
 
-def plant(**fields):
-    assert len(fields) <= 7
-    out = bytes([len(fields) << 1])
-    for name, v in fields.items():
-        out += bytes([PLANT_FIELDS.index(name)]) + (int32(v) if name in ("integrator", "reserved") else double(v))
-    return out
-
-
 def run(**fields):
     assert len(fields) <= 3
     out = bytes([len(fields) << 1])
     for name, v in fields.items():
         out += bytes([RUN_FIELDS.index(name)]) + (double(v) if name == "init_velocity_noise" else int64(v))
     return out
-
-
-def op_plant(s, force):
-    return b"\x00" + b"".join(double(x) for x in s) + double(force)
-
-
-def op_cell(x0, theta0, cell_seed):
-    return b"\x01" + double(x0) + double(theta0) + bytes([cell_seed])
-
-
-def op_grid(cells, threads=1):
-    """cells: (x0, theta0, seed, finished) tuples, 0 to 4 of them."""
-    count = len(cells) - 1 if cells else 31
-    out = b"\x02" + bytes([count, {1: 0, 2: 13, -1: 15}[threads]])
-    for x0, theta0, cell_seed, finished in cells:
-        out += double(x0) + double(theta0) + bytes([cell_seed, 3 if finished else 0])
-    return out
-
-
-def op_trajectory(x0, theta0, noise, traj_seed, max_steps):
-    return b"\x03" + double(x0) + double(theta0) + double(noise) + bytes([traj_seed, max_steps + 1])
-
-
-PAPER_SIZES = [0, -1, 1, 1224, 1226, 2**63 - 1, -2**63, 1225]
-
-
-def op_paper(n, null=False):
-    return b"\x04" + bytes([PAPER_SIZES.index(n) | (0x80 if null else 0)])
-
-
-SIM_OPS = (op_cell(0.5, 0.05, 1) + op_grid([(0.0, 0.02, 2, False), (-1.0, -0.1, 3, False)])
-           + op_trajectory(0.5, 0.1, "0", 4, 64) + op_plant((0.0, 0.1, 0.05, -0.2), 10.0))
-
-
-def sim_seeds():
-    rl = config({"mode": 1})
-    return {
-        "default-ico": plant() + run() + config() + NO_PRIOR + SIM_OPS,
-        "default-rl": plant() + run() + rl + NO_PRIOR + SIM_OPS,
-        "rl-prior": plant() + run() + rl + prior(("mean2", 5.0), ("mean3", 1.0)) + SIM_OPS,
-        "rk4-noise": plant(integrator=1) + run(init_velocity_noise=0.1) + config() + NO_PRIOR + SIM_OPS,
-        "grid-threads": (plant() + run() + rl + NO_PRIOR
-                         + op_grid([(0.0, 0.0, 1, False), (1.0, 0.1, 2, True), (-1.0, -0.1, 3, False),
-                                    (2.0, 0.2, 4, False)], threads=2)
-                         + op_grid([(0.0, 0.0, 1, False)], threads=-1) + op_grid([])
-                         + op_grid([("nan", 0.0, 1, False)])),
-        "paper-grid": plant() + run() + config() + NO_PRIOR + op_paper(1225) + op_paper(1224) + op_paper(0, True),
-        "bad-plant": plant(gravity="nan") + run() + config() + NO_PRIOR + SIM_OPS,
-        "bad-run": plant() + run(max_trials=0, init_velocity_noise="-1") + config() + NO_PRIOR + SIM_OPS,
-        "bad-config-prior": plant() + run() + config({"mode": 3}) + prior(((2, 2), "-1")) + SIM_OPS,
-        "default-search": plant() + run() + config({"mode": 2, "search.batch": 2}) + NO_PRIOR + SIM_OPS,
-        "search-prior": (plant() + run(max_trials=3) + config({"mode": 2, "search.batch": 1, "search.cov_scale": 4.0})
-                         + prior(("mean2", 5.0), ("mean3", 1.0)) + SIM_OPS),
-        "rl-literal": (plant() + run() + config({"mode": 1, "actor.update": 0, "actor.explore_ticks": 0})
-                       + NO_PRIOR + SIM_OPS),
-        "rl-learners": (plant() + run() + config({"mode": 1, "actor.update": 1, "actor.batch": 1,
-                                                  "actor.explore_ticks": 50, "critic.quirks": 1}) + NO_PRIOR + SIM_OPS),
-        "bad-arguments": (plant() + run() + config() + NO_PRIOR + op_cell("inf", 0.0, 1)
-                          + op_trajectory(0.0, 0.0, "nan", 1, 0) + op_trajectory(0.0, "nan", "0", 1, 10)),
-        "plant-extremes": (plant() + run() + config() + NO_PRIOR + op_plant(("1e300", "-1e30", "2.4", "nan"), "max")
-                           + op_plant(("0", "0", "3.2", "1e300"), "-max")),
-        "trajectory-fall": (plant() + run() + config({"policy.gain": "0"}) + NO_PRIOR
-                            + op_trajectory(0.0, 0.2, "0.01", 9, 64)),
-        # Known reproducer of the tick contract: a subnormal dt passes the plant check.
-        "repro-plant-dt-1e-310": plant(dt="1e-310") + run() + config() + NO_PRIOR + SIM_OPS,
-        # Found by fuzzing the fixed engine: float subnormals in the configuration or prior are
-        # checked as given, then flushed to 0 in the run (FTZ/DAZ), so the verdicts differ.
-        "repro-config-zone-theta-1e-39": (plant() + run() + config({"task.rule_threshold[0]": "1e-39"}) + NO_PRIOR
-                                          + SIM_OPS),
-        # the engine's plant is the cart-pole: a task of another size is refused
-        "task-six-inputs": (plant() + run() + config({"task.n_inputs": 6, "policy.input_range[4]": 1.0,
-                                                      "policy.input_range[5]": 1.0}) + NO_PRIOR + SIM_OPS),
-        "repro-prior-cov-diag-1e-39": plant() + run() + config() + prior(((0, 0), "1e-39")) + SIM_OPS,
-        "repro-prior-cov-asymmetric-1e-39": plant() + run() + config() + prior(((3, 0), "-1e-39")) + SIM_OPS,
-    }
 
 
 # ---- fuzz_model ----
@@ -854,9 +769,9 @@ MAX_PARAMS = 16
 MODEL_FIELDS = ["plant", "integrator", "dt"]  # then 3 + i: param<i>, 3 + MAX_PARAMS + i: bound<i>
 # bound<i> selectors: a bound of the range, or past n_params -0, 0, DBL_TRUE_MIN, -DBL_TRUE_MIN
 BOUNDS = ["min", "max", "below", "above"]
-M_STEP, M_DERIVATIVES, M_FAILED, M_ENERGY, M_START, M_GRID, M_REGISTRY, M_PLANT = range(8)
-# NULL pointers of an op (o >= 0xC0): the state array (plant op: the plant), the output (start:
-# the cell; plant op: the model), the rng
+# op kinds, (o & 7) % 7
+M_STEP, M_DERIVATIVES, M_FAILED, M_ENERGY, M_START, M_GRID, M_REGISTRY = range(7)
+# NULL pointers of an op (o >= 0xC0): the state array, the output (start: the cell), the rng
 NULL_STATE, NULL_OUT, NULL_RNG = 0xC8, 0xD0, 0xE0
 GRID_SIZES = ["exact", 0, -1, "exact-1", "exact+1", "max", "min", 1]
 
@@ -885,6 +800,7 @@ def model_raw(plant, integrator, dt, params, over=0):
 
 
 NULL_MODEL = b"\x03\x00"
+THETA_LIMIT = 12.0 * math.pi / 180.0  # the cart-pole's default, as cart_pole.c computes it
 
 
 def op_state(kind, s, u=None, nulls=0):
@@ -914,10 +830,6 @@ def op_registry(index, name=None):
     return out + bytes([3, len(raw)]) + raw
 
 
-def op_model_plant(s, force, reserved=0, nulls=0):
-    return bytes([M_PLANT | nulls]) + b"".join(double(x) for x in s) + double(force) + int32(reserved)
-
-
 # Run ops (op bytes 0x80..0xBF): kind, and NULL pointers with RUN_NULLS (the configuration, the
 # cell / cells / trajectory states, the run / trajectory forces).
 R_CELL, R_GRID, R_TRAJECTORY, R_CANCELLED = 0x80, 0x81, 0x82, 0x83
@@ -935,12 +847,12 @@ def xy_cell(x0, theta0, cell_seed=1, preset=None):
 
 
 def op_run_cell(cell, run_=None, cfg=None, prior_=NO_PRIOR, nulls=0):
-    """icoac_sim_run_cell_model; run_ and cfg default to run() and config()."""
+    """icoac_sim_run_cell; run_ and cfg default to run() and config()."""
     return bytes([R_CELL | nulls]) + (run_ or run()) + (cfg or config()) + prior_ + cell
 
 
 def op_run_grid(cells, threads=1, run_=None, cfg=None, prior_=NO_PRIOR, nulls=0, cancelled=False):
-    """icoac_sim_run_grid_model on 0 to 4 cells (cell specs)."""
+    """icoac_sim_run_grid on 0 to 4 cells (cell specs)."""
     count = len(cells) - 1 if cells else 31
     return (bytes([(R_CANCELLED if cancelled else R_GRID) | nulls]) + (run_ or run()) + (cfg or config()) + prior_
             + bytes([count, {1: 0, 2: 13, -1: 15}[threads]]) + b"".join(cells))
@@ -957,11 +869,18 @@ RL = config({"mode": 1})
 
 
 def run_ops(p):
-    """Each run op once on plant p's model within the tick budget (a cart-pole model runs twice,
-    through its plant struct too): ICO and RL cells, a grid with a finished cell, a trajectory."""
+    """Each run op once on plant p's model within the tick budget: ICO and RL cells, a grid with a
+    finished cell, a trajectory."""
     return (op_run_cell(grid_cell(600), ONE_TRIAL) + op_run_cell(xy_cell(0.1, 0.02, 3), SMALL_RUN, RL)
             + op_run_grid([grid_cell(0, 2), grid_cell(612, 2, "success"), xy_cell(-0.5, -0.05, 4)], 2, ONE_TRIAL)
             + op_run_trajectory(grid_cell(612, 5), "0.01", 64))
+
+
+def control_ops(cfg, prior_=NO_PRIOR, run_=None):
+    """A cell, a grid of two cells and a trajectory with one configuration, prior and run."""
+    return (op_run_cell(xy_cell(0.5, 0.05, 1), run_, cfg, prior_)
+            + op_run_grid([xy_cell(0.0, 0.02, 2), xy_cell(-1.0, -0.1, 3)], 1, run_, cfg, prior_)
+            + op_run_trajectory(xy_cell(0.5, 0.1, 4), "0", 64, cfg, prior_))
 
 
 def model_ops(p):
@@ -970,15 +889,14 @@ def model_ops(p):
     s = [0.01 * (i + 1) for i in range(n)]
     return (op_state(M_STEP, s, 0.5) + op_state(M_DERIVATIVES, s, -1.0) + op_state(M_FAILED, s)
             + op_state(M_ENERGY, s) + op_start(0.5, 0.05, 1, 0.01, 2) + op_model_grid(p)
-            + op_registry(p, ("plant", p)) + op_model_plant((0.1, 0.0, 0.02, 0.0), 1.0))
+            + op_registry(p, ("plant", p)))
 
 
 def model_seeds():
     nulls = (op_state(M_STEP, [], 0.0, NULL_STATE) + op_state(M_DERIVATIVES, [0.1], 0.0, NULL_OUT)
              + op_state(M_FAILED, [], nulls=NULL_STATE | NULL_OUT) + op_state(M_ENERGY, ["nan"], nulls=NULL_OUT)
              + op_start(0.0, 0.0, 1, "0", 1, NULL_STATE) + op_start(0.0, 0.0, 1, "0", 1, NULL_OUT)
-             + op_start(0.0, 0.0, 1, "0", 1, NULL_RNG) + op_model_plant(("0",) * 4, "0", nulls=NULL_STATE)
-             + op_model_plant(("0",) * 4, "0", nulls=NULL_OUT))
+             + op_start(0.0, 0.0, 1, "0", 1, NULL_RNG))
     s = {}
     for p, (name, n) in enumerate(PLANTS):
         s[f"{name}-default"] = model(p) + model_ops(p)
@@ -1042,8 +960,8 @@ def model_seeds():
         "runs-order-bad-model": model(1, param0="nan") + order,
         "runs-order-unfit-plant": model(2) + order,
         "runs-order-unused-param": model(0, param15=1.0) + order,
-        # -0 as an unused parameter: accepted, but no plant struct gives it back
-        "runs-unrepresentable": model(0, bound15="min") + run_ops(0),
+        # -0 as an unused parameter: accepted
+        "runs-unused-param-minus-0": model(0, bound15="min") + run_ops(0),
         "runs-cancelled": (model(1) + op_run_grid([grid_cell(3), grid_cell(5, 1, "failed")], 2, cancelled=True)
                            + op_run_grid([grid_cell(3, 1, "error")], cancelled=True)
                            + op_run_grid([grid_cell(3)], nulls=NULL_CFG, cancelled=True)),
@@ -1079,11 +997,27 @@ def model_seeds():
                      + op_registry(0, "cart_pole") + op_registry(1, "furuta_") + op_registry(2, "DOUBLE_CART_POLE")),
         "grid-bad-index": (model(0) + op_model_grid(-1) + op_model_grid(3, "exact-1") + op_model_grid(2**31 - 1, "max")
                            + op_model_grid(-2**31, "min", null=True)),
-        "from-plant": (model(0, integrator=1) + op_model_plant((0.1, 0.0, 0.02, 0.0), 10.0)
-                       + op_model_plant((2.4, 1.0, -0.25, "-1"), "-1e30") + op_model_plant(("nan", 0, 0, 0), 0.0)
-                       + op_model_plant(("1e300", "1e300", 0.1, "1e300"), "max", reserved=-1)),
-        "from-plant-furuta": model(1) + op_model_plant((0.1, 0.0, 0.02, 0.0), 1.0, reserved=2),
-        "from-plant-bad": model(0, param5="3.2", dt="0.25") + op_model_plant((0.1, 0.0, 0.02, 0.0), 1.0),
+        # the cart-pole's failure test at and just past its limits (2.4 m, 12 deg)
+        "cart-pole-failed-limits": (model(0) + op_state(M_FAILED, ["2.4", "0", Exact(THETA_LIMIT), "0"])
+                                    + op_state(M_FAILED, ["-2.4", "0", Exact(-THETA_LIMIT), "0"])
+                                    + op_state(M_FAILED, [Exact(math.nextafter(2.4, math.inf)), "0", "0", "0"])
+                                    + op_state(M_FAILED, ["0", "0", Exact(math.nextafter(THETA_LIMIT, math.inf)), "0"])
+                                    + op_state(M_FAILED, ["0", "inf", "0", "0"])
+                                    + op_state(M_FAILED, ["0", "0", "0", "nan"])),
+        # learners and settings of the runs
+        "runs-rl-literal": model(0) + control_ops(config({"mode": 1, "actor.update": 0, "actor.explore_ticks": 0})),
+        "runs-rl-learners": model(0) + control_ops(config({"mode": 1, "actor.update": 1, "actor.batch": 1,
+                                                           "actor.explore_ticks": 50, "critic.quirks": 1})),
+        "runs-search-prior": model(0) + control_ops(config({"mode": 2, "search.batch": 1, "search.cov_scale": 4.0}),
+                                                    prior(("mean2", 5.0), ("mean3", 1.0)), run(max_trials=3)),
+        "runs-rk4-noise": model(0, integrator=1) + control_ops(config(), run_=run(init_velocity_noise=0.1)),
+        # Known reproducers of the runs' contract: a subnormal dt passed the plant check; float
+        # subnormals in the configuration or prior were checked as given, then flushed to 0 in the
+        # run (FTZ/DAZ), so the verdicts differed.
+        "repro-runs-dt-1e-310": model(0, dt="1e-310") + control_ops(config()),
+        "repro-runs-config-zone-theta-1e-39": model(0) + control_ops(config({"task.rule_threshold[0]": "1e-39"})),
+        "repro-runs-prior-cov-diag-1e-39": model(0) + control_ops(config(), prior(((0, 0), "1e-39"))),
+        "repro-runs-prior-cov-asymmetric-1e-39": model(0) + control_ops(config(), prior(((3, 0), "-1e-39"))),
     })
     return s
 
@@ -1098,7 +1032,6 @@ def corpus():
         "fuzz_state": state_seeds("f"),
         "fuzz_state_mcu": state_seeds("f"),
         "fuzz_state_double": state_seeds("d"),
-        "fuzz_sim": sim_seeds(),
         "fuzz_model": model_seeds(),
     }
 
