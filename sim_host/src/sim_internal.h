@@ -11,7 +11,7 @@
 #define SIM_DT_DEFAULT 0.01
 
 /* Failure test of the plant (method.md) with strict limits; written so that NaN counts as failure.
- * Non-finite velocities fail too (icoac_sim_failed contract: "or not finite"); otherwise the
+ * Non-finite velocities fail too (icoac_sim_model_failed contract: "or not finite"); otherwise the
  * next tick hands them to the controller, which rejects the observation and the cell ends
  * as ICOAC_SIM_ERROR instead of a failed trial. */
 static inline int32_t sim_cart_pole_failed(double x_limit, double theta_limit, const double s[4])

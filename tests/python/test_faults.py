@@ -230,7 +230,7 @@ def test_c_failure_during_resume_leaves_files_intact(capsys, res, monkeypatch):
         calls.append(args)
         return B.SIM_ERR_THREAD
 
-    monkeypatch.setattr(B.lib, "icoac_sim_run_grid_model", failing_run_grid)
+    monkeypatch.setattr(B.lib, "icoac_sim_run_grid", failing_run_grid)
     before = snapshot(res)
     rc, _, err = main(capsys, "grid", "--out", res, "--resume", "--quiet")
     assert calls, "the C runner was not reached"
