@@ -465,3 +465,11 @@ def test_prior_from_a_run_of_other_input_signs_is_refused(tmp_path, ico_dir):
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and "the ICO run's input signs [1, 1, 1, 1] are not this task's [-1, 1, 1, 1]" in lines[0]
     assert not out.exists()
+    # the ceiling's search starts from the same mean, in the same coordinates
+    out = tmp_path / "ceiling"
+    res = run_cli("ceiling", "--prior-from", str(ico_dir), "--out", str(out), "--cells", "611",
+                  "--set", "task.input_sign=[-1,1,1,1]")
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "the ICO run's input signs [1, 1, 1, 1] are not this task's [-1, 1, 1, 1]" in lines[0]
+    assert not out.exists()

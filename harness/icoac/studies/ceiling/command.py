@@ -94,6 +94,7 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
     typical = ("typical ICO", as_weights(typical_w))
     if opt.prior_from is not None:
         prior_info = P.from_results(opt.prior_from, plant=opt.plant)
+        P.check_origin_task(prior_info, probe)  # its weights are in this task's coordinates
         typical = ("ICO mean (--prior-from)", as_weights(prior_info.mean, "--prior-from mean", n_inputs))
     template = grid.make_cells(seed, indices, plant=opt.plant)
     screen_settings = None
