@@ -48,7 +48,8 @@ RESULT_FIELDS = ("outcome", "status", "trials", "total_steps", "last_trial_steps
 CART_POLE_INPUTS = 4
 
 # The ICO prior: the ICO->RL prior (default frame and ridge) of an ICO grid of the default profile
-# (results/ico-seed0: seed 0, 1e5 trials, at ad0bc3e), stored in the reference by --generate.
+# (results/ico-seed0: seed 0, 1e5 trials, at ad0bc3e), stored in the reference by --generate and
+# kept by a --generate without --ico-prior-from.
 
 
 def _run_condition(name: str, ico_prior) -> np.ndarray:
@@ -102,16 +103,25 @@ def _commit() -> str:
         return "unknown"
 
 
-def generate(ico_prior_from: Path, reference: Path = REFERENCE) -> None:
-    from icoac.core import options
+def generate(ico_prior_from: Path | None, reference: Path = REFERENCE) -> None:
+    """Rewrite the reference; its ICO prior from an ICO results directory, or (None) the one it
+    holds, so that a deliberate change of the results' bits needs no new ICO grid."""
+    from icoac.core.registry import CONDITIONS
     from icoac.studies import prior as P
-    ico = P.from_results(ico_prior_from)
+    if ico_prior_from is None:
+        ico = _ico_prior_from_reference(np.load(reference))
+        source = "the previous reference's prior"
+    else:
+        ico = P.from_results(ico_prior_from)
+        source = str(ico_prior_from)
     arrays = {"ico_prior_mean": ico.mean[:CART_POLE_INPUTS],
               "ico_prior_cov": ico.cov[:CART_POLE_INPUTS, :CART_POLE_INPUTS]}
-    for name in (*options.CONDITIONS, *VARIANTS):
+    for name in (*CONDITIONS, *VARIANTS):
         arrays[name] = _run_condition(name, ico)
     meta = {"commit": _commit(), "cells": CELLS, "seed": SEED, "caps": CAPS, "ico_caps": ICO_CAPS,
-            "command": f"python -m tests.tools.compare_cells --generate --ico-prior-from {ico_prior_from}"}
+            "command": "python -m tests.tools.compare_cells --generate"
+                       + (f" --ico-prior-from {ico_prior_from}" if ico_prior_from is not None else ""),
+            "ico_prior": source}
     arrays["meta"] = np.array(json.dumps(meta))
     np.savez_compressed(reference, **arrays)
     print(f"wrote {reference} ({meta['commit']})")
@@ -124,7 +134,8 @@ def load_conditions(reference: Path = REFERENCE) -> list[str]:
 
 def compare(conditions=None, reference: Path = REFERENCE) -> dict[str, dict[str, int]]:
     """{condition: {"cells": compared, "identical": bit-identical cells, "outcome_or_trials": cells
-    whose outcome or trial count differs}}."""
+    whose outcome or trial count differs, "successes" and "new_successes": the reference's and
+    this library's successful cells}}."""
     data = np.load(reference)
     ico = _ico_prior_from_reference(data)
     report = {}
@@ -139,15 +150,16 @@ def compare(conditions=None, reference: Path = REFERENCE) -> dict[str, dict[str,
         coarse = (ref["outcome"] != new["outcome"]) | (ref["trials"] != new["trials"])
         report[condition] = {"cells": int(ref.size), "identical": int(same.sum()),
                              "outcome_or_trials": int(coarse.sum()),
-                             "successes": int((ref["outcome"] == 1).sum())}
+                             "successes": int((ref["outcome"] == 1).sum()),
+                             "new_successes": int((new["outcome"] == 1).sum())}
     return report
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--generate", action="store_true", help="rewrite the reference cells")
-    parser.add_argument("--ico-prior-from", type=Path, default=ROOT / "results" / "ico-seed0",
-                        help="ICO results directory of the prior (--generate only)")
+    parser.add_argument("--ico-prior-from", type=Path, default=None,
+                        help="ICO results directory of the prior (--generate only; default: the reference's own)")
     parser.add_argument("--condition", action="append", help="compare only these conditions")
     parser.add_argument("--reference", type=Path, default=REFERENCE, help="reference file (default: the committed one)")
     args = parser.parse_args(argv)
@@ -159,7 +171,8 @@ def main(argv=None) -> int:
     print(f"reference: commit {meta['commit']}, {len(meta['cells'])} cells, seed {meta['seed']}")
     for condition, row in report.items():
         print(f"{condition:24s} {row['identical']:3d} / {row['cells']} bit-identical, "
-              f"{row['outcome_or_trials']} differ in outcome or trials ({row['successes']} reference successes)")
+              f"{row['outcome_or_trials']} differ in outcome or trials (successes: {row['successes']} in the "
+              f"reference, {row['new_successes']} now)")
     return 0 if all(r["identical"] == r["cells"] for r in report.values()) else 1
 
 

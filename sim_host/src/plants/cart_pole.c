@@ -5,6 +5,7 @@
 
 #include "icoac_sim/icoac_sim.h"
 #include "sim_integrate.h"
+#include "sim_trig.h"
 #include "sim_internal.h"
 
 enum { GRAVITY, CART_MASS, POLE_MASS, HALF_LENGTH, X_LIMIT = SIM_CART_POLE_X_LIMIT, THETA_LIMIT, N_PARAMS };
@@ -14,8 +15,8 @@ static void derivatives(const double *p, const double *s, double force, double *
 {
     const double inv_total_mass = 1.0 / (p[CART_MASS] + p[POLE_MASS]);
     const double pole_moment = p[POLE_MASS] * p[HALF_LENGTH];
-    const double sin_t = sin(s[2]);
-    const double cos_t = cos(s[2]);
+    double sin_t, cos_t;
+    sim_sincos(s[2], &sin_t, &cos_t);
     const double temp = (force + pole_moment * s[3] * s[3] * sin_t) * inv_total_mass;
     const double theta_acc = (p[GRAVITY] * sin_t - cos_t * temp) /
                              (p[HALF_LENGTH] * (4.0 / 3.0 - p[POLE_MASS] * cos_t * cos_t * inv_total_mass));
@@ -41,8 +42,9 @@ static int32_t failed(const double *p, const double *s)
 static double energy(const double *p, const double *s)
 {
     const double m = p[POLE_MASS], l = p[HALF_LENGTH];
-    return 0.5 * (p[CART_MASS] + m) * s[1] * s[1] + m * l * cos(s[2]) * s[1] * s[3] +
-           (2.0 / 3.0) * m * l * l * s[3] * s[3] + m * p[GRAVITY] * l * cos(s[2]);
+    const double cos_t = sim_cos(s[2]);
+    return 0.5 * (p[CART_MASS] + m) * s[1] * s[1] + m * l * cos_t * s[1] * s[3] +
+           (2.0 / 3.0) * m * l * l * s[3] * s[3] + m * p[GRAVITY] * l * cos_t;
 }
 
 static const icoac_sim_param_t params[N_PARAMS] = {

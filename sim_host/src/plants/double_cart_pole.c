@@ -10,6 +10,7 @@
 
 #include "icoac_sim/icoac_sim.h"
 #include "sim_integrate.h"
+#include "sim_trig.h"
 
 enum { GRAVITY, CART_MASS, MASS1, MASS2, LENGTH1, LENGTH2, X_LIMIT, ANGLE_LIMIT, N_PARAMS };
 
@@ -35,8 +36,10 @@ static terms_t terms(const double *p)
 static void derivatives(const double *p, const double *s, double force, double *ds)
 {
     const terms_t t = terms(p);
-    const double s1 = sin(s[2]), c1 = cos(s[2]), s2 = sin(s[4]), c2 = cos(s[4]);
-    const double s12 = sin(s[2] - s[4]), c12 = cos(s[2] - s[4]);
+    double s1, c1, s2, c2, s12, c12;
+    sim_sincos(s[2], &s1, &c1);
+    sim_sincos(s[4], &s2, &c2);
+    sim_sincos(s[2] - s[4], &s12, &c12);
     /* symmetric mass matrix (m00 m01 m02 / m11 m12 / m22) and right-hand side r */
     const double m01 = t.a1 * c1, m02 = t.a2 * c2, m12 = t.b * c12;
     const double r0 = force + t.a1 * s1 * s[3] * s[3] + t.a2 * s2 * s[5] * s[5];
@@ -69,7 +72,7 @@ static int32_t failed(const double *p, const double *s)
 static double energy(const double *p, const double *s)
 {
     const terms_t t = terms(p);
-    const double c1 = cos(s[2]), c2 = cos(s[4]), c12 = cos(s[2] - s[4]);
+    const double c1 = sim_cos(s[2]), c2 = sim_cos(s[4]), c12 = sim_cos(s[2] - s[4]);
     const double v = s[1], w1 = s[3], w2 = s[5];
     const double kinetic = 0.5 * (t.m * v * v + t.j1 * w1 * w1 + t.j2 * w2 * w2) + t.a1 * c1 * v * w1 +
                            t.a2 * c2 * v * w2 + t.b * c12 * w1 * w2;

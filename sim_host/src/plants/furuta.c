@@ -16,6 +16,7 @@
 
 #include "icoac_sim/icoac_sim.h"
 #include "sim_integrate.h"
+#include "sim_trig.h"
 
 enum {
     GRAVITY, ARM_MASS, ARM_LENGTH, PENDULUM_MASS, PENDULUM_LENGTH, HUB_INERTIA, RESISTANCE,
@@ -42,7 +43,8 @@ static terms_t terms(const double *p)
 static void derivatives(const double *p, const double *s, double voltage, double *ds)
 {
     const terms_t t = terms(p);
-    const double sin_a = sin(s[2]), cos_a = cos(s[2]);
+    double sin_a, cos_a;
+    sim_sincos(s[2], &sin_a, &cos_a);
     const double torque = p[TORQUE_CONSTANT] * (voltage - p[TORQUE_CONSTANT] * s[1]) / p[RESISTANCE];
     /* mass matrix [[m11, m12], [m12, b]] and right-hand side (r1, r2) */
     const double m11 = t.a + t.b * sin_a * sin_a;
@@ -72,7 +74,8 @@ static int32_t failed(const double *p, const double *s)
 static double energy(const double *p, const double *s)
 {
     const terms_t t = terms(p);
-    const double sin_a = sin(s[2]), cos_a = cos(s[2]);
+    double sin_a, cos_a;
+    sim_sincos(s[2], &sin_a, &cos_a);
     return 0.5 * (t.a + t.b * sin_a * sin_a) * s[1] * s[1] + t.c * cos_a * s[1] * s[3] +
            0.5 * t.b * s[3] * s[3] + t.d * cos_a;
 }
