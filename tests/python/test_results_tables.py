@@ -58,3 +58,24 @@ def test_unknown_table_is_refused(tmp_path):
     page.write_text("<!-- table: nonsense bench-default.json -->\n<!-- end table -->\n")
     with pytest.raises(SystemExit, match="unknown table"):
         RT.render(page.read_text(), DATA)
+
+
+def test_compare_data_flags_a_change_beyond_the_seed_spread():
+    """compare_data: a summary against itself changes nothing; a rate moved by more than its sd is
+    flagged, one moved by less is not."""
+    import copy
+    import json
+    from pathlib import Path
+
+    from icoac.tools import compare_data
+
+    before = json.loads((Path(__file__).resolve().parents[2] / "docs" / "data" / "bench-default.json").read_text())
+    assert all(r["within"] and r["change"] == 0 for r in compare_data.rows(before, before))
+    after = copy.deepcopy(before)
+    ico = after["aggregate"]["ico"]["success_rate"]
+    ico["mean"] += 3 * max(ico["sd"], 1e-3)
+    rl = after["aggregate"]["rl"]["success_rate"]
+    rl["mean"] += 0.5 * rl["sd"]
+    flagged = {(r["condition"], r["rate"]) for r in compare_data.rows(before, after) if not r["within"]}
+    assert flagged == {("ico", "all cells")}
+    assert "| ico | all cells |" in compare_data.markdown(before, after)
