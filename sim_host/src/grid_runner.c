@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Grid runner: independent cells shared out to worker threads through an atomic counter; each
- * thread advances ICOAC_SIM_LANES of them in lockstep (sim_internal.h). */
+ * thread advances ICOAC_SIM_LANES of them in lockstep, a block of lanes (sim_internal.h). */
 #include <math.h>
 #include <pthread.h>
 #include <unistd.h>
@@ -21,7 +21,7 @@ typedef struct {
 /* The next pending cell started on lane: SIM_LANE_RUNNING, SIM_LANE_DONE when no cell is left,
  * or SIM_LANE_CANCELLED. A cell whose controller cannot be initialised gets its status and the
  * outcome ICOAC_SIM_ERROR. */
-static int take_cell(grid_job_t *job, sim_lane_t *lane)
+static int take_cell(grid_job_t *job, sim_block_t *block, sim_lane_t *lane)
 {
     for (;;) {
         const int64_t i = __atomic_fetch_add(&job->next_cell, 1, __ATOMIC_RELAXED);
@@ -39,45 +39,78 @@ static int take_cell(grid_job_t *job, sim_lane_t *lane)
             __atomic_store_n(&job->cells[i].outcome, ICOAC_SIM_ERROR, __ATOMIC_RELEASE);
             continue;
         }
-        state = sim_lane_start(&job->sim, lane);
+        state = sim_lane_start(&job->sim, block, lane);
         if (state != SIM_LANE_DONE) {
             return state;
         }
     }
 }
 
-/* ICOAC_SIM_LANES cells in lockstep; a lane whose cell finished takes the next one. On a cancel the
- * thread stops, and the cells of its other lanes stay PENDING (nothing of them was written). */
+/* What a worker knows of its lanes. */
+typedef struct {
+    sim_block_t block;
+    sim_lane_t lane[ICOAC_SIM_LANES];
+    int running[ICOAC_SIM_LANES]; /* the lane has a cell */
+    int acted[ICOAC_SIM_LANES];   /* its controller acted this tick */
+    int active;                   /* lanes running */
+} worker_lanes_t;
+
+/* The lane's cell ended (state DONE) or the run was cancelled: the lane takes the next cell, or
+ * rests (its column zero, its input 0) when none is left. 0 when the thread must stop. */
+static int refill(grid_job_t *job, worker_lanes_t *w, int l, int state)
+{
+    int32_t i;
+    if (state == SIM_LANE_DONE) {
+        state = take_cell(job, &w->block, &w->lane[l]);
+    }
+    if (state == SIM_LANE_CANCELLED) {
+        __atomic_store_n(&job->cancelled, 1, __ATOMIC_RELAXED);
+        return 0;
+    }
+    if (state == SIM_LANE_DONE) {
+        w->running[l] = 0;
+        --w->active;
+        for (i = 0; i < ICOAC_SIM_MAX_STATE; ++i) {
+            w->block.s[i * w->block.lanes + l] = 0.0;
+        }
+        w->block.u[l] = 0.0;
+    }
+    return 1;
+}
+
+/* ICOAC_SIM_LANES cells in lockstep: every running lane's controller acts, one plant step advances
+ * the block, every lane that acted sees its new state; a lane whose cell ended takes the next one
+ * after the plant step. On a cancel the thread stops, and the cells of its other lanes stay
+ * PENDING (nothing of them was written). */
 static void *worker(void *arg)
 {
     grid_job_t *job = (grid_job_t *)arg;
-    sim_lane_t lanes[ICOAC_SIM_LANES];
-    sim_lane_t *running[ICOAC_SIM_LANES];
-    int active = 0;
+    static const worker_lanes_t empty;
+    worker_lanes_t w = empty;
     int l;
     (void)sim_fpu_flush_subnormals(); /* a fresh thread: nothing to restore */
+    w.block.lanes = ICOAC_SIM_LANES;
     for (l = 0; l < ICOAC_SIM_LANES; ++l) {
-        const int state = take_cell(job, &lanes[l]);
-        if (state == SIM_LANE_CANCELLED) {
-            __atomic_store_n(&job->cancelled, 1, __ATOMIC_RELAXED);
+        w.lane[l].lane = l;
+        w.running[l] = 1;
+        ++w.active;
+        if (!refill(job, &w, l, SIM_LANE_DONE)) {
             return 0;
         }
-        if (state == SIM_LANE_RUNNING) {
-            running[active++] = &lanes[l];
-        }
     }
-    while (active > 0) {
-        for (l = 0; l < active; ++l) {
-            int state = sim_lane_tick(&job->sim, running[l]);
-            if (state == SIM_LANE_DONE) {
-                state = take_cell(job, running[l]);
-            }
-            if (state == SIM_LANE_CANCELLED) {
-                __atomic_store_n(&job->cancelled, 1, __ATOMIC_RELAXED);
+    while (w.active > 0) {
+        int ended[ICOAC_SIM_LANES];
+        for (l = 0; l < ICOAC_SIM_LANES; ++l) {
+            const int state = w.running[l] ? sim_lane_act(&job->sim, &w.block, &w.lane[l]) : SIM_LANE_DONE;
+            w.acted[l] = w.running[l] && state == SIM_LANE_RUNNING;
+            ended[l] = w.running[l] && !w.acted[l];
+        }
+        sim_block_step(&job->sim, &w.block);
+        for (l = 0; l < ICOAC_SIM_LANES; ++l) {
+            const int state = w.acted[l] ? sim_lane_observe(&job->sim, &w.block, &w.lane[l])
+                                         : (ended[l] ? SIM_LANE_DONE : SIM_LANE_RUNNING);
+            if (state != SIM_LANE_RUNNING && !refill(job, &w, l, state)) {
                 return 0;
-            }
-            if (state == SIM_LANE_DONE) { /* no cell left for it */
-                running[l--] = running[--active];
             }
         }
     }

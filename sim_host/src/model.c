@@ -87,7 +87,7 @@ int32_t icoac_sim_model_step(const icoac_sim_model_t *model, double state[ICOAC_
         return ICOAC_SIM_ERR_NONFINITE;
     }
     memcpy(s, state, (size_t)desc->n_state * sizeof s[0]);
-    desc->step(model->param, model->dt, model->integrator, s, u);
+    desc->step(model->param, model->dt, model->integrator, s, &u, 1);
     if (!all_finite(s, desc->n_state)) {
         return ICOAC_SIM_ERR_NONFINITE;
     }

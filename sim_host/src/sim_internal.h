@@ -23,7 +23,8 @@ static inline int32_t sim_cart_pole_failed(double x_limit, double theta_limit, c
 /* The cart-pole's step (plants/cart_pole.c) and where its limits sit in its parameter block
  * (x_limit, then theta_limit), so that the trial loop can call the one and test the others
  * without going through the descriptor. */
-void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *s, double force);
+void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *s, const double *forces,
+                        int32_t lanes);
 #define SIM_CART_POLE_X_LIMIT 4
 #define SIM_CART_POLE_THETA_LIMIT 5
 
@@ -62,22 +63,33 @@ typedef struct {
     volatile int64_t *progress;
 } sim_job_t;
 
-/* A cell in progress (trial.c): its controller, plant state and counters. A worker thread
- * advances ICOAC_SIM_LANES of them in lockstep, one tick each in turn: their ticks are
- * independent, so the processor overlaps one lane's dependency chain (controller -> force ->
- * plant -> next observation) with the other's. */
+/* The cells a worker thread advances in lockstep, one lane each: their plant states as a
+ * structure of arrays (component i of lane l at s[i * lanes + l], the layout of the plant's batch
+ * step), the plant inputs of the tick, and what the controllers see of the states. Each tick every
+ * lane's controller acts, then one plant step advances all lanes and tests them all, then each
+ * lane sees its new state: the lanes' dependency chains (controller -> input -> plant -> next
+ * observation) overlap, and no cell's result depends on the others. */
+typedef struct {
+    int32_t lanes; /* <= ICOAC_SIM_LANES */
+    double s[ICOAC_SIM_MAX_STATE * ICOAC_SIM_LANES];
+    double u[ICOAC_SIM_LANES];
+    icoac_input_t in[ICOAC_SIM_LANES]; /* each lane's state as the controller's input (sim_to_input) */
+    int32_t failed[ICOAC_SIM_LANES];   /* the plant's failure test of each lane's state */
+} sim_block_t;
+
+/* A cell in progress on lane `lane` of a block (trial.c): its controller and counters. */
 typedef struct {
     icoac_state_t ctrl;
     icoac_rng_t rng; /* the plant's: the drawn start components */
-    double s[ICOAC_SIM_MAX_STATE];
     icoac_sim_cell_t *cell;
     int64_t trials; /* finished trials */
     int64_t total;  /* their steps */
     int64_t steps;  /* steps of the trial in progress */
     int32_t status;
+    int32_t lane;   /* its column in the block */
 } sim_lane_t;
 
-/* sim_lane_start and sim_lane_tick: the lane runs on, its cell was written (outcome last, with
+/* The lane functions' results: the lane runs on, its cell was written (outcome last, with
  * release order), or the run was cancelled at the start of a trial (the cell left as it was). */
 #define SIM_LANE_RUNNING 0
 #define SIM_LANE_DONE 1
@@ -86,10 +98,16 @@ typedef struct {
 /* A fresh controller for cell on lane; returns the status of icoac_init (the lane is unusable
  * unless ICOAC_SIM_OK, and the cell untouched). */
 int32_t sim_lane_init(const sim_job_t *job, sim_lane_t *lane, icoac_sim_cell_t *cell);
-/* The first trial of an initialised lane: SIM_LANE_*. */
-int sim_lane_start(const sim_job_t *job, sim_lane_t *lane);
-/* One tick and plant step; at a trial's end the next trial or the cell's result: SIM_LANE_*. */
-int sim_lane_tick(const sim_job_t *job, sim_lane_t *lane);
+/* The first trial of an initialised lane (its start state written to the block): SIM_LANE_*. */
+int sim_lane_start(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane);
+/* The tick's controller step on the lane's state, its output the lane's plant input: SIM_LANE_*
+ * (DONE when the controller reported an error). */
+int sim_lane_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane);
+/* One plant step of every lane of the block under its input. */
+void sim_block_step(const sim_job_t *job, sim_block_t *block);
+/* After the plant step of a lane that acted: a failure or the success length ends the trial, and
+ * then the next trial starts or the cell's result is written: SIM_LANE_*. */
+int sim_lane_observe(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane);
 
 /* Flush subnormals to zero on this thread; returns the previous mode for sim_fpu_restore (fpu.c). */
 uint32_t sim_fpu_flush_subnormals(void);

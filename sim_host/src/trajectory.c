@@ -50,7 +50,7 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_model_t 
             break;
         }
         forces[k] = (double)out.force;
-        desc->step(model->param, model->dt, model->integrator, s, forces[k]);
+        desc->step(model->param, model->dt, model->integrator, s, &forces[k], 1);
         memcpy(states + row * (size_t)(k + 1), s, row * sizeof s[0]);
         *n_steps = k + 1;
         if (desc->failed(model->param, s)) {

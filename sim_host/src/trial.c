@@ -1,8 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The benchmark trial loop of one cell (method.md, benchmark protocol): trials from a fresh
- * controller until one lasts success_steps or max_trials have failed, as a lane
- * (sim_internal.h) that advances one tick per call, so that a worker thread can interleave
- * several cells. */
+ * controller until one lasts success_steps or max_trials have failed, as a lane of a block
+ * (sim_internal.h) that a worker thread advances in lockstep with the block's other lanes. */
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -20,8 +19,14 @@
 #define SIM_REAL_MAX ((double)FLT_MAX)
 #endif
 
-/* The plant state as the controller's reals. A value outside the real type's range would be
- * an undefined conversion: it is passed as NaN, which the controller rejects.
+/* A plant value as the controller's real. A value outside the real type's range would be an
+ * undefined conversion: it is passed as NaN, which the controller rejects. */
+static inline icoac_real_t sim_real(double v)
+{
+    return fabs(v) <= SIM_REAL_MAX ? (icoac_real_t)v : (icoac_real_t)NAN;
+}
+
+/* The plant state as the controller's input (sim_real of each value).
  * With SSE2 and float reals a 4-input task's values go out in one 16-byte store. The compiler
  * vectorizes icoac_step's reads of in->s into one 16-byte load, which cannot be forwarded from
  * four 4-byte stores: it then waits until they retire, and that serializes the ticks of the
@@ -45,7 +50,7 @@ void sim_to_input(const double *s, int32_t n, uint32_t flags, icoac_input_t *in)
     }
 #endif
     for (; i < n; ++i) {
-        in->s[i] = fabs(s[i]) <= SIM_REAL_MAX ? (icoac_real_t)s[i] : (icoac_real_t)NAN;
+        in->s[i] = sim_real(s[i]);
     }
     in->flags = flags;
     in->reflex = (icoac_real_t)0; /* the late signal comes from the task's rules */
@@ -71,18 +76,21 @@ static void add_progress(volatile int64_t *progress, int index, int64_t amount)
     }
 }
 
-/* One plant step under u; 1 when the plant then failed. The cart-pole's step is called and its
- * test made directly: through the descriptor, the ICO tick of every paper benchmark cost 4 %
- * more. */
-static inline int32_t lane_plant_step(const sim_job_t *job, double *s, double u)
+/* The lane's plant state out of the block (one contiguous state), and back. */
+static void lane_state(const sim_block_t *block, int32_t lane, int32_t n, double *x)
 {
-    const icoac_sim_model_t *model = job->model;
-    if (model->plant == ICOAC_SIM_CART_POLE) {
-        sim_cart_pole_step(model->param, model->dt, model->integrator, s, u);
-        return sim_cart_pole_failed(model->param[SIM_CART_POLE_X_LIMIT], model->param[SIM_CART_POLE_THETA_LIMIT], s);
+    int32_t i;
+    for (i = 0; i < n; ++i) {
+        x[i] = block->s[i * block->lanes + lane];
     }
-    job->desc->step(model->param, model->dt, model->integrator, s, u);
-    return job->desc->failed(model->param, s);
+}
+
+static void set_lane_state(sim_block_t *block, int32_t lane, int32_t n, const double *x)
+{
+    int32_t i;
+    for (i = 0; i < n; ++i) {
+        block->s[i * block->lanes + lane] = x[i];
+    }
 }
 
 /* The cell's result from the lane; outcome last, with release order: a reader that sees it
@@ -102,19 +110,22 @@ static int finish(const sim_job_t *job, sim_lane_t *lane, int32_t outcome)
 }
 
 /* A new trial from the cell's start (a cancel request is honoured here, between trials). */
-static int start_trial(const sim_job_t *job, sim_lane_t *lane)
+static int start_trial(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
 {
+    double x[ICOAC_SIM_MAX_STATE];
     if (job->cancel != 0 && __atomic_load_n(job->cancel, __ATOMIC_RELAXED) != 0) {
         return SIM_LANE_CANCELLED;
     }
-    sim_start_trial(job->desc, lane->cell, job->run->init_velocity_noise, &lane->rng, lane->s);
+    sim_start_trial(job->desc, lane->cell, job->run->init_velocity_noise, &lane->rng, x);
+    set_lane_state(block, lane->lane, job->desc->n_state, x);
+    sim_to_input(x, job->cfg->task.n_inputs, 0u, &block->in[lane->lane]);
     lane->steps = 0;
     lane->status = (int32_t)icoac_reset(&lane->ctrl);
     return lane->status == ICOAC_SIM_OK ? SIM_LANE_RUNNING : finish(job, lane, ICOAC_SIM_ERROR);
 }
 
 /* A trial ended: it lasted success_steps steps (balanced), or failed. */
-static int end_trial(const sim_job_t *job, sim_lane_t *lane, int balanced)
+static int end_trial(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane, int balanced)
 {
     ++lane->trials;
     lane->total += lane->steps;
@@ -126,7 +137,7 @@ static int end_trial(const sim_job_t *job, sim_lane_t *lane, int balanced)
     if (lane->trials >= job->run->max_trials) {
         return finish(job, lane, ICOAC_SIM_FAILED);
     }
-    return start_trial(job, lane);
+    return start_trial(job, block, lane);
 }
 
 int32_t sim_lane_init(const sim_job_t *job, sim_lane_t *lane, icoac_sim_cell_t *cell)
@@ -141,35 +152,85 @@ int32_t sim_lane_init(const sim_job_t *job, sim_lane_t *lane, icoac_sim_cell_t *
     return status;
 }
 
-int sim_lane_start(const sim_job_t *job, sim_lane_t *lane)
+int sim_lane_start(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
 {
-    return start_trial(job, lane);
+    return start_trial(job, block, lane);
 }
 
-int sim_lane_tick(const sim_job_t *job, sim_lane_t *lane)
+int sim_lane_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
 {
-    icoac_input_t in;
     icoac_output_t out;
-    int32_t failed;
-    sim_to_input(lane->s, job->cfg->task.n_inputs, 0u, &in);
-    lane->status = (int32_t)icoac_step(&lane->ctrl, &in, &out);
+    lane->status = (int32_t)icoac_step(&lane->ctrl, &block->in[lane->lane], &out);
     if (lane->status != ICOAC_SIM_OK) {
         return finish(job, lane, ICOAC_SIM_ERROR);
     }
-    failed = lane_plant_step(job, lane->s, (double)out.force);
+    block->u[lane->lane] = (double)out.force;
+    return SIM_LANE_RUNNING;
+}
+
+/* The plant step of every lane, then each lane's failure test and next input, all in loops over
+ * the lanes. The cart-pole's step and failure test are called directly: through the descriptor,
+ * the ICO tick of every paper benchmark cost more. */
+void sim_block_step(const sim_job_t *job, sim_block_t *block)
+{
+    const icoac_sim_model_t *model = job->model;
+    const double *p = model->param;
+    const int32_t lanes = block->lanes;
+    const int32_t n_inputs = job->cfg->task.n_inputs;
+    int32_t i, l;
+    if (model->plant == ICOAC_SIM_CART_POLE) {
+        const double *s = block->s;
+        const double x_limit = p[SIM_CART_POLE_X_LIMIT], theta_limit = p[SIM_CART_POLE_THETA_LIMIT];
+        sim_cart_pole_step(p, model->dt, model->integrator, block->s, block->u, lanes);
+        for (l = 0; l < lanes; ++l) {
+            /* sim_cart_pole_failed, with & for && so that the loop has no branch */
+            const double x = s[l], theta = s[2 * lanes + l];
+            const int inside = (x >= -x_limit) & (x <= x_limit) & (theta >= -theta_limit) & (theta <= theta_limit) &
+                               (fabs(s[lanes + l]) <= DBL_MAX) & (fabs(s[3 * lanes + l]) <= DBL_MAX);
+            block->failed[l] = !inside;
+        }
+    } else {
+        job->desc->step(p, model->dt, model->integrator, block->s, block->u, lanes);
+        for (l = 0; l < lanes; ++l) {
+            double x[ICOAC_SIM_MAX_STATE];
+            lane_state(block, l, job->desc->n_state, x);
+            block->failed[l] = job->desc->failed(p, x);
+        }
+    }
+    if (n_inputs == 4) { /* the cart-pole's task: a lane's inputs are written together */
+        for (l = 0; l < lanes; ++l) {
+            for (i = 0; i < 4; ++i) {
+                block->in[l].s[i] = sim_real(block->s[i * lanes + l]);
+            }
+        }
+        return;
+    }
+    for (i = 0; i < n_inputs; ++i) {
+        for (l = 0; l < lanes; ++l) {
+            block->in[l].s[i] = sim_real(block->s[i * lanes + l]);
+        }
+    }
+}
+
+int sim_lane_observe(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
+{
     ++lane->steps;
-    if (failed) {
+    if (block->failed[lane->lane]) {
         /* Let the controller learn from the failure state; it rejects NaN plant states,
          * which end the trial like any failure, but a numeric fault is an error. */
-        sim_to_input(lane->s, job->cfg->task.n_inputs, ICOAC_INPUT_TERMINAL, &in);
+        double x[ICOAC_SIM_MAX_STATE];
+        icoac_input_t in;
+        icoac_output_t out;
+        lane_state(block, lane->lane, job->desc->n_state, x);
+        sim_to_input(x, job->cfg->task.n_inputs, ICOAC_INPUT_TERMINAL, &in);
         if (icoac_step(&lane->ctrl, &in, &out) == ICOAC_ERR_NUMERIC) {
             lane->status = ICOAC_ERR_NUMERIC;
             return finish(job, lane, ICOAC_SIM_ERROR);
         }
-        return end_trial(job, lane, 0);
+        return end_trial(job, block, lane, 0);
     }
     /* a failure at the last step is a failure */
-    return lane->steps >= job->run->success_steps ? end_trial(job, lane, 1) : SIM_LANE_RUNNING;
+    return lane->steps >= job->run->success_steps ? end_trial(job, block, lane, 1) : SIM_LANE_RUNNING;
 }
 
 int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_model_t *model,
@@ -178,6 +239,7 @@ int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_model_t *m
                            volatile int64_t *progress)
 {
     sim_lane_t lane;
+    sim_block_t block;
     uint32_t fpu_mode;
     int state = SIM_LANE_RUNNING;
     int32_t status = sim_check_all(cfg, model, run);
@@ -190,11 +252,17 @@ int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_model_t *m
     {
         const sim_job_t job = {cfg, model, icoac_sim_plant_info(model->plant), run, prior, cancel, progress};
         fpu_mode = sim_fpu_flush_subnormals();
+        block.lanes = 1;
+        lane.lane = 0;
         status = sim_lane_init(&job, &lane, cell);
         if (status == ICOAC_SIM_OK) {
-            state = sim_lane_start(&job, &lane);
+            state = sim_lane_start(&job, &block, &lane);
             while (state == SIM_LANE_RUNNING) {
-                state = sim_lane_tick(&job, &lane);
+                state = sim_lane_act(&job, &block, &lane);
+                if (state == SIM_LANE_RUNNING) {
+                    sim_block_step(&job, &block);
+                    state = sim_lane_observe(&job, &block, &lane);
+                }
             }
         }
         sim_fpu_restore(fpu_mode);

@@ -203,12 +203,14 @@ static void test_grid_thread_independent(void)
 
 /* The lanes of a worker thread (ICOAC_SIM_LANES cells in lockstep, a lane refilled as its cell
  * ends): every mode, cells of very different lengths (one-trial successes next to cells that
- * run out of trials), a finished cell mixed in, an odd
- * count, and 1 to 3 threads. Each cell equals its run alone through icoac_sim_run_cell. */
+ * run out of trials), a finished cell mixed in, an odd count of more than twice the lanes (so
+ * that lanes are refilled on one thread, and rest at the end), and 1 to 3 threads. Each cell
+ * equals its run alone through icoac_sim_run_cell. */
 static void test_lanes_match_single_cells(void)
 {
-#define NLANE 11
-    static const int pick[NLANE] = {612, 0, 1224, 600, 24, 611, 613, 100, 1000, 587, 637};
+#define NLANE (2 * ICOAC_SIM_LANES + 5)
+    static const int listed[11] = {612, 0, 1224, 600, 24, 611, 613, 100, 1000, 587, 637};
+    int pick[NLANE];
     static icoac_sim_cell_t grid[TEST_PAPER_CELLS];
     const icoac_sim_model_t model = test_cart_pole();
     const icoac_sim_run_t run = test_small_run(40, 600);
@@ -216,6 +218,9 @@ static void test_lanes_match_single_cells(void)
     icoac_sim_cell_t solo[NLANE], cells[NLANE];
     int mode, threads, i;
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_grid(ICOAC_SIM_CART_POLE, grid, TEST_PAPER_CELLS, 99u));
+    for (i = 0; i < NLANE; ++i) {
+        pick[i] = i < 11 ? listed[i] : (i * 97 + 13) % TEST_PAPER_CELLS; /* the rest spread over the grid */
+    }
     for (mode = ICOAC_MODE_ICO; mode <= ICOAC_MODE_SEARCH; ++mode) {
         icoac_config_t cfg = test_default_config();
         int64_t short_cells = 0, long_cells = 0; /* <= 10 trials, all max_trials */

@@ -60,12 +60,12 @@ def test_state_is_opaque_aligned_storage():
 
 def test_abi_versions():
     assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 9
-    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 5
+    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 6
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
     # the host build's defaults: the dense critic kernel, two lanes per engine thread
     assert info["critic_kernel"] == "dense" and B.CONSTANTS["ICOAC_CRITIC_DENSE"] == 1
-    assert info["lanes"] == B.CONSTANTS["ICOAC_SIM_LANES"] == 2
+    assert info["lanes"] == B.CONSTANTS["ICOAC_SIM_LANES"] == 16
 
 
 def test_every_mirror_matches_the_c_field_table():

@@ -12,7 +12,7 @@
 extern "C" {
 #endif
 
-#define ICOAC_SIM_ABI_VERSION 5
+#define ICOAC_SIM_ABI_VERSION 6
 
 /* Status of sim functions: values below 100 are icoac_status_t, passed through. */
 typedef enum {
@@ -32,9 +32,9 @@ typedef enum {
 
 #define ICOAC_SIM_PI 3.14159265358979323846
 
-/* Cells each thread of icoac_sim_run_grid advances in lockstep, one tick each in turn (their
- * ticks overlap in the processor; no cell's result depends on it). */
-#define ICOAC_SIM_LANES 2
+/* Cells each thread of icoac_sim_run_grid advances in lockstep: each lane's controller tick, then
+ * one plant step for all of them, vectorised over the lanes (no cell's result depends on it). */
+#define ICOAC_SIM_LANES 16
 
 /* Valid plant and run ranges (closed): no subnormal or absurd value reaches the integrator,
  * whose worker threads flush subnormals to zero. */
@@ -175,9 +175,12 @@ typedef struct {
     int32_t reserved; /* 0 */
 } icoac_sim_sweep_t;
 
-/* One integration step of the plant's ODE: s (n_state values) advanced by dt under input u
- * with the integrator (icoac_sim_integrator_t); p holds the parameter block. */
-typedef void (*icoac_sim_step_fn)(const double *p, double dt, int32_t integrator, double *s, double u);
+/* One integration step of the plant's ODE for lanes states at once (a lockstep batch of cells),
+ * lane l advanced by dt under input u[l] with the integrator (icoac_sim_integrator_t); p holds
+ * the parameter block. s is a structure of arrays: component i of lane l at s[i * lanes + l]
+ * (one lane: the state in order). Each lane gets the arithmetic of a batch of one, bit for bit. */
+typedef void (*icoac_sim_step_fn)(const double *p, double dt, int32_t integrator, double *s, const double *u,
+                                  int32_t lanes);
 /* ds = ds/dt at state s under input u. */
 typedef void (*icoac_sim_derivatives_fn)(const double *p, const double *s, double u, double *ds);
 /* 1 when s is outside the plant's limits or not finite, else 0. */

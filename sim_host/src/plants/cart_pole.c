@@ -11,7 +11,7 @@
 enum { GRAVITY, CART_MASS, POLE_MASS, HALF_LENGTH, X_LIMIT = SIM_CART_POLE_X_LIMIT, THETA_LIMIT, N_PARAMS };
 
 /* d/dt (x, x_dot, theta, theta_dot) under force: Sutton's equations. */
-static void derivatives(const double *p, const double *s, double force, double *ds)
+SIM_DERIVATIVES derivatives(const double *p, const double *s, double force, double *ds)
 {
     const double inv_total_mass = 1.0 / (p[CART_MASS] + p[POLE_MASS]);
     const double pole_moment = p[POLE_MASS] * p[HALF_LENGTH];
@@ -27,9 +27,10 @@ static void derivatives(const double *p, const double *s, double force, double *
     ds[3] = theta_acc;
 }
 
-void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *s, double force)
+SIM_BATCH_STEP void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *s,
+                                       const double *forces, int32_t lanes)
 {
-    sim_integrate(derivatives, 4, p, dt, integrator, s, force);
+    sim_integrate(derivatives, 4, p, dt, integrator, s, forces, lanes);
 }
 
 static int32_t failed(const double *p, const double *s)

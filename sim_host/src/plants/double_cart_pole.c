@@ -33,7 +33,7 @@ static terms_t terms(const double *p)
     return t;
 }
 
-static void derivatives(const double *p, const double *s, double force, double *ds)
+SIM_DERIVATIVES derivatives(const double *p, const double *s, double force, double *ds)
 {
     const terms_t t = terms(p);
     double s1, c1, s2, c2, s12, c12;
@@ -57,9 +57,10 @@ static void derivatives(const double *p, const double *s, double force, double *
     ds[5] = (k02 * r0 + k12 * r1 + k22 * r2) / det;
 }
 
-static void step(const double *p, double dt, int32_t integrator, double *s, double force)
+SIM_BATCH_STEP static void step(const double *p, double dt, int32_t integrator, double *s,
+                                const double *forces, int32_t lanes)
 {
-    sim_integrate(derivatives, 6, p, dt, integrator, s, force);
+    sim_integrate(derivatives, 6, p, dt, integrator, s, forces, lanes);
 }
 
 /* Outside the track or either link's angle limit (strict), or not finite; NaN fails. */

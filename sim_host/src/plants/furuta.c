@@ -40,7 +40,7 @@ static terms_t terms(const double *p)
     return t;
 }
 
-static void derivatives(const double *p, const double *s, double voltage, double *ds)
+SIM_DERIVATIVES derivatives(const double *p, const double *s, double voltage, double *ds)
 {
     const terms_t t = terms(p);
     double sin_a, cos_a;
@@ -59,9 +59,10 @@ static void derivatives(const double *p, const double *s, double voltage, double
     ds[3] = (m11 * r2 - m12 * r1) / det;
 }
 
-static void step(const double *p, double dt, int32_t integrator, double *s, double voltage)
+SIM_BATCH_STEP static void step(const double *p, double dt, int32_t integrator, double *s,
+                                const double *voltages, int32_t lanes)
 {
-    sim_integrate(derivatives, 4, p, dt, integrator, s, voltage);
+    sim_integrate(derivatives, 4, p, dt, integrator, s, voltages, lanes);
 }
 
 /* Outside the arm or pendulum limit (strict), or not finite; NaN fails. */
