@@ -136,8 +136,10 @@ fuzz-campaign: build-fuzz
 fuzz-ledger:
 	@$(PYTHON) tests/fuzz/ledger.py $(FUZZ_LEDGER) $(FUZZ_SOURCES)
 
+# The speed figures; `make bench` records them in $(BENCH_OUT)/bench.json (key "speed").
 bench-speed: build
-	./build/release/sim_host/icoac_bench
+	mkdir -p $(BENCH_OUT)
+	./build/release/sim_host/icoac_bench --json $(BENCH_OUT)/speed.json
 
 # BENCH_ARGS: more bench options, e.g. BENCH_ARGS=--resume to continue a stopped run.
 # Per plant (bench-plant), the linear-policy ceiling first (about 40 s; a rerun replays its

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Grid runner: independent cells shared out to worker threads through an atomic counter; each
- * thread advances ICOAC_SIM_LANES of them in lockstep, a block of lanes (sim_internal.h). */
+ * thread advances the run's `lanes` of them in lockstep, a block (sim_internal.h). */
 #include <math.h>
 #include <pthread.h>
 #include <unistd.h>
@@ -49,9 +49,9 @@ static int take_cell(grid_job_t *job, sim_block_t *block, sim_lane_t *lane)
 /* What a worker knows of its lanes. */
 typedef struct {
     sim_block_t block;
-    sim_lane_t lane[ICOAC_SIM_LANES];
-    int running[ICOAC_SIM_LANES]; /* the lane has a cell */
-    int acted[ICOAC_SIM_LANES];   /* its controller acted this tick */
+    sim_lane_t lane[ICOAC_SIM_MAX_LANES];
+    int running[ICOAC_SIM_MAX_LANES]; /* the lane has a cell */
+    int acted[ICOAC_SIM_MAX_LANES];   /* its controller acted this tick */
     int active;                   /* lanes running */
 } worker_lanes_t;
 
@@ -78,7 +78,7 @@ static int refill(grid_job_t *job, worker_lanes_t *w, int l, int state)
     return 1;
 }
 
-/* ICOAC_SIM_LANES cells in lockstep: every running lane's controller acts, one plant step advances
+/* The run's `lanes` cells in lockstep: every running lane's controller acts, one plant step advances
  * the block, every lane that acted sees its new state; a lane whose cell ended takes the next one
  * after the plant step. On a cancel the thread stops, and the cells of its other lanes stay
  * PENDING (nothing of them was written). */
@@ -88,9 +88,10 @@ static void *worker(void *arg)
     static const worker_lanes_t empty;
     worker_lanes_t w = empty;
     int l;
+    const int lanes = (int)job->sim.run->lanes; /* checked: 1 .. ICOAC_SIM_MAX_LANES */
     (void)sim_fpu_flush_subnormals(); /* a fresh thread: nothing to restore */
-    w.block.lanes = ICOAC_SIM_LANES;
-    for (l = 0; l < ICOAC_SIM_LANES; ++l) {
+    w.block.lanes = lanes;
+    for (l = 0; l < lanes; ++l) {
         w.lane[l].lane = l;
         w.running[l] = 1;
         ++w.active;
@@ -99,14 +100,14 @@ static void *worker(void *arg)
         }
     }
     while (w.active > 0) {
-        int ended[ICOAC_SIM_LANES];
-        for (l = 0; l < ICOAC_SIM_LANES; ++l) {
+        int ended[ICOAC_SIM_MAX_LANES];
+        for (l = 0; l < lanes; ++l) {
             const int state = w.running[l] ? sim_lane_act(&job->sim, &w.block, &w.lane[l]) : SIM_LANE_DONE;
             w.acted[l] = w.running[l] && state == SIM_LANE_RUNNING;
             ended[l] = w.running[l] && !w.acted[l];
         }
         sim_block_step(&job->sim, &w.block);
-        for (l = 0; l < ICOAC_SIM_LANES; ++l) {
+        for (l = 0; l < lanes; ++l) {
             const int state = w.acted[l] ? sim_lane_observe(&job->sim, &w.block, &w.lane[l])
                                          : (ended[l] ? SIM_LANE_DONE : SIM_LANE_RUNNING);
             if (state != SIM_LANE_RUNNING && !refill(job, &w, l, state)) {

@@ -18,7 +18,7 @@ static const icoac_sim_constant_t constants[] = {
     CONSTANT(ICOAC_CARTPOLE_CRITIC_UNITS),
     CONSTANT(ICOAC_STATE_SIZE),
     CONSTANT(ICOAC_CRITIC_DENSE), /* the critic kernel of this build: 1 dense, 0 sparse */
-    CONSTANT(ICOAC_SIM_LANES),
+    CONSTANT(ICOAC_SIM_MAX_LANES),
     CONSTANT(ICOAC_INPUT_TERMINAL),
     CONSTANT(ICOAC_INPUT_LATE),
     /* switches */

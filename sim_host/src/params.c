@@ -18,6 +18,7 @@ void icoac_sim_run_default(icoac_sim_run_t *run)
 
 /* A run row's check (the kinds of icoac_params.h that run rows use). */
 #define RUN_OK_at_least(v, lo, hi) ((v) >= (lo))
+#define RUN_OK_int(v, lo, hi) ((v) >= (lo) && (v) <= (hi))
 #define RUN_OK_real_or_zero(v, lo, hi) ((v) == 0.0 || ((v) >= (lo) && (v) <= (hi)))
 
 int sim_velocity_noise_valid(double a)

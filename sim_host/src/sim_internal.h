@@ -70,11 +70,11 @@ typedef struct {
  * lane sees its new state: the lanes' dependency chains (controller -> input -> plant -> next
  * observation) overlap, and no cell's result depends on the others. */
 typedef struct {
-    int32_t lanes; /* <= ICOAC_SIM_LANES */
-    double s[ICOAC_SIM_MAX_STATE * ICOAC_SIM_LANES];
-    double u[ICOAC_SIM_LANES];
-    icoac_input_t in[ICOAC_SIM_LANES]; /* each lane's state as the controller's input (sim_to_input) */
-    int32_t failed[ICOAC_SIM_LANES];   /* the plant's failure test of each lane's state */
+    int32_t lanes; /* <= ICOAC_SIM_MAX_LANES */
+    double s[ICOAC_SIM_MAX_STATE * ICOAC_SIM_MAX_LANES];
+    double u[ICOAC_SIM_MAX_LANES];
+    icoac_input_t in[ICOAC_SIM_MAX_LANES]; /* each lane's state as the controller's input (sim_to_input) */
+    int32_t failed[ICOAC_SIM_MAX_LANES];   /* the plant's failure test of each lane's state */
 } sim_block_t;
 
 /* A cell in progress on lane `lane` of a block (trial.c): its controller and counters. */

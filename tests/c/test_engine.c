@@ -201,14 +201,14 @@ static void test_grid_thread_independent(void)
     }
 }
 
-/* The lanes of a worker thread (ICOAC_SIM_LANES cells in lockstep, a lane refilled as its cell
+/* The lanes of a worker thread (the run's `lanes` cells in lockstep, a lane refilled as its cell
  * ends): every mode, cells of very different lengths (one-trial successes next to cells that
- * run out of trials), a finished cell mixed in, an odd count of more than twice the lanes (so
- * that lanes are refilled on one thread, and rest at the end), and 1 to 3 threads. Each cell
- * equals its run alone through icoac_sim_run_cell. */
+ * run out of trials), a finished cell mixed in, an odd count, 1 to 3 threads, and blocks of 1, 3,
+ * 16 (the default: more than twice as many cells, so lanes are refilled and rest at the end) and
+ * 64 lanes (more lanes than cells). Each cell equals its run alone through icoac_sim_run_cell. */
 static void test_lanes_match_single_cells(void)
 {
-#define NLANE (2 * ICOAC_SIM_LANES + 5)
+#define NLANE 37
     static const int listed[11] = {612, 0, 1224, 600, 24, 611, 613, 100, 1000, 587, 637};
     int pick[NLANE];
     static icoac_sim_cell_t grid[TEST_PAPER_CELLS];
@@ -238,17 +238,23 @@ static void test_lanes_match_single_cells(void)
         }
         TEST_ASSERT_TRUE(short_cells > 0 && long_cells > 0); /* the lanes do end at different times */
         for (threads = 1; threads <= 3; ++threads) {
-            int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
-            memcpy(cells, solo, sizeof cells);
-            for (i = 0; i < NLANE; ++i) {
-                if (i != 4) {
-                    cells[i] = grid[pick[i]];
+            static const int64_t block[4] = {1, 3, 16, ICOAC_SIM_MAX_LANES};
+            int b;
+            for (b = 0; b < 4; ++b) {
+                int64_t progress[ICOAC_SIM_PROGRESS_LEN] = {0, 0, 0};
+                icoac_sim_run_t lanes_run = run;
+                lanes_run.lanes = block[b];
+                memcpy(cells, solo, sizeof cells);
+                for (i = 0; i < NLANE; ++i) {
+                    if (i != 4) {
+                        cells[i] = grid[pick[i]];
+                    }
                 }
+                TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_grid(&cfg, &model, &lanes_run, &prior, cells, NLANE,
+                                                                       threads, NULL, progress));
+                TEST_ASSERT_EQUAL_MEMORY(solo, cells, sizeof cells);
+                TEST_ASSERT_EQUAL_INT64(NLANE - 1, progress[ICOAC_SIM_PROGRESS_CELLS]);
             }
-            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK,
-                                  icoac_sim_run_grid(&cfg, &model, &run, &prior, cells, NLANE, threads, NULL, progress));
-            TEST_ASSERT_EQUAL_MEMORY(solo, cells, sizeof cells);
-            TEST_ASSERT_EQUAL_INT64(NLANE - 1, progress[ICOAC_SIM_PROGRESS_CELLS]);
         }
     }
 #undef NLANE
@@ -376,6 +382,9 @@ static void test_bad_parameters(void)
     model = good_model;
     run = good_run;
     run.init_velocity_noise = -1.0;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
+    run = good_run;
+    run.lanes = ICOAC_SIM_MAX_LANES + 1; /* a block larger than the worker's arrays */
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_grid(&cfg, &model, &run, NULL, cells, 2, 1, NULL, NULL));
     run = good_run;
 

@@ -235,6 +235,15 @@ static void test_plant_and_run_checks(void)
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_check(&run));
     run.init_velocity_noise = 0.0;
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_check(&run));
+    TEST_ASSERT_TRUE(run.lanes == 16);
+    run.lanes = 0;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_check(&run));
+    run.lanes = ICOAC_SIM_MAX_LANES + 1;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_RUN, icoac_sim_run_check(&run));
+    run.lanes = ICOAC_SIM_MAX_LANES;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_check(&run));
+    run.lanes = 1;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_run_check(&run));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_run_check(NULL));
 }
 

@@ -65,7 +65,7 @@ def test_abi_versions():
     assert info["sizeof_real"] in (4, 8)
     # the host build's defaults: the dense critic kernel, two lanes per engine thread
     assert info["critic_kernel"] == "dense" and B.CONSTANTS["ICOAC_CRITIC_DENSE"] == 1
-    assert info["lanes"] == B.CONSTANTS["ICOAC_SIM_LANES"] == 16
+    assert info["max_lanes"] == B.CONSTANTS["ICOAC_SIM_MAX_LANES"] == 64
 
 
 def test_every_mirror_matches_the_c_field_table():
@@ -118,8 +118,8 @@ def test_field_check_catches_missing_extra_size_and_dtype():
 
     with pytest.raises(LibraryError, match=r"icoac_counters_t\.spare is in the binding but not in the C layout"):
         B.check_mirror("icoac_counters_t", Extra)
-    with pytest.raises(LibraryError, match=r"sizeof\(icoac_sim_run_t\): C 32, binding 24"):
-        B.check_mirror("icoac_sim_run_t", B.Run, c_size=32)
+    with pytest.raises(LibraryError, match=r"sizeof\(icoac_sim_run_t\): C 40, binding 32"):
+        B.check_mirror("icoac_sim_run_t", B.Run, c_size=40)
     names = list(B.CELL_DTYPE.names)
     wrong = np.dtype([(n, B.CELL_DTYPE.fields[n][0]) if n != "outcome" else ("outcome", np.int64)
                       for n in names], align=True)
@@ -217,7 +217,8 @@ def test_config_defaults_match_spec():
     assert p == {"gravity": 9.8, "cart_mass": 1.0, "pole_mass": 0.1, "half_length": 0.5, "dt": 0.01,
                  "x_limit": 2.4, "theta_limit": pytest.approx(math.radians(12)), "integrator": "euler",
                  "name": "cart_pole"}
-    assert r == {"max_trials": 100000, "success_steps": 100000, "init_velocity_noise": pytest.approx(1e-4)}
+    assert r == {"max_trials": 100000, "success_steps": 100000, "init_velocity_noise": pytest.approx(1e-4),
+                 "lanes": 16}
     assert d["prior"] is None
 
 

@@ -705,7 +705,7 @@ def abi_info() -> dict:
         "sim_abi_version": int(lib.icoac_sim_abi_version()),
         "sizeof_real": int(_SIZEOF_REAL),
         "critic_kernel": "dense" if CONSTANTS["ICOAC_CRITIC_DENSE"] else "sparse",
-        "lanes": int(CONSTANTS["ICOAC_SIM_LANES"]),
+        "max_lanes": int(CONSTANTS["ICOAC_SIM_MAX_LANES"]),
     }
 
 

@@ -287,9 +287,14 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
     return written
 
 
+# The speed figures `make bench` writes before the bench (icoac_bench --json OUT/speed.json).
+SPEED_FILE = "speed.json"
+
+
 class BenchLog:
     """OUT/bench.json (a --summary-only run: OUT/bench-summary.json, so the grids' log stays):
-    wall time per stage and of the whole bench, rewritten after every stage."""
+    wall time per stage and of the whole bench, rewritten after every stage, and the engine's
+    speed figures when OUT/speed.json holds them (key "speed")."""
 
     def __init__(self, out: Path, meta: Mapping[str, Any], name: str = "bench.json"):
         self.path = Path(out) / name
@@ -304,6 +309,12 @@ class BenchLog:
                 previous = None
         if not isinstance(previous, dict):
             previous = None
+        speed = self.path.parent / SPEED_FILE
+        if speed.is_file():
+            try:
+                self.data["speed"] = results.read_json(speed, follow=False)
+            except ResultsError:
+                progress(f"{speed} is not readable JSON: bench.json goes without the speed figures")
         if previous and meta.get("resume") and isinstance(previous.get("previous_runs", []), list):
             self.data["previous_runs"] = previous.get("previous_runs", []) + [
                 {"stages": previous.get("stages", []), "total_wall_time": previous.get("total_wall_time")}]

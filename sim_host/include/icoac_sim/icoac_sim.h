@@ -32,9 +32,10 @@ typedef enum {
 
 #define ICOAC_SIM_PI 3.14159265358979323846
 
-/* Cells each thread of icoac_sim_run_grid advances in lockstep: each lane's controller tick, then
- * one plant step for all of them, vectorised over the lanes (no cell's result depends on it). */
-#define ICOAC_SIM_LANES 16
+/* The most cells a thread of icoac_sim_run_grid advances in lockstep (the run's `lanes`): each
+ * lane's controller tick, then one plant step for all of them, vectorised over the lanes (no
+ * cell's result depends on it). */
+#define ICOAC_SIM_MAX_LANES 64
 
 /* Valid plant and run ranges (closed): no subnormal or absurd value reaches the integrator,
  * whose worker threads flush subnormals to zero. */
@@ -56,7 +57,9 @@ typedef enum {
     X(run, success_steps, int64_t, scalar, at_least, "tick", 1, INT64_MAX, 100000, ICOAC_PARAM_ALL, essential, ICOAC_SIM_ERR_BAD_RUN, \
       "ticks of one trial that make a success (1e5: 1000 s)") \
     X(run, init_velocity_noise, double, scalar, real_or_zero, "state", ICOAC_SIM_NOISE_MIN, ICOAC_SIM_NOISE_MAX, 1.0e-4, ICOAC_PARAM_ALL, advanced, ICOAC_SIM_ERR_BAD_RUN, \
-      "a: the drawn start components (the cart-pole's velocities) ~ U(-a, a); 0: none")
+      "a: the drawn start components (the cart-pole's velocities) ~ U(-a, a); 0: none") \
+    X(run, lanes, int64_t, scalar, int, "cell", 1, ICOAC_SIM_MAX_LANES, 16, ICOAC_PARAM_ALL, advanced, ICOAC_SIM_ERR_BAD_RUN, \
+      "cells a grid thread runs in lockstep, its plant steps vectorised over them (no result depends on it)")
 /* clang-format on */
 typedef struct {
     ICOAC_SIM_RUN_PARAMS(ICOAC_PARAM_MEMBER)
