@@ -136,9 +136,11 @@ fuzz-campaign: build-fuzz
 fuzz-ledger:
 	@$(PYTHON) tests/fuzz/ledger.py $(FUZZ_LEDGER) $(FUZZ_SOURCES)
 
-# The speed figures; `make bench` records them in $(BENCH_OUT)/bench.json (key "speed").
+# The speed figures, after the plain-C reference tick; `make bench` records them in
+# $(BENCH_OUT)/bench.json (key "speed").
 bench-speed: build
 	mkdir -p $(BENCH_OUT)
+	./build/release/sim_host/reference_tick
 	./build/release/sim_host/icoac_bench --json $(BENCH_OUT)/speed.json
 
 # BENCH_ARGS: more bench options, e.g. BENCH_ARGS=--resume to continue a stopped run.
