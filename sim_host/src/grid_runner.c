@@ -50,16 +50,17 @@ static int take_cell(grid_job_t *job, sim_block_t *block, sim_lane_t *lane)
 typedef struct {
     sim_block_t block;
     sim_lane_t lane[ICOAC_SIM_MAX_LANES];
-    int running[ICOAC_SIM_MAX_LANES]; /* the lane has a cell */
-    int acted[ICOAC_SIM_MAX_LANES];   /* its controller acted this tick */
-    int active;                   /* lanes running */
+    int state[ICOAC_SIM_MAX_LANES]; /* SIM_LANE_RUNNING (a cell) or SIM_LANE_RESTING (none left) */
+    int active;                     /* lanes running */
 } worker_lanes_t;
 
-/* The lane's cell ended (state DONE) or the run was cancelled: the lane takes the next cell, or
- * rests (its column zero, its input 0) when none is left. 0 when the thread must stop. */
-static int refill(grid_job_t *job, worker_lanes_t *w, int l, int state)
+/* Lane l stopped running (state DONE: its cell ended, or it has none yet) or the run was
+ * cancelled: the lane takes the next cell, or rests (its column zero) when none is left. 0 when
+ * the thread must stop. */
+static int refill(grid_job_t *job, worker_lanes_t *w, int l)
 {
     int32_t i;
+    int state = w->state[l];
     if (state == SIM_LANE_DONE) {
         state = take_cell(job, &w->block, &w->lane[l]);
     }
@@ -67,8 +68,8 @@ static int refill(grid_job_t *job, worker_lanes_t *w, int l, int state)
         __atomic_store_n(&job->cancelled, 1, __ATOMIC_RELAXED);
         return 0;
     }
+    w->state[l] = state == SIM_LANE_DONE ? SIM_LANE_RESTING : state;
     if (state == SIM_LANE_DONE) {
-        w->running[l] = 0;
         --w->active;
         for (i = 0; i < ICOAC_SIM_MAX_STATE; ++i) {
             w->block.s[i * w->block.lanes + l] = 0.0;
@@ -78,10 +79,9 @@ static int refill(grid_job_t *job, worker_lanes_t *w, int l, int state)
     return 1;
 }
 
-/* The run's `lanes` cells in lockstep: every running lane's controller acts, one plant step advances
- * the block, every lane that acted sees its new state; a lane whose cell ended takes the next one
- * after the plant step. On a cancel the thread stops, and the cells of its other lanes stay
- * PENDING (nothing of them was written). */
+/* The run's `lanes` cells in lockstep, a block tick at a time (sim_block_tick); a lane whose cell
+ * ended takes the next one after the tick. On a cancel the thread stops, and the cells of its
+ * other lanes stay PENDING (nothing of them was written). */
 static void *worker(void *arg)
 {
     grid_job_t *job = (grid_job_t *)arg;
@@ -89,29 +89,22 @@ static void *worker(void *arg)
     worker_lanes_t w = empty;
     int l;
     const int lanes = (int)job->sim.run->lanes; /* checked: 1 .. ICOAC_SIM_MAX_LANES */
-    (void)sim_fpu_flush_subnormals(); /* a fresh thread: nothing to restore */
+    (void)sim_fpu_flush_subnormals();           /* a fresh thread: nothing to restore */
     w.block.lanes = lanes;
+    w.active = lanes;
     for (l = 0; l < lanes; ++l) {
         w.lane[l].lane = l;
-        w.running[l] = 1;
-        ++w.active;
-        if (!refill(job, &w, l, SIM_LANE_DONE)) {
+        w.state[l] = SIM_LANE_DONE;
+        if (!refill(job, &w, l)) {
             return 0;
         }
     }
     while (w.active > 0) {
-        int ended[ICOAC_SIM_MAX_LANES];
-        for (l = 0; l < lanes; ++l) {
-            const int state = w.running[l] ? sim_lane_act(&job->sim, &w.block, &w.lane[l]) : SIM_LANE_DONE;
-            w.acted[l] = w.running[l] && state == SIM_LANE_RUNNING;
-            ended[l] = w.running[l] && !w.acted[l];
-        }
-        sim_block_step(&job->sim, &w.block);
-        for (l = 0; l < lanes; ++l) {
-            const int state = w.acted[l] ? sim_lane_observe(&job->sim, &w.block, &w.lane[l])
-                                         : (ended[l] ? SIM_LANE_DONE : SIM_LANE_RUNNING);
-            if (state != SIM_LANE_RUNNING && !refill(job, &w, l, state)) {
-                return 0;
+        if (sim_block_tick(&job->sim, &w.block, w.lane, w.state) > 0) {
+            for (l = 0; l < lanes; ++l) {
+                if (w.state[l] != SIM_LANE_RUNNING && w.state[l] != SIM_LANE_RESTING && !refill(job, &w, l)) {
+                    return 0;
+                }
             }
         }
     }

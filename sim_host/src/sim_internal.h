@@ -94,20 +94,19 @@ typedef struct {
 #define SIM_LANE_RUNNING 0
 #define SIM_LANE_DONE 1
 #define SIM_LANE_CANCELLED 2
+#define SIM_LANE_RESTING 3 /* a worker's lane without a cell (none is left) */
 
 /* A fresh controller for cell on lane; returns the status of icoac_init (the lane is unusable
  * unless ICOAC_SIM_OK, and the cell untouched). */
 int32_t sim_lane_init(const sim_job_t *job, sim_lane_t *lane, icoac_sim_cell_t *cell);
 /* The first trial of an initialised lane (its start state written to the block): SIM_LANE_*. */
 int sim_lane_start(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane);
-/* The tick's controller step on the lane's state, its output the lane's plant input: SIM_LANE_*
- * (DONE when the controller reported an error). */
-int sim_lane_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane);
-/* One plant step of every lane of the block under its input. */
-void sim_block_step(const sim_job_t *job, sim_block_t *block);
-/* After the plant step of a lane that acted: a failure or the success length ends the trial, and
- * then the next trial starts or the cell's result is written: SIM_LANE_*. */
-int sim_lane_observe(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane);
+/* One tick of the block: every lane whose state[l] is SIM_LANE_RUNNING acts (its controller
+ * steps), one plant step advances all lanes, and each lane that acted observes its new state (a
+ * failure or the success length ends its trial; the next trial starts, or its cell's result is
+ * written). state[l] becomes the lane's SIM_LANE_*; lanes[l] is the lane of column l. Returns how
+ * many lanes stopped running this tick (their cells ended, or the run was cancelled). */
+int sim_block_tick(const sim_job_t *job, sim_block_t *block, sim_lane_t *lanes, int *state);
 
 /* Flush subnormals to zero on this thread; returns the previous mode for sim_fpu_restore (fpu.c). */
 uint32_t sim_fpu_flush_subnormals(void);

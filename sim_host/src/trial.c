@@ -157,7 +157,9 @@ int sim_lane_start(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
     return start_trial(job, block, lane);
 }
 
-int sim_lane_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
+/* The tick's controller step on the lane's input, its force the lane's plant input: SIM_LANE_*
+ * (DONE when the controller reported an error). */
+static inline int lane_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
 {
     icoac_output_t out;
     lane->status = (int32_t)icoac_step(&lane->ctrl, &block->in[lane->lane], &out);
@@ -171,7 +173,7 @@ int sim_lane_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
 /* The plant step of every lane, then each lane's failure test and next input, all in loops over
  * the lanes. The cart-pole's step and failure test are called directly: through the descriptor,
  * the ICO tick of every paper benchmark cost more. */
-void sim_block_step(const sim_job_t *job, sim_block_t *block)
+static void block_step(const sim_job_t *job, sim_block_t *block)
 {
     const icoac_sim_model_t *model = job->model;
     const double *p = model->param;
@@ -212,7 +214,9 @@ void sim_block_step(const sim_job_t *job, sim_block_t *block)
     }
 }
 
-int sim_lane_observe(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
+/* After the plant step of a lane that acted: a failure or the success length ends the trial, and
+ * then the next trial starts or the cell's result is written: SIM_LANE_*. */
+static inline int lane_observe(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
 {
     ++lane->steps;
     if (block->failed[lane->lane]) {
@@ -231,6 +235,29 @@ int sim_lane_observe(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
     }
     /* a failure at the last step is a failure */
     return lane->steps >= job->run->success_steps ? end_trial(job, block, lane, 1) : SIM_LANE_RUNNING;
+}
+
+int sim_block_tick(const sim_job_t *job, sim_block_t *block, sim_lane_t *lanes, int *state)
+{
+    int acted[ICOAC_SIM_MAX_LANES];
+    int32_t l;
+    int ended = 0;
+    for (l = 0; l < block->lanes; ++l) {
+        acted[l] = state[l] == SIM_LANE_RUNNING;
+        if (acted[l]) {
+            state[l] = lane_act(job, block, &lanes[l]);
+            acted[l] = state[l] == SIM_LANE_RUNNING;
+            ended += !acted[l];
+        }
+    }
+    block_step(job, block);
+    for (l = 0; l < block->lanes; ++l) {
+        if (acted[l]) {
+            state[l] = lane_observe(job, block, &lanes[l]);
+            ended += state[l] != SIM_LANE_RUNNING;
+        }
+    }
+    return ended;
 }
 
 int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_model_t *model,
@@ -258,11 +285,7 @@ int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_model_t *m
         if (status == ICOAC_SIM_OK) {
             state = sim_lane_start(&job, &block, &lane);
             while (state == SIM_LANE_RUNNING) {
-                state = sim_lane_act(&job, &block, &lane);
-                if (state == SIM_LANE_RUNNING) {
-                    sim_block_step(&job, &block);
-                    state = sim_lane_observe(&job, &block, &lane);
-                }
+                (void)sim_block_tick(&job, &block, &lane, &state);
             }
         }
         sim_fpu_restore(fpu_mode);
