@@ -85,6 +85,8 @@ typedef struct {
     int64_t trials; /* finished trials */
     int64_t total;  /* their steps */
     int64_t steps;  /* steps of the trial in progress */
+    int64_t reported_trials; /* of trials and total, what the progress counters have */
+    int64_t reported_steps;
     int32_t status;
     int32_t lane;   /* its column in the block */
 } sim_lane_t;

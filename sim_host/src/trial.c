@@ -93,10 +93,24 @@ static void set_lane_state(sim_block_t *block, int32_t lane, int32_t n, const do
     }
 }
 
+/* The lane's finished trials and their steps not yet in the progress counters, added. The
+ * counters are shared by every thread: a lane adds to them every SIM_PROGRESS_TRIALS trials, at
+ * its cell's end and at a cancel, not at every trial (measured: adding at every one of the ICO
+ * grid's short trials, two threads fighting over the counters' cache line took 23 % longer). */
+#define SIM_PROGRESS_TRIALS 64
+static void report(const sim_job_t *job, sim_lane_t *lane)
+{
+    add_progress(job->progress, ICOAC_SIM_PROGRESS_TRIALS, lane->trials - lane->reported_trials);
+    add_progress(job->progress, ICOAC_SIM_PROGRESS_STEPS, lane->total - lane->reported_steps);
+    lane->reported_trials = lane->trials;
+    lane->reported_steps = lane->total;
+}
+
 /* The cell's result from the lane; outcome last, with release order: a reader that sees it
  * non-PENDING sees the rest. */
 static int finish(const sim_job_t *job, sim_lane_t *lane, int32_t outcome)
 {
+    report(job, lane);
     icoac_sim_cell_t *cell = lane->cell;
     cell->trials = lane->trials;
     cell->total_steps = lane->total;
@@ -114,6 +128,7 @@ static int start_trial(const sim_job_t *job, sim_block_t *block, sim_lane_t *lan
 {
     double x[ICOAC_SIM_MAX_STATE];
     if (job->cancel != 0 && __atomic_load_n(job->cancel, __ATOMIC_RELAXED) != 0) {
+        report(job, lane);
         return SIM_LANE_CANCELLED;
     }
     sim_start_trial(job->desc, lane->cell, job->run->init_velocity_noise, &lane->rng, x);
@@ -129,8 +144,9 @@ static int end_trial(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane,
 {
     ++lane->trials;
     lane->total += lane->steps;
-    add_progress(job->progress, ICOAC_SIM_PROGRESS_TRIALS, 1);
-    add_progress(job->progress, ICOAC_SIM_PROGRESS_STEPS, lane->steps);
+    if (lane->trials - lane->reported_trials >= SIM_PROGRESS_TRIALS) {
+        report(job, lane);
+    }
     if (balanced) {
         return finish(job, lane, ICOAC_SIM_SUCCESS);
     }
@@ -148,6 +164,8 @@ int32_t sim_lane_init(const sim_job_t *job, sim_lane_t *lane, icoac_sim_cell_t *
     lane->trials = 0;
     lane->total = 0;
     lane->steps = 0;
+    lane->reported_trials = 0;
+    lane->reported_steps = 0;
     lane->status = status;
     return status;
 }

@@ -89,10 +89,11 @@ typedef struct {
     double cov[ICOAC_MAX_INPUTS][ICOAC_MAX_INPUTS];     /* final Sigma_w (RL); the leading n x n block */
 } icoac_sim_cell_t;
 
-/* Indices of the progress array given to icoac_sim_run_grid. */
+/* Indices of the progress array given to icoac_sim_run_grid. A thread adds a cell's trials and
+ * steps every 64 trials of it, at its end and at a cancel: a reader sees them with that lag. */
 #define ICOAC_SIM_PROGRESS_CELLS 0  /* cells finished */
 #define ICOAC_SIM_PROGRESS_TRIALS 1 /* trials finished */
-#define ICOAC_SIM_PROGRESS_STEPS 2  /* plant steps finished (updated per trial) */
+#define ICOAC_SIM_PROGRESS_STEPS 2  /* plant steps of those trials */
 #define ICOAC_SIM_PROGRESS_LEN 3
 
 const char *icoac_sim_status_str(int32_t status);
