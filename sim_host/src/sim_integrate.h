@@ -8,8 +8,14 @@
 #include "icoac_sim/icoac_sim.h"
 
 #define SIM_DERIVATIVES static inline __attribute__((always_inline)) void
-/* A plant's step, compiled for each vector width; the loader picks the machine's. */
+/* A plant's step, compiled for each vector width; the loader picks the machine's. Not with clang:
+ * clang 14 gives the clones' resolver of a static function external linkage, so that two plants'
+ * `step`s clash at link time; its builds run the baseline (SSE2) code. */
+#if defined(__clang__)
+#define SIM_BATCH_STEP
+#else
 #define SIM_BATCH_STEP __attribute__((target_clones("default", "avx2", "avx512f")))
+#endif
 
 /* Advance each of the lanes states of s (component i of lane l at s[i * lanes + l]) by one dt
  * under its own input u[l]: explicit Euler (every right-hand side from the old state, Sutton's
