@@ -150,7 +150,7 @@ CORRUPTIONS = {
                             ["cells.npz"]),
     "cells.npz not a zip": (lambda d: (d / "cells.npz").write_bytes(b"\x93NUMPY garbage"), ["cells.npz"]),
     "run.json [1,2]": (lambda d: (d / "run.json").write_text("[1, 2]"), ["run.json", "[1, 2] is not of type 'object'"]),
-    "run.json {}": (lambda d: (d / "run.json").write_text("{}"), ["run.json", "format_version None is not 2"]),
+    "run.json {}": (lambda d: (d / "run.json").write_text("{}"), ["run.json", "format_version None is not 3"]),
     "run.json not JSON": (lambda d: (d / "run.json").write_text('{"seed": '), ["run.json", "not valid JSON"]),
     "run.json config 5": (lambda d: edit_record(d, _set(["config"], 5)), ["config: 5 is not of type 'object'"]),
     "run.json controller 5": (lambda d: edit_record(d, _set(["config", "controller"], 5)), ["controller"]),

@@ -287,7 +287,7 @@ def test_old_records_are_refused_in_one_line(ico_dir):
     """Before 1.0 an old record format is refused, never filled in from today's defaults."""
     rec = json.loads((Path(ico_dir) / "run.json").read_text())
     results.check_record(rec)
-    with pytest.raises(ResultsError, match=r"run.json: format_version 1 is not 2; this version reads only the records "):
+    with pytest.raises(ResultsError, match=r"run.json: format_version 1 is not 3; this version reads only the records "):
         results.check_record({**rec, "format_version": 1})
     del rec["builds"]  # as every record before the list of builds
     with pytest.raises(ResultsError, match=r"the record: 'builds' is a required property"):

@@ -20,7 +20,7 @@ from icoac.core.options import SEED_LIMIT
 from icoac.core.plants import PLANTS
 from icoac.core.registry import CONDITIONS
 
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 _NULLABLE_STRING = {"type": ["string", "null"]}
 _NUMBERS = {"type": "array", "items": {"type": "number"}}
 
