@@ -110,8 +110,8 @@ static void report(const sim_job_t *job, sim_lane_t *lane)
  * non-PENDING sees the rest. */
 static int finish(const sim_job_t *job, sim_lane_t *lane, int32_t outcome)
 {
-    report(job, lane);
     icoac_sim_cell_t *cell = lane->cell;
+    report(job, lane);
     cell->trials = lane->trials;
     cell->total_steps = lane->total;
     cell->last_trial_steps = outcome == ICOAC_SIM_ERROR ? 0 : lane->steps;
@@ -203,11 +203,8 @@ static void block_step(const sim_job_t *job, sim_block_t *block)
         const double x_limit = p[SIM_CART_POLE_X_LIMIT], theta_limit = p[SIM_CART_POLE_THETA_LIMIT];
         sim_cart_pole_step(p, model->dt, model->integrator, block->s, block->u, lanes);
         for (l = 0; l < lanes; ++l) {
-            /* sim_cart_pole_failed, with & for && so that the loop has no branch */
-            const double x = s[l], theta = s[2 * lanes + l];
-            const int inside = (x >= -x_limit) & (x <= x_limit) & (theta >= -theta_limit) & (theta <= theta_limit) &
-                               (fabs(s[lanes + l]) <= DBL_MAX) & (fabs(s[3 * lanes + l]) <= DBL_MAX);
-            block->failed[l] = !inside;
+            const double x[4] = {s[l], s[lanes + l], s[2 * lanes + l], s[3 * lanes + l]};
+            block->failed[l] = sim_cart_pole_failed(x_limit, theta_limit, x);
         }
     } else {
         job->desc->step(p, model->dt, model->integrator, block->s, block->u, lanes);
