@@ -22,7 +22,7 @@ Callees outside the library (libm, libc, libgcc):
   through. Assumed: no loop in these runtime routines decrements sp; any other write of sp or an
   indirect branch fails the analysis.
 - Host (x86-64, glibc): the C library's routines are not in the build. Each call into glibc
-  (expf, logf, sqrtf, their double versions, memcpy, memset, memcmp) counts HOST_RUNTIME_FRAME
+  (expf, logf, sqrtf, their double versions, memcpy, memmove, memset, memcmp) counts HOST_RUNTIME_FRAME
   bytes, an assumption (these are leaf routines: a return address and a few saved registers),
   not a measurement.
 
@@ -47,11 +47,16 @@ CONFIGS = {
     "host": ("build/release", "icoac"),
     "host-double": ("build/release", "icoac_double"),
 }
-HOST_RUNTIME = ("expf", "logf", "sqrtf", "exp", "log", "sqrt", "memcpy", "memset", "memcmp")
+HOST_RUNTIME = ("expf", "logf", "sqrtf", "exp", "log", "sqrt", "memcpy", "memmove", "memset", "memcmp")
 HOST_RUNTIME_FRAME = 128  # bytes assumed per glibc routine (not measured)
 BUDGET_BEGIN, BUDGET_END = "<!-- stack-budget:begin -->", "<!-- stack-budget:end -->"
 BUDGET_COLUMNS = {"cortex-m4f": "cortex-m4f", "cortex-m0plus": "cortex-m0plus", "host": "host",
                   "host-double": "host"}
+
+
+# Public functions built only with a CMake option (firmware/CMakeLists.txt): not in the call
+# graph of a build that turned the option off, and required in any other.
+OPTIONAL_FUNCTIONS = {"icoac_batch_init": "ICOAC_BATCH", "icoac_step_batch": "ICOAC_BATCH"}
 
 
 class AnalysisError(Exception):
@@ -119,7 +124,21 @@ def read_callgraph(obj_dir):
             m = edge_re.match(line)
             if m:
                 edges.setdefault(m.group(1), []).append(m.group(2))
-    return frames, edges
+    return frames, multiversioned(frames, edges)
+
+
+def multiversioned(frames, edges):
+    """edges with a call to a function GCC compiled for several targets (target_clones: the
+    clones "f.default", "f.avx2"..., reached through the ifunc "f") replaced by calls to each of
+    its clones; its resolver's calls dropped (the loader runs it, before any call of the API)."""
+    clones = {}
+    for node in frames:
+        base, dot, suffix = node.rpartition(".")
+        if dot and base not in frames and suffix != "resolver" and base + ".resolver" in frames:
+            clones.setdefault(base, []).append(node)
+    resolvers = {base + ".resolver" for base in clones}
+    return {caller: [] if caller in resolvers else [c for callee in callees for c in clones.get(callee, [callee])]
+            for caller, callees in edges.items()}
 
 
 # --- runtime routines from a Cortex-M disassembly ----------------------------------------------
@@ -461,6 +480,15 @@ def build_path(build, *parts):
     return path
 
 
+def option_off(build, option):
+    """True when the CMake cache of build sets the boolean option off."""
+    cache = os.path.join(build, "CMakeCache.txt")
+    if not os.path.exists(cache):
+        return False
+    m = re.search(r"^%s:BOOL=(\S*)$" % re.escape(option), open(cache).read(), re.M)
+    return m is not None and m.group(1).upper() in ("OFF", "0", "FALSE", "NO", "N")
+
+
 def analyse(config, build=None):
     build_rel, lib = CONFIGS[config]
     build = build or os.path.join(ROOT, build_rel)
@@ -477,6 +505,8 @@ def analyse(config, build=None):
     all_bounds = bounds(frames, edges, runtime, accept_bounded=not config.startswith("cortex"), tails=tails)
     result = {}
     for fn in public_functions():
+        if fn not in all_bounds and fn in OPTIONAL_FUNCTIONS and option_off(build, OPTIONAL_FUNCTIONS[fn]):
+            continue
         if fn not in all_bounds:
             raise AnalysisError("public function %s not in the call graph of %s" % (fn, obj_dir))
         result[fn] = all_bounds[fn]

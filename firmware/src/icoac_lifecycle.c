@@ -30,7 +30,8 @@ static int cartpole_rules(const icoac_task_config_t *task)
     return same;
 }
 
-/* What the tick takes from the configuration in force, derived once: task.input_sign /
+/* What the tick takes from the configuration in force, derived once (and the state's batch
+ * stamp cleared): task.input_sign /
  * policy.input_range (0 past the task's inputs; the sign folded in, so a tick pays nothing for
  * it, and +1 gives 1 / range bit for bit), the critic's geometry, the shape tags and the search's
  * floors. */
@@ -38,6 +39,7 @@ static void derive(icoac_priv_state_t *st)
 {
     const int n = icoac_priv_inputs(&st->config);
     int i;
+    st->batch_token = 0u; /* a batch that loaded the state loads it again */
     for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
         const icoac_real_t sign = (st->config.task.input_sign[i] < 0) ? ICOAC_R(-1.0) : ICOAC_R(1.0);
         st->inv_range[i] = i < n ? sign / st->config.policy.input_range[i] : ICOAC_R(0.0);

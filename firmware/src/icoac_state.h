@@ -16,8 +16,8 @@
 
 /* The header word of an initialised state; it changes with the layout. A terminal tick turns a
  * trial's word into the ended one until icoac_reset: a tick in between is refused. */
-#define ICOAC_PRIV_STATE_MAGIC 0x1C0AC070u
-#define ICOAC_PRIV_STATE_ENDED 0x1C0AC07Eu
+#define ICOAC_PRIV_STATE_MAGIC 0x1C0AC071u
+#define ICOAC_PRIV_STATE_ENDED 0x1C0AC07Fu
 
 /* Critic blocks (icoac.h, critic): unit k = row * cells + cell with rows, cells <=
  * ICOAC_CRITIC_BLOCK_MAX and rows * cells <= ICOAC_MAX_CRITIC_UNITS, so rows + cells <=
@@ -114,6 +114,9 @@ typedef struct {
 typedef struct ICOAC_PRIV_MAY_ALIAS {
     uint32_t magic;                                   /* set by icoac_init; ENDED after a terminal tick */
     int32_t has_prev;                                 /* a previous tick of this trial is cached */
+    uint32_t batch_token;                             /* the stamp of the icoac_step_batch lane this state is
+                                                         loaded in (icoac_batch.c); 0: none. init, retune
+                                                         and reset clear it */
     icoac_config_t config;                            /* in force: checked by icoac_init / icoac_retune,
                                                          checked again by icoac_reset */
     icoac_priv_grid_t grid;                           /* the critic's geometry, derived */

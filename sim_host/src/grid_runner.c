@@ -90,7 +90,7 @@ static void *worker(void *arg)
     int l;
     const int lanes = (int)job->sim.run->lanes; /* checked: 1 .. ICOAC_SIM_MAX_LANES */
     (void)sim_fpu_flush_subnormals();           /* a fresh thread: nothing to restore */
-    w.block.lanes = lanes;
+    sim_block_init(&w.block, lanes);
     w.active = lanes;
     for (l = 0; l < lanes; ++l) {
         w.lane[l].lane = l;

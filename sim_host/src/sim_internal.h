@@ -75,9 +75,14 @@ typedef struct {
     int32_t lanes; /* <= ICOAC_SIM_MAX_LANES */
     double s[ICOAC_SIM_MAX_STATE * ICOAC_SIM_MAX_LANES];
     double u[ICOAC_SIM_MAX_LANES];
-    icoac_input_t in[ICOAC_SIM_MAX_LANES]; /* each lane's state as the controller's input (sim_to_input) */
-    int32_t failed[ICOAC_SIM_MAX_LANES];   /* the plant's failure test of each lane's state */
+    icoac_real_t in[ICOAC_MAX_INPUTS * ICOAC_SIM_MAX_LANES]; /* the controllers' inputs, laid out as s (sim_real) */
+    int32_t failed[ICOAC_SIM_MAX_LANES];                     /* the plant's failure test of each lane's state */
+    icoac_batch_t batch;                                     /* the controllers' ticks (icoac_step_batch) */
+    icoac_state_t *ctrl[ICOAC_SIM_MAX_LANES];                /* the running lanes' controllers, NULL for the others */
+    icoac_real_t force[ICOAC_SIM_MAX_LANES];
+    int32_t status[ICOAC_SIM_MAX_LANES];
 } sim_block_t;
+ICOAC_STATIC_ASSERT(ICOAC_SIM_MAX_LANES <= ICOAC_BATCH_MAX_LANES, a_block_is_one_batch);
 
 /* A cell in progress on lane `lane` of a block (trial.c): its controller and counters. */
 typedef struct {
@@ -99,6 +104,9 @@ typedef struct {
 #define SIM_LANE_DONE 1
 #define SIM_LANE_CANCELLED 2
 #define SIM_LANE_RESTING 3 /* a worker's lane without a cell (none is left) */
+
+/* An empty block of `lanes` lanes (1 .. ICOAC_SIM_MAX_LANES). */
+void sim_block_init(sim_block_t *block, int32_t lanes);
 
 /* A fresh controller for cell on lane; returns the status of icoac_init (the lane is unusable
  * unless ICOAC_SIM_OK, and the cell untouched). */

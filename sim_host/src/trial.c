@@ -93,6 +93,22 @@ static void set_lane_state(sim_block_t *block, int32_t lane, int32_t n, const do
     }
 }
 
+/* The lane's plant state as its controller's input, in the block (sim_real of each value). */
+static void set_lane_input(sim_block_t *block, int32_t lane, int32_t n, const double *x)
+{
+    int32_t i;
+    for (i = 0; i < n; ++i) {
+        block->in[i * block->lanes + lane] = sim_real(x[i]);
+    }
+}
+
+void sim_block_init(sim_block_t *block, int32_t lanes)
+{
+    (void)memset(block, 0, sizeof *block);
+    block->lanes = lanes;
+    (void)icoac_batch_init(&block->batch);
+}
+
 /* The lane's finished trials and their steps not yet in the progress counters, added. The
  * counters are shared by every thread: a lane adds to them every SIM_PROGRESS_TRIALS trials, at
  * its cell's end and at a cancel, not at every trial (measured: adding at every one of the ICO
@@ -133,7 +149,7 @@ static int start_trial(const sim_job_t *job, sim_block_t *block, sim_lane_t *lan
     }
     sim_start_trial(job->desc, lane->cell, job->run->init_velocity_noise, &lane->rng, x);
     set_lane_state(block, lane->lane, job->desc->n_state, x);
-    sim_to_input(x, job->cfg->task.n_inputs, 0u, &block->in[lane->lane]);
+    set_lane_input(block, lane->lane, job->cfg->task.n_inputs, x);
     lane->steps = 0;
     lane->status = (int32_t)icoac_reset(&lane->ctrl);
     return lane->status == ICOAC_SIM_OK ? SIM_LANE_RUNNING : finish(job, lane, ICOAC_SIM_ERROR);
@@ -175,17 +191,30 @@ int sim_lane_start(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
     return start_trial(job, block, lane);
 }
 
-/* The tick's controller step on the lane's input, its force the lane's plant input: SIM_LANE_*
- * (DONE when the controller reported an error). */
-static inline int lane_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
+/* Every running lane's controller ticks on its input (one icoac_step_batch); its force becomes
+ * the lane's plant input, or a lane whose controller reported an error ends (its cell's result
+ * written): state[l] becomes its SIM_LANE_*. Returns how many lanes ended. */
+static int block_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lanes, int *state)
 {
-    icoac_output_t out;
-    lane->status = (int32_t)icoac_step(&lane->ctrl, &block->in[lane->lane], &out);
-    if (lane->status != ICOAC_SIM_OK) {
-        return finish(job, lane, ICOAC_SIM_ERROR);
+    const int32_t n = block->lanes;
+    int32_t l;
+    int ended = 0;
+    for (l = 0; l < n; ++l) {
+        block->ctrl[l] = state[l] == SIM_LANE_RUNNING ? &lanes[l].ctrl : 0;
     }
-    block->u[lane->lane] = (double)out.force;
-    return SIM_LANE_RUNNING;
+    (void)icoac_step_batch(&block->batch, block->ctrl, n, block->in, job->cfg->task.n_inputs, 0, 0, block->force,
+                           block->status);
+    for (l = 0; l < n; ++l) {
+        if (state[l] == SIM_LANE_RUNNING) {
+            lanes[l].status = block->status[l];
+            if (block->status[l] != ICOAC_SIM_OK) {
+                state[l] = finish(job, &lanes[l], ICOAC_SIM_ERROR);
+                ++ended;
+            }
+            block->u[l] = (double)block->force[l];
+        }
+    }
+    return ended;
 }
 
 /* The plant step of every lane, then each lane's failure test and next input, all in loops over
@@ -214,18 +243,8 @@ static void block_step(const sim_job_t *job, sim_block_t *block)
             block->failed[l] = job->desc->failed(p, x);
         }
     }
-    if (n_inputs == 4) { /* the cart-pole's task: a lane's inputs are written together */
-        for (l = 0; l < lanes; ++l) {
-            for (i = 0; i < 4; ++i) {
-                block->in[l].s[i] = sim_real(block->s[i * lanes + l]);
-            }
-        }
-        return;
-    }
-    for (i = 0; i < n_inputs; ++i) {
-        for (l = 0; l < lanes; ++l) {
-            block->in[l].s[i] = sim_real(block->s[i * lanes + l]);
-        }
+    for (i = 0; i < n_inputs * lanes; ++i) { /* the inputs' layout is the states' */
+        block->in[i] = sim_real(block->s[i]);
     }
 }
 
@@ -256,14 +275,9 @@ int sim_block_tick(const sim_job_t *job, sim_block_t *block, sim_lane_t *lanes, 
 {
     int acted[ICOAC_SIM_MAX_LANES];
     int32_t l;
-    int ended = 0;
+    int ended = block_act(job, block, lanes, state);
     for (l = 0; l < block->lanes; ++l) {
         acted[l] = state[l] == SIM_LANE_RUNNING;
-        if (acted[l]) {
-            state[l] = lane_act(job, block, &lanes[l]);
-            acted[l] = state[l] == SIM_LANE_RUNNING;
-            ended += !acted[l];
-        }
     }
     block_step(job, block);
     for (l = 0; l < block->lanes; ++l) {
@@ -294,7 +308,7 @@ int32_t icoac_sim_run_cell(const icoac_config_t *cfg, const icoac_sim_model_t *m
     {
         const sim_job_t job = {cfg, model, icoac_sim_plant_info(model->plant), run, prior, cancel, progress};
         fpu_mode = sim_fpu_flush_subnormals();
-        block.lanes = 1;
+        sim_block_init(&block, 1);
         lane.lane = 0;
         status = sim_lane_init(&job, &lane, cell);
         if (status == ICOAC_SIM_OK) {

@@ -89,7 +89,7 @@ static void test_constants_table(void)
     }
     /* spot checks against the headers */
     TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == ICOAC_ABI_VERSION);
-    TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == 9);
+    TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == 10);
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == ICOAC_SIM_ABI_VERSION);
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == 6);
     TEST_ASSERT_TRUE(constant("ICOAC_CARTPOLE_INPUTS") == ICOAC_CARTPOLE_INPUTS);

@@ -32,6 +32,7 @@ endfunction()
 # The consumer build holds icoac's objects, the consumer's main.c and nothing else.
 function(check_library_only build)
   file(GLOB icoac_sources RELATIVE ${ICOAC_SOURCE_DIR}/firmware/src ${ICOAC_SOURCE_DIR}/firmware/src/*.c)
+  list(REMOVE_ITEM icoac_sources icoac_batch.c) # ICOAC_BATCH: off outside the developer build
   list(LENGTH icoac_sources expected_library_objects)
   file(GLOB_RECURSE objects RELATIVE ${build} ${build}/*.o ${build}/*.obj)
   list(FILTER objects EXCLUDE REGEX "^CMakeFiles/[0-9][^/]*/") # CMake's compiler identification

@@ -59,7 +59,7 @@ def test_state_is_opaque_aligned_storage():
 
 
 def test_abi_versions():
-    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 9
+    assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 10
     assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 6
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
@@ -340,7 +340,7 @@ def test_retune_and_the_configuration_in_force():
     assert status == out.status == B.CONSTANTS["ICOAC_ERR_TRIAL_ENDED"] and out.force == 0
     assert "icoac_reset" in B.status_str(status)
     raw = bytearray(bytes(state))
-    raw[8:12] = (99).to_bytes(4, "little")  # the configuration copy's mode (the state's layout is private:
-    ctypes.memmove(ctypes.addressof(state), bytes(raw), len(raw))  # it follows a 4-byte magic and has_prev)
+    raw[12:16] = (99).to_bytes(4, "little")  # the configuration copy's mode (the state's layout is private: it
+    ctypes.memmove(ctypes.addressof(state), bytes(raw), len(raw))  # follows a 4-byte magic, has_prev, batch_token)
     with pytest.raises(B.IcoacError, match="corrupted"):
         B.check_status(B.lib.icoac_reset(ctypes.byref(state)))

@@ -132,3 +132,25 @@ def test_the_public_functions_are_the_headers_declarations():
     assert {"icoac_step", "icoac_init", "icoac_reset", "icoac_retune", "icoac_config_check",
             "icoac_rng_normal", "icoac_status_str"} <= set(names)
     assert len(names) == len(set(names)) and all(n.startswith("icoac_") for n in names)
+
+
+def test_an_optional_function_is_skipped_only_where_its_option_is_off(tmp_path):
+    assert set(sb.OPTIONAL_FUNCTIONS) <= set(sb.public_functions())
+    cache = tmp_path / "CMakeCache.txt"
+    assert not sb.option_off(str(tmp_path), "ICOAC_BATCH")  # no cache: required
+    cache.write_text("ICOAC_BUILD_HOST:BOOL=OFF\nICOAC_BATCH:BOOL=OFF\n")
+    assert sb.option_off(str(tmp_path), "ICOAC_BATCH")
+    cache.write_text("ICOAC_BATCH:BOOL=ON\n")
+    assert not sb.option_off(str(tmp_path), "ICOAC_BATCH")
+    cache.write_text("ICOAC_BATCH_X:BOOL=OFF\n")
+    assert not sb.option_off(str(tmp_path), "ICOAC_BATCH")
+
+
+def test_a_multiversioned_call_counts_its_deepest_clone_and_not_its_resolver():
+    frames = {"f.c:g": (16, "static", "g"), "f.c:v.default": (8, "static", "v"),
+              "f.c:v.avx2": (900, "static", "v.avx2"), "f.c:v.resolver": (16, "static", "v.resolver")}
+    edges = {"f.c:g": ["f.c:v"], "f.c:v.resolver": ["__cpu_indicator_init"]}
+    graph = sb.multiversioned(frames, edges)
+    assert sorted(graph["f.c:g"]) == ["f.c:v.avx2", "f.c:v.default"]
+    assert graph["f.c:v.resolver"] == []
+    assert sb.bounds(frames, graph, {}, accept_bounded=True)["f.c:g"][0] == 916

@@ -289,6 +289,44 @@ icoac_status_t icoac_reset(icoac_state_t *state);
  * the slots, the learned values but the critic weights). */
 icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out);
 
+/* The batch tick (a host's simulation engine; built with CMake's ICOAC_BATCH, on by default for
+ * the host and left out of the microcontroller presets): up to ICOAC_BATCH_MAX_LANES states, one
+ * tick each, in lockstep.
+ * icoac_batch_t is caller-owned storage, 8-byte aligned, set up by icoac_batch_init. It keeps
+ * what a tick reads of each lane's state, loaded at the lane's first tick and again whenever
+ * icoac_init, icoac_retune, icoac_reset or icoac_step has changed that state (the load stamps
+ * the state; those functions clear the stamp or advance its tick counter), so the lanes' common
+ * ticks read nothing of their states but a header. A state is ticked by one batch, or by
+ * icoac_step, at a time; any state can move between lanes or leave the batch between calls. */
+#define ICOAC_BATCH_MAX_LANES 64
+#define ICOAC_BATCH_SIZE                                                                                 \
+    (((((4 * ICOAC_MAX_INPUTS) + (4 * ICOAC_MAX_RULES) + 14) * ICOAC_BATCH_MAX_LANES * (int)sizeof(icoac_real_t)) + \
+      (ICOAC_BATCH_MAX_LANES * 17) + (int)sizeof(icoac_input_t) + (int)sizeof(icoac_output_t) + 16 + 63) / 64 * 64)
+typedef struct {
+    uint64_t opaque[ICOAC_BATCH_SIZE / 8];
+} icoac_batch_t;
+
+/* An empty batch (ICOAC_ERR_NULL when batch is NULL). */
+icoac_status_t icoac_batch_init(icoac_batch_t *batch);
+
+/* One tick of `lanes` states in lockstep. Lane l (0 <= l < lanes) steps states[l] as
+ * icoac_step(states[l], &in, &out) would, bit for bit (force, status, the state afterwards), with
+ * in.s[i] = s[i * lanes + l] for i < inputs, in.flags = flags[l] (flags NULL: 0) and in.reflex =
+ * reflex[l] (reflex NULL: 0), and writes force[l] = out.force and status[l] = the lane's status.
+ * The other fields of icoac_output_t are not produced: a caller that wants them calls
+ * icoac_step. A lane's bad input or state gives that lane its status and changes no other lane;
+ * states[l] NULL gives ICOAC_ERR_NULL, and a state in a trial whose task has more than `inputs`
+ * inputs ICOAC_ERR_NULL (its input is missing), force 0 and no change. The states must be
+ * distinct. Returns ICOAC_OK when every lane's status is, else the first failed lane's status;
+ * with nothing read or written, ICOAC_ERR_NULL when batch, states, s, force or status is NULL,
+ * lanes is outside [0, ICOAC_BATCH_MAX_LANES] or inputs outside [1, ICOAC_MAX_INPUTS], and
+ * ICOAC_ERR_NOT_INITIALISED for a batch icoac_batch_init did not set up. The common ticks of ICO
+ * and search mode on a rule-table task run vectorised across the lanes; RL mode, sensor tasks,
+ * terminal ticks, learning ticks and errors run icoac_step per lane (firmware/src/icoac_batch.c). */
+icoac_status_t icoac_step_batch(icoac_batch_t *batch, icoac_state_t *const states[], int32_t lanes,
+                                const icoac_real_t *s, int32_t inputs, const uint32_t *flags,
+                                const icoac_real_t *reflex, icoac_real_t *force, int32_t *status);
+
 /* Current weights (ICO w or actor mean mu_w) and covariance Sigma_w. */
 icoac_status_t icoac_get_posterior(const icoac_state_t *state, icoac_prior_t *posterior);
 

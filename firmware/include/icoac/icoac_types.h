@@ -10,7 +10,7 @@ extern "C" {
 #endif
 
 /* Bump when a public struct layout or an enum value changes. */
-#define ICOAC_ABI_VERSION 9
+#define ICOAC_ABI_VERSION 10
 
 /* Real-number type: float by default; define ICOAC_REAL_DOUBLE=1 for double. */
 #if defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE

@@ -34,7 +34,7 @@ BUILD_INFO = PACKAGE_LIBRARY.parent / "build_info.json"   # the commit the packa
 DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.so"
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
-ABI_VERSION = 9
+ABI_VERSION = 10
 SIM_ABI_VERSION = 6
 
 
