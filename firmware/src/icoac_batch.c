@@ -28,6 +28,9 @@
  * lanes past the call's count compute on zeros and are not committed. */
 #define GROUP 16
 ICOAC_STATIC_ASSERT((L % GROUP) == 0, lanes_in_whole_groups);
+/* A group with fewer lanes for the vector pass runs them through icoac_step: the pass over the
+ * whole group would cost more. */
+#define MIN_VECTOR_LANES 4
 
 #define BATCH_MAGIC 0x1C0ACBA7u
 
@@ -82,8 +85,7 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
     uint8_t kind[L];               /* KIND_* */
     uint32_t magic;
     uint32_t next_token; /* never 0 */
-    int32_t rows;        /* inputs of the largest task loaded, at most N */
-    int32_t used_rules;  /* rules of the largest table loaded, at most R */
+    int32_t rows;        /* inputs of the largest task loaded, at most N: the rows gathered */
 } batch_t;
 
 ICOAC_STATIC_ASSERT(sizeof(batch_t) <= sizeof(icoac_batch_t), batch_fits_its_storage);
@@ -134,6 +136,21 @@ static uint8_t kind_of(const icoac_config_t *cfg)
     return kind;
 }
 
+/* What icoac_step may change of a loaded lane's state (the weights, the previous tick's penalty
+ * and cache, the tick counter), read again. */
+static void refresh_lane(batch_t *b, int32_t l, const icoac_priv_state_t *st)
+{
+    const uint8_t kind = b->kind[l];
+    const icoac_real_t *w = (kind == KIND_SEARCH) ? st->w_act : st->w;
+    int i;
+    for (i = 0; i < N; ++i) {
+        b->w[i][l] = w[i];
+    }
+    b->penalty_prev[l] = st->penalty_prev;
+    b->armed[l] = ((kind != KIND_ICO_LITERAL) || (st->has_prev != 0)) ? LANE_TRUE : LANE_FALSE;
+    b->ticks[l] = st->counters.ticks;
+}
+
 /* Lane l loaded from st (in a trial), and st stamped with the lane's token. The rules' inputs
  * and sides are those icoac_step's instance reads: the preset's when the cart-pole instance runs
  * with the state's tag, else the table's, bounded to the task's n. */
@@ -147,7 +164,6 @@ static void load_lane(batch_t *b, int32_t l, const icoac_state_t *state, icoac_p
     const int rules = icoac_priv_rules(task);
     int cartpole = 0;
     const uint8_t kind = kind_of(cfg);
-    const icoac_real_t *w = (kind == KIND_SEARCH) ? st->w_act : st->w;
     int i;
     int k;
     if ((task->n_inputs == ICOAC_CARTPOLE_INPUTS) && (task->late_source == (int32_t)ICOAC_LATE_RULES) &&
@@ -156,7 +172,6 @@ static void load_lane(batch_t *b, int32_t l, const icoac_state_t *state, icoac_p
     }
     for (i = 0; i < N; ++i) {
         b->inv_range[i][l] = st->inv_range[i];
-        b->w[i][l] = w[i];
     }
     for (k = 0; k < R; ++k) {
         const int32_t input = (cartpole != 0) ? cartpole_input[k & 3] : task->rule_input[k];
@@ -172,20 +187,15 @@ static void load_lane(batch_t *b, int32_t l, const icoac_state_t *state, icoac_p
     b->learns[l] = ((kind != KIND_SEARCH) && (cfg->learn != 0)) ? LANE_TRUE : LANE_FALSE;
     b->gain[l] = cfg->policy.gain;
     b->reflex_gain[l] = (cfg->policy.reflex_mode == (int32_t)ICOAC_REFLEX_GAIN) ? cfg->policy.gain : cfg->policy.reflex_force;
-    b->penalty_prev[l] = st->penalty_prev;
-    b->armed[l] = ((kind != KIND_ICO_LITERAL) || (st->has_prev != 0)) ? LANE_TRUE : LANE_FALSE;
     b->preset[l] = (cartpole != 0) ? LANE_TRUE : LANE_FALSE;
     b->kind[l] = kind;
     b->state[l] = state;
     b->token[l] = b->next_token;
-    b->ticks[l] = st->counters.ticks;
+    refresh_lane(b, l, st);
     st->batch_token = b->next_token;
     b->next_token = (b->next_token == UINT32_MAX) ? 1u : (b->next_token + 1u);
     if (n > b->rows) {
         b->rows = n;
-    }
-    if (rules > b->used_rules) {
-        b->used_rules = rules;
     }
 }
 
@@ -384,6 +394,10 @@ ICOAC_PRIV_NOINLINE static void scalar_lane(batch_t *b, const batch_args_t *a, i
         in->reflex = (a->reflex != NULL) ? a->reflex[l] : ICOAC_R(0.0);
         a->status[l] = (int32_t)icoac_step(state, in, &b->out);
         a->force[l] = b->out.force;
+        /* a lane loaded from this state stays so: icoac_step changed none of its configuration */
+        if ((b->state[l] == state) && (icoac_priv_state_c(state)->batch_token == b->token[l]) && (b->token[l] != 0u)) {
+            refresh_lane(b, l, icoac_priv_state_c(state));
+        }
     }
 }
 
@@ -411,20 +425,22 @@ static void gather_inputs(batch_t *b, const batch_args_t *a, int32_t g)
 ICOAC_PRIV_NOINLINE static void vector_lanes(batch_t *b, const batch_args_t *a)
 {
     const int32_t width = ((a->lanes + (GROUP - 1)) / GROUP) * GROUP;
-    int32_t l;
-    /* a corrupted batch stays inside its arrays */
-    b->rows = (b->rows < 0) ? 0 : ((b->rows > N) ? N : b->rows);
-    b->used_rules = (b->used_rules < 0) ? 0 : ((b->used_rules > R) ? R : b->used_rules);
     int32_t g;
+    int32_t l;
+    b->rows = (b->rows < 0) ? 0 : ((b->rows > N) ? N : b->rows); /* a corrupted batch stays inside its arrays */
     for (g = 0; g < width; g += GROUP) {
         int32_t count = 0;
         int32_t presets = 0;
         for (l = g; l < (g + GROUP); ++l) {
-            b->vector[l] = (l < a->lanes) ? classify(b, a, l) : 0;
+            b->vector[l] = (l < a->lanes) ? classify(b, a, l) : LANE_FALSE;
             count += (int32_t)b->vector[l];
             presets += (int32_t)(b->vector[l] & b->preset[l]);
         }
-        if (count > 0) {
+        if (count < MIN_VECTOR_LANES) {
+            for (l = g; l < (g + GROUP); ++l) {
+                b->vector[l] = LANE_FALSE;
+            }
+        } else {
             gather_inputs(b, a, g);
             if (presets == count) {
                 group_pass_cartpole(b, g);

@@ -297,11 +297,14 @@ icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_o
  * icoac_init, icoac_retune, icoac_reset or icoac_step has changed that state (the load stamps
  * the state; those functions clear the stamp or advance its tick counter), so the lanes' common
  * ticks read nothing of their states but a header. A state is ticked by one batch, or by
- * icoac_step, at a time; any state can move between lanes or leave the batch between calls. */
+ * icoac_step, at a time; any state can move between lanes or leave the batch between calls. A
+ * state whose bytes were changed by other means than the library's functions (corrupted memory)
+ * is not loaded again until one of those functions runs on it: its lane stays inside the batch,
+ * the state and the call's arrays, but may tick as loaded rather than as icoac_step would. */
 #define ICOAC_BATCH_MAX_LANES 64
 #define ICOAC_BATCH_SIZE                                                                                 \
     (((((4 * ICOAC_MAX_INPUTS) + (4 * ICOAC_MAX_RULES) + 14) * ICOAC_BATCH_MAX_LANES * (int)sizeof(icoac_real_t)) + \
-      (ICOAC_BATCH_MAX_LANES * 17) + (int)sizeof(icoac_input_t) + (int)sizeof(icoac_output_t) + 16 + 63) / 64 * 64)
+      (ICOAC_BATCH_MAX_LANES * 17) + (int)sizeof(icoac_input_t) + (int)sizeof(icoac_output_t) + 12 + 63) / 64 * 64)
 typedef struct {
     uint64_t opaque[ICOAC_BATCH_SIZE / 8];
 } icoac_batch_t;
