@@ -24,13 +24,14 @@
 #define R ICOAC_MAX_RULES
 #define L ICOAC_BATCH_MAX_LANES
 
-/* The vector loops run over whole groups of this many lanes (any vector width divides it); the
- * lanes past the call's count compute on zeros and are not committed. */
-#define GROUP 16
+/* The vector loops run over whole groups of this many lanes (an AVX2 vector of floats; measured
+ * against 16: as fast at 16 lanes, less work at 8); the lanes past the call's count compute on
+ * what their columns hold and are not committed. */
+#define GROUP 8
 ICOAC_STATIC_ASSERT((L % GROUP) == 0, lanes_in_whole_groups);
-/* A group with fewer lanes for the vector pass runs them through icoac_step: the pass over the
- * whole group would cost more. */
-#define MIN_VECTOR_LANES 4
+/* A call or a group with fewer lanes for the vector pass runs them through icoac_step: the pass
+ * over the whole group would cost more. */
+#define MIN_VECTOR_LANES ICOAC_BATCH_MIN_VECTOR_LANES
 
 #define BATCH_MAGIC 0x1C0ACBA7u
 
@@ -217,8 +218,8 @@ static uint32_t flags_of(const batch_args_t *a, int32_t l)
 }
 
 /* 1 when lane l's tick runs in the vector pass: its state in a trial and loaded (loaded now if it
- * was not), a vector kind, all its inputs present, not a terminal tick. A state is loaded only
- * for such a tick. */
+ * was not), a vector kind, all its inputs present, not a terminal tick. A lane of icoac_step's
+ * kind (RL mode, a sensor task) is loaded too: its next ticks then read only its header. */
 static lane_int_t classify(batch_t *b, const batch_args_t *a, int32_t l)
 {
     icoac_state_t *const state = a->states[l];
@@ -230,9 +231,8 @@ static lane_int_t classify(batch_t *b, const batch_args_t *a, int32_t l)
             (st->counters.ticks == b->ticks[l])) {
             loaded = 1;
         }
-        /* a state is loaded only for a tick of the vector pass: icoac_step's lanes are not stamped */
-        if ((st->magic == ICOAC_PRIV_STATE_MAGIC) && (loaded == 0) && (kind_of(&st->config) != KIND_SCALAR) &&
-            (icoac_priv_inputs(&st->config) <= a->inputs)) {
+        /* a lane whose input is missing is not loaded (its state not stamped) */
+        if ((st->magic == ICOAC_PRIV_STATE_MAGIC) && (loaded == 0) && (icoac_priv_inputs(&st->config) <= a->inputs)) {
             load_lane(b, l, state, st);
             loaded = 1;
         }
@@ -396,7 +396,11 @@ ICOAC_PRIV_NOINLINE static void scalar_lane(batch_t *b, const batch_args_t *a, i
         a->force[l] = b->out.force;
         /* a lane loaded from this state stays so: icoac_step changed none of its configuration */
         if ((b->state[l] == state) && (icoac_priv_state_c(state)->batch_token == b->token[l]) && (b->token[l] != 0u)) {
-            refresh_lane(b, l, icoac_priv_state_c(state));
+            if (b->kind[l] == KIND_SCALAR) {
+                b->ticks[l] = icoac_priv_state_c(state)->counters.ticks;
+            } else {
+                refresh_lane(b, l, icoac_priv_state_c(state));
+            }
         }
     }
 }
@@ -470,9 +474,11 @@ icoac_status_t icoac_step_batch(icoac_batch_t *batch, icoac_state_t *const state
     }
     if ((first == ICOAC_ERR_NOT_INITIALISED) && (b->magic == BATCH_MAGIC)) {
         first = ICOAC_OK;
-        vector_lanes(b, &a);
+        if (lanes >= MIN_VECTOR_LANES) {
+            vector_lanes(b, &a);
+        }
         for (l = 0; l < lanes; ++l) {
-            if (b->vector[l] == 0) {
+            if ((lanes < MIN_VECTOR_LANES) || (b->vector[l] == 0)) {
                 scalar_lane(b, &a, l);
             }
             if ((first == ICOAC_OK) && (status[l] != (int32_t)ICOAC_OK)) {

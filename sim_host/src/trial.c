@@ -191,19 +191,39 @@ int sim_lane_start(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
     return start_trial(job, block, lane);
 }
 
-/* Every running lane's controller ticks on its input (one icoac_step_batch); its force becomes
- * the lane's plant input, or a lane whose controller reported an error ends (its cell's result
- * written): state[l] becomes its SIM_LANE_*. Returns how many lanes ended. */
+/* Every running lane's controller ticks on its input, and its force becomes the lane's plant
+ * input, or a lane whose controller reported an error ends (its cell's result written): state[l]
+ * becomes its SIM_LANE_*. Returns how many lanes ended. One icoac_step_batch for the lanes; a
+ * configuration whose ticks have no vector path there (RL mode, a sensor task: icoac_batch.c),
+ * or a block of too few lanes for it, steps each lane with icoac_step instead, which spares the
+ * batch's bookkeeping. */
 static int block_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lanes, int *state)
 {
+    const icoac_config_t *cfg = job->cfg;
     const int32_t n = block->lanes;
-    int32_t l;
+    int32_t i, l;
     int ended = 0;
-    for (l = 0; l < n; ++l) {
-        block->ctrl[l] = state[l] == SIM_LANE_RUNNING ? &lanes[l].ctrl : 0;
+    if (cfg->mode == ICOAC_MODE_RL || cfg->task.late_source != ICOAC_LATE_RULES || n < ICOAC_BATCH_MIN_VECTOR_LANES) {
+        for (l = 0; l < n; ++l) {
+            if (state[l] == SIM_LANE_RUNNING) {
+                icoac_input_t in;
+                icoac_output_t out;
+                for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
+                    in.s[i] = i < cfg->task.n_inputs ? block->in[i * n + l] : (icoac_real_t)0;
+                }
+                in.flags = 0u;
+                in.reflex = (icoac_real_t)0;
+                block->status[l] = (int32_t)icoac_step(&lanes[l].ctrl, &in, &out);
+                block->force[l] = out.force;
+            }
+        }
+    } else {
+        for (l = 0; l < n; ++l) {
+            block->ctrl[l] = state[l] == SIM_LANE_RUNNING ? &lanes[l].ctrl : 0;
+        }
+        (void)icoac_step_batch(&block->batch, block->ctrl, n, block->in, cfg->task.n_inputs, 0, 0, block->force,
+                               block->status);
     }
-    (void)icoac_step_batch(&block->batch, block->ctrl, n, block->in, job->cfg->task.n_inputs, 0, 0, block->force,
-                           block->status);
     for (l = 0; l < n; ++l) {
         if (state[l] == SIM_LANE_RUNNING) {
             lanes[l].status = block->status[l];
