@@ -41,7 +41,7 @@ FUZZ_LEDGER ?= tests/fuzz/ledger
 FUZZ_C_SOURCES = firmware sim_host $(wildcard tests/fuzz/*.c tests/fuzz/*.h)
 FUZZ_SOURCES = $(shell git ls-tree HEAD $(FUZZ_C_SOURCES) 2>/dev/null | git hash-object --stdin | \
   cut -c1-12)$(shell git diff --quiet HEAD -- $(FUZZ_C_SOURCES) 2>/dev/null || echo -modified)
-FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_model
+FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_model fuzz_batch
 
 .PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-fuzz fuzz fuzz-campaign fuzz-ledger bench \
   bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant

@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Write the committed seed corpus of the fuzz targets, tests/fuzz/corpus/<target>/.
 
-Inputs follow the formats documented at the top of fuzz_controller.c, fuzz_state.c and
-fuzz_model.c; the value tables below mirror fuzz_input.c, the state fields
+Inputs follow the formats documented at the top of fuzz_controller.c, fuzz_state.c,
+fuzz_model.c and fuzz_batch.c; the value tables below mirror fuzz_input.c, the state fields
 fuzz_state.c. Files named repro-* are known reproducers.
 
     python3 tests/fuzz/gen_corpus.py          # (re)write the corpus
@@ -1022,6 +1022,60 @@ def model_seeds():
     return s
 
 
+# ---- fuzz_batch.c --------------------------------------------------------------------------
+
+def b_lane(mode, fields=None, prior_section=NO_PRIOR, seed_byte=1):
+    """A lane: mode byte (% 3: ICO, RL, search; 4: literal timing; 8: sensor task), config, prior."""
+    return bytes([mode]) + config(fields) + prior_section + bytes([seed_byte])
+
+
+def b_tick(flags, rotation=0, inputs=None, reflexes=None):
+    """A batch tick: per lane a flags byte (3 terminal, 4 late with a reflex), fresh inputs (a
+    list per lane of MAX_INPUTS values) or the previous ones moved by (f & 7) / 100."""
+    out = bytes([8 if inputs is not None else 0, rotation])
+    for i, f in enumerate(flags):
+        out += bytes([f])
+        if inputs is not None:
+            out += b"".join(real(v) for v in inputs[i])
+        if f & 4:
+            out += real((reflexes or {}).get(i, 0.5))
+    return out
+
+
+def b_op(op, lane, data=b""):
+    """4 reset, 5 retune (data: a config section), 6 icoac_step (data: MAX_INPUTS reals)."""
+    return bytes([op, lane]) + data
+
+
+def batch_seeds():
+    centre = [0.1, -0.2, 0.02, 0.3, 0.0, 0.0]
+    beyond = [1.0, 0.5, 0.3, -0.5, 0.1, -0.1]
+    modes = [0, 4, 2, 1, 8, 0, 4, 2]
+    s = {}
+    walk = b"".join(b_tick([(t * 3) % 3]) for t in range(60))
+    s["one-ico-lane-walk"] = bytes([0]) + b_lane(0) + walk + b_tick([3]) + b_op(4, 0) + walk
+    lanes8 = bytes([7]) + b"".join(b_lane(m, seed_byte=k + 1) for k, m in enumerate(modes))
+    ticks8 = b"".join(b_tick([(t + k) % 3 for k in range(8)], rotation=t % 8,
+                             inputs=[centre if (t + k) % 4 else beyond for k in range(8)]) for t in range(12))
+    s["eight-mixed-lanes"] = (lanes8 + ticks8 + b_tick([3] * 8) + b"".join(b_op(4, k) for k in range(8)) + ticks8
+                              + b_op(5, 2, config({"policy.gain": 3})) + b_op(6, 0, b"".join(real(v) for v in centre))
+                              + ticks8)
+    s["eight-lanes-late-reflex"] = lanes8 + b"".join(
+        b_tick([4 if k == 4 else 0 for k in range(8)], inputs=[centre] * 8, reflexes={4: "inf" if t == 3 else 1.5})
+        for t in range(6))
+    s["nan-in-one-lane"] = lanes8 + b_tick([0] * 8, inputs=[centre if k != 3 else ["nan"] + centre[1:]
+                                                              for k in range(8)]) + ticks8
+    lanes17 = bytes([16]) + b"".join(b_lane(modes[k % 8], seed_byte=k + 3) for k in range(17))
+    s["seventeen-lanes"] = lanes17 + b"".join(b_tick([(t * k) % 3 for k in range(17)], rotation=t) for t in range(30))
+    s["literal-timing-learning"] = bytes([3]) + b"".join(b_lane(4, {"ico.rate": 0.5}, seed_byte=k) for k in range(4)) + \
+        b"".join(b_tick([0] * 4, inputs=[beyond if t % 2 else centre] * 4) for t in range(20))
+    corrupt_batch = bytes([7 | 8, 0x40, 0x00, 64]) + bytes(range(64))
+    s["batch-bytes-overwritten"] = lanes8 + ticks8 + corrupt_batch + ticks8
+    corrupt_state = bytes([7, 0x10, 0x00, 32, 2]) + bytes([0xFF] * 32)
+    s["state-bytes-overwritten"] = lanes8 + ticks8 + corrupt_state + ticks8
+    return s
+
+
 def corpus():
     """{target: {file name: bytes}}."""
     float_seeds = controller_seeds("f")
@@ -1033,6 +1087,7 @@ def corpus():
         "fuzz_state_mcu": state_seeds("f"),
         "fuzz_state_double": state_seeds("d"),
         "fuzz_model": model_seeds(),
+        "fuzz_batch": batch_seeds(),
     }
 
 
