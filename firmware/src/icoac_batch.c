@@ -9,13 +9,15 @@
  * [input or rule][lane]: a lane is loaded once, then ticks read nothing of its state but its
  * header. A loaded lane stays valid while only icoac_step_batch ticks its state: the load stamps
  * the state with a token (icoac_state.h, batch_token) that icoac_init, icoac_retune and icoac_reset
- * clear, and records its tick counter, which icoac_step advances; either change reloads it.
+ * clear, and records its tick counter, which icoac_step advances; either change reloads it (a
+ * tick the batch itself hands to icoac_step re-reads only what that tick can change).
  *
  * The vectorised ticks are the common ones of ICO (both timings) and search mode on a rule-table
- * task: a non-terminal tick with finite inputs and force that learns nothing. They run as loops
- * over the lanes without data-dependent branches, each value computed with the scalar tick's
- * expression and order of operations (the dot product's pairing, the reflex force added last),
- * so the two agree without fast-math or contraction (-ffp-contract=off, GCC's default in ISO C).
+ * task: a non-terminal tick with finite inputs and force that learns nothing. They run as one
+ * loop over the lanes without data-dependent branches, each value computed with the scalar
+ * tick's expression and order of operations (the dot product's pairing, the reflex force added
+ * last), so the two agree without fast-math or contraction (-ffp-contract=off, GCC's default in
+ * ISO C; -fno-trapping-math, which changes no value, lets GCC if-convert the loop).
  * Every other lane runs icoac_step on its own input: RL mode (its critic is per lane), a sensor
  * task, terminal ticks, ICO's learning ticks, errors of any kind, states not in a trial. */
 #include "icoac_features.h"
@@ -73,8 +75,6 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
     /* the tick's rows */
     icoac_real_t raw[N][L]; /* the inputs */
     icoac_real_t x[N][L];   /* scaled */
-    icoac_real_t rule_value[L];
-    icoac_real_t reflex[L];
     icoac_real_t penalty[L];
     icoac_real_t force[L];
     lane_int_t vector[L]; /* 1: the vector pass's lane; cleared where its tick needs icoac_step */

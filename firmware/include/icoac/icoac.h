@@ -304,7 +304,7 @@ icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_o
 #define ICOAC_BATCH_MAX_LANES 64
 #define ICOAC_BATCH_MIN_VECTOR_LANES 4 /* a call of fewer lanes runs icoac_step for each */
 #define ICOAC_BATCH_SIZE                                                                                 \
-    (((((4 * ICOAC_MAX_INPUTS) + (4 * ICOAC_MAX_RULES) + 14) * ICOAC_BATCH_MAX_LANES * (int)sizeof(icoac_real_t)) + \
+    (((((4 * ICOAC_MAX_INPUTS) + (4 * ICOAC_MAX_RULES) + 12) * ICOAC_BATCH_MAX_LANES * (int)sizeof(icoac_real_t)) + \
       (ICOAC_BATCH_MAX_LANES * 17) + (int)sizeof(icoac_input_t) + (int)sizeof(icoac_output_t) + 12 + 63) / 64 * 64)
 typedef struct {
     uint64_t opaque[ICOAC_BATCH_SIZE / 8];
