@@ -26,11 +26,11 @@ static inline icoac_real_t sim_real(double v)
     return fabs(v) <= SIM_REAL_MAX ? (icoac_real_t)v : (icoac_real_t)NAN;
 }
 
-/* The plant state as the controller's input (sim_real of each value).
- * With SSE2 and float reals a 4-input task's values go out in one 16-byte store. The compiler
- * vectorizes icoac_step's reads of in->s into one 16-byte load, which cannot be forwarded from
- * four 4-byte stores: it then waits until they retire, and that serializes the ticks of the
- * engine's lanes (measured: two lanes in lockstep ran no faster than one). */
+/* The plant state as the controller's input (sim_real of each value), for a tick outside the
+ * block's batch (the terminal tick, a trajectory). With SSE2 and float reals a 4-input task's
+ * values go out in one 16-byte store: the compiler vectorizes icoac_step's reads of in->s into
+ * one 16-byte load, which cannot be forwarded from four 4-byte stores, and would wait until they
+ * retire (measured when every lane's tick came this way: two lanes ran no faster than one). */
 void sim_to_input(const double *s, int32_t n, uint32_t flags, icoac_input_t *in)
 {
     int32_t i = 0;
@@ -191,6 +191,26 @@ int sim_lane_start(const sim_job_t *job, sim_block_t *block, sim_lane_t *lane)
     return start_trial(job, block, lane);
 }
 
+/* Lane l's controller input out of the block, for icoac_step. A 4-input task's floats go out in
+ * one 16-byte store with SSE2, as in sim_to_input (icoac_step reads them with one load). */
+static inline void lane_input(const sim_block_t *block, int32_t l, int32_t n_inputs, icoac_input_t *in)
+{
+    const int32_t lanes = block->lanes;
+    int32_t i = 0;
+#if defined(__SSE2__) && !(defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE)
+    if (n_inputs == 4) {
+        _mm_storeu_ps(in->s, _mm_setr_ps(block->in[l], block->in[lanes + l], block->in[2 * lanes + l],
+                                         block->in[3 * lanes + l]));
+        i = 4;
+    }
+#endif
+    for (; i < ICOAC_MAX_INPUTS; ++i) {
+        in->s[i] = i < n_inputs ? block->in[i * lanes + l] : (icoac_real_t)0;
+    }
+    in->flags = 0u;
+    in->reflex = (icoac_real_t)0;
+}
+
 /* Every running lane's controller ticks on its input, and its force becomes the lane's plant
  * input, or a lane whose controller reported an error ends (its cell's result written): state[l]
  * becomes its SIM_LANE_*. Returns how many lanes ended. One icoac_step_batch for the lanes; a
@@ -201,18 +221,14 @@ static int block_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lanes
 {
     const icoac_config_t *cfg = job->cfg;
     const int32_t n = block->lanes;
-    int32_t i, l;
+    int32_t l;
     int ended = 0;
     if (cfg->mode == ICOAC_MODE_RL || cfg->task.late_source != ICOAC_LATE_RULES || n < ICOAC_BATCH_MIN_VECTOR_LANES) {
         for (l = 0; l < n; ++l) {
             if (state[l] == SIM_LANE_RUNNING) {
                 icoac_input_t in;
                 icoac_output_t out;
-                for (i = 0; i < ICOAC_MAX_INPUTS; ++i) {
-                    in.s[i] = i < cfg->task.n_inputs ? block->in[i * n + l] : (icoac_real_t)0;
-                }
-                in.flags = 0u;
-                in.reflex = (icoac_real_t)0;
+                lane_input(block, l, cfg->task.n_inputs, &in);
                 block->status[l] = (int32_t)icoac_step(&lanes[l].ctrl, &in, &out);
                 block->force[l] = out.force;
             }
