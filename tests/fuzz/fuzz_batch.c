@@ -23,7 +23,8 @@
  *               a lane with a config section over its configuration; 6 icoac_step of a lane on
  *               real inputs; 7 raw bytes over the batch's storage (o & 8) or over both twins
  *               of a lane at an offset (2 bytes), n bytes: from then on only the safety
- *               promise is checked.
+ *               promise is checked, and a batch whose header was overwritten is refused
+ *               (ICOAC_ERR_NOT_INITIALISED, no lane written).
  */
 #include <math.h>
 #include <stdint.h>
@@ -149,8 +150,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 reflex[c] = (f & 4u) ? fz_real(&r) : (icoac_real_t)0;
                 states[c] = lane->batch;
             }
+            for (c = 0; c < n_lanes; ++c) {
+                force[c] = (icoac_real_t)-7;
+                status[c] = -7;
+            }
             result = icoac_step_batch(batch, states, n_lanes, s, N, flags, reflex, force, status);
             FZ_CHECK(named_status((int32_t)result), "batch result %d", (int)result);
+            if (status[0] == -7) {
+                /* the call refused the batch (its bytes overwritten): nothing written */
+                FZ_CHECK(!faithful && result == ICOAC_ERR_NOT_INITIALISED, "lane 0 not written, result %d",
+                         (int)result);
+                for (c = 0; c < n_lanes; ++c) {
+                    FZ_CHECK(status[c] == -7 && force[c] == (icoac_real_t)-7, "lane %d written by a refused call", c);
+                }
+                continue;
+            }
             for (c = 0; c < n_lanes; ++c) {
                 fz_lane_t *lane = &lanes[(c + rotation) % n_lanes];
                 icoac_input_t in;

@@ -1071,6 +1071,10 @@ def batch_seeds():
         b"".join(b_tick([0] * 4, inputs=[beyond if t % 2 else centre] * 4) for t in range(20))
     corrupt_batch = bytes([7 | 8, 0x40, 0x00, 64]) + bytes(range(64))
     s["batch-bytes-overwritten"] = lanes8 + ticks8 + corrupt_batch + ticks8
+    # the batch's header (its magic, past the lanes' arrays, near 16.5 KB) overwritten: refused
+    tail = b"".join(bytes([7 | 8]) + struct.pack("<H", offset) + bytes([255]) + bytes([0xBE] * 255)
+                    for offset in range(16000, 16800, 255))
+    s["batch-header-overwritten"] = lanes8 + ticks8 + tail + ticks8
     corrupt_state = bytes([7, 0x10, 0x00, 32, 2]) + bytes([0xFF] * 32)
     s["state-bytes-overwritten"] = lanes8 + ticks8 + corrupt_state + ticks8
     return s
