@@ -41,8 +41,15 @@ class StaleRecord(ResultsError):
     two writes. Resuming the run repairs it."""
 
 
+# What `make bench` itself writes into the tree (its data and figures, Makefile BENCH_DATA and
+# BENCH_FIGURES): a change there does not change what the tree computes, so it does not make the
+# tree dirty; otherwise every plant after the first of `make bench BENCH_PLANTS=all` would be.
+BENCH_OUTPUTS = ("docs/data", "docs/figures")
+
+
 def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
-    """Commit of the repository and whether the working tree has uncommitted changes. For an
+    """Commit of the repository and whether the working tree has uncommitted changes (but in
+    BENCH_OUTPUTS). For an
     installed package (repo = its site-packages), the commit its wheel was built from, as the
     build recorded it (harness/icoac/lib/build_info.json); None for both when unknown: a directory
     that is not the top of a git work tree is not taken for the repository around it."""
@@ -64,7 +71,8 @@ def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
     if top is None or Path(top.strip()).resolve() != Path(repo).resolve():
         return {"commit": None, "dirty": None}
     commit = git("rev-parse", "HEAD")
-    status = git("status", "--porcelain", "--untracked-files=no")
+    status = git("status", "--porcelain", "--untracked-files=no", "--", ".",
+                 *(f":(exclude){path}" for path in BENCH_OUTPUTS))
     return {"commit": commit.strip() if commit else None,
             "dirty": bool(status.strip()) if status is not None else None}
 

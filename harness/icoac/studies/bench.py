@@ -20,7 +20,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from icoac.core import geometry, grid, metrics, plants, results, store
+from icoac.core import geometry, grid, metrics, plants, results, stats, store
 from icoac.studies import tables
 from icoac.studies import prior as P
 from icoac.studies.ceiling.records import bench_ceiling, load_ceiling, reference_lines
@@ -38,6 +38,9 @@ PAPER = {
     "ico-rl": {"success_rate": 0.84, "note": "Fig. 2b; most cells 5-2000 trials, a few > 2000"},
     "rl": {"success_rate": None, "note": "Fig. 3: smaller domain than ICO, very slow; no number in the text"},
 }
+# The paired comparisons of the summary beyond each learner against its control: the paper's
+# method against the learners a user would pick instead (same caps only).
+COMPARISONS = (("ico-rl", "rl"), ("ico-rl", "search"), ("ico-rl", "ico-search"), ("ico-rl", "search-control"))
 # The learners after ICO and its prior, in stage order.
 LEARNERS = PRIOR_CONDITIONS
 
@@ -111,12 +114,29 @@ def _paper_plant(plant: str) -> bool:
     return plants.PLANTS[plant].paper
 
 
-def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, Any]:
-    """{condition: [run.json records over seeds]} -> mean/sd per statistic and condition."""
+def intervals(cells: Mapping[int, np.ndarray], grid: geometry.PlantGrid) -> dict[str, list[float] | None]:
+    """The bootstrap intervals (icoac.core.stats) of a condition's statistics from its cells per seed:
+    success rate (all cells, interior cells) and median trials to success."""
+    seeds = sorted(cells)
+    success = np.stack([metrics.success_mask(cells[s]) for s in seeds])
+    trials = np.stack([metrics.trials_to_success(cells[s]) for s in seeds])
+    inner = grid.interior_mask(cells[seeds[0]])
+    return {"success_rate": stats.interval(success, stats.rate),
+            "success_rate_interior": stats.interval(success[:, inner], stats.rate),
+            "median_trials_to_success": stats.interval(trials, stats.median_of_successes)}
+
+
+def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]],
+              cells: Mapping[str, Mapping[int, np.ndarray]] | None = None) -> dict[str, Any]:
+    """{condition: [run.json records over seeds]} -> mean/sd per statistic and condition; with the
+    conditions' cells ({condition: {seed: cells}}) each statistic of STATS but the elapsed time gets
+    its 95 % interval (``ci95``, icoac.core.stats)."""
     out: dict[str, Any] = {}
     for cond, recs in records.items():
         if not recs:
             continue
+        cis = (intervals(cells[cond], geometry.of(results.record_plant(recs[0])))
+               if cells is not None and cells.get(cond) else {})
         entry: dict[str, Any] = {"seeds": [r.get("seed") for r in recs],
                                  "n_cells": recs[0]["summary"]["n_cells"],
                                  "n_interior": recs[0]["summary"]["n_interior"],
@@ -127,6 +147,8 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, A
             values = [r["summary"].get(key) for r in recs]
             mean, sd, n = _mean_sd(values)
             entry[key] = {"mean": mean, "sd": sd, "n": n, "per_seed": values}
+            if key in cis:
+                entry[key]["ci95"] = cis[key]
         entry.update(_curves_and_quantiles(recs))
         if cond == "ico-rl":
             t = [(r.get("prior_info") or {}).get("ico_phase_simulated_time") for r in recs]
@@ -139,7 +161,8 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]]) -> dict[str, A
 def gain_over_control(cells: Mapping[int, np.ndarray], control: Mapping[int, np.ndarray]) -> dict[str, Any]:
     """Per seed {seed: cell array} of a condition and of its no-learning control -> mean/sd of the
     cells it gains (succeed, the control does not), loses, and the difference in points of
-    success rate (all cells)."""
+    success rate (all cells), with that difference's interval and McNemar's test per seed
+    (``paired``, icoac.core.stats.paired)."""
     gained, lost, points = [], [], []
     for seed in sorted(set(cells) & set(control)):
         a = metrics.success_mask(cells[seed])
@@ -151,15 +174,27 @@ def gain_over_control(cells: Mapping[int, np.ndarray], control: Mapping[int, np.
     for key, values in (("cells_gained", gained), ("cells_lost", lost), ("points", points)):
         mean, sd, n = _mean_sd(values)
         out[key] = {"mean": mean, "sd": sd, "n": n, "per_seed": values}
+    out["paired"] = compare(cells, control)
     return out
 
 
-def _fmt(stat: Mapping[str, Any] | None, pct: bool = False) -> str:
-    if not stat or stat.get("mean") is None:
-        return "n/a"
-    if pct:
-        return f"{percent(stat['mean'])} ± {percent(stat['sd'])}"
-    return f"{stat['mean']:.4g} ± {stat['sd']:.2g}"
+def compare(a: Mapping[int, np.ndarray], b: Mapping[int, np.ndarray]) -> dict[str, Any]:
+    """Two conditions' cells per seed -> the paired difference of their success rates (points, its
+    interval) and McNemar's test per seed (icoac.core.stats.paired)."""
+    return stats.paired({s: metrics.success_mask(c) for s, c in a.items()},
+                        {s: metrics.success_mask(c) for s, c in b.items()})
+
+
+def add_comparisons(agg: dict[str, Any], cells: Mapping[str, Mapping[int, np.ndarray]]) -> None:
+    """Each learner against its no-learning control (``gain_over_control``), and the COMPARISONS that
+    the summary holds at the same caps (``versus``: {B: compare(A, B)} in A's entry)."""
+    for cond in REGISTRY.values():
+        if cond.control is not None and cells.get(cond.name) and cells.get(cond.control) and cond.name in agg:
+            agg[cond.name]["gain_over_control"] = gain_over_control(cells[cond.name], cells[cond.control])
+    for a, b in COMPARISONS:
+        if a in agg and b in agg and cells.get(a) and cells.get(b) and all(
+                agg[a][k] == agg[b][k] for k in ("max_trials", "success_steps", "n_cells")):
+            agg[a].setdefault("versus", {})[b] = compare(cells[a], cells[b])
 
 
 def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
@@ -183,7 +218,8 @@ def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
 def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None,
                      grid: geometry.PlantGrid = geometry.CART_POLE) -> str:
     title = "" if grid is geometry.CART_POLE else f" ({grid.plant})"
-    lines = [f"# ICO and the learners with their no-learning controls{title}: mean ± sd over seeds", "",
+    lines = [f"# ICO and the learners with their no-learning controls{title}: mean ± sd over seeds "
+             "(95 % interval over cells and seeds)", "",
              "| condition | seeds | caps (trials / steps) | success (all) | success (interior) | "
              "median trials to success | mean elapsed sim. time of successes (s) | paper |",
              "|---|---|---|---|---|---|---|---|"]
@@ -194,22 +230,17 @@ def summary_markdown(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None =
         paper = e["paper"] or {}
         ptxt = (f"{percent(paper['success_rate'], 0)}; " if paper.get("success_rate") else "") + paper.get("note", "")
         lines.append(f"| {REGISTRY[cond].label} | {len(e['seeds'])} | {e['max_trials']:g} / {e['success_steps']:g} | "
-                     f"{_fmt(e['success_rate'], True)} of {e['n_cells']} | "
-                     f"{_fmt(e['success_rate_interior'], True)} of {e['n_interior']} | "
-                     f"{_fmt(e['median_trials_to_success'])} | {_fmt(e['mean_elapsed_time_success'])} | {ptxt} |")
-    gains = [(c, agg[c]["gain_over_control"]) for c in CONDITIONS if c in agg and "gain_over_control" in agg[c]]
-    if gains:
-        lines += ["", "Gain over the no-learning control (same prior, acting weights, noise stream, resets "
-                  "and caps, every update off), per seed, mean ± sd:", "",
-                  "| condition | control | points of success (all) | cells gained | cells lost |",
-                  "|---|---|---|---|---|"]
-        for cond, g in gains:
-            control = REGISTRY[REGISTRY[cond].control]
-            lines.append(f"| {REGISTRY[cond].label} | {control.label} | {_fmt(g['points'])} | "
-                         f"{_fmt(g['cells_gained'])} | {_fmt(g['cells_lost'])} |")
+                     f"{tables.rate(e['success_rate'])} of {e['n_cells']} | "
+                     f"{tables.rate(e['success_rate_interior'])} of {e['n_interior']} | "
+                     f"{tables.number(e['median_trials_to_success'])} | {tables.number(e['mean_elapsed_time_success'])} | {ptxt} |")
+    paired = tables.paired_table(agg)
+    if paired:
+        lines += ["", "Paired comparisons: each learner against its no-learning control (same prior, acting weights, "
+                  "noise stream, resets and caps, every update off), and ICO->RL against the other learners at the "
+                  "same caps; cells and seeds drawn together (icoac.core.stats):", ""] + paired
     if "ico-rl" in agg and agg["ico-rl"].get("ico_phase_simulated_time", {}).get("mean") is not None:
         lines += ["", "ICO->RL counts RL-phase trials only (A17); the ICO phase that produced each prior took "
-                  f"{_fmt(agg['ico-rl']['ico_phase_simulated_time'])} s of simulated time (whole ICO grid)."]
+                  f"{tables.number(agg['ico-rl']['ico_phase_simulated_time'])} s of simulated time (whole ICO grid)."]
     if ceiling is not None:
         lines += ceiling_markdown(ceiling)
     lines += tables.curve_tables(agg, ceiling)
@@ -232,12 +263,27 @@ def write_summary(out: Path, agg: Mapping[str, Any], ceiling: Mapping[str, Any] 
     return md, js
 
 
-def write_data(opt: "BenchOptions", agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None) -> Path:
+def cell_builds(records: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """The builds (commit, dirty) that wrote the cells of the records, each once, in first-seen order."""
+    out: list[dict[str, Any]] = []
+    for record in records:
+        for build in results.recorded_builds(record):
+            entry = {"commit": build.get("commit"), "dirty": build.get("dirty")}
+            if entry not in out:
+                out.append(entry)
+    return out
+
+
+def write_data(opt: "BenchOptions", agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None,
+               builds: Sequence[Mapping[str, Any]] = ()) -> Path:
     """The summary docs/results.md's tables are written from (icoac.tools.results_tables): the
-    aggregate, the ceiling's best w with its protocols, and what produced them."""
+    aggregate, the ceiling's best w with its protocols, and what produced them: the commit that
+    summarised (``git``), the builds that wrote the cells (``cell_builds``) and the intervals'
+    settings."""
     record = {**({} if opt.plant == CART_POLE else {"plant": opt.plant}),
               "profile": opt.profile, "seeds": opt.seed_list(), "configuration": opt.configuration,
               "set": list(opt.sets), "prior_std": opt.prior_std, "git": results.git_info(),
+              "cell_builds": list(builds), "intervals": stats.settings(),
               "timestamp": results.timestamp(), "aggregate": agg,
               "ceiling": None if ceiling is None else {"settings": ceiling["settings"], "best": ceiling["best"]}}
     Path(opt.data).parent.mkdir(parents=True, exist_ok=True)
@@ -447,17 +493,13 @@ def stages(opt: BenchOptions) -> list[Stage]:
 
     def summary_stage(ctx):
         recs = {c: [ctx[(c, s)][1] for s in seeds if (c, s) in ctx] for c in CONDITIONS}
-        agg = aggregate(recs)
-        for cond in REGISTRY.values():
-            condition, control = cond.name, cond.control
-            if control is not None and condition in agg and control in agg:
-                agg[condition]["gain_over_control"] = gain_over_control(
-                    {s: ctx[(condition, s)][0] for s in seeds if (condition, s) in ctx},
-                    {s: ctx[(control, s)][0] for s in seeds if (control, s) in ctx})
+        cells = {c: {s: ctx[(c, s)][0] for s in seeds if (c, s) in ctx} for c in CONDITIONS}
+        agg = aggregate(recs, cells)
+        add_comparisons(agg, cells)
         ctx["aggregate"] = agg
         md, js = write_summary(out, agg, ceiling_record(), plant_grid)
         if opt.data is not None:
-            write_data(opt, agg, ceiling_record())
+            write_data(opt, agg, ceiling_record(), cell_builds([r for rs in recs.values() for r in rs]))
             progress(f"  wrote {opt.data}")
         print(md.read_text(), end="")
         progress(f"  wrote {md} and {js}")

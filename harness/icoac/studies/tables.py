@@ -18,16 +18,23 @@ assert set(PRIOR_WORDS) == set(MEAN_RULES + COV_RULES)
 PRIOR_TABLE = tuple(c.name for c in REGISTRY.values() if c.mode == "rl" and c.learns)
 
 
-def _pct(stat: Mapping[str, Any] | None) -> str:
-    if not stat or stat.get("mean") is None:
-        return "n/a"
-    return f"{percent(stat['mean'])} ± {percent(stat['sd'])}"
+def _interval(stat: Mapping[str, Any], scale: float, fmt: str) -> str:
+    ci = stat.get("ci95")
+    return "" if not ci else f" ({scale * ci[0]:{fmt}}–{scale * ci[1]:{fmt}})"
 
 
-def _num(stat: Mapping[str, Any] | None) -> str:
+def rate(stat: Mapping[str, Any] | None) -> str:
+    """A rate's mean ± sd over seeds, with its 95 % interval in brackets when it has one."""
     if not stat or stat.get("mean") is None:
         return "n/a"
-    return f"{stat['mean']:.4g} ± {stat['sd']:.2g}"
+    return f"{percent(stat['mean'])} ± {percent(stat['sd'])}{_interval(stat, 100.0, '.1f')}"
+
+
+def number(stat: Mapping[str, Any] | None) -> str:
+    """A statistic's mean ± sd over seeds, with its 95 % interval in brackets when it has one."""
+    if not stat or stat.get("mean") is None:
+        return "n/a"
+    return f"{stat['mean']:.4g} ± {stat['sd']:.2g}{_interval(stat, 1.0, '.4g')}"
 
 
 def _at(series: Mapping[str, Sequence], i: int) -> dict[str, Any]:
@@ -48,9 +55,40 @@ def prior_table(agg: Mapping[str, Any]) -> list[str]:
         mean, cov = REGISTRY[cond].prior
         c = agg.get(REGISTRY[cond].control or "", {})
         gain = (e.get("gain_over_control") or {}).get("points")
-        lines.append(f"| {REGISTRY[cond].label} | {PRIOR_WORDS[mean]} | {PRIOR_WORDS[cov]} | {_pct(e['success_rate'])} | "
-                     f"{_pct(e['success_rate_interior'])} | {_num(e['median_trials_to_success'])} | "
-                     f"{_pct(c.get('success_rate'))} | {_num(c.get('median_trials_to_success'))} | {_num(gain)} |")
+        lines.append(f"| {REGISTRY[cond].label} | {PRIOR_WORDS[mean]} | {PRIOR_WORDS[cov]} | {rate(e['success_rate'])} | "
+                     f"{rate(e['success_rate_interior'])} | {number(e['median_trials_to_success'])} | "
+                     f"{rate(c.get('success_rate'))} | {number(c.get('median_trials_to_success'))} | {number(gain)} |")
+    return lines
+
+
+def _p_value(p: float) -> str:
+    """A p-value to two digits; one below the smallest double scipy returns as 0 is shown as such."""
+    return "< 1e-300" if p == 0 else f"{p:.2g}"
+
+
+def paired_table(agg: Mapping[str, Any]) -> list[str]:
+    """Each learner against its no-learning control, and the summary's comparisons (``versus``):
+    the difference of success rates (all cells) in points with its 95 % interval, the cells only
+    one of the two succeeds in (mean over seeds) and McNemar's p, the largest over the seeds."""
+    rows = []
+    for cond in CONDITIONS:
+        e = agg.get(cond) or {}
+        if (e.get("gain_over_control") or {}).get("paired"):
+            rows.append((cond, REGISTRY[cond].control, e["gain_over_control"]["paired"]))
+        rows += [(cond, other, test) for other, test in (e.get("versus") or {}).items()]
+    if not rows:
+        return []
+    lines = ["| condition | against | points of success (all) | 95 % interval | cells only the condition | "
+             "cells only the other | McNemar p (largest over seeds) |", "|---|---|---|---|---|---|---|"]
+    for cond, other, t in rows:
+        if t.get("points") is None:
+            continue
+        ci = t.get("ci95")
+        only_a = sum(m["only_a"] for m in t["mcnemar"]) / len(t["mcnemar"])
+        only_b = sum(m["only_b"] for m in t["mcnemar"]) / len(t["mcnemar"])
+        lines.append(f"| {REGISTRY[cond].label} | {REGISTRY[other].label} | {t['points']:+.1f} | "
+                     f"{'n/a' if ci is None else f'{ci[0]:+.1f} to {ci[1]:+.1f}'} | {only_a:.4g} | {only_b:.4g} | "
+                     f"{_p_value(t['p_max'])} |")
     return lines
 
 
@@ -75,7 +113,7 @@ def within_table(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = Non
         curve = e["success_within"]
         cells = []
         for k in ks:
-            cells.append(_pct(_at(curve["all"], curve["k"].index(k))) if k <= e["max_trials"] else "")
+            cells.append(rate(_at(curve["all"], curve["k"].index(k))) if k <= e["max_trials"] else "")
         lines.append(f"| {REGISTRY[cond].label} | {e['max_trials']:g} | " + " | ".join(cells) + " |")
     for name, proto in ((ceiling or {}).get("best", {}).get("protocols", {}) or {}).items():
         curve = proto.get("success_within")
@@ -98,7 +136,7 @@ def quantile_table(agg: Mapping[str, Any], key: str = "trials_to_success_quantil
     lines = ["| condition | " + " | ".join(f"{float(q) * 100:g} %" for q in qs) + " |", "|---|" + "---|" * len(qs)]
     for cond in conds:
         series = agg[cond][key]
-        lines.append(f"| {REGISTRY[cond].label} | " + " | ".join(_num(_at(series, i)) for i in range(len(qs))) + " |")
+        lines.append(f"| {REGISTRY[cond].label} | " + " | ".join(number(_at(series, i)) for i in range(len(qs))) + " |")
     return lines
 
 
