@@ -47,12 +47,19 @@ TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
 }
 
 
+def _commit(git: Mapping[str, Any]) -> str:
+    return (git.get("commit") or "unknown")[:7] + ("+dirty" if git.get("dirty") else "")
+
+
 def provenance(data: Mapping[str, Any]) -> str:
-    git = data.get("git") or {}
-    commit = (git.get("commit") or "unknown")[:7] + ("+dirty" if git.get("dirty") else "")
+    """The line under a table: what the summary was made from, and the builds that wrote its cells
+    when they are not the summarising commit."""
+    commit = _commit(data.get("git") or {})
+    builds = [_commit(b) for b in data.get("cell_builds") or []]
+    cells = f" (cells by {', '.join(builds)})" if builds and builds != [commit] else ""
     plant = f"plant {data['plant']}, " if data.get("plant") else ""
     return (f"*From docs/data: {plant}profile {data['profile']}, seeds {data['seeds']}, configuration "
-            f"{data['configuration']}{' ' + ' '.join(data['set']) if data.get('set') else ''}, commit {commit}.*")
+            f"{data['configuration']}{' ' + ' '.join(data['set']) if data.get('set') else ''}, commit {commit}{cells}.*")
 
 
 def render(text: str, data_dir: Path) -> str:
