@@ -286,7 +286,7 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2,...",
                    help="values of one parameter (repeatable; names as for --set); prior_frame=central,all "
                         "and prior_ridge allowed")
-    w.add_argument("--condition", choices=R.PRIOR_CONDITIONS, default=R.PRIOR_CONDITIONS[0])
+    w.add_argument("--condition", choices=R.SWEEP_CONDITIONS, default=R.SWEEP_CONDITIONS[0])
     sel = w.add_mutually_exclusive_group()
     sel.add_argument("--cells", default=None, help="cell indices, e.g. 0,5,600-610")
     sel.add_argument("--subset", type=_subset, default=None, help="N evenly spread cells, at most the grid's cell count")
@@ -409,7 +409,7 @@ def cmd_grid(args) -> int:
     info = None
     if explicit or not args.resume:
         info = conditions.condition_prior(condition, args.prior_from, _frame(args), args.prior_ridge, args.prior_std,
-                                           plant=args.plant or O.CART_POLE)
+                                           plant=args.plant or O.CART_POLE, overrides=_overrides(args))
     spec = _dask_spec(args)
     cells, record, cancelled = conditions.run_condition(
         condition=condition, out=Path(args.out), seed=args.seed or 0, threads=_threads_arg(args),

@@ -228,11 +228,12 @@ def test_condition_overrides():
     default c = 64; ICO->RL and the ICO mean with sigma_w^2 I on the C defaults' reading; the
     two RL conditions with a zero mean on the readings their sweeps chose (mean reading, sigma_L
     0.1, sigma_u 5, alpha 0.1, exploration until tick 1000); nothing else overridden. Each
-    actor-critic and search condition has its prior rule."""
+    actor-critic and search condition has its prior rule. The LQR baseline is ICO mode with every
+    update off."""
     assert set(CONDITION_OVERRIDES) == set(CONDITIONS) and CONDITIONS == (
         "ico", "ico-rl", "ico-rl-control", "ico-mean-rl", "ico-mean-rl-control", "rl-ico-cov", "rl-ico-cov-control",
-        "rl", "rl-control", "ico-search", "ico-search-control", "search", "search-control")
-    assert {c.name: c.control_of for c in REGISTRY.values() if not c.learns} == {
+        "rl", "rl-control", "ico-search", "ico-search-control", "search", "search-control", "lqr")
+    assert {c.name: c.control_of for c in REGISTRY.values() if c.control_of} == {
         "ico-rl-control": "ico-rl", "ico-mean-rl-control": "ico-mean-rl", "rl-ico-cov-control": "rl-ico-cov",
         "rl-control": "rl", "ico-search-control": "ico-search", "search-control": "search"}
     assert {c.name: c.prior for c in REGISTRY.values() if c.learns and c.prior} == {
@@ -240,7 +241,7 @@ def test_condition_overrides():
         "rl": ("zero", "isotropic"), "ico-search": ("ico", "ico"), "search": ("zero", "identity")}
     default = build_config().flat()
     modes = {"ico": "ico", "ico-rl": "rl", "ico-mean-rl": "rl", "rl-ico-cov": "rl", "rl": "rl",
-             "ico-search": "search", "search": "search"}
+             "ico-search": "search", "search": "search", "lqr": "ico"}
     zero_mean = ("rl-ico-cov", "rl")
     for condition in CONDITIONS:
         flat = build_config(condition=condition).flat()
@@ -254,7 +255,7 @@ def test_condition_overrides():
             assert (flat["actor.update"], flat["actor.likelihood_std"], flat["actor.noise_std"], flat["actor.scale"],
                     flat["actor.explore_ticks"]) == ("mean", pytest.approx(0.1), {"rl-ico-cov": 5.0, "rl": 12.0}[base],
                                                      pytest.approx(0.1), 1000)
-        if not REGISTRY[condition].learns:  # a control is its condition with every update off
+        if REGISTRY[condition].control_of:  # a control is its condition with every update off
             assert {n: v for n, v in flat.items() if n != "learn"} == \
                 {n: v for n, v in build_config(condition=base).flat().items() if n != "learn"}
 

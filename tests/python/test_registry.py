@@ -15,7 +15,9 @@ from icoac.studies import prior as P
 from icoac.studies.conditions import condition_prior
 from icoac.core.config import CONDITION_OVERRIDES, build_config
 from icoac.core.errors import UsageError
-from icoac.core.registry import CONDITIONS, PRIOR_CONDITIONS, REGISTRY, Condition, PriorRule
+from icoac.core.plants import PLANTS
+from icoac.core.registry import CONDITIONS, PRIOR_CONDITIONS, REGISTRY, SWEEP_CONDITIONS, Condition, PriorRule
+from icoac.core.signs import linearise
 
 # The condition tables of the harness before the registry (captured from main at ad0bc3e). When a
 # condition's overrides change on purpose (registry.py), change them here too.
@@ -23,14 +25,15 @@ BEFORE = json.loads((Path(__file__).resolve().parent / "fixtures" / "conditions_
 
 
 def test_same_conditions_as_before():
-    assert list(CONDITIONS) == BEFORE["conditions"]
+    """The learning conditions and controls as before; the baselines (fixed policies) came after."""
+    assert [c for c in CONDITIONS if not REGISTRY[c].baseline] == BEFORE["conditions"]
     assert {c.name: c.control_of for c in REGISTRY.values() if c.control_of} == BEFORE["control_of"]
     assert {c.name: list(c.prior) for c in REGISTRY.values() if c.prior and c.learns} == BEFORE["prior_rules"]
-    assert {c.name: c.label for c in REGISTRY.values()} == BEFORE["labels"]
+    assert {c.name: c.label for c in REGISTRY.values() if not c.baseline} == BEFORE["labels"]
     assert [c for c in CONDITIONS if REGISTRY[c].mode == "rl"] == BEFORE["rl_conditions"]
     assert [c for c in CONDITIONS if REGISTRY[c].mode == "search"] == BEFORE["search_conditions"]
     assert list(tables.PRIOR_TABLE) == BEFORE["prior_table"]
-    assert list(bench.LEARNERS) == BEFORE["conditions"][1:]
+    assert list(bench.LEARNERS) == BEFORE["conditions"][1:] + ["lqr"]
 
 
 @pytest.mark.parametrize("condition", BEFORE["conditions"])
@@ -46,7 +49,7 @@ def test_same_controller_config_as_before(condition):
 
 def test_every_control_exists_and_points_back():
     learners = [c for c in REGISTRY.values() if c.learns]
-    controls = [c for c in REGISTRY.values() if not c.learns]
+    controls = [c for c in REGISTRY.values() if c.control_of is not None]
     assert [c.name for c in learners if c.control is None] == ["ico"]  # every learner but ICO has one
     assert len(controls) == len(learners) - 1
     for cond in learners:
@@ -64,7 +67,7 @@ def test_every_control_exists_and_points_back():
         assert REGISTRY[control.control_of].control == control.name
     # the order of the bench: each control right after its condition
     for i, name in enumerate(CONDITIONS):
-        if not REGISTRY[name].learns:
+        if REGISTRY[name].control_of is not None:
             assert CONDITIONS[i - 1] == REGISTRY[name].control_of
 
 
@@ -136,3 +139,55 @@ def test_registry_imports_nothing_heavy():
     code = ("import sys, icoac.core.registry, icoac.core.options; "
             "assert not {'numpy', 'icoac.core.binding', 'icoac.core.config'} & set(sys.modules), sorted(sys.modules)")
     subprocess.run([sys.executable, "-c", code], check=True, cwd=Path(__file__).resolve().parents[2])
+
+
+def _riccati_by_iteration(a, b, q, r, steps=400_000, tol=1e-13):
+    """K of the discrete LQR by iterating the Riccati difference equation to its fixed point: an
+    algorithm independent of scipy's solver, which the harness uses."""
+    p = q.copy()
+    for _ in range(steps):
+        k = np.linalg.solve(r + b.T @ p @ b, b.T @ p @ a)
+        nxt = q + a.T @ p @ (a - b @ k)
+        if np.max(np.abs(nxt - p)) <= tol * np.max(np.abs(nxt)):
+            return np.linalg.solve(r + b.T @ nxt @ b, b.T @ nxt @ a).ravel()
+        p = nxt
+    raise AssertionError("the Riccati iteration did not converge")
+
+
+@pytest.mark.parametrize("plant", list(PLANTS))
+def test_lqr_baseline_acts_with_the_plants_lqr_gain(plant):
+    """The LQR condition never learns and has no control; it runs ICO mode with every update off
+    and its prior mean as w, and that w is the plant's discrete LQR gain (Q = diag(1 / range^2),
+    R = 1 / G^2): G w_i sign_i / range_i = -K_i, with K found by iterating the Riccati equation,
+    and the gain closes the linearised loop."""
+    cond = REGISTRY["lqr"]
+    assert cond.baseline and not cond.learns and cond.control is None
+    assert "lqr" in PRIOR_CONDITIONS and "lqr" not in SWEEP_CONDITIONS
+    cfg = build_config(condition="lqr", plant=plant)
+    assert cfg.flat()["learn"] is False and cfg.flat()["mode"] == "ico"
+    info = condition_prior("lqr", None, P.DEFAULT_FRAME, P.DEFAULT_RIDGE, plant=plant)
+    n = cfg.n_inputs
+    ranges = np.array(list(cfg.controller.policy.input_range)[:n])
+    signs = np.array(list(cfg.controller.task.input_sign)[:n], dtype=float)
+    gain = float(cfg.controller.policy.gain)
+    k = -np.asarray(info.mean) * gain * signs / ranges
+    a, b = linearise(cfg)
+    want = _riccati_by_iteration(a, b, np.diag(1.0 / ranges ** 2), np.array([[1.0 / gain ** 2]]))
+    np.testing.assert_allclose(k, want, rtol=1e-6, atol=1e-9)
+    assert np.max(np.abs(np.linalg.eigvals(a - b @ k.reshape(1, n)))) < 1.0
+    assert info.extra["mean_from"] == "lqr" and info.source is None
+
+
+def test_lqr_baseline_grid_keeps_its_w(tmp_path):
+    """A grid of the LQR condition acts with the LQR w in every cell and learns nothing: every
+    cell's final weights are the prior mean (in the controller's real type)."""
+    from icoac.core import binding as B
+    from icoac.studies.conditions import run_condition
+    info = condition_prior("lqr", None, P.DEFAULT_FRAME, P.DEFAULT_RIDGE)
+    cells, record, _ = run_condition(condition="lqr", out=tmp_path / "lqr", seed=0, threads=1,
+                                     overrides={"max_trials": 3, "success_steps": 500}, cell_spec=[0, 300, 612, 900],
+                                     info=info, progress=False)
+    w = np.asarray(info.mean, dtype=B.real_dtype).astype(float)
+    np.testing.assert_array_equal(cells["weights"][:, :4], np.tile(w, (4, 1)))
+    assert record["config"]["controller"]["learn"] is False and np.all(cells["trials"] >= 1)
+    assert cells["outcome"][2] == B.SUCCESS  # cell 612, the upright at the centre

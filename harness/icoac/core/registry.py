@@ -19,9 +19,9 @@ from typing import Any, Mapping, NamedTuple
 # The controller modes a condition runs in (the names of the C enum, icoac.core.binding.MODES).
 MODES = ("ico", "rl", "search")
 # The words of a prior rule. Mean: "ico" (the ICO prior's, from the final weights of an ICO grid,
-# --prior-from) or "zero". Covariance: "ico" (the ICO prior's), "isotropic" (sigma_w^2 I with
+# --prior-from), "zero", or "lqr" (the plant's LQR gain as a w, icoac.core.signs.lqr_weights). Covariance: "ico" (the ICO prior's), "isotropic" (sigma_w^2 I with
 # sigma_w = --prior-std) or "identity" (I: the search's Sigma0 = search.cov_scale * I).
-MEAN_RULES = ("ico", "zero")
+MEAN_RULES = ("ico", "zero", "lqr")
 COV_RULES = ("ico", "isotropic", "identity")
 CONTROL_SUFFIX = "-control"
 
@@ -47,6 +47,7 @@ class Condition:
     overrides: Mapping[str, Any] = field(default_factory=dict)
     control: str | None = None              # the name of its no-learning control
     control_of: str | None = None           # a control: the condition it is the control of
+    baseline: bool = False                  # a fixed policy that never learns (no control of its own)
 
     def __post_init__(self):
         if self.mode not in MODES:
@@ -57,7 +58,7 @@ class Condition:
 
     @property
     def learns(self) -> bool:
-        return self.control_of is None
+        return self.control_of is None and not self.baseline
 
     @property
     def base(self) -> str:
@@ -101,13 +102,18 @@ REGISTRY: Mapping[str, Condition] = MappingProxyType({c.name: c for c in (
     *_learner("ico-search", "ICO->search", "search", PriorRule("ico", "ico")),
     # prior N(0, I) (method.md, L4); Sigma0 = 4 I by the sweeps
     *_learner("search", "search", "search", PriorRule("zero", "identity"), {"search.cov_scale": 4}),
+    # no learning: the discrete LQR of the plant linearised upright, with the Q and R that give the
+    # task its input signs (Q = diag(1 / input_range^2), R = 1 / G^2), acting as the fixed w of the
+    # same policy (ICO mode with every update off acts with its prior mean)
+    Condition("lqr", "LQR", "ico", PriorRule("lqr", "identity"), baseline=True),
 )})
 
 # Derived views.
 CONDITIONS = tuple(REGISTRY)
-# The conditions that learn from a prior (everything but ICO), in order: sweep's choices, the bench's
-# stages after ICO.
+# The conditions that run from a prior (everything but ICO), in order: the bench's stages after ICO.
 PRIOR_CONDITIONS = tuple(c.name for c in REGISTRY.values() if c.prior is not None)
+# The learners a sweep tunes (a prior condition that learns).
+SWEEP_CONDITIONS = tuple(c.name for c in REGISTRY.values() if c.prior is not None and c.learns)
 
 
 def _check() -> None:
@@ -119,6 +125,7 @@ def _check() -> None:
             assert base.control == c.name and (base.mode, base.prior, base.overrides) == \
                 (c.mode, c.prior, c.overrides), c
         assert "mode" not in c.overrides and "learn" not in c.overrides, c
+        assert not c.baseline or (c.control is None and c.control_of is None and c.prior is not None), c
 
 
 _check()

@@ -51,6 +51,23 @@ def lqr_gain(a: np.ndarray, b: np.ndarray, q: np.ndarray, r: float) -> np.ndarra
     return k if np.all(np.isfinite(k)) else None
 
 
+def lqr_weights(cfg, force: float | None = None) -> tuple[float, ...] | None:
+    """The discrete LQR gain of cfg's plant at the upright (Q = diag(1 / input_range^2), R = 1 / F^2
+    with F = ``force``, default G = policy.gain) as the w of the controller's policy:
+    w_i = -K_i * input_range_i * input_sign_i / G, so that F = G w^T x~ equals -K s while no input
+    is clipped. None when G is not positive or the Riccati equation has no stabilising solution."""
+    gain = float(cfg.controller.policy.gain)
+    if gain <= 0:
+        return None
+    n = cfg.n_inputs
+    ranges = np.array(list(cfg.controller.policy.input_range)[:n], dtype=np.float64)
+    signs = np.array(list(cfg.controller.task.input_sign)[:n], dtype=np.float64)
+    a, b = linearise(cfg)
+    f = gain if force is None else float(force)
+    k = lqr_gain(a, b, np.diag(1.0 / ranges ** 2), 1.0 / f ** 2)
+    return None if k is None else tuple(float(v) for v in -k * ranges * signs / gain)
+
+
 def lqr_signs(a: np.ndarray, b: np.ndarray, ranges: np.ndarray, gain: float) -> tuple[int, ...] | None:
     """sign(-K_i) of the LQR gain of (a, b) with Q = diag(1 / ranges^2), R = 1 / gain^2 (gain 0: 1);
     None when the Riccati equation has no stabilising solution."""

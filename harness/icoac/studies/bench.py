@@ -318,7 +318,7 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
                                           [agg[c]["mean_elapsed_time_success"] for c in conds]))
         curved = [c for c in conds if agg[c].get("success_within")]
         if curved:
-            bases = [c.name for c in REGISTRY.values() if c.learns]
+            bases = [c.name for c in REGISTRY.values() if c.control_of is None]
             curves = [{"label": REGISTRY[c].label, "mean": agg[c]["success_within"]["all"]["mean"],
                        "sd": agg[c]["success_within"]["all"]["sd"], "control": not REGISTRY[c].learns,
                        "color": bases.index(REGISTRY[c].base)} for c in curved]
@@ -460,10 +460,12 @@ def stages(opt: BenchOptions) -> list[Stage]:
         def run(ctx):
             info = P.from_results(seed_dir(out, "ico", seed), frame, opt.ridge, opt.plant)
             for cond in REGISTRY.values():
-                if cond.prior is not None and cond.learns:
-                    ctx[("prior", cond.name, seed)] = P.condition_prior(cond.name, info, opt.prior_std, plant_grid.n_inputs)
+                if cond.prior is not None and cond.control_of is None:
+                    ctx[("prior", cond.name, seed)] = P.condition_prior(
+                        cond.name, info, opt.prior_std, plant_grid.n_inputs,
+                        cfg=build_config(overrides(cond.name), condition=cond.name, plant=opt.plant))
             for cond in REGISTRY.values():  # a control shares its condition's prior
-                if not cond.learns:
+                if cond.control_of is not None:
                     ctx[("prior", cond.name, seed)] = ctx[("prior", cond.base, seed)]
             progress(f"  prior seed {seed}: {info.n_cells} cells, mean "
                      + ", ".join(f"{v:.4g}" for v in info.mean))

@@ -29,16 +29,20 @@ def check_condition(condition: Any) -> str:
 
 
 def condition_prior(condition: str, prior_from, frame, ridge: float, std: float = P.DEFAULT_STD,
-                    plant: str = CART_POLE) -> P.PriorInfo | None:
+                    plant: str = CART_POLE, overrides: dict | None = None) -> P.PriorInfo | None:
     """PriorInfo of a condition (None for ico) by its rule (icoac.core.registry); a no-learning
     control has the prior of its condition. --prior-from is required exactly when the rule takes
-    the mean or the covariance from ICO: a condition that takes nothing from ICO refuses it."""
+    the mean or the covariance from ICO: a condition that takes nothing from ICO refuses it. The
+    LQR mean is that of the configuration the condition runs with (``overrides`` on the plant)."""
     cond = REGISTRY[check_condition(condition)]
     condition, rule = cond.base, cond.prior
     if rule is None or not rule.takes_ico:
         if prior_from is not None:
             raise UsageError(f"condition {condition} takes nothing from ICO; drop --prior-from")
-        return None if rule is None else P.condition_prior(condition, None, std, geometry.of(plant).n_inputs)
+        if rule is None:
+            return None
+        cfg = build_config(overrides or {}, condition=condition, plant=plant) if rule.mean == "lqr" else None
+        return P.condition_prior(condition, None, std, geometry.of(plant).n_inputs, cfg=cfg)
     if prior_from is None:
         raise UsageError(f"condition {condition} needs --prior-from ICO_RESULTS_DIR")
     return P.condition_prior(condition, P.from_results(prior_from, frame, ridge, plant), std,

@@ -23,6 +23,7 @@ from icoac.core.errors import PriorError
 from icoac.core.options import FRAME_NAMES, PRIOR_FRAME as DEFAULT_FRAME, PRIOR_RIDGE as DEFAULT_RIDGE
 from icoac.core.options import PRIOR_STD as DEFAULT_STD
 from icoac.core.plants import PRIOR_CELLS, spec as plant_spec
+from icoac.core.signs import lqr_weights
 from icoac.core.registry import COV_RULES, MEAN_RULES, REGISTRY
 
 _TOL = 1e-9
@@ -131,10 +132,20 @@ def compute(cells: np.ndarray, frame: tuple[float, float] | str | None = DEFAULT
 
 # The words of a prior rule (icoac.core.registry) -> the mean (from the ICO prior) and covariance (from
 # the ICO prior and sigma_w).
-_MEANS = {"ico": lambda ico, n: ico.mean.copy(), "zero": lambda ico, n: np.zeros(n)}
+_MEANS = {"ico": lambda ico, n, cfg: ico.mean.copy(), "zero": lambda ico, n, cfg: np.zeros(n),
+          "lqr": lambda ico, n, cfg: _lqr_mean(cfg)}
 _COVS = {"ico": lambda ico, std, n: ico.cov.copy(), "isotropic": lambda ico, std, n: std ** 2 * np.eye(n),
          "identity": lambda ico, std, n: np.eye(n)}
 assert tuple(_MEANS) == MEAN_RULES and tuple(_COVS) == COV_RULES
+
+
+def _lqr_mean(cfg) -> np.ndarray:
+    if cfg is None:
+        raise PriorError("the LQR prior needs the run's configuration (its plant and task)")
+    w = lqr_weights(cfg)
+    if w is None:
+        raise PriorError(f"plant {cfg.plant_name}: no stabilising LQR gain at the upright (or policy.gain <= 0)")
+    return np.array(w)
 
 
 # sigma_w of an isotropic prior: sigma_w^2 must be a covariance the controller takes (at most
@@ -161,11 +172,12 @@ def check_prior_std(std: Any, what: str = "--prior-std") -> float:
 
 
 def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_STD,
-                    n_inputs: int = B.N_INPUTS) -> PriorInfo:
+                    n_inputs: int = B.N_INPUTS, cfg=None) -> PriorInfo:
     """The prior of a condition by its rule (icoac.core.registry) for a task of n_inputs inputs (the
     cart-pole's 4 unless given; an ICO prior of another size is refused): the
     mean and the covariance each from the ICO prior ``ico`` or not ("zero" mean, "isotropic" std^2 I,
-    "identity" I). Provenance is recorded only for what came from ICO: a prior that takes nothing
+    "identity" I), or the mean from the LQR gain of the plant of ``cfg`` (the RunConfig the condition
+    runs with; "lqr"). Provenance is recorded only for what came from ICO: a prior that takes nothing
     from it carries no source."""
     rule = REGISTRY[condition].prior
     if rule is None:
@@ -178,7 +190,7 @@ def condition_prior(condition: str, ico: PriorInfo | None, std: float = DEFAULT_
         check_prior_std(std)
     if ico is not None and len(ico.mean) != n_inputs:
         raise PriorError(f"condition {condition}: the ICO prior has {len(ico.mean)} weights, the task {n_inputs} inputs")
-    mean, cov = _MEANS[mean_rule](ico, n_inputs), _COVS[cov_rule](ico, std, n_inputs)
+    mean, cov = _MEANS[mean_rule](ico, n_inputs, cfg), _COVS[cov_rule](ico, std, n_inputs)
     extra = {"mean_from": mean_rule, "cov_from": cov_rule}
     if cov_rule == "isotropic":
         extra["prior_std"] = float(std)

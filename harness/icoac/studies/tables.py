@@ -13,7 +13,7 @@ from icoac.core.registry import CONDITIONS, COV_RULES, MEAN_RULES, REGISTRY
 # The budgets k of the success-within-k table (those up to the largest cap of the summary).
 TABLE_BUDGETS = (1, 10, 100, 1000, 10_000, 100_000)
 # The actor-critic priors, ICO->RL first: (condition, what its mean and covariance are).
-PRIOR_WORDS = {"ico": "ICO", "zero": "0", "isotropic": "σ_w²·I", "identity": "I"}
+PRIOR_WORDS = {"ico": "ICO", "zero": "0", "lqr": "LQR", "isotropic": "σ_w²·I", "identity": "I"}
 assert set(PRIOR_WORDS) == set(MEAN_RULES + COV_RULES)
 PRIOR_TABLE = tuple(c.name for c in REGISTRY.values() if c.mode == "rl" and c.learns)
 
