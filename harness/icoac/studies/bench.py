@@ -127,6 +127,29 @@ def intervals(cells: Mapping[int, np.ndarray], grid: geometry.PlantGrid) -> dict
             "median_trials_to_success": stats.interval(trials, stats.median_of_successes)}
 
 
+# What a grid cost, per seed: every trial and simulated second of every cell (successful or not),
+# and the wall time of the grid run (its record's, on its threads).
+COST = (("trials", lambda r: r["summary"]["total_trials"]),
+        ("simulated_time", lambda r: r["summary"]["total_elapsed_time"]),
+        ("wall_time", lambda r: r["wall_time"]))
+
+
+def _cost(recs: Sequence[Mapping[str, Any]], ico: Sequence[Mapping[str, Any]] | None) -> dict[str, Any]:
+    """Mean/sd over seeds of a condition's whole-grid cost (COST); for a condition whose prior comes
+    from ICO, also with the ICO grid of the same seed added (``with_ico``), the phase its own
+    trial counts leave out."""
+    def stat(values):
+        mean, sd, n = _mean_sd(values)
+        return {"mean": mean, "sd": sd, "n": n, "per_seed": values}
+
+    out: dict[str, Any] = {key: stat([float(get(r)) for r in recs]) for key, get in COST}
+    if ico:
+        by_seed = {r.get("seed"): r for r in ico}
+        paired = [(r, by_seed[r.get("seed")]) for r in recs if r.get("seed") in by_seed]
+        out["with_ico"] = {key: stat([float(get(r)) + float(get(i)) for r, i in paired]) for key, get in COST}
+    return out
+
+
 def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]],
               cells: Mapping[str, Mapping[int, np.ndarray]] | None = None) -> dict[str, Any]:
     """{condition: [run.json records over seeds]} -> mean/sd per statistic and condition; with the
@@ -151,6 +174,8 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]],
             if key in cis:
                 entry[key]["ci95"] = cis[key]
         entry.update(_curves_and_quantiles(recs))
+        entry["cost"] = _cost(recs, records.get("ico") if (REGISTRY[cond].prior or ()) and
+                              REGISTRY[cond].prior.takes_ico else None)
         if cond == "ico-rl":
             t = [(r.get("prior_info") or {}).get("ico_phase_simulated_time") for r in recs]
             mean, sd, n = _mean_sd(t)

@@ -92,6 +92,23 @@ def paired_table(agg: Mapping[str, Any]) -> list[str]:
     return lines
 
 
+def cost_table(agg: Mapping[str, Any]) -> list[str]:
+    """What each condition's whole grid cost (every cell, successful or not), mean over seeds: trials,
+    simulated time, wall time; for a condition with an ICO prior, the same with its ICO grid added."""
+    conds = [c for c in CONDITIONS if c in agg and agg[c].get("cost")]
+    if not conds:
+        return []
+    lines = ["| condition | cap | trials | simulated time (s) | wall time (s) | with the ICO phase: trials | "
+             "simulated time (s) | wall time (s) |", "|---|---|---|---|---|---|---|---|"]
+    for cond in conds:
+        e, cost = agg[cond], agg[cond]["cost"]
+        ico = cost.get("with_ico") or {}
+        own = " | ".join(f"{cost[k]['mean']:.3g}" for k in ("trials", "simulated_time", "wall_time"))
+        both = " | ".join(f"{ico[k]['mean']:.3g}" if k in ico else "" for k in ("trials", "simulated_time", "wall_time"))
+        lines.append(f"| {REGISTRY[cond].label} | {e['max_trials']:g} | {own} | {both} |")
+    return lines
+
+
 def budgets_of(agg: Mapping[str, Any]) -> list[int]:
     """The table's budgets up to the largest trial cap of the summary."""
     cap = max((e["max_trials"] for e in agg.values() if isinstance(e, Mapping) and "max_trials" in e), default=0)
@@ -141,10 +158,11 @@ def quantile_table(agg: Mapping[str, Any], key: str = "trials_to_success_quantil
 
 
 def curve_tables(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> list[str]:
-    """The three tables with their headings, for summary.md."""
+    """The tables after the comparison, with their headings, for summary.md."""
     out: list[str] = []
     for title, lines in (
             ("The actor-critic from the four priors, each beside its no-learning control", prior_table(agg)),
+            ("What each whole grid cost (every cell), mean over seeds", cost_table(agg)),
             ("Success within k trials (all cells), mean ± sd over seeds", within_table(agg, ceiling)),
             ("Trials to success: quantiles over the successful cells, mean ± sd over seeds", quantile_table(agg)),
             ("Simulated time to success (s): quantiles over the successful cells, mean ± sd over seeds",

@@ -40,6 +40,7 @@ def _summary(data: Mapping[str, Any]) -> list[str]:
 TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
     "comparison": _summary,
     "paired": lambda d: tables.paired_table(d["aggregate"]),
+    "cost": lambda d: tables.cost_table(d["aggregate"]),
     "priors": lambda d: tables.prior_table(d["aggregate"]),
     "within": lambda d: tables.within_table(d["aggregate"], d.get("ceiling")),
     "trials-quantiles": lambda d: tables.quantile_table(d["aggregate"]),
