@@ -109,6 +109,52 @@ def cost_table(agg: Mapping[str, Any]) -> list[str]:
     return lines
 
 
+# The rows of the headline table beside the best method: the paper's method, the learner it is
+# compared with in the paper, and the baseline that needs no learning.
+HEADLINE_ROWS = ("ico-rl", "rl", "lqr")
+
+
+def _total_cost(entry: Mapping[str, Any]) -> Mapping[str, Any]:
+    """A condition's whole-grid cost, its ICO phase included where its prior comes from ICO."""
+    cost = entry.get("cost") or {}
+    return cost.get("with_ico") or cost
+
+
+def recommended(agg: Mapping[str, Any]) -> str | None:
+    """The method to use at the learners' cap (ICO->RL's): of the conditions whose mean success over
+    all cells lies within the 95 % interval of the highest, the one whose whole grid took the fewest
+    trials (ICO phase included); the highest itself when intervals or costs are missing."""
+    if "ico-rl" not in agg:
+        return None
+    cap = agg["ico-rl"]["max_trials"]
+    same_cap = [c for c in CONDITIONS if c in agg and agg[c]["max_trials"] == cap]
+    best = max(same_cap, key=lambda c: agg[c]["success_rate"]["mean"])
+    ci = agg[best]["success_rate"].get("ci95")
+    if not ci or not all("trials" in _total_cost(agg[c]) for c in same_cap):
+        return best
+    tied = [c for c in same_cap if agg[c]["success_rate"]["mean"] >= ci[0]]
+    return min(tied, key=lambda c: _total_cost(agg[c])["trials"]["mean"])
+
+
+def headline_table(summaries: Sequence[Mapping[str, Any]]) -> list[str]:
+    """Per plant (one data file each): the recommended method, then HEADLINE_ROWS; each with its
+    success, 95 % interval, and the whole grid's total cost (_total_cost)."""
+    lines = ["| plant | method | success, all cells (95 % interval) | trials, whole grid | "
+             "simulated time (s) | wall time (s) |", "|---|---|---|---|---|---|"]
+    for data in summaries:
+        agg = data["aggregate"]
+        best = recommended(agg)
+        if best is None:
+            continue
+        for cond in [best] + [c for c in HEADLINE_ROWS if c in agg and c != best]:
+            cost = _total_cost(agg[cond])
+            total = " | ".join(f"{cost[k]['mean']:.3g}" if k in cost else "n/a"
+                               for k in ("trials", "simulated_time", "wall_time"))
+            name = f"**{REGISTRY[cond].label}** (use)" if cond == best else REGISTRY[cond].label
+            lines.append(f"| {data.get('plant', 'cart_pole')} | {name} | {rate(agg[cond]['success_rate'])} | {total} |")
+    return lines if len(lines) > 2 else []
+
+
 def budgets_of(agg: Mapping[str, Any]) -> list[int]:
     """The table's budgets up to the largest trial cap of the summary."""
     cap = max((e["max_trials"] for e in agg.values() if isinstance(e, Mapping) and "max_trials" in e), default=0)

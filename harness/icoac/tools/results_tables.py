@@ -24,8 +24,8 @@ from icoac.studies import tables
 from icoac.studies.bench import summary_markdown
 from icoac.tools.pages import update_or_check
 
-BLOCK = re.compile(r"(<!-- table: (?P<name>[a-z-]+) (?P<file>[\w.-]+\.json) -->\n)(?P<body>.*?)(<!-- end table -->)",
-                   re.S)
+BLOCK = re.compile(r"(<!-- table: (?P<name>[a-z-]+) (?P<file>[\w.-]+\.json(,[\w.-]+\.json)*) -->\n)(?P<body>.*?)"
+                   r"(?P<end><!-- end table -->)", re.S)
 
 
 def _summary(data: Mapping[str, Any]) -> list[str]:
@@ -37,6 +37,10 @@ def _summary(data: Mapping[str, Any]) -> list[str]:
     return lines[start:end]
 
 
+# Tables of several summaries (a block naming FILE1,FILE2,...): one row group per file.
+MULTI_TABLES: dict[str, Callable[[list[Mapping[str, Any]]], list[str]]] = {
+    "headline": tables.headline_table,
+}
 TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
     "comparison": _summary,
     "paired": lambda d: tables.paired_table(d["aggregate"]),
@@ -67,14 +71,23 @@ def render(text: str, data_dir: Path) -> str:
     """text with every table block rewritten from its summary."""
     cache: dict[str, Mapping[str, Any]] = {}
 
-    def block(m: re.Match) -> str:
-        name, file = m.group("name"), m.group("file")
-        if name not in TABLES:
-            raise SystemExit(f"unknown table {name!r} in a block; known: {', '.join(TABLES)}")
+    def load(file: str) -> Mapping[str, Any]:
         if file not in cache:
             cache[file] = json.loads((data_dir / file).read_text())
-        lines = TABLES[name](cache[file])
-        return m.group(1) + "\n".join(lines + ["", provenance(cache[file])]) + "\n" + m.group(5)
+        return cache[file]
+
+    def block(m: re.Match) -> str:
+        name, files = m.group("name"), m.group("file").split(",")
+        if name in MULTI_TABLES:
+            lines = MULTI_TABLES[name]([load(f) for f in files])
+            for f in files:
+                lines += ["", provenance(load(f))]
+        elif name in TABLES and len(files) == 1:
+            lines = TABLES[name](load(files[0])) + ["", provenance(load(files[0]))]
+        else:
+            raise SystemExit(f"unknown table {name!r} of {len(files)} file(s) in a block; known: "
+                             f"{', '.join(TABLES)} (one file), {', '.join(MULTI_TABLES)} (several)")
+        return m.group(1) + "\n".join(lines) + "\n" + m.group("end")
 
     return BLOCK.sub(block, text)
 
