@@ -22,8 +22,9 @@ def blocks(text):
 def test_results_page_has_the_tables_of_its_summaries():
     found = blocks(PAGE.read_text())
     assert {name for name, _ in found} >= {"comparison", "priors", "within", "trials-quantiles"}
-    for _, file in found:
-        assert (DATA / file).is_file(), file
+    for _, files in found:
+        for file in files.split(","):
+            assert (DATA / file).is_file(), file
 
 
 def test_results_page_agrees_with_its_summaries():
@@ -37,7 +38,7 @@ def test_a_changed_number_is_caught(tmp_path):
     data = tmp_path / "data"
     shutil.copy(PAGE, page)
     shutil.copytree(DATA, data)
-    file = blocks(page.read_text())[0][1]
+    file = next(f for _, f in blocks(page.read_text()) if "," not in f)
     summary = json.loads((data / file).read_text())
     entry = summary["aggregate"]["ico-rl"]["success_rate"]
     entry["mean"] += 0.01
@@ -79,3 +80,40 @@ def test_compare_data_flags_a_change_beyond_the_seed_spread():
     flagged = {(r["condition"], r["rate"]) for r in compare_data.rows(before, after) if not r["within"]}
     assert flagged == {("ico", "all cells")}
     assert "| ico | all cells |" in compare_data.markdown(before, after)
+
+
+def _entry(rate, lo, trials, cap=1000, ico_trials=None):
+    cost = {"trials": {"mean": trials}, "simulated_time": {"mean": 1.0}, "wall_time": {"mean": 1.0}}
+    if ico_trials is not None:
+        cost["with_ico"] = {k: {"mean": v["mean"] + ico_trials} for k, v in cost.items()}
+    return {"max_trials": cap, "success_rate": {"mean": rate, "sd": 0.0, "ci95": [lo, 2 * rate - lo]}, "cost": cost}
+
+
+def test_the_method_to_use_is_the_cheapest_within_the_best_interval():
+    """The highest rate sets the interval; of the conditions inside it the one with the fewest trials
+    for the whole grid wins, its ICO phase counted; one outside it does not, however cheap; ICO at
+    another cap is not a candidate."""
+    from icoac.studies import tables
+    agg = {"ico": _entry(0.99, 0.98, 1, cap=100000),
+           "ico-rl": _entry(0.95, 0.93, 100, ico_trials=10**7),
+           "ico-search": _entry(0.96, 0.94, 50, ico_trials=10**7),   # the highest: interval [0.94, 0.98]
+           "search": _entry(0.945, 0.93, 500),                       # inside it
+           "search-control": _entry(0.95, 0.93, 400),                # inside it, fewer trials
+           "lqr": _entry(0.90, 0.88, 10)}                            # the cheapest, outside it
+    assert tables.recommended(agg) == "search-control"
+    agg["search"]["cost"]["trials"]["mean"] = 300
+    assert tables.recommended(agg) == "search"
+    lines = tables.headline_table([{"aggregate": agg}, {"plant": "furuta", "aggregate": agg}])
+    assert [line.split(" | ")[1] for line in lines[2:]] == ["**search** (use)", "ICO->RL", "LQR"] * 2
+    assert "1e+07" in lines[3]   # ICO->RL's row counts its ICO phase
+    del agg["ico-search"]["success_rate"]["ci95"]
+    assert tables.recommended(agg) == "ico-search"  # without an interval: the highest
+
+
+def test_a_block_over_several_summaries(tmp_path):
+    page = "<!-- table: headline bench-default.json,bench-default-furuta.json -->\n<!-- end table -->\n"
+    text = RT.render(page, DATA)
+    assert text.count("*From docs/data:") == 2 and "| furuta |" in text and "| cart_pole |" in text
+    with pytest.raises(SystemExit, match="unknown table"):
+        RT.render("<!-- table: comparison bench-default.json,bench-default-furuta.json -->\n<!-- end table -->\n",
+                  DATA)
