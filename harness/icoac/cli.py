@@ -307,7 +307,7 @@ def build_parser() -> argparse.ArgumentParser:
     w.set_defaults(func=cmd_sweep)
 
     c = sub.add_parser(
-        "ceiling", help="the linear-policy ceiling (method.md, L5): fixed-w evaluation, search for the best w, "
+        "ceiling", help="the best single w found (method.md, L5): fixed-w evaluation, search for the best w, "
                         "first-step bound",
         epilog="Without --w: a seeded search (typical ICO weights - the mean of --prior-from - and LQR gains "
                "as starting points, random search over magnitudes and signs, local refinement), screened "

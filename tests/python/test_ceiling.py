@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The linear-policy ceiling (method.md, L5, icoac.studies.ceiling): fixed-w evaluation, the search, the
+"""The best single w found (method.md, L5, icoac.studies.ceiling): fixed-w evaluation, the search, the
 first-step bound, the command and its files, the bench's reference lines."""
 import json
 import shutil
@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from icoac.core import binding as B
+from icoac.core import signs
 from icoac.studies import bench, figures
 from icoac.core import geometry, grid, options, results
 from icoac.studies.ceiling import fixed, lqr, records, weights
@@ -150,10 +151,10 @@ def test_dare_gain_solves_the_riccati_equation(force):
     import scipy.linalg
 
     cfg = fixed.fixed_config(W)
-    a, b = lqr.linearise(cfg)
+    a, b = signs.linearise(cfg)
     q = np.diag(1.0 / np.array(list(cfg.controller.policy.input_range)[:4], dtype=float) ** 2)
     r = 1.0 / force ** 2
-    k = lqr.lqr_gain(a, b, q, r)
+    k = signs.lqr_gain(a, b, q, r)
     p = scipy.linalg.solve_discrete_are(a, b, q, np.array([[r]]))
     gain = np.linalg.solve(r + b.T @ p @ b, b.T @ p @ a)
     residual = a.T @ p @ a - p - a.T @ p @ b @ gain + q
@@ -166,13 +167,13 @@ def test_dare_gain_solves_the_riccati_equation(force):
 def test_dare_gain_none_without_a_stabilising_solution():
     a = np.diag([1.5, 0.5, 0.5, 0.5])       # an unstable mode the input cannot reach
     b = np.array([[0.0], [1.0], [0.0], [0.0]])
-    assert lqr.lqr_gain(a, b, np.eye(4), 1.0) is None
-    assert lqr.lqr_gain(np.diag([0.5, 0.5, 0.5, 0.5]), b, np.eye(4), 1.0) is not None
+    assert signs.lqr_gain(a, b, np.eye(4), 1.0) is None
+    assert signs.lqr_gain(np.diag([0.5, 0.5, 0.5, 0.5]), b, np.eye(4), 1.0) is not None
 
 
 def test_lqr_starting_points_stabilise_the_linearised_plant():
     cfg = fixed.fixed_config(W)
-    a, b = lqr.linearise(cfg)
+    a, b = signs.linearise(cfg)
     starts = lqr.lqr_starts(cfg)
     assert len(starts) == len(lqr.LQR_FORCES)
     ranges = np.array(list(cfg.controller.policy.input_range)[:B.N_INPUTS], dtype=float)
@@ -230,7 +231,7 @@ def small_ceiling(tmp_path_factory):
 def test_command_writes_its_records(small_ceiling):
     out, res = small_ceiling
     record = json.loads((out / "ceiling.json").read_text())
-    assert "Linear-policy ceiling" in (out / "ceiling.md").read_text() and "Best w" in res.stdout
+    assert "Best single w found" in (out / "ceiling.md").read_text() and "Best w" in res.stdout
     s = record["search"]
     assert s["screened"] == len(s["trace"]) == 12 and s["seed"] == 0 and len(s["confirmed"]) == 2
     assert record["settings"]["cells"] == list(range(600, 625)) and record["git"]["commit"]
@@ -408,9 +409,9 @@ def test_bench_shows_a_ceiling_when_there_is_one(small_ceiling, tmp_path):
                                                           "median_trials_to_success": 3.0,
                                                           "mean_elapsed_time_success": 10.0},
                                     "config": {"run": {"max_trials": 10, "success_steps": 100}}}]})
-    assert "Linear-policy ceiling" not in bench.summary_markdown(agg)
+    assert "Best single w found" not in bench.summary_markdown(agg)
     text = bench.summary_markdown(agg, record)
-    assert "Linear-policy ceiling" in text and "First-step bound" in text
+    assert "Best single w found" in text and "First-step bound" in text
     plain = bench.comparison_figures(agg, tmp_path / "f1", None, None)
     shown = bench.comparison_figures(agg, tmp_path / "f2", None, None, ceiling=record)
     assert [p.name for p in plain] == [p.name for p in shown] == ["fig3a_success_rate.png", "fig3b_elapsed_time.png"]

@@ -7,6 +7,7 @@ import io
 import json
 import math
 import shutil
+import sys
 import tempfile
 from pathlib import Path
 
@@ -138,11 +139,23 @@ def test_parse_value_never_raises(text):
     parse_value(text)
 
 
+def _has_subnormal(value) -> bool:
+    if isinstance(value, float):
+        return value != 0.0 and abs(value) < sys.float_info.min
+    if isinstance(value, list):
+        return any(_has_subnormal(v) for v in value)
+    if isinstance(value, dict):
+        return any(_has_subnormal(v) for v in value.values())
+    return False
+
+
 @given(json_values)
 def test_parse_value_reads_json(value):
+    """JSON reads as itself, except that a subnormal number makes the whole text stay a string (no
+    field takes one: icoac.core.literals.real)."""
     text = json.dumps(value)
     assume("NaN" not in text)
-    assert parse_value(text) == value
+    assert parse_value(text) == (text if _has_subnormal(value) else value)
 
 
 def _paths(d, prefix=()):

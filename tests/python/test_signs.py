@@ -47,10 +47,10 @@ def test_derived_signs_are_the_lqr_gain_pattern(plant):
     w_i = -K_i range_i sign_i / G are all >= 0: the feedback ICO's growing weights can reach."""
     cfg = C.build_config(plant=plant)
     n = cfg.n_inputs
-    a, b = lqr.linearise(cfg)
+    a, b = signs.linearise(cfg)
     ranges = np.array(list(cfg.controller.policy.input_range)[:n])
     gain = float(cfg.controller.policy.gain)
-    k = lqr.lqr_gain(a, b, np.diag(1 / ranges ** 2), 1 / gain ** 2)
+    k = signs.lqr_gain(a, b, np.diag(1 / ranges ** 2), 1 / gain ** 2)
     sign = np.array(list(cfg.controller.task.input_sign)[:n])
     assert np.all(-k * ranges * sign / gain >= 0)
     # and the ceiling's LQR start at that R is those weights

@@ -5,7 +5,7 @@ search grids with their no-learning controls (method.md, L1), summary, figures.
 Layout: OUT/<condition>/seed-<n>/ (results directories), OUT/bench.json (wall time per stage),
 OUT/summary.md and OUT/summary.json (mean and sd over seeds next to the paper's numbers).
 
-The linear-policy ceiling (method.md, L5) is not a bench stage: `python -m icoac ceiling --out
+The best single w found (method.md, L5) is not a bench stage: `python -m icoac ceiling --out
 OUT/ceiling` measures it, and the bench shows it (a section of summary.md, reference lines in
 Fig. 3a) when OUT/ceiling/ceiling.json exists or --ceiling names one.
 """
@@ -142,11 +142,14 @@ def _cost(recs: Sequence[Mapping[str, Any]], ico: Sequence[Mapping[str, Any]] | 
         mean, sd, n = _mean_sd(values)
         return {"mean": mean, "sd": sd, "n": n, "per_seed": values}
 
+    if not all("total_trials" in r["summary"] and "wall_time" in r for r in recs):
+        return {}
     out: dict[str, Any] = {key: stat([float(get(r)) for r in recs]) for key, get in COST}
     if ico:
         by_seed = {r.get("seed"): r for r in ico}
         paired = [(r, by_seed[r.get("seed")]) for r in recs if r.get("seed") in by_seed]
-        out["with_ico"] = {key: stat([float(get(r)) + float(get(i)) for r, i in paired]) for key, get in COST}
+        if paired and _cost([i for _, i in paired], None):
+            out["with_ico"] = {key: stat([float(get(r)) + float(get(i)) for r, i in paired]) for key, get in COST}
     return out
 
 
@@ -231,7 +234,7 @@ def ceiling_markdown(record: Mapping[str, Any]) -> list[str]:
         cap = "one trial per cell" if p == "first" else f"retries up to {s.get('max_trials', st['max_trials']):g} trials"
         parts.append(f"{cap}: {percent(s['success_rate'])} of {s['n_cells']} cells, "
                      f"{percent(s['success_rate_interior'])} of {s['n_interior']} interior")
-    lines = ["", f"Linear-policy ceiling (method.md, L5; no learning, the best single w = {format_w(best['w'])} "
+    lines = ["", f"Best single w found (method.md, L5; no learning, the best single w = {format_w(best['w'])} "
              f"of `python -m icoac ceiling`, seed {st['seed']}, horizon {st['success_steps']:g} steps): "
              + "; ".join(parts) + "."]
     b = record.get("first_step_bound") or {}
@@ -351,7 +354,7 @@ def comparison_figures(agg: Mapping[str, Any], figdir: Path, ico_cells: np.ndarr
             retries = ((ceiling or {}).get("best", {}).get("protocols", {}) or {}).get("retries") or {}
             line = None
             if retries.get("success_within"):
-                line = {"label": f"linear-policy ceiling (retries, cap {retries.get('max_trials', 0):g})",
+                line = {"label": f"best single w found (retries, cap {retries.get('max_trials', 0):g})",
                         "rate": retries["success_within"]["all"]}
             written.append(figures.plot_fig3c(figdir / "fig3c_learning_curves.png",
                                               agg[curved[0]]["success_within"]["k"], curves,

@@ -266,7 +266,7 @@ def make_figures(cells: np.ndarray, record: Mapping, out: str | Path, *, label: 
     return written
 
 
-# Reference lines of the linear-policy ceiling (icoac.studies.ceiling) in Fig. 3a, by protocol label.
+# Reference lines of the best single w found (icoac.studies.ceiling) in Fig. 3a, by protocol label.
 CEILING_STYLES = {"first trial": dict(colors="tab:green", linestyles="-."),
                   "retries": dict(colors="tab:purple", linestyles=":")}
 
@@ -277,7 +277,7 @@ def plot_fig3a(path: str | Path, labels: Sequence[str], all_stats: Sequence[Mapp
     """Fig. 3a: mean success rate per condition (+- sd over seeds), all cells and interior cells,
     with the paper's values (e.g. ~68 % ICO, ~84 % ICO->RL) marked. ``ceiling`` ({protocol label:
     success rate over all cells}, e.g. {"first trial": 0.915, "retries": 0.967}, from
-    icoac.studies.ceiling.reference_lines) adds horizontal lines "linear-policy ceiling (label)" across
+    icoac.studies.ceiling.reference_lines) adds horizontal lines "best single w found (label)" across
     the plot; without it the figure is exactly the one without ceiling."""
     def mv(stats):
         m = [np.nan if s is None or s.get("mean") is None else 100 * s["mean"] for s in stats]
@@ -306,7 +306,7 @@ def plot_fig3a(path: str | Path, labels: Sequence[str], all_stats: Sequence[Mapp
             first = False
         for name, rate in (ceiling or {}).items():
             style = dict(linewidth=1.0, **CEILING_STYLES.get(name, dict(colors="grey", linestyles="-.")))
-            ax.hlines(100 * rate, -0.5, len(labels) - 0.5, label=f"linear-policy ceiling ({name}) {percent(rate)}",
+            ax.hlines(100 * rate, -0.5, len(labels) - 0.5, label=f"best single w found ({name}) {percent(rate)}",
                       **style)
         if ceiling:
             ax.set_xlim(-0.5, len(labels) - 0.5)
@@ -354,7 +354,7 @@ def plot_fig3c(path: str | Path, budgets: Sequence[int], curves: Sequence[Mappin
     """Fig. 3c: success rate (all cells) against the trial budget k, log axis, one curve per
     condition (mean over seeds, the band +- sd), a no-learning control dashed in its condition's
     colour. ``curves``: {"label", "mean", "sd", "control": bool, "color": index}. ``ceiling``:
-    {"label", "rate"} (one curve, the linear-policy ceiling's retries at the same cap)."""
+    {"label", "rate"} (one curve, the best single w found's retries at the same cap)."""
     k = np.asarray(budgets, dtype=float)
     keep = k <= (cap if cap is not None else k.max())
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]

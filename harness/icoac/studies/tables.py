@@ -163,7 +163,7 @@ def budgets_of(agg: Mapping[str, Any]) -> list[int]:
 
 def within_table(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = None) -> list[str]:
     """Success (all cells) within k trials, mean ± sd over seeds, for every condition in the
-    summary, with the linear-policy ceiling's rows (its first trial is k = 1; its retries run to
+    summary, with the best single w found's rows (its first trial is k = 1; its retries run to
     their own cap)."""
     ks = budgets_of(agg)
     conds = [c for c in CONDITIONS if c in agg and agg[c].get("success_within")]
@@ -184,7 +184,7 @@ def within_table(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = Non
         if curve is None:
             continue
         cells = [percent(curve["all"][curve["k"].index(k)]) if cap is None or k <= cap else "" for k in ks]
-        lines.append(f"| linear-policy ceiling ({'first trial' if name == 'first' else name}) | "
+        lines.append(f"| best single w found ({'first trial' if name == 'first' else name}) | "
                      f"{'' if cap is None else f'{cap:g}'} | " + " | ".join(cells) + " |")
     return lines
 

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """`ceiling`: what the policy class F = G * w^T x~ + U can reach on the plant's grid, with no
-learning (method.md, L5, "the linear-policy ceiling"). Every simulation runs in C through the engine.
+learning (method.md, L5, "the best single w found"). Every simulation runs in C through the engine.
 
 Modules, each one concern (imports go down the list, never up):
 

@@ -92,7 +92,7 @@ def summary_markdown(record: Mapping[str, Any]) -> str:
     unit = B.plant_info(plant)["input"][1]
     names = "w_x, w_ẋ, w_θ, w_θ̇" if plant == CART_POLE else ", ".join(
         f"w_{name}" for name, _ in B.plant_info(plant)["state"])
-    lines = ["# Linear-policy ceiling (method.md, L5)", "",
+    lines = ["# Best single w found (method.md, L5)", "",
              f"Policy F = G·wᵀx̃ + U with G = {pol.get('gain', 'n/a'):g} {unit}, reflex {pol.get('reflex_mode')} "
              f"({pol.get('reflex_force', 'n/a'):g} {unit}), no learning (learn = 0); "
              f"{'' if plant == CART_POLE else f'plant {plant}; '}seed {st['seed']}, "
