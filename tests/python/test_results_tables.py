@@ -104,7 +104,7 @@ def test_the_method_to_use_is_the_cheapest_within_the_best_interval():
     agg["search"]["cost"]["trials"]["mean"] = 300
     assert tables.recommended(agg) == "search"
     lines = tables.headline_table([{"aggregate": agg}, {"plant": "furuta", "aggregate": agg}])
-    assert [line.split(" | ")[1] for line in lines[2:]] == ["**search** (use)", "ICO->RL", "LQR"] * 2
+    assert [line.split(" | ")[1] for line in lines[2:]] == ["**search** (use)", "ICO->RL", "search control", "LQR"] * 2
     assert "1e+07" in lines[3]   # ICO->RL's row counts its ICO phase
     del agg["ico-search"]["success_rate"]["ci95"]
     assert tables.recommended(agg) == "ico-search"  # without an interval: the highest

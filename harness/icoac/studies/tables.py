@@ -109,9 +109,10 @@ def cost_table(agg: Mapping[str, Any]) -> list[str]:
     return lines
 
 
-# The rows of the headline table beside the best method: the paper's method, the learner it is
-# compared with in the paper, and the baseline that needs no learning.
-HEADLINE_ROWS = ("ico-rl", "rl", "lqr")
+# The rows of the headline table beside the method to use: the paper's method, the learner it is
+# compared with in the paper, the per-trial random w (the search's control: no learning, no model)
+# and the baseline that needs the model.
+HEADLINE_ROWS = ("ico-rl", "rl", "search-control", "lqr")
 
 
 def _total_cost(entry: Mapping[str, Any]) -> Mapping[str, Any]:
