@@ -92,19 +92,24 @@ def paired_table(agg: Mapping[str, Any]) -> list[str]:
     return lines
 
 
-def cost_table(agg: Mapping[str, Any]) -> list[str]:
+def cost_table(agg: Mapping[str, Any], wall_time: bool = True) -> list[str]:
     """What each condition's whole grid cost (every cell, successful or not), mean over seeds: trials,
-    simulated time, wall time; for a condition with an ICO prior, the same with its ICO grid added."""
+    simulated time and (``wall_time``) wall time; for a condition with an ICO prior, the same with
+    its ICO grid added. Without wall time the table is the same for every run of the same cells
+    (summary.md: a resumed bench writes the same summary as an uninterrupted one)."""
     conds = [c for c in CONDITIONS if c in agg and agg[c].get("cost")]
     if not conds:
         return []
-    lines = ["| condition | cap | trials | simulated time (s) | wall time (s) | with the ICO phase: trials | "
-             "simulated time (s) | wall time (s) |", "|---|---|---|---|---|---|---|---|"]
+    keys = ("trials", "simulated_time", "wall_time") if wall_time else ("trials", "simulated_time")
+    heads = {"trials": "trials", "simulated_time": "simulated time (s)", "wall_time": "wall time (s)"}
+    lines = ["| condition | cap | " + " | ".join(heads[k] for k in keys) + " | "
+             + " | ".join(("with the ICO phase: " if i == 0 else "") + heads[k] for i, k in enumerate(keys)) + " |",
+             "|---|---|" + "---|" * (2 * len(keys))]
     for cond in conds:
         e, cost = agg[cond], agg[cond]["cost"]
         ico = cost.get("with_ico") or {}
-        own = " | ".join(f"{cost[k]['mean']:.3g}" for k in ("trials", "simulated_time", "wall_time"))
-        both = " | ".join(f"{ico[k]['mean']:.3g}" if k in ico else "" for k in ("trials", "simulated_time", "wall_time"))
+        own = " | ".join(f"{cost[k]['mean']:.3g}" for k in keys)
+        both = " | ".join(f"{ico[k]['mean']:.3g}" if k in ico else "" for k in keys)
         lines.append(f"| {REGISTRY[cond].label} | {e['max_trials']:g} | {own} | {both} |")
     return lines
 
@@ -209,7 +214,8 @@ def curve_tables(agg: Mapping[str, Any], ceiling: Mapping[str, Any] | None = Non
     out: list[str] = []
     for title, lines in (
             ("The actor-critic from the four priors, each beside its no-learning control", prior_table(agg)),
-            ("What each whole grid cost (every cell), mean over seeds", cost_table(agg)),
+            ("What each whole grid cost (every cell), mean over seeds; wall times in bench.json and "
+             "docs/data", cost_table(agg, wall_time=False)),
             ("Success within k trials (all cells), mean ± sd over seeds", within_table(agg, ceiling)),
             ("Trials to success: quantiles over the successful cells, mean ± sd over seeds", quantile_table(agg)),
             ("Simulated time to success (s): quantiles over the successful cells, mean ± sd over seeds",
