@@ -78,6 +78,12 @@ def _mean_sd(values: Sequence[float | None]) -> tuple[float | None, float | None
     return float(np.mean(v)), sd, int(v.size)
 
 
+def _stat(values: Sequence[float | None]) -> dict[str, Any]:
+    """A statistic over seeds as the summaries store it: mean, sd, n and the per-seed values."""
+    mean, sd, n = _mean_sd(values)
+    return {"mean": mean, "sd": sd, "n": n, "per_seed": list(values)}
+
+
 STATS = (
     ("success_rate", "success rate (all)"),
     ("success_rate_interior", "success rate (interior)"),
@@ -137,19 +143,15 @@ COST = (("trials", lambda r: r["summary"]["total_trials"]),
 def _cost(recs: Sequence[Mapping[str, Any]], ico: Sequence[Mapping[str, Any]] | None) -> dict[str, Any]:
     """Mean/sd over seeds of a condition's whole-grid cost (COST); for a condition whose prior comes
     from ICO, also with the ICO grid of the same seed added (``with_ico``), the phase its own
-    trial counts leave out."""
-    def stat(values):
-        mean, sd, n = _mean_sd(values)
-        return {"mean": mean, "sd": sd, "n": n, "per_seed": values}
-
+    trial counts leave out. Empty for records written before the summaries counted totals."""
     if not all("total_trials" in r["summary"] and "wall_time" in r for r in recs):
         return {}
-    out: dict[str, Any] = {key: stat([float(get(r)) for r in recs]) for key, get in COST}
+    out: dict[str, Any] = {key: _stat([float(get(r)) for r in recs]) for key, get in COST}
     if ico:
         by_seed = {r.get("seed"): r for r in ico}
         paired = [(r, by_seed[r.get("seed")]) for r in recs if r.get("seed") in by_seed]
         if paired and _cost([i for _, i in paired], None):
-            out["with_ico"] = {key: stat([float(get(r)) + float(get(i)) for r, i in paired]) for key, get in COST}
+            out["with_ico"] = {key: _stat([float(get(r)) + float(get(i)) for r, i in paired]) for key, get in COST}
     return out
 
 
@@ -171,18 +173,15 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]],
                                  "success_steps": recs[0]["config"]["run"]["success_steps"],
                                  "paper": PAPER.get(cond) if _paper_plant(results.record_plant(recs[0])) else None}
         for key, _ in STATS:
-            values = [r["summary"].get(key) for r in recs]
-            mean, sd, n = _mean_sd(values)
-            entry[key] = {"mean": mean, "sd": sd, "n": n, "per_seed": values}
+            entry[key] = _stat([r["summary"].get(key) for r in recs])
             if key in cis:
                 entry[key]["ci95"] = cis[key]
         entry.update(_curves_and_quantiles(recs))
-        entry["cost"] = _cost(recs, records.get("ico") if (REGISTRY[cond].prior or ()) and
-                              REGISTRY[cond].prior.takes_ico else None)
+        rule = REGISTRY[cond].prior
+        entry["cost"] = _cost(recs, records.get("ico") if rule is not None and rule.takes_ico else None)
         if cond == "ico-rl":
-            t = [(r.get("prior_info") or {}).get("ico_phase_simulated_time") for r in recs]
-            mean, sd, n = _mean_sd(t)
-            entry["ico_phase_simulated_time"] = {"mean": mean, "sd": sd, "n": n, "per_seed": t}
+            entry["ico_phase_simulated_time"] = _stat(
+                [(r.get("prior_info") or {}).get("ico_phase_simulated_time") for r in recs])
         out[cond] = entry
     return out
 
@@ -199,10 +198,8 @@ def gain_over_control(cells: Mapping[int, np.ndarray], control: Mapping[int, np.
         gained.append(float(np.count_nonzero(a & ~b)))
         lost.append(float(np.count_nonzero(~a & b)))
         points.append(100.0 * (float(a.mean()) - float(b.mean())))
-    out: dict[str, Any] = {}
-    for key, values in (("cells_gained", gained), ("cells_lost", lost), ("points", points)):
-        mean, sd, n = _mean_sd(values)
-        out[key] = {"mean": mean, "sd": sd, "n": n, "per_seed": values}
+    out: dict[str, Any] = {key: _stat(values) for key, values in
+                           (("cells_gained", gained), ("cells_lost", lost), ("points", points))}
     out["paired"] = compare(cells, control)
     return out
 
