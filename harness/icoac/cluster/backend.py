@@ -249,7 +249,7 @@ class _Run:
         self.progress = progress
         self.desc = desc
         self.poll_interval = poll_interval
-        self.bar = grid._Progress(cells.size, cells.size - pending.size, progress, desc)
+        self.bar = grid.Progress(cells.size, cells.size - pending.size, progress, desc)
         self.stopping = False
         for idx in chunks_of(pending, size):
             self._submit(idx)

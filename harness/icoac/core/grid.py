@@ -165,7 +165,7 @@ class GridRun:
         return bool(np.all(self.cells["outcome"] != B.PENDING))
 
 
-class _Progress:
+class Progress:
     """tqdm bar over cells with trials and ticks/s in the postfix (silent when disabled)."""
 
     def __init__(self, total: int, initial: int, enabled: bool, desc: str):
@@ -297,7 +297,7 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
             except KeyboardInterrupt:
                 pass
 
-    bar = _Progress(cells.size, cells.size - pending, progress, desc)
+    bar = Progress(cells.size, cells.size - pending, progress, desc)
     thread = threading.Thread(target=worker, name="icoac-grid", daemon=True)
     thread.start()
     checkpoints = Checkpoints(checkpoint, checkpoint_every, checkpoint_cells)

@@ -18,6 +18,9 @@ from typing import Any, Mapping, NamedTuple
 
 # The controller modes a condition runs in (the names of the C enum, icoac.core.binding.MODES).
 MODES = ("ico", "rl", "search")
+# The optimisers that learn outside the controller, over its fixed policy (trials in C, the
+# optimiser in Python between them): icoac.studies.baselines.
+OPTIMISERS = ("cma-es",)
 # The words of a prior rule. Mean: "ico" (the ICO prior's, from the final weights of an ICO grid,
 # --prior-from), "zero", or "lqr" (the plant's LQR gain as a w, icoac.core.signs.lqr_weights). Covariance: "ico" (the ICO prior's), "isotropic" (sigma_w^2 I with
 # sigma_w = --prior-std) or "identity" (I: the search's Sigma0 = search.cov_scale * I).
@@ -48,12 +51,16 @@ class Condition:
     control: str | None = None              # the name of its no-learning control
     control_of: str | None = None           # a control: the condition it is the control of
     baseline: bool = False                  # a fixed policy that never learns (no control of its own)
+    optimiser: str | None = None            # learns outside the controller (OPTIMISERS), its updates off
 
     def __post_init__(self):
         if self.mode not in MODES:
             raise ValueError(f"condition {self.name}: unknown mode {self.mode!r}")
         if self.prior is not None and (self.prior.mean not in MEAN_RULES or self.prior.cov not in COV_RULES):
             raise ValueError(f"condition {self.name}: bad prior rule {self.prior!r}")
+        if self.optimiser is not None and (self.optimiser not in OPTIMISERS or self.mode != "ico"):
+            raise ValueError(f"condition {self.name}: an optimiser ({', '.join(OPTIMISERS)}) runs a fixed policy "
+                             "(mode ico)")
         object.__setattr__(self, "overrides", MappingProxyType(dict(self.overrides)))
 
     @property
@@ -66,8 +73,10 @@ class Condition:
         return self.control_of or self.name
 
     def config_overrides(self) -> dict[str, Any]:
-        """Every controller field the condition sets over the C defaults."""
-        return {"mode": self.mode, **self.overrides, **({} if self.learns else {"learn": 0})}
+        """Every controller field the condition sets over the C defaults (learn 0 where the controller
+        does not learn: a control, a baseline, an optimiser's fixed policy)."""
+        fixed = not self.learns or self.optimiser is not None
+        return {"mode": self.mode, **self.overrides, **({"learn": 0} if fixed else {})}
 
 
 def _learner(name: str, label: str, mode: str, prior: PriorRule | None = None,
@@ -106,6 +115,11 @@ REGISTRY: Mapping[str, Condition] = MappingProxyType({c.name: c for c in (
     # task its input signs (Q = diag(1 / input_range^2), R = 1 / G^2), acting as the fixed w of the
     # same policy (ICO mode with every update off acts with its prior mean)
     Condition("lqr", "LQR", "ico", PriorRule("lqr", "identity"), baseline=True),
+    # CMA-ES per cell over the fixed w of the same policy, from the search control's N(0, 4 I)
+    # (icoac.studies.baselines.cma_es); no control of its own: the search control is CMA-ES
+    # without its adaptation
+    Condition("cma-es", "CMA-ES", "ico", PriorRule("zero", "identity"), {"search.cov_scale": 4},
+              optimiser="cma-es"),
 )})
 
 # Derived views.

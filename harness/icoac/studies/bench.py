@@ -41,7 +41,7 @@ PAPER = {
 # The paired comparisons of the summary beyond each learner against its control: the paper's
 # method against the learners a user would pick instead (same caps only).
 COMPARISONS = (("ico-rl", "rl"), ("ico-rl", "search"), ("ico-rl", "ico-search"), ("ico-rl", "search-control"),
-               ("ico-rl", "lqr"))
+               ("ico-rl", "lqr"), ("ico-rl", "cma-es"), ("cma-es", "search-control"))
 # The learners after ICO and its prior, in stage order.
 LEARNERS = PRIOR_CONDITIONS
 

@@ -131,6 +131,8 @@ def run_condition(*, condition: str, out: Path, seed: int, threads: int, overrid
 def _run(st: store.ResultsStore, cfg: RunConfig, cells: np.ndarray, *, previous: dict | None, condition: str,
          seed: int, threads: int, indices, extra, fresh: bool, progress: bool, checkpoint_every, checkpoint_cells,
          cancel_after, dask=None) -> tuple[np.ndarray, dict, bool]:
+    if REGISTRY[condition].optimiser is not None:  # Python between its trials: local threads only
+        dask = None
     if dask is not None and not hasattr(dask, "run_grid"):  # a DaskSpec: a session for this grid
         from icoac.cluster.backend import open_backend
         with open_backend(dask) as session:
@@ -154,6 +156,9 @@ def _run(st: store.ResultsStore, cfg: RunConfig, cells: np.ndarray, *, previous:
     if previous is None:
         save(cells, 0.0)  # every cell PENDING: resumable from the first second
     runner = functools.partial(grid.run_grid, threads=threads) if dask is None else dask.run_grid
+    if REGISTRY[condition].optimiser is not None:
+        from icoac.studies.baselines import cma_es
+        runner = functools.partial(cma_es.run_grid, threads=threads)
     run = runner(cfg, cells, progress=progress,
                  checkpoint=lambda snap: save(snap, wall_before + time.monotonic() - t0),
                  checkpoint_every=DEFAULT_CHECKPOINT_EVERY if checkpoint_every is None else checkpoint_every,

@@ -117,7 +117,7 @@ def cost_table(agg: Mapping[str, Any], wall_time: bool = True) -> list[str]:
 # The rows of the headline table beside the method to use: the paper's method, the learner it is
 # compared with in the paper, the per-trial random w (the search's control: no learning, no model)
 # and the baseline that needs the model.
-HEADLINE_ROWS = ("ico-rl", "rl", "search-control", "lqr")
+HEADLINE_ROWS = ("ico-rl", "rl", "search-control", "cma-es", "lqr")
 
 
 def _total_cost(entry: Mapping[str, Any]) -> Mapping[str, Any]:
