@@ -98,3 +98,9 @@ def test_refuses_a_prior_with_covariances():
 def test_candidates_as_the_controller_runs_them():
     w = cma_es.real_weights(np.array([1e-45, -3e7, 0.1, 2.0]))
     assert w[0] == 0 and w[1] == -cma_es.W_LIMIT and w[2] == np.float64(np.float32(0.1)) and w[3] == 2.0
+
+
+def test_every_runner_of_the_condition_is_cma_es():
+    """A bench stage, a condition run and a sweep all run cma-es through its own runner, never the
+    engine's fixed-w evaluation of its start mean."""
+    assert C.local_runner("cma-es") is cma_es.run_grid and C.local_runner("search") is grid.run_grid

@@ -49,6 +49,15 @@ def condition_prior(condition: str, prior_from, frame, ridge: float, std: float 
                              geometry.of(plant).n_inputs)
 
 
+def local_runner(condition: str):
+    """What runs a condition's grid on this machine: the engine (grid.run_grid), or for an optimiser
+    its own runner with the same contract."""
+    if REGISTRY[condition].optimiser is not None:
+        from icoac.studies.baselines import cma_es
+        return cma_es.run_grid
+    return grid.run_grid
+
+
 def nothing_to_resume(out: Path) -> UsageError:
     return UsageError(f"--resume: no results to resume in {str(out)!r} (none written yet: run the command "
                       "without --resume)")
@@ -155,10 +164,7 @@ def _run(st: store.ResultsStore, cfg: RunConfig, cells: np.ndarray, *, previous:
     t0 = time.monotonic()
     if previous is None:
         save(cells, 0.0)  # every cell PENDING: resumable from the first second
-    runner = functools.partial(grid.run_grid, threads=threads) if dask is None else dask.run_grid
-    if REGISTRY[condition].optimiser is not None:
-        from icoac.studies.baselines import cma_es
-        runner = functools.partial(cma_es.run_grid, threads=threads)
+    runner = functools.partial(local_runner(condition), threads=threads) if dask is None else dask.run_grid
     run = runner(cfg, cells, progress=progress,
                  checkpoint=lambda snap: save(snap, wall_before + time.monotonic() - t0),
                  checkpoint_every=DEFAULT_CHECKPOINT_EVERY if checkpoint_every is None else checkpoint_every,

@@ -23,6 +23,7 @@ import numpy as np
 from icoac.core import binding as B
 from icoac.core import geometry, grid, metrics, results, store
 from icoac.studies import prior as P
+from icoac.studies.conditions import local_runner
 from icoac.core.binding import ConfigError
 from icoac.core.config import build_config, canonical, command_overrides, given_twice, named_sets, parse_sets, parse_value
 from icoac.core.errors import SweepError, UsageError
@@ -305,8 +306,9 @@ def _run_settings(opt: SweepOptions, out: Path, held: store.DirectoryLock, meta:
             rates, rates_failed, trials, elapsed = [], [], [], []
             for seed in seeds:
                 cells = grid.make_cells(seed, indices, plant=cfg.plant_name)
-                res = (grid.run_grid(cfg, cells, threads=opt.threads, progress=False) if session is None
-                   else session.run_grid(cfg, cells, progress=False))
+                res = (local_runner(opt.condition)(cfg, cells, threads=opt.threads, progress=False)
+                       if session is None or REGISTRY[opt.condition].optimiser is not None
+                       else session.run_grid(cfg, cells, progress=False))
                 if res.cancelled:
                     print("[sweep] interrupted: finished settings are in the CSV; rerun to resume", file=sys.stderr)
                     return 130
