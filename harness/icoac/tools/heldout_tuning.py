@@ -1,0 +1,122 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The held-out tuning of every learner on a plant (the protocol: icoac.studies.heldout,
+docs/tuning.md):
+
+    python -m icoac.tools.heldout_tuning --plant cart_pole --out results/tuning-cart_pole
+
+ICO first: its settings on the tuning cells and seeds. Its chosen setting's grids then give the
+learners that take ICO's output their priors, seed for seed (the central frame's cells among the
+tuning cells). Every (learner, setting, seed) is a results directory
+OUT/<learner>/<setting>/seed-<s>/, so a stopped run resumes where it stopped (rerun the command).
+OUT/tuning.json and OUT/summary.md hold each learner's ranking and choice."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from icoac.core import metrics, results
+from icoac.core.errors import HarnessError
+from icoac.core.plants import PLANTS
+from icoac.core.registry import REGISTRY
+from icoac.studies import bench, heldout
+from icoac.studies import prior as P
+from icoac.studies.conditions import condition_prior, run_condition
+
+ORDER = tuple(heldout.SPACES)  # ICO first: the others may take its output
+
+
+def run_setting(args, learner: str, index: int, setting: dict[str, Any], ico_dirs: dict[int, Path] | None
+                ) -> dict[str, Any]:
+    """Every tuning seed of one setting; its row of the ranking."""
+    caps = bench.PROFILES["default"]["ico" if learner == "ico" else "rl"]
+    cells_spec = [int(i) for i in heldout.tuning_cells(args.plant)]
+    rates, trials, cost, wall = [], [], 0, 0.0
+    for seed in heldout.TUNING_SEEDS:
+        out = args.out / learner / heldout.key(setting) / f"seed-{seed}"
+        rule = REGISTRY[learner].prior
+        info = None if rule is None else condition_prior(
+            learner, ico_dirs[seed] if rule.takes_ico else None, P.CENTRAL, P.DEFAULT_RIDGE, plant=args.plant,
+            overrides={**caps, **setting})
+        cells, record, cancelled = run_condition(
+            condition=learner, out=out, seed=seed, threads=args.threads, overrides={**caps, **setting},
+            cell_spec=cells_spec, resume=bool(results.present(out)), progress=not args.quiet, info=info,
+            plant=args.plant)
+        if cancelled:
+            raise KeyboardInterrupt
+        ok = metrics.success_mask(cells)
+        rates.append(float(ok.mean()))
+        trials.extend(cells["trials"][ok].tolist())
+        cost += int(np.sum(cells["trials"]))
+        wall += float(record["wall_time"])
+    row = {"order": index, "setting": setting, "key": heldout.key(setting), "success_rate": float(np.mean(rates)),
+           "success_rates": rates, "median_trials": float(np.median(trials)) if trials else None,
+           "trials": cost, "wall_time": wall}
+    print(f"[tuning] {learner} {row['key']}: {100 * row['success_rate']:.1f} %, median "
+          f"{row['median_trials']} trials, {wall:.0f} s", file=sys.stderr, flush=True)
+    return row
+
+
+def tune(args, learner: str, ico_dirs: dict[int, Path] | None) -> dict[str, Any]:
+    rows = [run_setting(args, learner, i, s, ico_dirs) for i, s in enumerate(heldout.settings(learner))]
+    ranked = heldout.rank(rows)
+    return {"learner": learner, "rows": rows, "chosen": ranked[0]["setting"], "chosen_key": ranked[0]["key"],
+            "default_kept": ranked[0]["order"] == 0, "trials": sum(r["trials"] for r in rows),
+            "wall_time": sum(r["wall_time"] for r in rows)}
+
+
+def markdown(data: dict[str, Any]) -> str:
+    lines = [f"# Held-out tuning, {data['plant']}", "",
+             f"Tuning cells: {data['n_tuning_cells']} of {data['n_cells']}; seeds {data['protocol']['tuning_seeds']}; "
+             f"criterion: {data['protocol']['criterion']}.", ""]
+    for name, t in data["learners"].items():
+        lines += [f"## {REGISTRY[name].label} (`{name}`)", "",
+                  f"Chosen: `{t['chosen_key']}`{' (the default)' if t['default_kept'] else ''}; "
+                  f"{t['trials']} trials, {t['wall_time']:.0f} s.", "",
+                  "| rank | setting | success (%) | per seed (%) | median trials |", "|---|---|---|---|---|"]
+        for i, r in enumerate(heldout.rank(t["rows"]), 1):
+            seeds = ", ".join(f"{100 * v:.1f}" for v in r["success_rates"])
+            lines.append(f"| {i} | `{r['key']}`{' (default)' if r['order'] == 0 else ''} | "
+                         f"{100 * r['success_rate']:.2f} | {seeds} | {r['median_trials']} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m icoac.tools.heldout_tuning", description=__doc__.split("\n")[0])
+    ap.add_argument("--plant", default="cart_pole", choices=tuple(PLANTS))
+    ap.add_argument("--out", required=True, type=Path)
+    ap.add_argument("--learners", nargs="+", choices=ORDER, default=list(ORDER),
+                    help="the learners to tune (ICO always runs first: the others take its chosen grids)")
+    ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--quiet", action="store_true")
+    args = ap.parse_args(argv)
+    data: dict[str, Any] = {"plant": args.plant, "protocol": heldout.protocol(),
+                            "n_tuning_cells": int(heldout.tuning_cells(args.plant).size),
+                            "n_cells": int(heldout.heldout_mask(args.plant).size), "learners": {},
+                            "git": results.git_info()}
+    try:
+        ico = tune(args, "ico", None)
+        data["learners"]["ico"] = ico
+        ico_dirs = {s: args.out / "ico" / ico["chosen_key"] / f"seed-{s}" for s in heldout.TUNING_SEEDS}
+        for learner in ORDER[1:]:
+            if learner in args.learners:
+                data["learners"][learner] = tune(args, learner, ico_dirs)
+    except HarnessError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted; rerun the same command to resume", file=sys.stderr)
+        return 130
+    (args.out / "tuning.json").write_text(json.dumps(data, indent=1))
+    (args.out / "summary.md").write_text(markdown(data))
+    print(markdown(data))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,78 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The held-out tuning protocol (icoac.studies.heldout) and its runner (icoac.tools.heldout_tuning):
+a fixed split disjoint from evaluation, the same budget for every learner with its default first,
+the committed criterion, and the runner's priors from ICO's chosen grids."""
+import json
+
+import numpy as np
+import pytest
+
+from icoac.core import results
+from icoac.core.config import build_config
+from icoac.core.plants import PLANTS
+from icoac.core.registry import REGISTRY
+from icoac.studies import bench, heldout as H
+from icoac.tools import heldout_tuning as T
+
+
+@pytest.mark.parametrize("plant", sorted(PLANTS))
+def test_split_is_fixed_and_held_out(plant):
+    if not PLANTS[plant].has_task:
+        pytest.skip(f"{plant} has no task")
+    cells = H.tuning_cells(plant)
+    assert np.array_equal(cells, H.tuning_cells(plant)) and np.all(np.diff(cells) > 0)
+    held = H.heldout_mask(plant)
+    assert cells.size == round(H.TUNING_FRACTION * held.size) and not held[cells].any()
+    assert np.count_nonzero(held) == held.size - cells.size
+
+
+def test_splits_differ_by_plant_and_seeds_are_disjoint():
+    assert not np.array_equal(H.tuning_cells("cart_pole"), H.tuning_cells("furuta"))
+    evaluation = set(range(bench.PROFILES["default"]["seeds"]))
+    assert not evaluation & set(H.TUNING_SEEDS)
+
+
+@pytest.mark.parametrize("learner", list(H.SPACES))
+def test_same_budget_default_first_every_setting_valid(learner):
+    settings = H.settings(learner)
+    assert len(settings) == H.SETTINGS and len({H.key(s) for s in settings}) == H.SETTINGS
+    first = build_config(settings[0], condition=learner)
+    assert bytes(first.controller) == bytes(build_config(condition=learner).controller)
+    for s in settings:
+        build_config(s, condition=learner)  # ConfigError if the C check refused one
+
+
+def test_every_learner_is_tuned():
+    learners = {c.name for c in REGISTRY.values() if c.learns}
+    assert set(H.SPACES) == learners
+
+
+def test_criterion():
+    rows = [{"order": 0, "success_rate": 0.90, "median_trials": 10.0},
+            {"order": 1, "success_rate": 0.95, "median_trials": 50.0},
+            {"order": 2, "success_rate": 0.95, "median_trials": 20.0},
+            {"order": 3, "success_rate": 0.95, "median_trials": 20.0},
+            {"order": 4, "success_rate": 0.95, "median_trials": None}]
+    assert [r["order"] for r in H.rank(rows)] == [2, 3, 1, 4, 0]
+
+
+def test_runner_takes_icos_chosen_grids(tmp_path, monkeypatch):
+    """Two settings each for ICO and ICO->RL on six tuning cells at small caps: the ranking is the
+    criterion's, and ICO->RL's prior comes from ICO's chosen setting, seed for seed."""
+    monkeypatch.setattr(H, "tuning_cells", lambda plant: np.array([560, 600, 610, 612, 640, 700]))
+    monkeypatch.setattr(H, "SPACES", {"ico": {"ico.rate": [1e-4, 1e-3]},
+                                      "ico-rl": {"actor.noise_std": [3, 1]}})
+    monkeypatch.setitem(bench.PROFILES, "default", {**bench.PROFILES["default"],
+                                                     "ico": {"max_trials": 3000, "success_steps": 1000},
+                                                     "rl": {"max_trials": 200, "success_steps": 1000}})
+    assert T.main(["--out", str(tmp_path), "--learners", "ico-rl", "--quiet"]) == 0
+    data = json.loads((tmp_path / "tuning.json").read_text())
+    ico = data["learners"]["ico"]
+    assert [r["key"] for r in ico["rows"]] == ["ico.rate=0.0001", "ico.rate=0.001"]
+    best = H.rank(ico["rows"])[0]
+    assert ico["chosen_key"] == best["key"]
+    for seed in H.TUNING_SEEDS:
+        _, rec = results.load(tmp_path / "ico-rl" / "actor.noise_std=1" / f"seed-{seed}")
+        assert rec["cells"] == [560, 600, 610, 612, 640, 700] and rec["seed"] == seed
+        assert rec["prior_info"]["source"] == str((tmp_path / "ico" / ico["chosen_key"] / f"seed-{seed}").resolve())
+    assert "Chosen:" in (tmp_path / "summary.md").read_text()
