@@ -78,7 +78,7 @@ def _mean_sd(values: Sequence[float | None]) -> tuple[float | None, float | None
     return float(np.mean(v)), sd, int(v.size)
 
 
-def _stat(values: Sequence[float | None]) -> dict[str, Any]:
+def seed_stat(values: Sequence[float | None]) -> dict[str, Any]:
     """A statistic over seeds as the summaries store it: mean, sd, n and the per-seed values."""
     mean, sd, n = _mean_sd(values)
     return {"mean": mean, "sd": sd, "n": n, "per_seed": list(values)}
@@ -146,12 +146,12 @@ def _cost(recs: Sequence[Mapping[str, Any]], ico: Sequence[Mapping[str, Any]] | 
     trial counts leave out. Empty for records written before the summaries counted totals."""
     if not all("total_trials" in r["summary"] and "wall_time" in r for r in recs):
         return {}
-    out: dict[str, Any] = {key: _stat([float(get(r)) for r in recs]) for key, get in COST}
+    out: dict[str, Any] = {key: seed_stat([float(get(r)) for r in recs]) for key, get in COST}
     if ico:
         by_seed = {r.get("seed"): r for r in ico}
         paired = [(r, by_seed[r.get("seed")]) for r in recs if r.get("seed") in by_seed]
         if paired and _cost([i for _, i in paired], None):
-            out["with_ico"] = {key: _stat([float(get(r)) + float(get(i)) for r, i in paired]) for key, get in COST}
+            out["with_ico"] = {key: seed_stat([float(get(r)) + float(get(i)) for r, i in paired]) for key, get in COST}
     return out
 
 
@@ -173,14 +173,14 @@ def aggregate(records: Mapping[str, Sequence[Mapping[str, Any]]],
                                  "success_steps": recs[0]["config"]["run"]["success_steps"],
                                  "paper": PAPER.get(cond) if _paper_plant(results.record_plant(recs[0])) else None}
         for key, _ in STATS:
-            entry[key] = _stat([r["summary"].get(key) for r in recs])
+            entry[key] = seed_stat([r["summary"].get(key) for r in recs])
             if key in cis:
                 entry[key]["ci95"] = cis[key]
         entry.update(_curves_and_quantiles(recs))
         rule = REGISTRY[cond].prior
         entry["cost"] = _cost(recs, records.get("ico") if rule is not None and rule.takes_ico else None)
         if cond == "ico-rl":
-            entry["ico_phase_simulated_time"] = _stat(
+            entry["ico_phase_simulated_time"] = seed_stat(
                 [(r.get("prior_info") or {}).get("ico_phase_simulated_time") for r in recs])
         out[cond] = entry
     return out
@@ -198,7 +198,7 @@ def gain_over_control(cells: Mapping[int, np.ndarray], control: Mapping[int, np.
         gained.append(float(np.count_nonzero(a & ~b)))
         lost.append(float(np.count_nonzero(~a & b)))
         points.append(100.0 * (float(a.mean()) - float(b.mean())))
-    out: dict[str, Any] = {key: _stat(values) for key, values in
+    out: dict[str, Any] = {key: seed_stat(values) for key, values in
                            (("cells_gained", gained), ("cells_lost", lost), ("points", points))}
     out["paired"] = compare(cells, control)
     return out
