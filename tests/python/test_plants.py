@@ -53,8 +53,10 @@ def double_cart_pole_bodies(p, q):
 
 
 def furuta_forces(p, q, qd, u):
-    """Generalised forces besides gravity: the motor (back-EMF included) and viscous friction."""
+    """Generalised forces besides gravity: the motor (its voltage saturated, back-EMF included) and
+    viscous friction."""
     k, r = p["torque_constant"], p["resistance"]
+    u = np.clip(u, -p["voltage_limit"], p["voltage_limit"])
     return np.array([k * (u - k * qd[0]) / r - p["arm_damping"] * qd[0], -p["pendulum_damping"] * qd[1]])
 
 

@@ -9,9 +9,12 @@
  *
  * State (theta, theta_dot, alpha, alpha_dot): arm angle about the motor axis, pendulum angle
  * from upright (positive when the pendulum leans the way the arm's tip moves for theta_dot > 0).
- * Input: motor voltage V; the motor's torque is k_t (V - k_t theta_dot) / R_m (inductance
- * neglected, back-EMF constant = torque constant in SI units). Links are thin uniform rods: the
- * arm pivots at one end, the pendulum at the arm's tip. */
+ * Input: motor voltage V, saturated at the amplifier's limit (+-10 V); the motor's torque is
+ * k_t (V - k_t theta_dot) / R_m (inductance neglected, back-EMF constant = torque constant in SI
+ * units). Links are thin uniform rods: the arm pivots at one end, the pendulum at the arm's tip.
+ * The viscous damping of both joints is that of Quanser's parameter script for this unit
+ * (qube2_rotpen_param.m). The model without damping and limit is the variant
+ * --set arm_damping=0 --set pendulum_damping=0 --set voltage_limit=1e6 (docs/plants.md). */
 #include <math.h>
 
 #include "icoac_sim/icoac_sim.h"
@@ -20,7 +23,7 @@
 
 enum {
     GRAVITY, ARM_MASS, ARM_LENGTH, PENDULUM_MASS, PENDULUM_LENGTH, HUB_INERTIA, RESISTANCE,
-    TORQUE_CONSTANT, ARM_DAMPING, PENDULUM_DAMPING, ARM_LIMIT, PENDULUM_LIMIT, N_PARAMS
+    TORQUE_CONSTANT, ARM_DAMPING, PENDULUM_DAMPING, ARM_LIMIT, PENDULUM_LIMIT, VOLTAGE_LIMIT, N_PARAMS
 };
 
 /* Inertia terms of the Lagrangian: T = 1/2 (a + b sin^2 alpha) theta_dot^2
@@ -45,7 +48,10 @@ SIM_DERIVATIVES derivatives(const double *p, const double *s, double voltage, do
     const terms_t t = terms(p);
     double sin_a, cos_a;
     sim_sincos(s[2], &sin_a, &cos_a);
-    const double torque = p[TORQUE_CONSTANT] * (voltage - p[TORQUE_CONSTANT] * s[1]) / p[RESISTANCE];
+    /* the amplifier's saturation; NaN passes through (the step's finiteness check reports it) */
+    const double limit = p[VOLTAGE_LIMIT];
+    const double applied = voltage > limit ? limit : (voltage < -limit ? -limit : voltage);
+    const double torque = p[TORQUE_CONSTANT] * (applied - p[TORQUE_CONSTANT] * s[1]) / p[RESISTANCE];
     /* mass matrix [[m11, m12], [m12, b]] and right-hand side (r1, r2) */
     const double m11 = t.a + t.b * sin_a * sin_a;
     const double m12 = t.c * cos_a;
@@ -98,14 +104,16 @@ static const icoac_sim_param_t params[N_PARAMS] = {
      "R_m, motor terminal resistance (QUBE-Servo 2)"},
     {"torque_constant", "N m/A", 0.042, 0.0, ICOAC_SIM_PHYS_MAX, "essential",
      "k_t, motor torque constant = back-EMF constant in SI units (QUBE-Servo 2)"},
-    {"arm_damping", "N m s/rad", 0.0, 0.0, ICOAC_SIM_PHYS_MAX, "advanced",
-     "D_r, viscous damping of the arm (0: frictionless, like the cart-pole)"},
-    {"pendulum_damping", "N m s/rad", 0.0, 0.0, ICOAC_SIM_PHYS_MAX, "advanced",
-     "D_p, viscous damping of the pendulum (0: frictionless)"},
+    {"arm_damping", "N m s/rad", 0.0015, 0.0, ICOAC_SIM_PHYS_MAX, "advanced",
+     "D_r, viscous damping of the arm (Quanser's qube2_rotpen_param.m; 0: frictionless)"},
+    {"pendulum_damping", "N m s/rad", 0.0005, 0.0, ICOAC_SIM_PHYS_MAX, "advanced",
+     "D_p, viscous damping of the pendulum (the same script; 0: frictionless)"},
     {"arm_limit", "rad", 0.5 * ICOAC_SIM_PI, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
      "failure when |theta| exceeds it (our choice)"},
     {"pendulum_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX, "advanced",
      "failure when |alpha| exceeds it (our choice, as the cart-pole's)"},
+    {"voltage_limit", "V", 10.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+     "|V| applied saturates at it (the unit's amplifier: 10 V; 1e6: practically none)"},
 };
 
 /* Its task, chosen by its sweep (docs/sweeps-furuta.md): inputs (arm angle, arm velocity,
