@@ -43,7 +43,7 @@ FUZZ_SOURCES = $(shell git ls-tree HEAD $(FUZZ_C_SOURCES) 2>/dev/null | git hash
   cut -c1-12)$(shell git diff --quiet HEAD -- $(FUZZ_C_SOURCES) 2>/dev/null || echo -modified)
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_model fuzz_batch
 
-.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-fuzz fuzz fuzz-campaign fuzz-ledger bench \
+.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-fuzz fuzz fuzz-campaign fuzz-ledger bench tuning ablation \
   bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
@@ -206,6 +206,17 @@ sweeps-plants: build venv
 	$(DOUBLE_SWEEPS) --stage learners --prior-from $(BENCH_OUT)-double_cart_pole/ico/seed-0
 	$(DOUBLE_SWEEPS) --report
 	cp results/sweeps-double_cart_pole/summary.md docs/sweeps-double_cart_pole.md
+
+# The held-out tuning of every learner on PLANT (docs/tuning.md), resumable; its choices in
+# results/tuning-$(PLANT)/summary.md.
+tuning: build venv
+	$(VPY) -m icoac.tools.heldout_tuning --plant $(PLANT) --out results/tuning-$(PLANT)
+
+# How much ICO the prior needs (method.md, L10): on the cart-pole bench's ICO grids (make bench
+# first); the table in docs/results.md comes from docs/data/ico-ablation.json.
+ablation: build venv
+	$(VPY) -m icoac.tools.ico_ablation --bench $(BENCH_OUT) --out results/ico-ablation --seeds 0 1 2 3 4 \
+	  --data docs/data/ico-ablation.json
 
 # Microcontroller resource report: cross builds, QEMU runs, table in docs/porting.md.
 target-report: deps
