@@ -76,3 +76,5 @@ def test_runner_takes_icos_chosen_grids(tmp_path, monkeypatch):
         assert rec["cells"] == [560, 600, 610, 612, 640, 700] and rec["seed"] == seed
         assert rec["prior_info"]["source"] == str((tmp_path / "ico" / ico["chosen_key"] / f"seed-{seed}").resolve())
     assert "Chosen:" in (tmp_path / "summary.md").read_text()
+    table = T.choices_table(data)
+    assert len(table) == 4 and table[2].startswith("| ICO |") and table[3].startswith("| ICO->RL |")

@@ -69,10 +69,51 @@ def tune(args, learner: str, ico_dirs: dict[int, Path] | None) -> dict[str, Any]
             "wall_time": sum(r["wall_time"] for r in rows)}
 
 
+def choices_table(data: dict[str, Any]) -> list[str]:
+    """Each learner's choice (docs/results.md, block tuning): the setting, its success on the
+    tuning cells beside the default's, and what the tuning cost."""
+    lines = ["| learner | chosen setting | success, tuning cells (%) | the default's (%) | trials | wall time (s) |",
+             "|---|---|---|---|---|---|"]
+    for name, t in data["learners"].items():
+        best = heldout.rank(t["rows"])[0]
+        default = next(r for r in t["rows"] if r["order"] == 0)
+        chosen = "the default" if t["default_kept"] else f"`{t['chosen_key']}`"
+        lines.append(f"| {REGISTRY[name].label} | {chosen} | {100 * best['success_rate']:.1f} | "
+                     f"{100 * default['success_rate']:.1f} | {t['trials']:.3g} | {t['wall_time']:.0f} |")
+    return lines
+
+
+READING_OF = {"gradient": "gradient (β = 0.001)", "mean": "mean (σ_L = 0.1, α = 0.1)"}
+
+
+def prior_reading_table(data: dict[str, Any]) -> list[str]:
+    """The four actor-critic priors x the two readings at every exploration noise of their shared
+    space (docs/results.md, block prior-reading): success on the tuning cells, mean over the tuning
+    seeds; the paper's same-parameter protocol is a column."""
+    def rows_of(name):
+        return [r for r in data["learners"].get(name, {"rows": []})["rows"]
+                if {"actor.update", "actor.noise_std"} <= set(r["setting"])]
+    names = [n for n in ("ico-rl", "ico-mean-rl", "rl-ico-cov", "rl") if rows_of(n)]
+    if not names:
+        return []
+    noises = sorted({r["setting"]["actor.noise_std"] for n in names for r in rows_of(n)})
+    lines = ["| prior (learner) | reading | " + " | ".join(f"σ_u = {v:g} N" for v in noises) + " |",
+             "|---|---|" + "---|" * len(noises)]
+    for name in names:
+        for reading in READING_OF:
+            rows = {r["setting"]["actor.noise_std"]: r for r in rows_of(name) if r["setting"]["actor.update"] == reading}
+            cells = [f"{100 * rows[v]['success_rate']:.1f}" if v in rows else "" for v in noises]
+            lines.append(f"| {REGISTRY[name].label} | {READING_OF[reading]} | " + " | ".join(cells) + " |")
+    return lines
+
+
 def markdown(data: dict[str, Any]) -> str:
     lines = [f"# Held-out tuning, {data['plant']}", "",
              f"Tuning cells: {data['n_tuning_cells']} of {data['n_cells']}; seeds {data['protocol']['tuning_seeds']}; "
-             f"criterion: {data['protocol']['criterion']}.", ""]
+             f"criterion: {data['protocol']['criterion']}.", "", *choices_table(data), ""]
+    grid = prior_reading_table(data)
+    if grid:
+        lines += ["Success on the tuning cells (%), prior x reading x exploration noise:", "", *grid, ""]
     for name, t in data["learners"].items():
         lines += [f"## {REGISTRY[name].label} (`{name}`)", "",
                   f"Chosen: `{t['chosen_key']}`{' (the default)' if t['default_kept'] else ''}; "
@@ -93,9 +134,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--learners", nargs="+", choices=ORDER, default=list(ORDER),
                     help="the learners to tune (ICO always runs first: the others take its chosen grids)")
     ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--data", type=Path, help="also write tuning.json here (docs/data/...)")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
-    data: dict[str, Any] = {"plant": args.plant, "protocol": heldout.protocol(),
+    data: dict[str, Any] = {"plant": args.plant, "profile": "default", "configuration": "default", "set": [],
+                            "seeds": list(heldout.TUNING_SEEDS), "protocol": heldout.protocol(),
                             "n_tuning_cells": int(heldout.tuning_cells(args.plant).size),
                             "n_cells": int(heldout.heldout_mask(args.plant).size), "learners": {},
                             "git": results.git_info()}
@@ -113,6 +156,8 @@ def main(argv: list[str] | None = None) -> int:
         print("interrupted; rerun the same command to resume", file=sys.stderr)
         return 130
     (args.out / "tuning.json").write_text(json.dumps(data, indent=1))
+    if args.data is not None:
+        args.data.write_text(json.dumps(data, indent=1))
     (args.out / "summary.md").write_text(markdown(data))
     print(markdown(data))
     return 0

@@ -22,7 +22,7 @@ from typing import Any, Callable, Mapping
 
 from icoac.studies import tables
 from icoac.studies.bench import summary_markdown
-from icoac.tools import ico_ablation
+from icoac.tools import heldout_tuning, ico_ablation
 from icoac.tools.pages import update_or_check
 
 BLOCK = re.compile(r"(<!-- table: (?P<name>[a-z-]+) (?P<file>[\w.-]+\.json(,[\w.-]+\.json)*) -->\n)(?P<body>.*?)"
@@ -51,6 +51,8 @@ TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
     "trials-quantiles": lambda d: tables.quantile_table(d["aggregate"]),
     "time-quantiles": lambda d: tables.quantile_table(d["aggregate"], "elapsed_time_quantiles"),
     "ico-ablation": ico_ablation.table,
+    "tuning": heldout_tuning.choices_table,
+    "prior-reading": heldout_tuning.prior_reading_table,
 }
 
 
