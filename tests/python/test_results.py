@@ -1,5 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 import json
+import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -65,3 +67,23 @@ def test_git_info_is_the_checkout_or_nothing(tmp_path, monkeypatch):
     assert results.git_info() == {"commit": "a" * 40, "dirty": False}
     info.write_text("not json")
     assert results.git_info() == {"commit": None, "dirty": None}
+
+
+def test_what_runs_write_does_not_make_the_tree_dirty(tmp_path):
+    """A change under RUN_OUTPUTS (the bench's data and figures, the fuzzing ledger) leaves the tree
+    clean; a change anywhere else makes it dirty."""
+    def git(*args):
+        subprocess.run(["git", "-C", str(tmp_path), *args], check=True, capture_output=True)
+    git("init", "-q")
+    files = [Path(p) / "f.txt" for p in results.RUN_OUTPUTS] + [Path("harness") / "f.txt"]
+    for f in files:
+        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / f).write_text("a\n")
+    git("add", "-A")
+    git("-c", "user.name=t", "-c", "user.email=t@t", "commit", "-qm", "c")
+    assert results.git_info(tmp_path)["dirty"] is False
+    for f in files[:-1]:
+        (tmp_path / f).write_text("b\n")
+    assert results.git_info(tmp_path)["dirty"] is False
+    (tmp_path / files[-1]).write_text("b\n")
+    assert results.git_info(tmp_path)["dirty"] is True

@@ -41,15 +41,16 @@ class StaleRecord(ResultsError):
     two writes. Resuming the run repairs it."""
 
 
-# What `make bench` itself writes into the tree (its data and figures, Makefile BENCH_DATA and
-# BENCH_FIGURES): a change there does not change what the tree computes, so it does not make the
-# tree dirty; otherwise every plant after the first of `make bench BENCH_PLANTS=all` would be.
-BENCH_OUTPUTS = ("docs/data", "docs/figures")
+# What runs themselves write into the tree: `make bench`'s data and figures (Makefile BENCH_DATA
+# and BENCH_FIGURES) and `make fuzz`'s ledger. A change there does not change what the tree
+# computes, so it does not make the tree dirty; otherwise every plant after the first of
+# `make bench BENCH_PLANTS=all` would be, and every grid started while a fuzzing run appends.
+RUN_OUTPUTS = ("docs/data", "docs/figures", "tests/fuzz/ledger")
 
 
 def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
     """Commit of the repository and whether the working tree has uncommitted changes (but in
-    BENCH_OUTPUTS). For an
+    RUN_OUTPUTS). For an
     installed package (repo = its site-packages), the commit its wheel was built from, as the
     build recorded it (harness/icoac/lib/build_info.json); None for both when unknown: a directory
     that is not the top of a git work tree is not taken for the repository around it."""
@@ -72,7 +73,7 @@ def git_info(repo: Path = B.REPO_ROOT) -> dict[str, Any]:
         return {"commit": None, "dirty": None}
     commit = git("rev-parse", "HEAD")
     status = git("status", "--porcelain", "--untracked-files=no", "--", ".",
-                 *(f":(exclude){path}" for path in BENCH_OUTPUTS))
+                 *(f":(exclude){path}" for path in RUN_OUTPUTS))
     return {"commit": commit.strip() if commit else None,
             "dirty": bool(status.strip()) if status is not None else None}
 
