@@ -56,6 +56,14 @@ def test_criterion():
     assert [r["order"] for r in H.rank(rows)] == [2, 3, 1, 4, 0]
 
 
+def test_report_runs_nothing_and_names_what_is_pending(tmp_path, monkeypatch):
+    monkeypatch.setattr(H, "tuning_cells", lambda plant: np.array([600, 610]))
+    assert T.main(["--out", str(tmp_path), "--report", "--quiet"]) == 0
+    data = json.loads((tmp_path / "tuning.json").read_text())
+    assert all("pending" in t for t in data["learners"].values()) and not (tmp_path / "ico").exists()
+    assert "not yet run (0 of 12 settings finished)" in "\n".join(T.choices_table(data))
+
+
 def test_runner_takes_icos_chosen_grids(tmp_path, monkeypatch):
     """Two settings each for ICO and ICO->RL on six tuning cells at small caps: the ranking is the
     criterion's, and ICO->RL's prior comes from ICO's chosen setting, seed for seed."""

@@ -30,14 +30,21 @@ from icoac.studies.conditions import condition_prior, run_condition
 ORDER = tuple(heldout.SPACES)  # ICO first: the others may take its output
 
 
+def finished(out: Path) -> bool:
+    return results.exists(out) and bool(results.load(out)[1].get("complete"))
+
+
 def run_setting(args, learner: str, index: int, setting: dict[str, Any], ico_dirs: dict[int, Path] | None
-                ) -> dict[str, Any]:
-    """Every tuning seed of one setting; its row of the ranking."""
+                ) -> dict[str, Any] | None:
+    """Every tuning seed of one setting; its row of the ranking (None with --report when a seed's
+    grid is not finished: nothing runs then)."""
     caps = bench.PROFILES["default"]["ico" if learner == "ico" else "rl"]
     cells_spec = [int(i) for i in heldout.tuning_cells(args.plant)]
     rates, trials, cost, wall = [], [], 0, 0.0
     for seed in heldout.TUNING_SEEDS:
         out = args.out / learner / heldout.key(setting) / f"seed-{seed}"
+        if args.report and not finished(out):
+            return None
         rule = REGISTRY[learner].prior
         info = None if rule is None else condition_prior(
             learner, ico_dirs[seed] if rule.takes_ico else None, P.CENTRAL, P.DEFAULT_RIDGE, plant=args.plant,
@@ -62,7 +69,10 @@ def run_setting(args, learner: str, index: int, setting: dict[str, Any], ico_dir
 
 
 def tune(args, learner: str, ico_dirs: dict[int, Path] | None) -> dict[str, Any]:
+    """The learner's rows and choice; with --report and unfinished settings, {"pending": ...}."""
     rows = [run_setting(args, learner, i, s, ico_dirs) for i, s in enumerate(heldout.settings(learner))]
+    if None in rows:
+        return {"learner": learner, "pending": len(rows) - rows.count(None), "settings": len(rows)}
     ranked = heldout.rank(rows)
     return {"learner": learner, "rows": rows, "chosen": ranked[0]["setting"], "chosen_key": ranked[0]["key"],
             "default_kept": ranked[0]["order"] == 0, "trials": sum(r["trials"] for r in rows),
@@ -75,6 +85,10 @@ def choices_table(data: dict[str, Any]) -> list[str]:
     lines = ["| learner | chosen setting | success, tuning cells (%) | the default's (%) | trials | wall time (s) |",
              "|---|---|---|---|---|---|"]
     for name, t in data["learners"].items():
+        if "pending" in t:
+            lines.append(f"| {REGISTRY[name].label} | not yet run ({t['pending']} of {t['settings']} settings "
+                         "finished) | | | | |")
+            continue
         best = heldout.rank(t["rows"])[0]
         default = next(r for r in t["rows"] if r["order"] == 0)
         chosen = "the default" if t["default_kept"] else f"`{t['chosen_key']}`"
@@ -91,7 +105,7 @@ def prior_reading_table(data: dict[str, Any]) -> list[str]:
     space (docs/results.md, block prior-reading): success on the tuning cells, mean over the tuning
     seeds; the paper's same-parameter protocol is a column."""
     def rows_of(name):
-        return [r for r in data["learners"].get(name, {"rows": []})["rows"]
+        return [r for r in data["learners"].get(name, {}).get("rows", [])
                 if {"actor.update", "actor.noise_std"} <= set(r["setting"])]
     names = [n for n in ("ico-rl", "ico-mean-rl", "rl-ico-cov", "rl") if rows_of(n)]
     if not names:
@@ -115,6 +129,8 @@ def markdown(data: dict[str, Any]) -> str:
     if grid:
         lines += ["Success on the tuning cells (%), prior x reading x exploration noise:", "", *grid, ""]
     for name, t in data["learners"].items():
+        if "pending" in t:
+            continue
         lines += [f"## {REGISTRY[name].label} (`{name}`)", "",
                   f"Chosen: `{t['chosen_key']}`{' (the default)' if t['default_kept'] else ''}; "
                   f"{t['trials']} trials, {t['wall_time']:.0f} s.", "",
@@ -135,6 +151,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="the learners to tune (ICO always runs first: the others take its chosen grids)")
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--data", type=Path, help="also write tuning.json here (docs/data/...)")
+    ap.add_argument("--report", action="store_true",
+                    help="run nothing: report the learners whose settings have all finished")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
     data: dict[str, Any] = {"plant": args.plant, "profile": "default", "configuration": "default", "set": [],
@@ -145,16 +163,20 @@ def main(argv: list[str] | None = None) -> int:
     try:
         ico = tune(args, "ico", None)
         data["learners"]["ico"] = ico
-        ico_dirs = {s: args.out / "ico" / ico["chosen_key"] / f"seed-{s}" for s in heldout.TUNING_SEEDS}
+        ico_dirs = None if "pending" in ico else \
+            {s: args.out / "ico" / ico["chosen_key"] / f"seed-{s}" for s in heldout.TUNING_SEEDS}
         for learner in ORDER[1:]:
             if learner in args.learners:
-                data["learners"][learner] = tune(args, learner, ico_dirs)
+                data["learners"][learner] = tune(args, learner, ico_dirs) if ico_dirs or \
+                    not REGISTRY[learner].prior.takes_ico else \
+                    {"learner": learner, "pending": 0, "settings": len(heldout.settings(learner))}
     except HarnessError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("interrupted; rerun the same command to resume", file=sys.stderr)
         return 130
+    args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "tuning.json").write_text(json.dumps(data, indent=1))
     if args.data is not None:
         args.data.write_text(json.dumps(data, indent=1))
