@@ -216,11 +216,9 @@ class DaskSession:
         grid.check_run_args(cells, checkpoint_every, checkpoint_cells)
         cfg.check()
         t_start = time.monotonic()
-        pending = np.flatnonzero(cells["outcome"] == B.PENDING)
+        pending = grid.pending_cells(cells)
         if pending.size == 0:
             return grid.GridRun(cells, False, 0.0, B.OK)
-        grid.check_coordinates(cells)
-        grid.reset_pending(cells)
         if chunk_cells is not None:
             DaskSpec(workers=1, chunk_cells=chunk_cells).check()
         size = chunk_cells or self.spec.chunk_cells or auto_chunk(pending.size, self.nthreads())

@@ -145,6 +145,16 @@ def finished_snapshot(cells: np.ndarray) -> np.ndarray:
     return snap
 
 
+def pending_cells(cells: np.ndarray) -> np.ndarray:
+    """The indices of the PENDING cells a grid run is to run; when there are some, the coordinates
+    are checked (ConfigError) and the pending cells' result fields cleared."""
+    pending = np.flatnonzero(cells["outcome"] == B.PENDING)
+    if pending.size:
+        check_coordinates(cells)
+        reset_pending(cells)
+    return pending
+
+
 def reset_pending(cells: np.ndarray, mask: np.ndarray | None = None) -> None:
     """Clear the result fields of cells in mask (default: every PENDING cell)."""
     if mask is None:
@@ -268,12 +278,10 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
     check_run_args(cells, checkpoint_every, checkpoint_cells)
     threads = check_threads(threads)
     cfg.check()
-    pending = int(np.count_nonzero(cells["outcome"] == B.PENDING))
     t_start = time.monotonic()
-    if pending == 0 or cells.size == 0:
+    pending = pending_cells(cells).size
+    if pending == 0:
         return GridRun(cells, False, 0.0, B.OK)
-    check_coordinates(cells)
-    reset_pending(cells)
 
     cancel = np.zeros(1, dtype=np.int32)
     counters = np.zeros(B.PROGRESS_LEN, dtype=np.int64)

@@ -20,12 +20,12 @@ from typing import Any
 import numpy as np
 
 from icoac.core import metrics, results
-from icoac.core.errors import HarnessError
 from icoac.core.plants import PLANTS
 from icoac.core.registry import REGISTRY
 from icoac.studies import bench, heldout
 from icoac.studies import prior as P
 from icoac.studies.conditions import condition_prior, run_condition
+from icoac.tools.resumable import guarded
 
 ORDER = tuple(heldout.SPACES)  # ICO first: the others may take its output
 
@@ -77,6 +77,25 @@ def tune(args, learner: str, ico_dirs: dict[int, Path] | None) -> dict[str, Any]
     return {"learner": learner, "rows": rows, "chosen": ranked[0]["setting"], "chosen_key": ranked[0]["key"],
             "default_kept": ranked[0]["order"] == 0, "trials": sum(r["trials"] for r in rows),
             "wall_time": sum(r["wall_time"] for r in rows)}
+
+
+def run(args) -> dict[str, Any]:
+    """ICO, then every learner asked for, from ICO's chosen grids."""
+    data: dict[str, Any] = {"plant": args.plant, "profile": "default", "configuration": "default", "set": [],
+                            "seeds": list(heldout.TUNING_SEEDS), "protocol": heldout.protocol(),
+                            "n_tuning_cells": int(heldout.tuning_cells(args.plant).size),
+                            "n_cells": int(heldout.heldout_mask(args.plant).size), "learners": {},
+                            "git": results.git_info()}
+    ico = tune(args, "ico", None)
+    data["learners"]["ico"] = ico
+    ico_dirs = None if "pending" in ico else \
+        {s: args.out / "ico" / ico["chosen_key"] / f"seed-{s}" for s in heldout.TUNING_SEEDS}
+    for learner in ORDER[1:]:
+        if learner in args.learners:
+            data["learners"][learner] = tune(args, learner, ico_dirs) if ico_dirs or \
+                not REGISTRY[learner].prior.takes_ico else \
+                {"learner": learner, "pending": 0, "settings": len(heldout.settings(learner))}
+    return data
 
 
 def choices_table(data: dict[str, Any]) -> list[str]:
@@ -155,27 +174,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="run nothing: report the learners whose settings have all finished")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
-    data: dict[str, Any] = {"plant": args.plant, "profile": "default", "configuration": "default", "set": [],
-                            "seeds": list(heldout.TUNING_SEEDS), "protocol": heldout.protocol(),
-                            "n_tuning_cells": int(heldout.tuning_cells(args.plant).size),
-                            "n_cells": int(heldout.heldout_mask(args.plant).size), "learners": {},
-                            "git": results.git_info()}
-    try:
-        ico = tune(args, "ico", None)
-        data["learners"]["ico"] = ico
-        ico_dirs = None if "pending" in ico else \
-            {s: args.out / "ico" / ico["chosen_key"] / f"seed-{s}" for s in heldout.TUNING_SEEDS}
-        for learner in ORDER[1:]:
-            if learner in args.learners:
-                data["learners"][learner] = tune(args, learner, ico_dirs) if ico_dirs or \
-                    not REGISTRY[learner].prior.takes_ico else \
-                    {"learner": learner, "pending": 0, "settings": len(heldout.settings(learner))}
-    except HarnessError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("interrupted; rerun the same command to resume", file=sys.stderr)
-        return 130
+    status, data = guarded(lambda: run(args))
+    if data is None:
+        return status
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "tuning.json").write_text(json.dumps(data, indent=1))
     if args.data is not None:

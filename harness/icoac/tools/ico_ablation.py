@@ -28,12 +28,13 @@ import numpy as np
 
 from icoac.core import binding as B
 from icoac.core import geometry, metrics, results
-from icoac.core.errors import HarnessError, PriorError
+from icoac.core.errors import PriorError
 from icoac.core.plants import spec as plant_spec
 from icoac.core.registry import REGISTRY
 from icoac.studies import bench, tables
 from icoac.studies import prior as P
 from icoac.studies.conditions import run_condition
+from icoac.tools.resumable import guarded
 
 SIZES = (1, 5, 25)           # ICO cells of the ablation; "frame": every cell of the central frame
 LEARNER = "ico-mean-rl"
@@ -177,14 +178,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--data", type=Path, help="also write the summary's data here (docs/data/...)")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
-    try:
-        data = run(args)
-    except HarnessError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("interrupted; rerun the same command to resume", file=sys.stderr)
-        return 130
+    status, data = guarded(lambda: run(args))
+    if data is None:
+        return status
     text = json.dumps(data, indent=1)
     (args.out / "ablation.json").write_text(text)
     (args.out / "summary.md").write_text(markdown(data))

@@ -138,11 +138,9 @@ def run_grid(cfg: RunConfig, cells: np.ndarray, threads: int = 0, progress: bool
     start = start_distribution(cfg)
     cap = int(cfg.run.max_trials)
     t_start = time.monotonic()
-    pending = np.flatnonzero(cells["outcome"] == B.PENDING)
+    pending = grid.pending_cells(cells)
     if pending.size == 0:
         return grid.GridRun(cells, False, 0.0, B.OK)
-    grid.check_coordinates(cells)
-    grid.reset_pending(cells)
     todo: queue.SimpleQueue = queue.SimpleQueue()
     for i in pending:
         todo.put(int(i))
