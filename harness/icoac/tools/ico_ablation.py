@@ -82,6 +82,7 @@ def run(args) -> dict[str, Any]:
     profile = bench.PROFILES[args.profile]
     cells_spec = profile["cells"](grid) if profile["cells"] else None
     rows: dict[str, Any] = {}
+    every: list = []  # every learner record read or written: the builds behind the table
     for k in [*SIZES, "frame"]:
         recs, cells, ico_costs, note = [], {}, [], None
         grid_costs = []
@@ -108,6 +109,7 @@ def run(args) -> dict[str, Any]:
                 if cancelled:
                     raise KeyboardInterrupt
             recs.append(r)
+            every.append(r)
             cells[seed] = c
         rows[str(k)] = row(k, recs, cells, ico_costs, note)
         ico_grid = {key: bench.seed_stat([c[key] for c in grid_costs]) for key in grid_costs[0]}
@@ -115,7 +117,7 @@ def run(args) -> dict[str, Any]:
     return {"plant": args.plant, "profile": args.profile, "configuration": "default", "set": [],
             "seeds": list(args.seeds), "bench": str(args.bench),
             "learner": LEARNER, "sizes": [*SIZES, "frame"], "draw_stream": DRAW_STREAM, "caps": dict(profile["rl"]),
-            "rows": rows, "ico_grid": ico_grid, "git": results.git_info()}
+            "rows": rows, "ico_grid": ico_grid, "git": results.git_info(), "cell_builds": bench.cell_builds(every)}
 
 
 def row(k, recs, cells, ico_costs, note) -> dict[str, Any]:
