@@ -7,11 +7,13 @@ import json
 import numpy as np
 import pytest
 
-from icoac.core import results
+from icoac.core import metrics, results
 from icoac.core.config import build_config
 from icoac.core.plants import PLANTS
 from icoac.core.registry import REGISTRY
 from icoac.studies import bench, heldout as H
+from icoac.studies import prior as P
+from icoac.studies.conditions import condition_prior, run_condition
 from icoac.tools import heldout_tuning as T
 
 
@@ -86,3 +88,36 @@ def test_runner_takes_icos_chosen_grids(tmp_path, monkeypatch):
     assert "Chosen:" in (tmp_path / "summary.md").read_text()
     table = T.choices_table(data)
     assert len(table) == 4 and table[2].startswith("| ICO |") and table[3].startswith("| ICO->RL |")
+
+
+def test_evaluation_against_the_bench_defaults(tmp_path, monkeypatch):
+    """--evaluate: ICO's choice runs on every cell with the bench's seeds, ICO->RL from the
+    evaluated ICO grids; the table sets the held-out and all-cell rates beside the bench's."""
+    caps = {"ico": {"max_trials": 200, "success_steps": 200}, "rl": {"max_trials": 20, "success_steps": 200}}
+    monkeypatch.setattr(H, "tuning_cells", lambda plant: np.array([171, 200, 612, 613, 1020, 1053]))
+    monkeypatch.setattr(H, "SPACES", {"ico": {"ico.rate": [1e-4, 1e-2]}, "ico-rl": {"actor.noise_std": [3]}})
+    monkeypatch.setitem(bench.PROFILES, "default", {**bench.PROFILES["default"], "seeds": 2, **caps})
+    bench_dir = tmp_path / "bench"
+    for seed in (0, 1):
+        run_condition(condition="ico", out=bench.seed_dir(bench_dir, "ico", seed), seed=seed, threads=2,
+                      overrides=caps["ico"], progress=False)
+        info = condition_prior("ico-rl", bench.seed_dir(bench_dir, "ico", seed), P.CENTRAL, P.DEFAULT_RIDGE)
+        run_condition(condition="ico-rl", out=bench.seed_dir(bench_dir, "ico-rl", seed), seed=seed, threads=2,
+                      overrides=caps["rl"], info=info, progress=False)
+    out = tmp_path / "tuning"
+    assert T.main(["--out", str(out), "--learners", "ico-rl", "--evaluate", "--bench", str(bench_dir),
+                   "--quiet"]) == 0
+    data = json.loads((out / "tuning.json").read_text())
+    ev = data["evaluation"]
+    assert ev["seeds"] == [0, 1] and ev["n_heldout"] == 1219
+    for name in ("ico", "ico-rl"):
+        e = ev["learners"][name]
+        default = [metrics.success_mask(results.load(bench.seed_dir(bench_dir, name, s))[0]) for s in (0, 1)]
+        assert e["all"]["default"]["mean"] == pytest.approx(np.mean(default))
+        held = H.heldout_mask("cart_pole")
+        assert e["heldout"]["default"]["mean"] == pytest.approx(np.mean([m[held] for m in default]))
+    assert not data["learners"]["ico"]["default_kept"]  # 1e-2 learns more within 200 trials
+    assert ev["learners"]["ico"]["rerun"] and ev["learners"]["ico-rl"]["rerun"]
+    _, rec = results.load(out / "evaluation" / "ico-rl" / "seed-1")
+    assert rec["prior_info"]["source"] == str((out / "evaluation" / "ico" / "seed-1").resolve())
+    assert len(T.evaluation_table(data)) == 4

@@ -8,7 +8,13 @@ ICO first: its settings on the tuning cells and seeds. Its chosen setting's grid
 learners that take ICO's output their priors, seed for seed (the central frame's cells among the
 tuning cells). Every (learner, setting, seed) is a results directory
 OUT/<learner>/<setting>/seed-<s>/, so a stopped run resumes where it stopped (rerun the command).
-OUT/tuning.json and OUT/summary.md hold each learner's ranking and choice."""
+OUT/tuning.json and OUT/summary.md hold each learner's ranking and choice.
+
+--evaluate --bench DIR then runs each learner's choice on every cell with the bench's seeds (ICO
+first again; the others' priors from its evaluated grids) into OUT/evaluation/, and sets it beside
+the bench's grids of the current defaults: success on the held-out cells and on all cells, and the
+paired difference. A learner that kept its default and takes nothing from ICO is the bench's grid
+itself, read, not rerun."""
 from __future__ import annotations
 
 import argparse
@@ -19,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from icoac.core import metrics, results
+from icoac.core import metrics, results, stats
 from icoac.core.plants import PLANTS
 from icoac.core.registry import REGISTRY
 from icoac.studies import bench, heldout
@@ -98,6 +104,76 @@ def run(args) -> dict[str, Any]:
     return data
 
 
+def _rates(masks: dict[int, np.ndarray]) -> dict[str, Any]:
+    """Mean success over seeds with its bootstrap interval (icoac.core.stats)."""
+    stack = np.stack([masks[s] for s in sorted(masks)])
+    return {"mean": float(stack.mean()), "ci95": stats.interval(stack, stats.rate)}
+
+
+def evaluate(args, data: dict[str, Any]) -> dict[str, Any]:
+    """Each tuned learner's choice on every cell with the bench's seeds, against the bench's grids
+    of the defaults (see the module's head)."""
+    seeds = list(range(bench.PROFILES["default"]["seeds"]))
+    held = heldout.heldout_mask(args.plant)
+    root = args.out / "evaluation"
+    ico = data["learners"]["ico"]
+    ico_dirs = {s: (bench.seed_dir(args.bench, "ico", s) if ico["default_kept"] else root / "ico" / f"seed-{s}")
+                for s in seeds}
+    out: dict[str, Any] = {}
+    for learner, t in data["learners"].items():
+        if "pending" in t:
+            continue
+        caps = bench.PROFILES["default"]["ico" if learner == "ico" else "rl"]
+        rule = REGISTRY[learner].prior
+        reuse = t["default_kept"] and (rule is None or not rule.takes_ico or ico["default_kept"])
+        chosen, default = {}, {}
+        for seed in seeds:
+            d = bench.seed_dir(args.bench if reuse else root, learner, seed)
+            if not reuse:
+                info = None if rule is None else condition_prior(
+                    learner, ico_dirs[seed] if rule.takes_ico else None, P.CENTRAL, P.DEFAULT_RIDGE,
+                    plant=args.plant, overrides={**caps, **t["chosen"]})
+                _, _, cancelled = run_condition(
+                    condition=learner, out=d, seed=seed, threads=args.threads, overrides={**caps, **t["chosen"]},
+                    resume=bool(results.present(d)), progress=not args.quiet, info=info, plant=args.plant)
+                if cancelled:
+                    raise KeyboardInterrupt
+            chosen[seed] = metrics.success_mask(results.load(d)[0])
+            default[seed] = metrics.success_mask(results.load(bench.seed_dir(args.bench, learner, seed))[0])
+        out[learner] = {"chosen_key": t["chosen_key"], "default_kept": t["default_kept"], "rerun": not reuse,
+                        "all": {"chosen": _rates(chosen), "default": _rates(default),
+                                "paired": stats.paired(chosen, default)},
+                        "heldout": {"chosen": _rates({s: m[held] for s, m in chosen.items()}),
+                                    "default": _rates({s: m[held] for s, m in default.items()}),
+                                    "paired": stats.paired({s: m[held] for s, m in chosen.items()},
+                                                           {s: m[held] for s, m in default.items()})}}
+        print(f"[evaluation] {learner}: held-out {100 * out[learner]['heldout']['default']['mean']:.1f} -> "
+              f"{100 * out[learner]['heldout']['chosen']['mean']:.1f} %", file=sys.stderr, flush=True)
+    return {"seeds": seeds, "bench": str(args.bench), "n_heldout": int(np.count_nonzero(held)), "learners": out}
+
+
+def _pct(r: dict[str, Any]) -> str:
+    lo, hi = r["ci95"] or (None, None)
+    return f"{100 * r['mean']:.1f} %" + (f" ({100 * lo:.1f}–{100 * hi:.1f})" if lo is not None else "")
+
+
+def evaluation_table(data: dict[str, Any]) -> list[str]:
+    """The choices on the evaluation seeds (docs/results.md, block tuning-evaluation): held-out and
+    all cells, the default's and the choice's, and the paired difference on the held-out cells."""
+    ev = data["evaluation"]
+    lines = [f"| learner | setting | held-out cells ({ev['n_heldout']}): default | chosen | difference (points) | "
+             "all cells: default | chosen |", "|---|---|---|---|---|---|---|"]
+    for name, e in ev["learners"].items():
+        p = e["heldout"]["paired"]
+        lo, hi = p["ci95"] or (None, None)
+        diff = f"{p['points']:+.1f}" + (f" ({lo:+.1f} to {hi:+.1f})" if lo is not None else "")
+        setting = "the default" if e["default_kept"] else f"`{e['chosen_key']}`"
+        lines.append(f"| {REGISTRY[name].label} | {setting} | {_pct(e['heldout']['default'])} | "
+                     f"{_pct(e['heldout']['chosen'])} | {diff} | {_pct(e['all']['default'])} | "
+                     f"{_pct(e['all']['chosen'])} |")
+    return lines
+
+
 def choices_table(data: dict[str, Any]) -> list[str]:
     """Each learner's choice (docs/results.md, block tuning): the setting, its success on the
     tuning cells beside the default's, and what the tuning cost."""
@@ -144,6 +220,9 @@ def markdown(data: dict[str, Any]) -> str:
     lines = [f"# Held-out tuning, {data['plant']}", "",
              f"Tuning cells: {data['n_tuning_cells']} of {data['n_cells']}; seeds {data['protocol']['tuning_seeds']}; "
              f"criterion: {data['protocol']['criterion']}.", "", *choices_table(data), ""]
+    if "evaluation" in data:
+        lines += [f"On the evaluation seeds {data['evaluation']['seeds']}, against the bench's defaults:", "",
+                  *evaluation_table(data), ""]
     grid = prior_reading_table(data)
     if grid:
         lines += ["Success on the tuning cells (%), prior x reading x exploration noise:", "", *grid, ""]
@@ -172,9 +251,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--data", type=Path, help="also write tuning.json here (docs/data/...)")
     ap.add_argument("--report", action="store_true",
                     help="run nothing: report the learners whose settings have all finished")
+    ap.add_argument("--evaluate", action="store_true",
+                    help="then run each choice on every cell with the bench's seeds, against --bench's defaults")
+    ap.add_argument("--bench", type=Path, help="the bench whose grids are the defaults' (--evaluate)")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
-    status, data = guarded(lambda: run(args))
+    if args.evaluate and args.bench is None:
+        ap.error("--evaluate needs --bench")
+
+    def body():
+        data = run(args)
+        if args.evaluate and "pending" not in data["learners"]["ico"]:
+            data["evaluation"] = evaluate(args, data)
+        return data
+    status, data = guarded(body)
     if data is None:
         return status
     args.out.mkdir(parents=True, exist_ok=True)

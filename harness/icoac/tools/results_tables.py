@@ -53,6 +53,7 @@ TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
     "ico-ablation": ico_ablation.table,
     "tuning": heldout_tuning.choices_table,
     "prior-reading": heldout_tuning.prior_reading_table,
+    "tuning-evaluation": heldout_tuning.evaluation_table,
 }
 
 
