@@ -210,7 +210,8 @@ def prior_reading_table(data: dict[str, Any]) -> list[str]:
              "|---|---|" + "---|" * len(noises)]
     for name in names:
         for reading in READING_OF:
-            rows = {r["setting"]["actor.noise_std"]: r for r in rows_of(name) if r["setting"]["actor.update"] == reading}
+            rows = {r["setting"]["actor.noise_std"]: r for r in rows_of(name)
+                    if r["setting"]["actor.update"] == reading}
             cells = [f"{100 * rows[v]['success_rate']:.1f}" if v in rows else "" for v in noises]
             lines.append(f"| {REGISTRY[name].label} | {READING_OF[reading]} | " + " | ".join(cells) + " |")
     return lines

@@ -86,7 +86,8 @@ def real_weights(w: np.ndarray) -> np.ndarray:
     return real.astype(np.float64)
 
 
-def run_one(trials: _Trials, start: tuple[np.ndarray, float, np.ndarray], cap: int, x0: float, theta0: float, seed: int, stop: threading.Event | None = None) -> np.ndarray | None:
+def run_one(trials: _Trials, start: tuple[np.ndarray, float, np.ndarray], cap: int, x0: float, theta0: float,
+            seed: int, stop: threading.Event | None = None) -> np.ndarray | None:
     """CMA-ES on one cell; its result record (outcome, trials, steps, the final w, the optimiser's
     covariance), or None when ``stop`` was raised before it finished."""
     import cma
