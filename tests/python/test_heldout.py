@@ -63,7 +63,7 @@ def test_report_runs_nothing_and_names_what_is_pending(tmp_path, monkeypatch):
     assert T.main(["--out", str(tmp_path), "--report", "--quiet"]) == 0
     data = json.loads((tmp_path / "tuning.json").read_text())
     assert all("pending" in t for t in data["learners"].values()) and not (tmp_path / "ico").exists()
-    assert "not yet run (0 of 12 settings finished)" in "\n".join(T.choices_table(data))
+    assert "unfinished (0 of 12 settings finished)" in "\n".join(T.choices_table(data))
 
 
 def test_runner_takes_icos_chosen_grids(tmp_path, monkeypatch):

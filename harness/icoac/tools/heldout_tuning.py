@@ -181,7 +181,7 @@ def choices_table(data: dict[str, Any]) -> list[str]:
              "|---|---|---|---|---|---|"]
     for name, t in data["learners"].items():
         if "pending" in t:
-            lines.append(f"| {REGISTRY[name].label} | not yet run ({t['pending']} of {t['settings']} settings "
+            lines.append(f"| {REGISTRY[name].label} | unfinished ({t['pending']} of {t['settings']} settings "
                          "finished) | | | | |")
             continue
         best = heldout.rank(t["rows"])[0]
