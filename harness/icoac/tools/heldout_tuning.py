@@ -46,7 +46,7 @@ def run_setting(args, learner: str, index: int, setting: dict[str, Any], ico_dir
     grid is not finished: nothing runs then)."""
     caps = bench.PROFILES["default"]["ico" if learner == "ico" else "rl"]
     cells_spec = [int(i) for i in heldout.tuning_cells(args.plant)]
-    rates, trials, cost, wall = [], [], 0, 0.0
+    rates, trials, cost, wall, records = [], [], 0, 0.0, []
     for seed in heldout.TUNING_SEEDS:
         out = args.out / learner / heldout.key(setting) / f"seed-{seed}"
         if args.report and not finished(out):
@@ -66,9 +66,10 @@ def run_setting(args, learner: str, index: int, setting: dict[str, Any], ico_dir
         trials.extend(cells["trials"][ok].tolist())
         cost += int(np.sum(cells["trials"]))
         wall += float(record["wall_time"])
+        records.append(record)
     row = {"order": index, "setting": setting, "key": heldout.key(setting), "success_rate": float(np.mean(rates)),
            "success_rates": rates, "median_trials": float(np.median(trials)) if trials else None,
-           "trials": cost, "wall_time": wall}
+           "trials": cost, "wall_time": wall, "builds": bench.cell_builds(records)}
     print(f"[tuning] {learner} {row['key']}: {100 * row['success_rate']:.1f} %, median "
           f"{row['median_trials']} trials, {wall:.0f} s", file=sys.stderr, flush=True)
     return row
@@ -101,6 +102,8 @@ def run(args) -> dict[str, Any]:
             data["learners"][learner] = tune(args, learner, ico_dirs) if ico_dirs or \
                 not REGISTRY[learner].prior.takes_ico else \
                 {"learner": learner, "pending": 0, "settings": len(heldout.settings(learner))}
+    builds = [b for t in data["learners"].values() for r in t.get("rows", []) for b in r["builds"]]
+    data["cell_builds"] = [b for i, b in enumerate(builds) if b not in builds[:i]]
     return data
 
 
