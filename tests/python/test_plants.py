@@ -56,7 +56,7 @@ def furuta_forces(p, q, qd, u):
     """Generalised forces besides gravity: the motor (its voltage saturated, back-EMF included) and
     viscous friction."""
     k, r = p["torque_constant"], p["resistance"]
-    u = np.clip(u, -p["voltage_limit"], p["voltage_limit"])
+    u = np.clip(u, -p["max_voltage"], p["max_voltage"])
     return np.array([k * (u - k * qd[0]) / r - p["arm_damping"] * qd[0], -p["pendulum_damping"] * qd[1]])
 
 

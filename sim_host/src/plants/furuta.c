@@ -14,7 +14,7 @@
  * units). Links are thin uniform rods: the arm pivots at one end, the pendulum at the arm's tip.
  * The viscous damping of both joints is that of Quanser's parameter script for this unit
  * (qube2_rotpen_param.m). The model without damping and limit is the variant
- * --set arm_damping=0 --set pendulum_damping=0 --set voltage_limit=1e6 (docs/plants.md). */
+ * --set arm_damping=0 --set pendulum_damping=0 --set max_voltage=1e6 (docs/plants.md). */
 #include <math.h>
 
 #include "icoac_sim/icoac_sim.h"
@@ -23,7 +23,7 @@
 
 enum {
     GRAVITY, ARM_MASS, ARM_LENGTH, PENDULUM_MASS, PENDULUM_LENGTH, HUB_INERTIA, RESISTANCE,
-    TORQUE_CONSTANT, ARM_DAMPING, PENDULUM_DAMPING, ARM_LIMIT, PENDULUM_LIMIT, VOLTAGE_LIMIT, N_PARAMS
+    TORQUE_CONSTANT, ARM_DAMPING, PENDULUM_DAMPING, ARM_LIMIT, PENDULUM_LIMIT, MAX_VOLTAGE, N_PARAMS
 };
 
 /* Inertia terms of the Lagrangian: T = 1/2 (a + b sin^2 alpha) theta_dot^2
@@ -49,7 +49,7 @@ SIM_DERIVATIVES derivatives(const double *p, const double *s, double voltage, do
     double sin_a, cos_a;
     sim_sincos(s[2], &sin_a, &cos_a);
     /* the amplifier's saturation; NaN passes through (the step's finiteness check reports it) */
-    const double limit = p[VOLTAGE_LIMIT];
+    const double limit = p[MAX_VOLTAGE];
     const double applied = voltage > limit ? limit : (voltage < -limit ? -limit : voltage);
     const double torque = p[TORQUE_CONSTANT] * (applied - p[TORQUE_CONSTANT] * s[1]) / p[RESISTANCE];
     /* mass matrix [[m11, m12], [m12, b]] and right-hand side (r1, r2) */
@@ -112,7 +112,7 @@ static const icoac_sim_param_t params[N_PARAMS] = {
      "failure when |theta| exceeds it (our choice)"},
     {"pendulum_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX, "advanced",
      "failure when |alpha| exceeds it (our choice, as the cart-pole's)"},
-    {"voltage_limit", "V", 10.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+    {"max_voltage", "V", 10.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
      "|V| applied saturates at it (the unit's amplifier: 10 V; 1e6: practically none)"},
 };
 
