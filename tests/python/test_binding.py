@@ -229,25 +229,28 @@ def test_condition_overrides():
     two RL conditions with a zero mean on the readings their sweeps chose (mean reading, sigma_L
     0.1, sigma_u 5, alpha 0.1, exploration until tick 1000); nothing else overridden. Each
     actor-critic and search condition has its prior rule. The LQR baseline is ICO mode with every
-    update off."""
+    update off; so is CMA-ES, which learns outside the controller from the search control's
+    N(0, 4 I)."""
     assert set(CONDITION_OVERRIDES) == set(CONDITIONS) and CONDITIONS == (
         "ico", "ico-rl", "ico-rl-control", "ico-mean-rl", "ico-mean-rl-control", "rl-ico-cov", "rl-ico-cov-control",
-        "rl", "rl-control", "ico-search", "ico-search-control", "search", "search-control", "lqr")
+        "rl", "rl-control", "ico-search", "ico-search-control", "search", "search-control", "lqr", "cma-es")
     assert {c.name: c.control_of for c in REGISTRY.values() if c.control_of} == {
         "ico-rl-control": "ico-rl", "ico-mean-rl-control": "ico-mean-rl", "rl-ico-cov-control": "rl-ico-cov",
         "rl-control": "rl", "ico-search-control": "ico-search", "search-control": "search"}
     assert {c.name: c.prior for c in REGISTRY.values() if c.learns and c.prior} == {
         "ico-rl": ("ico", "ico"), "ico-mean-rl": ("ico", "isotropic"), "rl-ico-cov": ("zero", "ico"),
-        "rl": ("zero", "isotropic"), "ico-search": ("ico", "ico"), "search": ("zero", "identity")}
+        "rl": ("zero", "isotropic"), "ico-search": ("ico", "ico"), "search": ("zero", "identity"),
+        "cma-es": ("zero", "identity")}
     default = build_config().flat()
     modes = {"ico": "ico", "ico-rl": "rl", "ico-mean-rl": "rl", "rl-ico-cov": "rl", "rl": "rl",
-             "ico-search": "search", "search": "search", "lqr": "ico"}
+             "ico-search": "search", "search": "search", "lqr": "ico", "cma-es": "ico"}
     zero_mean = ("rl-ico-cov", "rl")
     for condition in CONDITIONS:
         flat = build_config(condition=condition).flat()
         base = REGISTRY[condition].base
-        assert flat["mode"] == modes[base] and flat["learn"] is REGISTRY[condition].learns
-        assert flat["search.cov_scale"] == (4.0 if base == "search" else 64.0)
+        controller_learns = REGISTRY[condition].learns and REGISTRY[condition].optimiser is None
+        assert flat["mode"] == modes[base] and flat["learn"] is controller_learns
+        assert flat["search.cov_scale"] == (4.0 if base in ("search", "cma-es") else 64.0)
         changed = {n for n in flat if flat[n] != default[n]}
         reading = {"actor.update", "actor.likelihood_std", "actor.noise_std", "actor.scale"}
         assert changed <= {"mode", "learn", "search.cov_scale"} | (reading if base in zero_mean else set()), condition

@@ -379,10 +379,10 @@ def test_bench_quick_writes_comparison(tmp_path):
         data = (fig / name).read_bytes()
         assert data[:8] == PNG and len(data) > 5000
     # every condition: ICO, the actor-critic from the four priors, ICO->search and search, each
-    # learner with its control, and the LQR baseline
+    # learner with its control, the LQR baseline and CMA-ES
     conds = ("ico", "ico-rl", "ico-rl-control", "ico-mean-rl", "ico-mean-rl-control", "rl-ico-cov",
              "rl-ico-cov-control", "rl", "rl-control", "ico-search", "ico-search-control", "search",
-             "search-control", "lqr")
+             "search-control", "lqr", "cma-es")
     assert CONDITIONS == conds
     for cond in conds:
         for seed in (0, 1):
