@@ -133,6 +133,31 @@ int32_t icoac_sim_model_failed(const icoac_sim_model_t *model, const double stat
     return ICOAC_SIM_OK;
 }
 
+int32_t icoac_sim_model_step_lanes(const icoac_sim_model_t *model, double *states, const double *u,
+                                   int32_t *ended, int64_t lanes)
+{
+    int64_t lane;
+    int32_t status = icoac_sim_model_check(model);
+    if (status != ICOAC_SIM_OK) {
+        return status;
+    }
+    if (lanes < 0 || (lanes > 0 && (states == 0 || u == 0 || ended == 0))) {
+        return ICOAC_SIM_ERR_BAD_ARGUMENT;
+    }
+    for (lane = 0; lane < lanes; ++lane) {
+        double *s = states + lane * ICOAC_SIM_MAX_STATE;
+        int32_t failed = 1;
+        if (ended[lane] != 0) {
+            continue;
+        }
+        if (icoac_sim_model_step(model, s, u[lane]) == ICOAC_SIM_OK) {
+            (void)icoac_sim_model_failed(model, s, &failed);
+        }
+        ended[lane] = failed != 0 ? 1 : 0;
+    }
+    return ICOAC_SIM_OK;
+}
+
 int32_t icoac_sim_model_energy(const icoac_sim_model_t *model, const double state[ICOAC_SIM_MAX_STATE],
                                double *energy)
 {

@@ -17,6 +17,13 @@
 #define SIM_BATCH_STEP __attribute__((target_clones("default", "avx2", "avx512f")))
 #endif
 
+/* An actuator's saturation at +-limit (a plant's max_force or max_voltage), inside its
+ * derivatives; NaN passes through, for the step's finiteness check to report. */
+static inline double sim_saturate(double u, double limit)
+{
+    return u > limit ? limit : (u < -limit ? -limit : u);
+}
+
 /* Advance each of the lanes states of s (component i of lane l at s[i * lanes + l]) by one dt
  * under its own input u[l]: explicit Euler (every right-hand side from the old state, Sutton's
  * order) or classical RK4. */

@@ -160,6 +160,72 @@ static void test_nonfinite_input(void)
     TEST_ASSERT_TRUE(strstr(icoac_sim_status_str(ICOAC_SIM_ERR_NONFINITE), "not finite") != NULL);
 }
 
+/* icoac_sim_model_step_lanes: each lane as icoac_sim_model_step then icoac_sim_model_failed on its
+ * own state; an ended lane untouched; a lane with a non-finite input ends with its state kept. */
+static void test_step_lanes(void)
+{
+    int32_t i, c;
+    for (i = 0; i < icoac_sim_plant_count(); ++i) {
+        const icoac_sim_plant_desc_t *d = plant(i);
+        icoac_sim_model_t model;
+        double lanes[4][ICOAC_SIM_MAX_STATE] = {{0}}, before[4][ICOAC_SIM_MAX_STATE], one[ICOAC_SIM_MAX_STATE];
+        const double u[4] = {0.5, 0.5, (double)NAN, 0.0};
+        int32_t ended[4] = {0, 1, 0, 0}, failed = -1;
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_default(&model, i));
+        for (c = 0; c < d->n_state; ++c) {
+            lanes[0][c] = lanes[1][c] = lanes[2][c] = 0.01 * (c + 1);
+        }
+        lanes[3][0] = 1e3; /* outside every plant's limit on its first component */
+        memcpy(before, lanes, sizeof lanes);
+        memcpy(one, lanes[0], sizeof one);
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step_lanes(&model, &lanes[0][0], u, ended, 4));
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step(&model, one, u[0]));
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_failed(&model, one, &failed));
+        TEST_ASSERT_EQUAL_MEMORY(one, lanes[0], sizeof one);
+        TEST_ASSERT_EQUAL_INT(failed, ended[0]);
+        TEST_ASSERT_EQUAL_MEMORY(before[1], lanes[1], sizeof one);
+        TEST_ASSERT_EQUAL_INT(1, ended[1]);
+        TEST_ASSERT_EQUAL_MEMORY(before[2], lanes[2], sizeof one);
+        TEST_ASSERT_EQUAL_INT(1, ended[2]);
+        TEST_ASSERT_EQUAL_INT(1, ended[3]);
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step_lanes(&model, NULL, NULL, NULL, 0));
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_model_step_lanes(&model, NULL, u, ended, 1));
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_model_step_lanes(&model, &lanes[0][0], u, ended, -1));
+        model.dt = (double)NAN;
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_model_step_lanes(&model, &lanes[0][0], u, ended, 4));
+    }
+}
+
+/* Every plant with an input saturation (a parameter named max_...) applies at most that input: a
+ * step under ten times the limit equals the step under the limit, and a step under half of it
+ * differs from both. */
+static void test_input_saturation(void)
+{
+    int32_t i, k, n_saturating = 0;
+    for (i = 0; i < icoac_sim_plant_count(); ++i) {
+        const icoac_sim_plant_desc_t *d = plant(i);
+        for (k = 0; k < d->n_params; ++k) {
+            icoac_sim_model_t model;
+            double at[ICOAC_SIM_MAX_STATE] = {0}, beyond[ICOAC_SIM_MAX_STATE] = {0}, half[ICOAC_SIM_MAX_STATE] = {0};
+            if (strncmp(d->params[k].name, "max_", 4) != 0) {
+                continue;
+            }
+            ++n_saturating;
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_default(&model, i));
+            model.param[k] = 2.0;
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step(&model, at, 2.0));
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step(&model, beyond, 20.0));
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step(&model, half, 1.0));
+            TEST_ASSERT_EQUAL_MEMORY(at, beyond, sizeof at);
+            TEST_ASSERT_TRUE(memcmp(at, half, sizeof at) != 0);
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step(&model, beyond, -20.0));
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step(&model, at, -2.0));
+            TEST_ASSERT_EQUAL_MEMORY(at, beyond, sizeof at);
+        }
+    }
+    TEST_ASSERT_EQUAL_INT(icoac_sim_plant_count(), n_saturating);
+}
+
 /* 1 when the default model of plant i fails with component c at value v (the rest 0). */
 static int32_t fails_at(int32_t i, int32_t c, double v)
 {
@@ -382,6 +448,8 @@ int main(void)
     RUN_TEST(test_registry);
     RUN_TEST(test_model_checks);
     RUN_TEST(test_nonfinite_input);
+    RUN_TEST(test_step_lanes);
+    RUN_TEST(test_input_saturation);
     RUN_TEST(test_failure_limits);
     RUN_TEST(test_grids);
     RUN_TEST(test_trial_start);

@@ -160,7 +160,7 @@ def random_model(name, rng):
     for i, pr in enumerate(info["params"]):
         if "limit" not in pr["name"] and pr["name"] != "gravity":
             value = pr["value"] if pr["value"] != 0.0 else 1e-3  # friction: nonzero here
-            model.param[i] = value * rng.uniform(0.5, 2.0)
+            model.param[i] = min(value * rng.uniform(0.5, 2.0), pr["max"])  # a max_force of 1e6 stays
     B.check_status(B.lib.icoac_sim_model_check(ctypes.byref(model)))
     return model, info
 

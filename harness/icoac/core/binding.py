@@ -35,7 +35,7 @@ DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.s
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
 ABI_VERSION = 10
-SIM_ABI_VERSION = 6
+SIM_ABI_VERSION = 7
 
 
 class IcoacError(HarnessError):
@@ -624,6 +624,10 @@ _PROTOTYPES = {
     "icoac_sim_model_derivatives": ([_P(Model), _state_r, ctypes.c_double, _state_w], ctypes.c_int32),
     "icoac_sim_model_failed": ([_P(Model), _state_r, _P(ctypes.c_int32)], ctypes.c_int32),
     "icoac_sim_model_energy": ([_P(Model), _state_r, _P(ctypes.c_double)], ctypes.c_int32),
+    "icoac_sim_model_step_lanes": ([_P(Model), ndpointer(np.float64, ndim=2, flags="C_CONTIGUOUS,WRITEABLE"),
+                                    ndpointer(np.float64, ndim=1, flags="C_CONTIGUOUS"),
+                                    ndpointer(np.int32, ndim=1, flags="C_CONTIGUOUS,WRITEABLE"), ctypes.c_int64],
+                                   ctypes.c_int32),
     "icoac_sim_plant_grid": ([ctypes.c_int32, _cells_p, ctypes.c_int64, ctypes.c_uint64], ctypes.c_int32),
     "icoac_rng_seed": ([_P(Rng), ctypes.c_uint64, ctypes.c_uint64], None),
     "icoac_sim_model_start": ([_P(Model), ndpointer(CELL_DTYPE, shape=(1,), flags="C_CONTIGUOUS"), ctypes.c_double, _P(Rng), _state_w], ctypes.c_int32),
@@ -777,3 +781,14 @@ def model_default(plant: Union[int, str], **params: float) -> Model:
             raise ConfigError(SIM_ERR_BAD_PLANT, f"plant {plant_info(index)['name']} has no parameter {key!r}")
     check_status(lib.icoac_sim_model_check(ctypes.byref(model)), "plant model")
     return model
+
+
+def model_step_lanes(model: Model, states: np.ndarray, u: np.ndarray, ended: np.ndarray) -> None:
+    """icoac_sim_model_step_lanes in place: states (lanes, MAX_STATE) float64, u (lanes,) float64,
+    ended (lanes,) int32; a lane already ended is left alone, a lane that fails (or whose state or
+    input is not finite) gets ended = 1."""
+    lanes = len(u)
+    if states.shape != (lanes, MAX_STATE) or ended.shape != (lanes,):
+        raise ValueError(f"step_lanes: states must be ({lanes}, {MAX_STATE}) and ended ({lanes},), "
+                         f"got {states.shape} and {ended.shape}")
+    check_status(lib.icoac_sim_model_step_lanes(ctypes.byref(model), states, u, ended, lanes), "plant step")

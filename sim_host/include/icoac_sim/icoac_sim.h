@@ -12,7 +12,7 @@
 extern "C" {
 #endif
 
-#define ICOAC_SIM_ABI_VERSION 6
+#define ICOAC_SIM_ABI_VERSION 7
 
 /* Status of sim functions: values below 100 are icoac_status_t, passed through. */
 typedef enum {
@@ -277,6 +277,13 @@ int32_t icoac_sim_model_derivatives(const icoac_sim_model_t *model, const double
 /* *failed = 1 when the state is outside the plant's limits or not finite, else 0. */
 int32_t icoac_sim_model_failed(const icoac_sim_model_t *model, const double state[ICOAC_SIM_MAX_STATE],
                                int32_t *failed);
+/* Steps lanes states (states: lanes rows of ICOAC_SIM_MAX_STATE values) one period each, lane i
+ * under u[i], for a policy evaluated outside the controller on many cells at once. A lane whose
+ * ended[i] is nonzero is left alone; a lane that fails the plant's test, or whose state or input
+ * is not finite or would become so (its state then kept), gets ended[i] = 1. Statuses:
+ * ICOAC_SIM_ERR_BAD_PLANT (model), ICOAC_SIM_ERR_BAD_ARGUMENT (lanes < 0, or a NULL array). */
+int32_t icoac_sim_model_step_lanes(const icoac_sim_model_t *model, double *states, const double *u,
+                                   int32_t *ended, int64_t lanes);
 /* ICOAC_SIM_ERR_BAD_ARGUMENT when the plant has no energy function. */
 int32_t icoac_sim_model_energy(const icoac_sim_model_t *model, const double state[ICOAC_SIM_MAX_STATE],
                                double *energy);

@@ -8,11 +8,12 @@
 #include "sim_trig.h"
 #include "sim_internal.h"
 
-enum { GRAVITY, CART_MASS, POLE_MASS, HALF_LENGTH, X_LIMIT = SIM_CART_POLE_X_LIMIT, THETA_LIMIT, N_PARAMS };
+enum { GRAVITY, CART_MASS, POLE_MASS, HALF_LENGTH, X_LIMIT = SIM_CART_POLE_X_LIMIT, THETA_LIMIT, MAX_FORCE, N_PARAMS };
 
-/* d/dt (x, x_dot, theta, theta_dot) under force: Sutton's equations. */
-SIM_DERIVATIVES derivatives(const double *p, const double *s, double force, double *ds)
+/* d/dt (x, x_dot, theta, theta_dot) under force (saturated at max_force): Sutton's equations. */
+SIM_DERIVATIVES derivatives(const double *p, const double *s, double command, double *ds)
 {
+    const double force = sim_saturate(command, p[MAX_FORCE]);
     const double inv_total_mass = 1.0 / (p[CART_MASS] + p[POLE_MASS]);
     const double pole_moment = p[POLE_MASS] * p[HALF_LENGTH];
     double sin_t, cos_t;
@@ -61,6 +62,8 @@ static const icoac_sim_param_t params[N_PARAMS] = {
      "failure when |x| exceeds it"},
     {"theta_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX, "advanced",
      "failure when |theta| exceeds it"},
+    {"max_force", "N", 1.0e6, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+     "|force| applied saturates at it (1e6: practically none, the paper's plant; 10: Barto et al.'s)"},
 };
 
 /* The paper's task: the controller's defaults. */

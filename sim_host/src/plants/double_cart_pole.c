@@ -12,7 +12,7 @@
 #include "sim_integrate.h"
 #include "sim_trig.h"
 
-enum { GRAVITY, CART_MASS, MASS1, MASS2, LENGTH1, LENGTH2, X_LIMIT, ANGLE_LIMIT, N_PARAMS };
+enum { GRAVITY, CART_MASS, MASS1, MASS2, LENGTH1, LENGTH2, X_LIMIT, ANGLE_LIMIT, MAX_FORCE, N_PARAMS };
 
 /* Inertia terms: T = 1/2 qdot^T M qdot with q = (x, theta1, theta2),
  * M = [[m, a1 c1, a2 c2], [a1 c1, j1, b c12], [a2 c2, b c12, j2]], V = g (a1 c1 + a2 c2). */
@@ -33,9 +33,10 @@ static terms_t terms(const double *p)
     return t;
 }
 
-SIM_DERIVATIVES derivatives(const double *p, const double *s, double force, double *ds)
+SIM_DERIVATIVES derivatives(const double *p, const double *s, double command, double *ds)
 {
     const terms_t t = terms(p);
+    const double force = sim_saturate(command, p[MAX_FORCE]);
     double s1, c1, s2, c2, s12, c12;
     sim_sincos(s[2], &s1, &c1);
     sim_sincos(s[4], &s2, &c2);
@@ -97,6 +98,8 @@ static const icoac_sim_param_t params[N_PARAMS] = {
      "failure when |x| exceeds it (our choice, as the cart-pole's)"},
     {"angle_limit", "rad", 12.0 * ICOAC_SIM_PI / 180.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_THETA_LIMIT_MAX, "advanced",
      "failure when |theta1| or |theta2| exceeds it (our choice, as the cart-pole's)"},
+    {"max_force", "N", 1.0e6, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+     "|force| applied saturates at it (1e6: practically none)"},
 };
 
 /* Its task, chosen by its sweep (docs/sweeps-double_cart_pole.md): six inputs scaled to the track

@@ -48,9 +48,7 @@ SIM_DERIVATIVES derivatives(const double *p, const double *s, double voltage, do
     const terms_t t = terms(p);
     double sin_a, cos_a;
     sim_sincos(s[2], &sin_a, &cos_a);
-    /* the amplifier's saturation; NaN passes through (the step's finiteness check reports it) */
-    const double limit = p[MAX_VOLTAGE];
-    const double applied = voltage > limit ? limit : (voltage < -limit ? -limit : voltage);
+    const double applied = sim_saturate(voltage, p[MAX_VOLTAGE]); /* the amplifier's */
     const double torque = p[TORQUE_CONSTANT] * (applied - p[TORQUE_CONSTANT] * s[1]) / p[RESISTANCE];
     /* mass matrix [[m11, m12], [m12, b]] and right-hand side (r1, r2) */
     const double m11 = t.a + t.b * sin_a * sin_a;

@@ -1,0 +1,153 @@
+# SPDX-License-Identifier: Apache-2.0
+"""PPO and SAC (Stable-Baselines3, icoac.studies.baselines.sb3) on a plant, trained once per seed
+over random grid cells and evaluated on every cell of that seed's grid:
+
+    python -m icoac.tools.rl_baselines --plant furuta --out results/rl-baselines-furuta \\
+        --bench results/bench-furuta --data docs/data/rl-baselines-furuta.json
+
+Needs the [baselines] extra (`make baselines`). The plant's actuator limit (its max_... parameter,
+--set to change it) bounds the actions. Each (algorithm, seed) is OUT/<algo>/seed-<s>/ with the
+trained model and result.json; a stopped run resumes at the first unfinished one (one run is not
+resumed inside). --bench DIR (grids with the same plant parameters) adds the paired per-cell tests
+against its conditions, seed for seed. --report runs nothing."""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from icoac.core import metrics, results, stats
+from icoac.core.config import build_config, model_to_dict, parse_sets
+from icoac.core.errors import UsageError
+from icoac.core.plants import PLANTS
+from icoac.core.registry import REGISTRY
+from icoac.studies import bench, heldout
+from icoac.studies.baselines import sb3
+from icoac.tools.resumable import guarded
+
+RESULT = "result.json"
+
+
+def _mask(text: str) -> np.ndarray:
+    return np.frombuffer(text.encode(), dtype=np.uint8) == ord("1")
+
+
+def run_one(args, cfg, algo: str, seed: int, steps: int) -> dict[str, Any]:
+    """Train and evaluate one seed (or read its finished result)."""
+    out = args.out / algo / f"seed-{seed}"
+    if (out / RESULT).is_file():
+        return json.loads((out / RESULT).read_text())
+    if args.report:
+        return {}
+    out.mkdir(parents=True, exist_ok=True)
+    print(f"[{algo} seed {seed}] training {steps} steps", file=sys.stderr, flush=True)
+    trained = sb3.train(algo, cfg, seed, steps)
+    trained.model.save(out / "model.zip")
+    if trained.normalizer is not None:
+        trained.normalizer.save(str(out / "vecnormalize.pkl"))
+    t0 = time.monotonic()
+    lasted, ok = sb3.evaluate(trained.act, cfg, seed)
+    eval_wall = time.monotonic() - t0
+    result = {"algo": algo, "seed": seed, "steps": trained.steps, "episodes": trained.episodes,
+              "simulated_time": trained.steps * float(cfg.model.dt), "train_wall_time": trained.wall_time,
+              "eval_wall_time": eval_wall, "success": "".join("1" if x else "0" for x in ok),
+              "lasted": [int(v) for v in lasted], "git": results.git_info()}
+    tmp = out / (RESULT + ".tmp")
+    tmp.write_text(json.dumps(result))
+    os.replace(tmp, out / RESULT)
+    print(f"[{algo} seed {seed}] {100 * ok.mean():.1f} % of {ok.size} cells; train {trained.wall_time:.0f} s, "
+          f"evaluation {eval_wall:.0f} s", file=sys.stderr, flush=True)
+    return result
+
+
+def _rates(masks: dict[int, np.ndarray]) -> dict[str, Any]:
+    stack = np.stack([masks[s] for s in sorted(masks)])
+    return {"mean": float(stack.mean()), "ci95": stats.interval(stack, stats.rate) if len(masks) > 1 else None}
+
+
+def bench_masks(args, cfg, seeds: list[int]) -> dict[str, dict[int, np.ndarray]]:
+    """Each condition of --bench that has grids for these seeds: its success masks; the plant
+    parameters must be ours."""
+    out: dict[str, dict[int, np.ndarray]] = {}
+    ours = model_to_dict(cfg.model)
+    for condition in REGISTRY:
+        masks = {}
+        for seed in seeds:
+            d = bench.seed_dir(args.bench, condition, seed)
+            if not results.exists(d):
+                continue
+            cells, record = results.load(d)
+            theirs = model_to_dict(results.load_config(record).model)
+            if theirs != ours:
+                raise UsageError(f"--bench {d} ran the plant with other parameters ({theirs} against {ours})")
+            masks[seed] = metrics.success_mask(cells)
+        if masks:
+            out[condition] = masks
+    return out
+
+
+def collect(args, cfg) -> dict[str, Any]:
+    name, limit = sb3.actuator_limit(cfg)
+    held = heldout.heldout_mask(cfg.plant_name)
+    data: dict[str, Any] = {"plant": cfg.plant_name, "set": args.set, "actuator": {"parameter": name, "limit": limit},
+                            "success_steps": int(cfg.run.success_steps), "plant_parameters": model_to_dict(cfg.model),
+                            "n_cells": int(held.size), "n_heldout": int(np.count_nonzero(held)),
+                            "intervals": stats.settings(), "algorithms": {}}
+    others = bench_masks(args, cfg, args.seeds) if args.bench is not None else {}
+    if args.bench is not None:
+        data["bench"] = str(args.bench)
+    for algo in args.algos:
+        steps = args.steps or sb3.ALGORITHMS[algo].budget
+        runs = {s: r for s in args.seeds if (r := run_one(args, cfg, algo, s, steps))}
+        entry: dict[str, Any] = {"settings": sb3.settings(algo, steps), "runs": runs}
+        if runs:
+            masks = {s: _mask(r["success"]) for s, r in runs.items()}
+            entry["all"] = _rates(masks)
+            entry["heldout"] = _rates({s: m[held] for s, m in masks.items()})
+            entry["paired"] = {c: stats.paired(masks, m) for c, m in others.items()}
+        data["algorithms"][algo] = entry
+    return data
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m icoac.tools.rl_baselines", description=__doc__.split("\n")[0])
+    ap.add_argument("--plant", default="cart_pole", choices=tuple(PLANTS))
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                    help="a plant or run parameter (success_steps: the evaluation's horizon)")
+    ap.add_argument("--algos", nargs="+", choices=tuple(sb3.ALGORITHMS), default=list(sb3.ALGORITHMS))
+    ap.add_argument("--seeds", nargs="+", type=int, default=list(range(bench.PROFILES["default"]["seeds"])))
+    ap.add_argument("--steps", type=int, help="env steps per training run (default: each algorithm's budget)")
+    ap.add_argument("--out", required=True, type=Path)
+    ap.add_argument("--bench", type=Path, help="grids of the same plant to pair with (OUT/<condition>/seed-<s>)")
+    ap.add_argument("--data", type=Path, help="also write the summary here (docs/data/...)")
+    ap.add_argument("--report", action="store_true", help="run nothing: summarise the finished runs")
+    args = ap.parse_args(argv)
+
+    def body():
+        if args.steps is not None and args.steps < 1:
+            raise UsageError(f"--steps must be at least 1, got {args.steps}")
+        cfg = build_config(parse_sets(args.set, plant=args.plant), plant=args.plant)
+        sb3.actuator_limit(cfg)
+        return collect(args, cfg)
+    status, data = guarded(body)
+    if data is None:
+        return status
+    text = json.dumps(data, indent=1)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "rl-baselines.json").write_text(text)
+    if args.data is not None:
+        args.data.write_text(text)
+    for algo, entry in data["algorithms"].items():
+        if "all" in entry:
+            print(f"{algo}: {100 * entry['all']['mean']:.1f} % of all cells over seeds {sorted(entry['runs'])}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
