@@ -52,7 +52,7 @@ ALGORITHMS: Mapping[str, Algorithm] = {
     "sac": Algorithm(
         "SAC", "RL Zoo hyperparams/sac.yml, MuJoCo defaults",
         {"learning_starts": 10_000},
-        normalize=False, budget=100_000, zoo_budget=1_000_000),
+        normalize=False, budget=30_000, zoo_budget=1_000_000),
 }
 
 
