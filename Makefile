@@ -43,7 +43,7 @@ FUZZ_SOURCES = $(shell git ls-tree HEAD $(FUZZ_C_SOURCES) 2>/dev/null | git hash
   cut -c1-12)$(shell git diff --quiet HEAD -- $(FUZZ_C_SOURCES) 2>/dev/null || echo -modified)
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_model fuzz_batch
 
-.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-fuzz fuzz fuzz-campaign fuzz-ledger bench tuning ablation \
+.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-baselines baselines baselines-venv test-fuzz fuzz fuzz-campaign fuzz-ledger bench tuning ablation \
   bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
@@ -98,7 +98,27 @@ test-c: build
 # with its reason, when pip cannot reach a package index); PYTEST_ARGS='-m "not slow"' leaves it out.
 PYTEST_ARGS ?=
 test-python: build venv
-	$(VPY) -m pytest -q tests/python $(PYTEST_ARGS)
+	$(VPY) -m pytest -q tests/python -m "not baselines" $(PYTEST_ARGS)
+
+# The [baselines] extra (Stable-Baselines3 with torch: about 3 GB), installed once into .venv.
+baselines-venv: $(VENV)/.baselines
+$(VENV)/.baselines: $(VENV)/.installed
+	$(VPY) -m pip install -q "$$($(VPY) -c 'import tomllib; \
+	  print(tomllib.load(open("pyproject.toml", "rb"))["project"]["optional-dependencies"]["baselines"][0])')"
+	@touch $@
+
+# The smoke tests of the PPO and SAC adapters (marker baselines), which need that extra.
+test-baselines: build baselines-venv
+	$(VPY) -m pytest -q tests/python -m baselines $(PYTEST_ARGS)
+
+# PPO and SAC on the Furuta pendulum (its +-10 V) and on the cart-pole at +-10 N (Barto et al.'s
+# force), paired with the bench grids of the same plant (docs/results.md, "PPO and SAC").
+baselines: build baselines-venv
+	$(VPY) -m icoac.tools.rl_baselines --plant furuta --out results/rl-baselines-furuta \
+	  --bench $(BENCH_OUT)-furuta --data docs/data/rl-baselines-furuta.json
+	$(VPY) -m icoac.tools.rl_baselines --plant cart_pole --set max_force=10 \
+	  --out results/rl-baselines-cart_pole-10N --bench $(BENCH_OUT)-10N \
+	  --data docs/data/rl-baselines-cart_pole-10N.json
 
 build-fuzz: deps
 	cmake --preset fuzz >/dev/null

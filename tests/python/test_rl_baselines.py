@@ -1,0 +1,74 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The PPO and SAC adapters (icoac.studies.baselines.sb3, icoac.tools.rl_baselines): a short
+training of each on the Furuta pendulum, the evaluation on every cell against the plant stepped
+by hand, the records and the refusals. Needs the [baselines] extra: `make test-baselines`."""
+import ctypes
+import json
+
+import numpy as np
+import pytest
+
+pytest.importorskip("stable_baselines3", reason="the [baselines] extra is not installed (make test-baselines)")
+
+from icoac.core import binding as B  # noqa: E402
+from icoac.core.config import build_config, parse_sets  # noqa: E402
+from icoac.core.errors import UsageError  # noqa: E402
+from icoac.gym.plants import ModelParameters, model_start, plant_grid  # noqa: E402
+from icoac.studies.baselines import sb3  # noqa: E402
+from icoac.tools import rl_baselines  # noqa: E402
+
+pytestmark = pytest.mark.baselines
+
+
+def furuta(**sets):
+    return build_config(parse_sets([f"{k}={v}" for k, v in sets.items()], plant="furuta"), plant="furuta")
+
+
+@pytest.mark.parametrize("algo", sorted(sb3.ALGORITHMS))
+def test_train_and_evaluate(algo):
+    cfg = furuta(success_steps=60)
+    trained = sb3.train(algo, cfg, seed=3, steps=320)
+    assert trained.steps == 320 and trained.episodes >= 1
+    lasted, ok = sb3.evaluate(trained.act, cfg, grid_seed=1)
+    assert lasted.shape == ok.shape == (1225,)
+    assert np.all((lasted >= 1) & (lasted <= 60)) and np.all(lasted[ok] == 60)
+    # one cell replayed by hand: the same start, the same deterministic forces, the same end
+    cell = int(np.argmax(lasted))
+    flag = ctypes.c_int32(0)
+    parameters = ModelParameters(cfg.model, float(cfg.run.init_velocity_noise))
+    state = model_start(parameters, plant_grid(int(cfg.model.plant), 1)[cell:cell + 1])
+    for step in range(1, 61):
+        force = float(trained.act(state[None, :4])[0]) * 10.0
+        B.check_status(B.lib.icoac_sim_model_step(ctypes.byref(cfg.model), state, force))
+        B.check_status(B.lib.icoac_sim_model_failed(ctypes.byref(cfg.model), state, ctypes.byref(flag)))
+        if flag.value:
+            break
+    assert step == lasted[cell] and bool(ok[cell]) == (not flag.value)
+    # the same seed trains the same policy
+    again = sb3.train(algo, cfg, seed=3, steps=320)
+    probe = np.random.default_rng(0).uniform(-0.2, 0.2, (16, 4))
+    assert np.array_equal(trained.act(probe), again.act(probe))
+
+
+def test_actuator_limit_is_the_plants():
+    assert sb3.actuator_limit(furuta()) == ("max_voltage", 10.0)
+    assert sb3.actuator_limit(furuta(max_voltage=4)) == ("max_voltage", 4.0)
+    cart = build_config({}, plant="cart_pole")
+    with pytest.raises(UsageError, match=r"max_force = 1e\+06 is no actuator limit; set one"):
+        sb3.actuator_limit(cart)
+
+
+def test_tool_resumes_and_reports(tmp_path, capsys):
+    argv = ["--plant", "furuta", "--algos", "ppo", "--seeds", "0", "--steps", "64", "--set", "success_steps=20",
+            "--out", str(tmp_path / "out")]
+    assert rl_baselines.main(argv + ["--data", str(tmp_path / "data.json")]) == 0
+    data = json.loads((tmp_path / "data.json").read_text())
+    run = data["algorithms"]["ppo"]["runs"]["0"]
+    assert run["steps"] == 64 and len(run["success"]) == 1225 and data["actuator"]["limit"] == 10.0
+    assert data["algorithms"]["ppo"]["settings"]["steps"] == 64
+    before = (tmp_path / "out" / "ppo" / "seed-0" / "result.json").stat().st_mtime_ns
+    assert rl_baselines.main(argv + ["--report"]) == 0  # nothing rerun
+    assert (tmp_path / "out" / "ppo" / "seed-0" / "result.json").stat().st_mtime_ns == before
+    assert rl_baselines.main(["--plant", "cart_pole", "--out", str(tmp_path / "x"), "--report"]) == 2
+    assert "max_force = 1e+06 is no actuator limit" in capsys.readouterr().err
+    assert rl_baselines.main(argv + ["--steps", "0"]) == 2
