@@ -110,6 +110,29 @@ def test_the_method_to_use_is_the_cheapest_within_the_best_interval():
     assert tables.recommended(agg) == "ico-search"  # without an interval: the highest
 
 
+def test_policies_trained_once_join_the_headline_of_their_plant_and_settings():
+    """PPO and SAC rows (an rl-baselines data file) follow the bench rows of the same plant and --set,
+    with their training cost; a file of other settings adds nothing; the rl-baselines table pairs
+    them with the bench's conditions."""
+    from icoac.studies import tables
+    from icoac.tools import rl_baselines
+    agg = {"ico-rl": _entry(0.95, 0.93, 100), "search": _entry(0.96, 0.94, 50)}
+    bench = {"plant": "cart_pole", "set": ["max_force=10"], "aggregate": agg}
+    paired = {"points": -3.5, "ci95": [-5.0, -2.0], "p_max": 0.001}
+    trained = {"plant": "cart_pole", "set": ["max_force=10"], "algorithms": {"ppo": {
+        "settings": {"algorithm": "PPO", "steps": 200000, "zoo_steps": 1000000},
+        "runs": {"0": {}, "1": {}}, "all": {"mean": 0.5, "sd": 0.1, "ci95": [0.45, 0.55]},
+        "heldout": {"mean": 0.49}, "paired": {"ico-rl": paired},
+        "cost": {"trials": {"mean": 321.0}, "steps": {"mean": 2e5}, "simulated_time": {"mean": 2e3},
+                 "wall_time": {"mean": 250.0}}}}}
+    lines = tables.headline_table([bench, trained, {**trained, "set": []}])
+    assert [line.split(" | ")[1] for line in lines[2:]] == ["**search** (use)", "ICO->RL", "PPO (trained once)"]
+    assert lines[-1].startswith("| cart_pole (max_force=10) |") and "| 321 | 2e+03 | 250 |" in lines[-1]
+    rows = rl_baselines.table(trained)
+    assert "against ICO->RL (points)" in rows[0] and "-3.5 (-5.0 to -2.0), p ≤ 0.001" in rows[2]
+    assert "| 2e+05 (1e+06) | 2 |" in rows[2]
+
+
 def test_a_block_over_several_summaries(tmp_path):
     page = "<!-- table: headline bench-default.json,bench-default-furuta.json -->\n<!-- end table -->\n"
     text = RT.render(page, DATA)

@@ -142,22 +142,39 @@ def recommended(agg: Mapping[str, Any]) -> str | None:
     return min(tied, key=lambda c: _total_cost(agg[c])["trials"]["mean"])
 
 
+def _plant_label(data: Mapping[str, Any]) -> str:
+    return data.get("plant", "cart_pole") + (f" ({', '.join(data['set'])})" if data.get("set") else "")
+
+
 def headline_table(summaries: Sequence[Mapping[str, Any]]) -> list[str]:
-    """Per plant (one data file each): the recommended method, then HEADLINE_ROWS; each with its
-    success, 95 % interval, and the whole grid's total cost (_total_cost)."""
+    """Per plant (one bench data file each): the recommended method, then HEADLINE_ROWS, then the
+    policies trained once over the grid (PPO, SAC: an rl-baselines data file of the same plant and
+    settings); each with its success, 95 % interval, and the whole grid's total cost (_total_cost;
+    a policy trained once: its training episodes and steps, and its training and evaluation wall
+    time)."""
     lines = ["| plant | method | success, all cells (95 % interval) | trials, whole grid | "
              "simulated time (s) | wall time (s) |", "|---|---|---|---|---|---|"]
-    for data in summaries:
+    benches = [d for d in summaries if "aggregate" in d]
+    trained = [d for d in summaries if "algorithms" in d]
+
+    def row(plant: str, name: str, success: Mapping[str, Any], cost: Mapping[str, Any]) -> str:
+        total = " | ".join(f"{cost[k]['mean']:.3g}" if k in cost else "n/a"
+                           for k in ("trials", "simulated_time", "wall_time"))
+        return f"| {plant} | {name} | {rate(success)} | {total} |"
+    for data in benches:
         agg = data["aggregate"]
         best = recommended(agg)
         if best is None:
             continue
+        plant = _plant_label(data)
         for cond in [best] + [c for c in HEADLINE_ROWS if c in agg and c != best]:
-            cost = _total_cost(agg[cond])
-            total = " | ".join(f"{cost[k]['mean']:.3g}" if k in cost else "n/a"
-                               for k in ("trials", "simulated_time", "wall_time"))
             name = f"**{REGISTRY[cond].label}** (use)" if cond == best else REGISTRY[cond].label
-            lines.append(f"| {data.get('plant', 'cart_pole')} | {name} | {rate(agg[cond]['success_rate'])} | {total} |")
+            lines.append(row(plant, name, agg[cond]["success_rate"], _total_cost(agg[cond])))
+        for other in trained:
+            if (other["plant"], list(other["set"])) == (data.get("plant", "cart_pole"), list(data.get("set") or [])):
+                for e in other["algorithms"].values():
+                    if "all" in e:
+                        lines.append(row(plant, f"{e['settings']['algorithm']} (trained once)", e["all"], e["cost"]))
     return lines if len(lines) > 2 else []
 
 

@@ -22,7 +22,7 @@ from typing import Any, Callable, Mapping
 
 from icoac.studies import tables
 from icoac.studies.bench import summary_markdown
-from icoac.tools import heldout_tuning, ico_ablation
+from icoac.tools import heldout_tuning, ico_ablation, rl_baselines
 from icoac.tools.pages import update_or_check
 
 BLOCK = re.compile(r"(<!-- table: (?P<name>[a-z-]+) (?P<file>[\w.-]+\.json(,[\w.-]+\.json)*) -->\n)(?P<body>.*?)"
@@ -54,6 +54,7 @@ TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
     "tuning": heldout_tuning.choices_table,
     "prior-reading": heldout_tuning.prior_reading_table,
     "tuning-evaluation": heldout_tuning.evaluation_table,
+    "rl-baselines": rl_baselines.table,
 }
 
 

@@ -18,7 +18,7 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
 
@@ -27,7 +27,7 @@ from icoac.core.config import build_config, model_to_dict, parse_sets
 from icoac.core.errors import UsageError
 from icoac.core.plants import PLANTS
 from icoac.core.registry import REGISTRY
-from icoac.studies import bench, heldout
+from icoac.studies import bench, heldout, tables
 from icoac.studies.baselines import sb3
 from icoac.tools.resumable import guarded
 
@@ -67,8 +67,11 @@ def run_one(args, cfg, algo: str, seed: int, steps: int) -> dict[str, Any]:
 
 
 def _rates(masks: dict[int, np.ndarray]) -> dict[str, Any]:
+    """Mean success over seeds, its sd over seeds and its bootstrap interval over cells and seeds."""
     stack = np.stack([masks[s] for s in sorted(masks)])
-    return {"mean": float(stack.mean()), "ci95": stats.interval(stack, stats.rate) if len(masks) > 1 else None}
+    per_seed = stack.mean(axis=1)
+    return {"mean": float(per_seed.mean()), "sd": float(per_seed.std(ddof=1)) if len(masks) > 1 else 0.0,
+            "ci95": stats.interval(stack, stats.rate)}
 
 
 def bench_masks(args, cfg, seeds: list[int]) -> dict[str, dict[int, np.ndarray]]:
@@ -111,8 +114,50 @@ def collect(args, cfg) -> dict[str, Any]:
             entry["all"] = _rates(masks)
             entry["heldout"] = _rates({s: m[held] for s, m in masks.items()})
             entry["paired"] = {c: stats.paired(masks, m) for c, m in others.items()}
+        if runs:
+            entry["cost"] = {key: {"mean": float(np.mean([r[field] for r in runs.values()]))}
+                             for key, field in (("trials", "episodes"), ("steps", "steps"),
+                                                ("simulated_time", "simulated_time"))}
+            entry["cost"]["wall_time"] = {"mean": float(np.mean([r["train_wall_time"] + r["eval_wall_time"]
+                                                                 for r in runs.values()]))}
         data["algorithms"][algo] = entry
+    gits = [r["git"] for e in data["algorithms"].values() for r in e["runs"].values()]
+    data.update(profile="rl-baselines", configuration="default", git=results.git_info(),
+                seeds=sorted({int(s) for e in data["algorithms"].values() for s in e["runs"]}),
+                cell_builds=[g for i, g in enumerate(gits) if g not in gits[:i]])
     return data
+
+
+def _points(p: Mapping[str, Any]) -> str:
+    if p.get("points") is None:
+        return "n/a"
+    lo, hi = p["ci95"] or (None, None)
+    ci = f" ({lo:+.1f} to {hi:+.1f})" if lo is not None else ""
+    return f"{p['points']:+.1f}{ci}, p ≤ {p['p_max']:.2g}"
+
+
+PAIRED_WITH = ("ico-rl", "rl", "search", "cma-es", "lqr")
+
+
+def table(data: Mapping[str, Any]) -> list[str]:
+    """PPO and SAC on one plant: budget, success (all and held-out cells), cost, and the paired
+    difference against the bench's conditions (points, their interval, McNemar's largest p)."""
+    paired = [c for c in PAIRED_WITH if any(c in e.get("paired", {}) for e in data["algorithms"].values())]
+    lines = ["| method | env steps (RL Zoo's) | seeds | success, all cells (95 % interval) | held-out cells | "
+             "training episodes | simulated time (s) | wall time (s) | " +
+             " | ".join(f"against {REGISTRY[c].label} (points)" for c in paired) + " |",
+             "|---|---|---|---|---|---|---|---|" + "---|" * len(paired)]
+    for algo, e in data["algorithms"].items():
+        if "all" not in e:
+            continue
+        st, cost = e["settings"], e["cost"]
+        cells = [f"{st['algorithm']}", f"{st['steps']:.3g} ({st['zoo_steps']:.0e})", str(len(e["runs"])),
+                 tables.rate(e["all"]), tables.percent(e["heldout"]["mean"]),
+                 f"{cost['trials']['mean']:.3g}", f"{cost['simulated_time']['mean']:.3g}",
+                 f"{cost['wall_time']['mean']:.3g}"] + [_points(e["paired"][c]) if c in e["paired"] else "n/a"
+                                                        for c in paired]
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
 
 
 def main(argv: list[str] | None = None) -> int:
