@@ -310,7 +310,8 @@ def build_parser() -> argparse.ArgumentParser:
         "ceiling", help="the best single w found (method.md, L5): fixed-w evaluation, search for the best w, "
                         "first-step bound",
         epilog="Without --w: a seeded search (typical ICO weights - the mean of --prior-from - and LQR gains "
-               "as starting points, random search over magnitudes and signs, local refinement), screened "
+               "as starting points, random search over magnitudes and signs, local refinement; or CMA-ES from "
+               "the best starting point, --optimiser cma-es), screened "
                "with one trial per cell at --screen-steps steps; the best --confirm are run at the full "
                "horizon and the best of them under every --protocol. Writes OUT/search.json (every screen; "
                "rerunning the same command resumes), OUT/evals/*/ (results directories), "
@@ -328,7 +329,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"trial cap of the retries protocol (default: --profile's, else {O.CEILING_MAX_TRIALS})")
     c.add_argument("--success-steps", type=_positive_int, default=None,
                    help="full horizon: steps of a successful trial (default 1e5)")
-    c.add_argument("--cells", default=None, help="subset of the plant grid's cell indices (row-major, from 0), e.g. 0,5,600-610")
+    c.add_argument("--cells", default=None,
+                   help="subset of the plant grid's cell indices (row-major, from 0), e.g. 0,5,600-610, or 'tuning': "
+                        "the held-out split's tuning cells (docs/tuning.md)")
+    c.add_argument("--optimiser", choices=O.CEILING_OPTIMISERS, default=None,
+                   help="the search: pattern (starting points, random search, pattern refinement; the default) or "
+                        "cma-es (CMA-ES on w from the best starting point), each screening --candidates w")
     c.add_argument("--candidates", type=_int_in(1, O.CEILING_MAX_CANDIDATES, f"an integer in [1, {O.CEILING_MAX_CANDIDATES}]"),
                    default=None, metavar="N", help=f"distinct w screened by the search (default {O.CEILING_CANDIDATES})")
     c.add_argument("--screen-steps", type=_positive_int, default=None, metavar="N",
@@ -491,7 +497,7 @@ def cmd_ceiling(args) -> int:
         protocol=args.protocol, max_trials=O.CEILING_MAX_TRIALS if max_trials is None else max_trials,
         success_steps=success_steps, cells=args.cells,
         candidates=args.candidates, screen_steps=args.screen_steps, confirm=args.confirm, seed=args.seed,
-        threads=args.threads, sets=args.set or [], quiet=args.quiet, plant=args.plant)
+        optimiser=args.optimiser, threads=args.threads, sets=args.set or [], quiet=args.quiet, plant=args.plant)
     return ceiling.run_ceiling(opt, argv=sys.argv[1:])
 
 

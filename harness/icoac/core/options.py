@@ -59,6 +59,7 @@ CEILING_CANDIDATES = 1000        # distinct w screened by the search (starting p
 CEILING_SCREEN_STEPS = 1000      # horizon of the screening runs (first protocol)
 CEILING_CONFIRM = 5              # best screened w confirmed at the full horizon
 CEILING_MAX_CANDIDATES = 100_000
+CEILING_OPTIMISERS = ("pattern", "cma-es")  # the search's optimiser (the first: the default)
 # A typical ICO weight vector (w_x, w_xdot, w_theta, w_thetadot): the start of the search when no
 # ICO results directory is given (--prior-from).
 TYPICAL_ICO_WEIGHTS = (0.094, 0.066, 0.365, 0.080)

@@ -31,6 +31,7 @@ TUNING_FRACTION = 0.3
 TUNING_SEEDS = (100, 101)
 SETTINGS = 12
 TIE = 1e-9
+TUNING_CELLS = "tuning"  # the cell spec that names the tuning cells (`ceiling --cells tuning`)
 
 # Each learner's space: parameter -> values, full factorial, SETTINGS settings each, the current
 # cart-pole default first. The four actor-critic priors share one space: the two readings with their
@@ -83,6 +84,14 @@ def tuning_cells(plant: str) -> np.ndarray:
     rng = np.random.Generator(np.random.PCG64([SPLIT_STREAM, _plant_seed(plant)]))
     n = int(round(TUNING_FRACTION * grid.cells))
     return np.sort(rng.choice(grid.cells, size=n, replace=False))
+
+
+def cell_spec(spec: Any, plant: str) -> Any:
+    """A command's --cells with the name TUNING_CELLS replaced by the plant's tuning cells (a list of
+    indices); any other spec unchanged."""
+    if isinstance(spec, str) and spec.strip() == TUNING_CELLS:
+        return [int(i) for i in tuning_cells(plant)]
+    return spec
 
 
 def heldout_mask(plant: str) -> np.ndarray:

@@ -22,7 +22,7 @@ from typing import Any, Callable, Mapping
 
 from icoac.studies import tables
 from icoac.studies.bench import summary_markdown
-from icoac.tools import heldout_tuning, ico_ablation, rl_baselines
+from icoac.tools import heldout_tuning, ico_ablation, one_w, rl_baselines
 from icoac.tools.pages import update_or_check
 
 BLOCK = re.compile(r"(<!-- table: (?P<name>[a-z-]+) (?P<file>[\w.-]+\.json(,[\w.-]+\.json)*) -->\n)(?P<body>.*?)"
@@ -41,6 +41,7 @@ def _summary(data: Mapping[str, Any]) -> list[str]:
 # Tables of several summaries (a block naming FILE1,FILE2,...): one row group per file.
 MULTI_TABLES: dict[str, Callable[[list[Mapping[str, Any]]], list[str]]] = {
     "headline": tables.headline_table,
+    "one-w": one_w.table,
 }
 TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
     "comparison": _summary,

@@ -13,21 +13,24 @@ import numpy as np
 
 from icoac.core import binding as B
 from icoac.core import geometry, grid, results, store
+from icoac.studies import heldout
 from icoac.studies import prior as P
 from icoac.core.errors import UsageError
-from icoac.core.options import CART_POLE, CEILING_CANDIDATES, CEILING_CONFIRM, CEILING_FILE, CEILING_MAX_CANDIDATES, CEILING_MAX_TRIALS, CEILING_PROTOCOLS, CEILING_SCREEN_STEPS, INT64_MAX
+from icoac.core.options import CART_POLE, CEILING_CANDIDATES, CEILING_CONFIRM, CEILING_FILE, CEILING_MAX_CANDIDATES, CEILING_MAX_TRIALS, CEILING_OPTIMISERS, CEILING_PROTOCOLS, CEILING_SCREEN_STEPS, INT64_MAX
 from icoac.studies.ceiling.bound import first_step_bound
+from icoac.studies.ceiling.cma_search import CMA_ES, cma_search
 from icoac.studies.ceiling.fixed import check_overrides, eval_dir, evaluate_into, fixed_config, protocol_summary, protocols_of
 from icoac.studies.ceiling.lqr import lqr_starts
 from icoac.studies.ceiling.records import FORMAT_VERSION, SEARCH_FILE, SUMMARY_MD, ScreenStore, summary_markdown
-from icoac.studies.ceiling.search import screen_cells, search
+from icoac.studies.ceiling.search import PATTERN, screen_cells, search
 from icoac.studies.ceiling.weights import as_weights, format_w, parse_weights, typical_weights
 
 
 @dataclass
 class CeilingOptions:
-    """What `ceiling` runs (see icoac.cli): a given w (no search) or the search, the protocols of
-    the final evaluation, caps, cells, budgets."""
+    """What `ceiling` runs (see icoac.cli): a given w (no search) or the search and its optimiser
+    (None: the pattern search), the protocols of the final evaluation, caps, cells ('tuning': the
+    held-out split's tuning cells), budgets."""
     out: Path
     prior_from: Path | None = None
     w: Sequence[float] | str | None = None
@@ -39,10 +42,15 @@ class CeilingOptions:
     screen_steps: int | None = None
     confirm: int | None = None
     seed: int = 0
+    optimiser: str | None = None
     threads: int = 0
     sets: Sequence[str] = ()
     quiet: bool = False
     plant: str = CART_POLE
+
+
+OPTIMISERS = (PATTERN, CMA_ES)  # --optimiser, the first the default
+assert OPTIMISERS == CEILING_OPTIMISERS
 
 
 def _positive(name: str, value: Any, hi: int = INT64_MAX) -> int:
@@ -66,8 +74,11 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
     threads = grid.check_threads(opt.threads)
     max_trials = _positive("--max-trials", opt.max_trials)
     overrides = check_overrides(opt.sets, opt.plant)
+    optimiser = PATTERN if opt.optimiser is None else opt.optimiser
+    if optimiser not in OPTIMISERS:
+        raise UsageError(f"--optimiser {optimiser!r:.40}: valid: {', '.join(OPTIMISERS)}")
     try:
-        indices = grid.parse_cell_indices(opt.cells, geometry.of(opt.plant).cells)
+        indices = grid.parse_cell_indices(heldout.cell_spec(opt.cells, opt.plant), geometry.of(opt.plant).cells)
     except B.ConfigError as exc:
         raise UsageError(f"--cells: {exc}") from None
     n_inputs = geometry.of(opt.plant).n_inputs
@@ -79,7 +90,8 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
     if opt.w is not None:
         given = parse_weights(opt.w, n=n_inputs) if isinstance(opt.w, str) else as_weights(opt.w, "--w", n_inputs)
         extra = [name for name, v in (("--prior-from", opt.prior_from), ("--candidates", opt.candidates),
-                                      ("--screen-steps", opt.screen_steps), ("--confirm", opt.confirm)) if v is not None]
+                                      ("--screen-steps", opt.screen_steps), ("--confirm", opt.confirm),
+                                      ("--optimiser", opt.optimiser)) if v is not None]
         if extra:
             raise UsageError(f"--w evaluates the given w without a search; {', '.join(extra)} apply to the search")
         fixed_config(given, "first", success_steps=success_steps, overrides=overrides, plant=opt.plant)
@@ -118,7 +130,7 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
                         "path": prior_info.source, "mean": list(prior_info.mean), "n_cells": prior_info.n_cells,
                         "commit": prior_info.source_commit}}
         if given is None:
-            settings.update(candidates=candidates, screen_steps=screen_steps, confirm=confirm)
+            settings.update(candidates=candidates, screen_steps=screen_steps, confirm=confirm, optimiser=optimiser)
         record: dict[str, Any] = {"format_version": FORMAT_VERSION, "command": "ceiling", "argv": list(argv),
                                   "settings": settings, "git": git, "abi": B.abi_info(),
                                   "policy": {"gain": float(probe.controller.policy.gain),
@@ -163,10 +175,13 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
                                         f"{entry['n_success']} cells; best {best['n_success']} {format_w(best['w'])}")
 
                 starts = [typical] + lqr_starts(probe)
-                _log(opt.quiet, f"search: {candidates} candidates screened at {screen_steps} steps (first trial), "
-                                f"{len(starts)} starting points")
+                _log(opt.quiet, f"search ({optimiser}): {candidates} candidates screened at {screen_steps} steps "
+                                f"(first trial), {len(starts)} starting points")
                 t0 = time.monotonic()
-                res = search(screen, starts, candidates, seed, report=report)
+                if optimiser == CMA_ES:  # its fitness needs the most steps a screen can survive
+                    res = cma_search(screen, starts, candidates, seed, template.size * screen_steps, report=report)
+                else:
+                    res = search(screen, starts, candidates, seed, report=report)
                 screens.flush()
                 screen_wall = time.monotonic() - t0
                 _log(opt.quiet, f"  {len(res.trace)} screened ({screens.reused} from {SEARCH_FILE}) in "
@@ -186,7 +201,8 @@ def run_ceiling(opt: CeilingOptions, argv: Sequence[str] = ()) -> int:
                     "candidates": candidates, "screen_steps": screen_steps, "confirm": confirm, "seed": seed,
                     "stop": res.stop, "refinement_steps": res.refinement_steps,
                     "refinement_origins": res.refinement_origins, "screened": len(res.trace),
-                    "phases": {p: sum(1 for e in res.trace if e["phase"] == p) for p in ("start", "random", "refine")},
+                    "phases": {p: sum(1 for e in res.trace if e["phase"] == p) for p in res.phases},
+                    "optimiser": res.optimiser,
                     "reused_screens": screens.reused, "screen_wall_time": screen_wall,
                     "confirm_wall_time": time.monotonic() - t0,
                     "starts": res.starts, "screen_best": res.best, "confirmed": confirmed, "trace": res.trace}

@@ -18,7 +18,7 @@ from icoac.core import results, store
 from icoac.core.errors import ResultsError, UsageError
 from icoac.core.metrics import percent
 from icoac.core.options import CART_POLE, CEILING_DIR, CEILING_FILE, CEILING_PROTOCOLS
-from icoac.studies.ceiling.search import Screen
+from icoac.studies.ceiling.search import PATTERN, Screen
 from icoac.studies.ceiling.weights import as_weights, format_w
 
 FORMAT_VERSION = 1
@@ -26,6 +26,7 @@ SEARCH_FILE = "search.json"
 SUMMARY_MD = "ceiling.md"
 FLUSH_EVERY = 2.0                             # s between rewrites of search.json
 PROTOCOL_LABELS = {"first": "first trial", "retries": "retries"}
+PHASE_LABELS = {"start": "starting points", "random": "random", "refine": "refinement", "cma": "CMA-ES"}
 
 
 class ScreenStore:
@@ -80,6 +81,14 @@ class ScreenStore:
         self.last = time.monotonic()
 
 
+def _optimiser_text(optimiser: Mapping[str, Any] | None) -> str:
+    """What the summary says of the optimiser: nothing for the pattern search (its phases say it)."""
+    if not optimiser or optimiser["name"] == PATTERN or "sigma0" not in optimiser:
+        return ""
+    return (f"; CMA-ES from {optimiser['start']}, sigma0 {optimiser['sigma0']:.4g}, population "
+            f"{optimiser['popsize']}, {len(optimiser['runs'])} run(s)")
+
+
 def _count(s: Mapping[str, Any], key: str, den: str, rate: str) -> str:
     return f"{s[key]} of {s[den]} ({percent(s[rate])})"
 
@@ -120,8 +129,9 @@ def summary_markdown(record: Mapping[str, Any]) -> str:
     s = record.get("search")
     if s:
         ph = s["phases"]
+        phases = ", ".join(f"{n} {PHASE_LABELS[p]}" for p, n in ph.items())
         lines += ["", f"Search: {s['screened']} candidates screened at {s['screen_steps']} steps, first trial "
-                      f"({ph['start']} starting points, {ph['random']} random, {ph['refine']} refinement; stop: "
+                      f"({phases}{_optimiser_text(s.get('optimiser'))}; stop: "
                       f"{s['stop']}; seed {s['seed']}); the best {len(s['confirmed'])} confirmed at "
                       f"{st['success_steps']:g} steps:", "",
                   "| # | w | screen: success (interior) | full horizon, first trial: success (interior) |",

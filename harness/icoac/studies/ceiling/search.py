@@ -28,7 +28,7 @@ screening set, by construction.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
@@ -48,6 +48,8 @@ LOCAL_FLIP = 0.1
 STEP_START, STEP_MIN = 0.5, 1.0 / 32.0
 GAUSS_MOVES = 4
 CLIP_MAGNITUDES = (1e-4, 1e3)
+PATTERN = "pattern"   # this search's name (--optimiser)
+PATTERN_PHASES = ("start", "random", "refine")
 
 
 @dataclass(frozen=True)
@@ -80,7 +82,7 @@ def rank_key(entry: Mapping[str, Any]) -> tuple[int, int]:
     return (entry["n_success"], entry["total_steps"])
 
 
-class _Budget(Exception):
+class BudgetSpent(Exception):
     """The candidate budget is spent."""
 
 
@@ -92,6 +94,8 @@ class SearchResult:
     stop: str               # "budget", or "exhausted" (every start and random candidate refined)
     refinement_steps: list[float]
     refinement_origins: list[int]   # index of the candidate each refinement started from
+    optimiser: dict = field(default_factory=lambda: {"name": PATTERN})  # its name and settings
+    phases: tuple[str, ...] = PATTERN_PHASES  # the phases of its trace, in order
 
     def ranked(self) -> list[dict]:
         """Screened candidates, best first (ties: earlier first)."""
@@ -103,33 +107,46 @@ def _clip(w: np.ndarray) -> np.ndarray:
     return np.sign(w) * np.clip(np.abs(w), lo, hi)
 
 
+class Screening:
+    """The screened candidates of a search: each distinct w (as the controller runs it) screened
+    once by ``screen``, in order, until ``candidates`` are spent (then BudgetSpent); the incumbent is
+    the best screened (first of equals)."""
+
+    def __init__(self, screen: Callable[[tuple[float, ...]], Screen], candidates: int,
+                 report: Callable[[dict, dict], None] | None = None):
+        if isinstance(candidates, bool) or not isinstance(candidates, int) or candidates < 1:
+            raise UsageError(f"--candidates must be an integer >= 1, got {candidates!r:.40}")
+        self.screen, self.candidates, self.report = screen, candidates, report
+        self.trace: list[dict] = []
+        self.seen: dict[tuple[float, ...], dict] = {}
+        self.best: dict | None = None
+
+    def trial(self, w, phase: str, label: str) -> dict:
+        """The screened entry of w (clipped unless a starting point); an earlier equal w's entry
+        is returned without spending the budget."""
+        w = as_weights(w if phase == "start" else _clip(np.asarray(w, dtype=np.float64)), "candidate")
+        if w in self.seen:
+            return self.seen[w]
+        if len(self.trace) >= self.candidates:
+            raise BudgetSpent
+        s = self.screen(w)
+        entry = {"index": len(self.trace), "phase": phase, "label": label, "w": list(w), **asdict(s)}
+        self.trace.append(entry)
+        self.seen[w] = entry
+        if self.best is None or rank_key(entry) > rank_key(self.best):
+            self.best = entry
+        if self.report is not None:
+            self.report(entry, self.best)
+        return entry
+
+
 def search(screen: Callable[[tuple[float, ...]], Screen], starts: Sequence[tuple[str, Sequence[float]]],
            candidates: int, seed: int, report: Callable[[dict, dict], None] | None = None) -> SearchResult:
     """The search of the module docstring: ``candidates`` distinct w are screened by ``screen``
     (starting points first), the random phase takes half of what remains, refinement the rest."""
-    if isinstance(candidates, bool) or not isinstance(candidates, int) or candidates < 1:
-        raise UsageError(f"--candidates must be an integer >= 1, got {candidates!r:.40}")
+    screening = Screening(screen, candidates, report)
+    trial, trace = screening.trial, screening.trace
     rng = np.random.default_rng([int(grid.check_seed(seed)), SEARCH_STREAM])
-    trace: list[dict] = []
-    seen: dict[tuple[float, ...], dict] = {}
-    state: dict[str, Any] = {"best": None}
-
-    def trial(w, phase: str, label: str) -> dict:
-        w = as_weights(w if phase == "start" else _clip(np.asarray(w, dtype=np.float64)), "candidate")
-        if w in seen:
-            return seen[w]
-        if len(trace) >= candidates:
-            raise _Budget
-        s = screen(w)
-        entry = {"index": len(trace), "phase": phase, "label": label, "w": list(w), **asdict(s)}
-        trace.append(entry)
-        seen[w] = entry
-        if state["best"] is None or rank_key(entry) > rank_key(state["best"]):
-            state["best"] = entry
-        if report is not None:
-            report(entry, state["best"])
-        return entry
-
     start_list = [(label, as_weights(w, f"starting point {label}")) for label, w in starts]
     steps: list[float] = []
     origins: list[int] = []
@@ -176,7 +193,7 @@ def search(screen: Callable[[tuple[float, ...]], Screen], starts: Sequence[tuple
                     step /= 2.0
                 else:
                     incumbent = round_best
-    except _Budget:
+    except BudgetSpent:
         stop = "budget"
     return SearchResult(starts=[{"label": label, "w": list(w)} for label, w in start_list], trace=trace,
-                        best=state["best"], stop=stop, refinement_steps=steps, refinement_origins=origins)
+                        best=screening.best, stop=stop, refinement_steps=steps, refinement_origins=origins)
