@@ -11,7 +11,7 @@
  *           the double below min, the double above max; past n_params: -0, 0, DBL_TRUE_MIN,
  *           -DBL_TRUE_MIN).
  *   ops     at most FZ_MODEL_OPS, until the input ends. Op byte o; o in [0x80, 0xC0): a run op
- *           (below); else (o & 7) % 7 (7 reads as 0):
+ *           (below); else o & 7:
  *           0 step      6 doubles state, 1 double u: icoac_sim_model_step.
  *           1 deriv     6 doubles state, 1 double u: icoac_sim_model_derivatives.
  *           2 failed    6 doubles state: icoac_sim_model_failed.
@@ -25,8 +25,11 @@
  *                       selector byte k % 4: 0 NULL, 1 the name of plant (byte % count),
  *                       2 that name less its last character, 3 a length byte (% 24) and that
  *                       many bytes: icoac_sim_plant_find.
+ *           7 lanes     lane count byte (% 5), then per lane 6 doubles state, 1 double u and an
+ *                       ended byte (% 3: 0, 1, -5): icoac_sim_model_step_lanes, each lane
+ *                       against icoac_sim_model_step and _failed on a copy of its state.
  *           o >= 0xC0: NULL pointers, bit 3 the state array, bit 4 the output (ds, failed,
- *           energy; start: the cell), bit 5 the rng.
+ *           energy; start: the cell; lanes: u), bit 5 the rng (lanes: ended).
  *           A state's entries past the plant's n_state are replaced by a canary.
  *   run ops o & 3, on the model; o & 0x20: NULL pointers, bit 2 the configuration, bit 3 the
  *           cell / cells / trajectory states, bit 4 the run / trajectory forces.
@@ -112,7 +115,7 @@
 #define FZ_NAME_MAX 24
 
 /* Op kinds (op byte (o & 7) % OP_KINDS) and NULL-pointer bits of the op byte. */
-enum { OP_STEP, OP_DERIVATIVES, OP_FAILED, OP_ENERGY, OP_START, OP_GRID, OP_REGISTRY, OP_KINDS };
+enum { OP_STEP, OP_DERIVATIVES, OP_FAILED, OP_ENERGY, OP_START, OP_GRID, OP_REGISTRY, OP_LANES, OP_KINDS };
 #define NULL_STATE 0x08u
 #define NULL_OUT 0x10u
 #define NULL_RNG 0x20u
@@ -428,6 +431,52 @@ static void call_start(const setup_t *su, const icoac_sim_cell_t *cell, double n
     }
     c->status = icoac_sim_model_start(su->model, (nulls & NULL_OUT) ? 0 : cell, noise, (nulls & NULL_RNG) ? 0 : &rng,
                                       (nulls & NULL_STATE) ? 0 : c->s);
+}
+
+/* Op 7: icoac_sim_model_step_lanes over 0-4 lanes. A refused call leaves every lane as it was; an
+ * accepted one leaves the lanes given as ended alone and gives each other lane what
+ * icoac_sim_model_step and icoac_sim_model_failed give on a copy of it (ended = 1 when the step
+ * is refused), and writes no entry past n_state. */
+static void op_lanes(fz_reader_t *r, const setup_t *su, unsigned nulls)
+{
+    enum { LANES = 4 };
+    static const int32_t ended_values[3] = {0, 1, -5};
+    double states[LANES][MAXS], s0[LANES][MAXS], u[LANES];
+    int32_t ended[LANES], ended0[LANES];
+    const int lanes = fz_u8(r) % (LANES + 1);
+    int32_t status;
+    int i, k;
+    for (i = 0; i < lanes; ++i) {
+        for (k = 0; k < MAXS; ++k) {
+            s0[i][k] = fz_double(r);
+        }
+        u[i] = fz_double(r);
+        ended0[i] = ended_values[fz_u8(r) % 3];
+    }
+    memcpy(states, s0, sizeof states);
+    memcpy(ended, ended0, sizeof ended);
+    status = icoac_sim_model_step_lanes(su->model, (nulls & NULL_STATE) ? 0 : &states[0][0],
+                                        (nulls & NULL_OUT) ? 0 : u, (nulls & NULL_RNG) ? 0 : ended, lanes);
+    FZ_CHECK(fz_sim_status_known(status), "step_lanes returned unknown status %d", (int)status);
+    if (su->check != ICOAC_SIM_OK || (lanes > 0 && (nulls & (NULL_STATE | NULL_OUT | NULL_RNG)))) {
+        FZ_CHECK(status == (su->check != ICOAC_SIM_OK ? su->check : ICOAC_SIM_ERR_BAD_ARGUMENT),
+                 "step_lanes returned %d (model check %d, nulls %u)", (int)status, (int)su->check, nulls);
+        FZ_CHECK(memcmp(states, s0, sizeof states) == 0 && memcmp(ended, ended0, sizeof ended) == 0,
+                 "step_lanes returned %d but changed a lane", (int)status);
+        return;
+    }
+    FZ_CHECK(status == ICOAC_SIM_OK, "step_lanes of a valid model returned %d", (int)status);
+    for (i = 0; i < lanes; ++i) {
+        double ref[MAXS];
+        int32_t failed = 1;
+        memcpy(ref, s0[i], sizeof ref);
+        if (ended0[i] == 0 && icoac_sim_model_step(su->model, ref, u[i]) == ICOAC_SIM_OK) {
+            FZ_CHECK(icoac_sim_model_failed(su->model, ref, &failed) == ICOAC_SIM_OK, "failed refused a stepped state");
+        }
+        FZ_CHECK(ended[i] == (ended0[i] != 0 ? ended0[i] : failed) && memcmp(states[i], ref, sizeof ref) == 0,
+                 "step_lanes lane %d: ended %d (given %d, expected %d) or its state differs", i, (int)ended[i],
+                 (int)ended0[i], (int)failed);
+    }
 }
 
 static void op_start(fz_reader_t *r, const setup_t *su, unsigned nulls)
@@ -1017,6 +1066,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         case OP_START: op_start(&r, &su, nulls); break;
         case OP_GRID: op_grid(&r); break;
         case OP_REGISTRY: op_registry(&r); break;
+        case OP_LANES: op_lanes(&r, &su, nulls); break;
         default: op_state(&r, &su, (op & 7) % OP_KINDS, nulls); break;
         }
     }
