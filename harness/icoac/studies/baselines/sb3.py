@@ -19,7 +19,7 @@ steps of random actions first). torch runs on one CPU thread.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
 import numpy as np
@@ -40,7 +40,6 @@ class Algorithm:
     normalize: bool              # VecNormalize of observations and rewards (the Zoo's ``normalize``)
     budget: int                  # env steps of the default run
     zoo_budget: int              # the Zoo's n_timesteps for its entry
-    policy_kwargs: Mapping[str, Any] = field(default_factory=dict)
 
 
 ALGORITHMS: Mapping[str, Algorithm] = {
@@ -122,8 +121,7 @@ def train(algo: str, cfg: RunConfig, seed: int, steps: int) -> Trained:
     if spec.normalize:
         venv = VecNormalize(venv, gamma=spec.hyper.get("gamma", 0.99))
     cls = getattr(sb3, spec.label)
-    model = cls("MlpPolicy", venv, seed=seed, device="cpu", verbose=0, **spec.hyper,
-                **({"policy_kwargs": dict(spec.policy_kwargs)} if spec.policy_kwargs else {}))
+    model = cls("MlpPolicy", venv, seed=seed, device="cpu", verbose=0, **spec.hyper)
     model.learn(total_timesteps=steps)
     monitor = venv.venv.envs[0] if spec.normalize else venv.envs[0]
     normalizer = venv if spec.normalize else None
@@ -165,8 +163,9 @@ def evaluate(act: Callable[[np.ndarray], np.ndarray], cfg: RunConfig, grid_seed:
 def settings(algo: str, steps: int) -> dict[str, Any]:
     """What a run records of its algorithm's settings."""
     spec = ALGORITHMS[algo]
+    sb3, torch = _sb3()
     return {"algorithm": spec.label, "source": spec.source, "hyperparameters": dict(spec.hyper),
             "normalize": spec.normalize, "policy": "MlpPolicy", "steps": steps, "zoo_steps": spec.zoo_budget,
             "train_episode_steps": TRAIN_EPISODE_STEPS, "torch_threads": 1,
-            "stable_baselines3": _sb3()[0].__version__, "torch": _sb3()[1].__version__}
+            "stable_baselines3": sb3.__version__, "torch": torch.__version__}
 
