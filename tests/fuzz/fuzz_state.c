@@ -553,6 +553,7 @@ static void check_retune(run_t *run, const icoac_config_t *next)
     memcpy(ex->inv_range, st->inv_range, sizeof ex->inv_range);
     memcpy(ex->search.floor, st->search.floor, sizeof ex->search.floor);
     memcpy(&ex->grid, &st->grid, sizeof ex->grid); /* derived again from the same grid and mode */
+    ex->batch_token = 0u; /* a batch that had loaded the state loads it again */
     FZ_CHECK(memcmp(&expect, run->state, sizeof expect) == 0,
              "op %d: icoac_retune changed more than the configuration and what it derives", run->op);
 }
