@@ -19,9 +19,10 @@ FORBIDDEN = f"{PACKAGE}.cli"
 ENTRY = f"{PACKAGE}.__main__"  # the one module allowed to import the command line
 
 # The layers (folders of the package) and the layers each may import: the core imports no other
-# layer; the integrations (Dask, Gymnasium) only the core; the studies the core and the Dask backend
-# that runs their grids; the command line and the maintainers' tools what they drive.
-LAYERS = {"core": set(), "cluster": {"core"}, "gym": {"core"}, "studies": {"core", "cluster"},
+# layer; the integrations (Dask, Gymnasium) only the core; the studies the core, the Dask backend
+# that runs their grids and the envs the trained baselines learn on; the command line and the
+# maintainers' tools what they drive.
+LAYERS = {"core": set(), "cluster": {"core"}, "gym": {"core"}, "studies": {"core", "cluster", "gym"},
           "cli": {"core", "cluster", "gym", "studies"}, "tools": {"core", "cluster", "studies"}}
 
 
