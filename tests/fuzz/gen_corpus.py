@@ -1080,6 +1080,29 @@ def batch_seeds():
     return s
 
 
+# Op 7 of fuzz_model (icoac_sim_model_step_lanes), written byte by byte: model mode and plant,
+# op 7, the lane count, then per lane 6 value selectors of the state, one of u and an ended byte.
+LANE_SEEDS = {
+    "lanes-mixed": bytes([0x00, 0x00, 0x07, 3] + [0] * 6 + [12, 0] + [8, 0, 0, 0, 0, 0] + [0, 0] + [0] * 6 + [9, 1]
+                         + [0xCF, 1] + [0] * 6 + [12, 0] + [0xE7, 2] + [0] * 16),
+    "lanes-furuta": bytes([0x02, 0x01, 0x07, 4] + [20] * 6 + [24, 0] + [5, 6, 7, 0, 0, 0] + [12, 2] + [0] * 6
+                          + [10, 0] + [13] * 6 + [14, 0]),
+    "lanes-null-model": bytes([0x03, 0x02, 0x07, 2] + [0] * 16),
+}
+# fuzz_state_double's finding of 2026-12-06 (a retune after icoac_step_batch had loaded the state:
+# the batch stamp is cleared), kept as found.
+RETUNE_AFTER_BATCH_LOAD = bytes.fromhex(
+    "010100000100000a000000000029000aec1f00081f03081f06081f09081f0c081f0f081f12081f15081f181e081f2108"
+    "1f24081f27081f2a081f2d3d081f30081f33081f36081f39081f3c081f3f081f420ffffaa883635838081f45081f4808"
+    "1f4b081f4e081f51081f54081f57081f5a081f5d081f60081f63081f66081f6908000000000000003a081f75081f7808"
+    "1f7b081f7e081f81081f84081f87081f8a081f8d081f90081f93081f96081f99081f9c081f9f081fa2081fa5081fa808"
+    "1fab081fae08021800000000181fcd0c1c00001ecd0c1c00000101044801450000010000000000000a000c2000082101"
+    "0522020a10000000000120ab6a20ab2a1220ab2affffffffffffffffffffffffffffffffffffffff05301fcd0c081f45"
+    "081f48081f4b081f4e081f51081f54081f5708000120ab6a20ab2a1220ab2a480502371f9ad91f9a191e00801f004004"
+    "03022a2100400304000101000403022a2100400304000101050120ab6a20ab2a1220ab2a0210000000000501200005ab"
+    "6a20ab2a1220ab2a02100000000005")
+
+
 def corpus():
     """{target: {file name: bytes}}."""
     float_seeds = controller_seeds("f")
@@ -1089,8 +1112,8 @@ def corpus():
         "fuzz_controller_double": controller_seeds("d"),
         "fuzz_state": state_seeds("f"),
         "fuzz_state_mcu": state_seeds("f"),
-        "fuzz_state_double": state_seeds("d"),
-        "fuzz_model": model_seeds(),
+        "fuzz_state_double": {**state_seeds("d"), "retune-after-batch-load": RETUNE_AFTER_BATCH_LOAD},
+        "fuzz_model": {**model_seeds(), **LANE_SEEDS},
         "fuzz_batch": batch_seeds(),
     }
 
