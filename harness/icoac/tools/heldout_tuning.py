@@ -107,12 +107,6 @@ def run(args) -> dict[str, Any]:
     return data
 
 
-def _rates(masks: dict[int, np.ndarray]) -> dict[str, Any]:
-    """Mean success over seeds with its bootstrap interval (icoac.core.stats)."""
-    stack = np.stack([masks[s] for s in sorted(masks)])
-    return {"mean": float(stack.mean()), "ci95": stats.interval(stack, stats.rate)}
-
-
 def evaluate(args, data: dict[str, Any]) -> dict[str, Any]:
     """Each tuned learner's choice on every cell with the bench's seeds, against the bench's grids
     of the defaults (see the module's head)."""
@@ -144,10 +138,10 @@ def evaluate(args, data: dict[str, Any]) -> dict[str, Any]:
             chosen[seed] = metrics.success_mask(results.load(d)[0])
             default[seed] = metrics.success_mask(results.load(bench.seed_dir(args.bench, learner, seed))[0])
         out[learner] = {"chosen_key": t["chosen_key"], "default_kept": t["default_kept"], "rerun": not reuse,
-                        "all": {"chosen": _rates(chosen), "default": _rates(default),
+                        "all": {"chosen": stats.success(chosen), "default": stats.success(default),
                                 "paired": stats.paired(chosen, default)},
-                        "heldout": {"chosen": _rates({s: m[held] for s, m in chosen.items()}),
-                                    "default": _rates({s: m[held] for s, m in default.items()}),
+                        "heldout": {"chosen": stats.success({s: m[held] for s, m in chosen.items()}),
+                                    "default": stats.success({s: m[held] for s, m in default.items()}),
                                     "paired": stats.paired({s: m[held] for s, m in chosen.items()},
                                                            {s: m[held] for s, m in default.items()})}}
         print(f"[evaluation] {learner}: held-out {100 * out[learner]['heldout']['default']['mean']:.1f} -> "

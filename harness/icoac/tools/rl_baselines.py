@@ -66,14 +66,6 @@ def run_one(args, cfg, algo: str, seed: int, steps: int) -> dict[str, Any]:
     return result
 
 
-def _rates(masks: dict[int, np.ndarray]) -> dict[str, Any]:
-    """Mean success over seeds, its sd over seeds and its bootstrap interval over cells and seeds."""
-    stack = np.stack([masks[s] for s in sorted(masks)])
-    per_seed = stack.mean(axis=1)
-    return {"mean": float(per_seed.mean()), "sd": float(per_seed.std(ddof=1)) if len(masks) > 1 else 0.0,
-            "ci95": stats.interval(stack, stats.rate)}
-
-
 def bench_masks(args, cfg, seeds: list[int]) -> dict[str, dict[int, np.ndarray]]:
     """Each condition of --bench that has grids for these seeds: its success masks; the plant
     parameters must be ours."""
@@ -111,8 +103,8 @@ def collect(args, cfg) -> dict[str, Any]:
         entry: dict[str, Any] = {"settings": sb3.settings(algo, steps), "runs": runs}
         if runs:
             masks = {s: _mask(r["success"]) for s, r in runs.items()}
-            entry["all"] = _rates(masks)
-            entry["heldout"] = _rates({s: m[held] for s, m in masks.items()})
+            entry["all"] = stats.success(masks)
+            entry["heldout"] = stats.success({s: m[held] for s, m in masks.items()})
             entry["paired"] = {c: stats.paired(masks, m) for c, m in others.items()}
         if runs:
             entry["cost"] = {key: {"mean": float(np.mean([r[field] for r in runs.values()]))}
