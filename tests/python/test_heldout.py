@@ -34,14 +34,21 @@ def test_splits_differ_by_plant_and_seeds_are_disjoint():
     assert not evaluation & set(H.TUNING_SEEDS)
 
 
+@pytest.mark.parametrize("plant", sorted(p for p in PLANTS if PLANTS[p].has_task))
 @pytest.mark.parametrize("learner", list(H.SPACES))
-def test_same_budget_default_first_every_setting_valid(learner):
-    settings = H.settings(learner)
+def test_same_budget_default_first_every_setting_valid(learner, plant):
+    settings = H.settings(learner, plant)
     assert len(settings) == H.SETTINGS and len({H.key(s) for s in settings}) == H.SETTINGS
-    first = build_config(settings[0], condition=learner)
-    assert bytes(first.controller) == bytes(build_config(condition=learner).controller)
+    first = build_config(settings[0], condition=learner, plant=plant)
+    assert bytes(first.controller) == bytes(build_config(condition=learner, plant=plant).controller)
     for s in settings:
-        build_config(s, condition=learner)  # ConfigError if the C check refused one
+        build_config(s, condition=learner, plant=plant)  # ConfigError if the C check refused one
+
+
+def test_the_cart_poles_space_is_the_one_its_runs_used():
+    """The cart-pole's tuning ran with SPACES as committed in 22d5b07: a plant's own spaces leave it."""
+    assert H.spaces("cart_pole") == dict(H.SPACES)
+    assert H.settings("ico")[:2] == [{"ico.rate": 1e-4, "ico.timing": "code"}, {"ico.rate": 1e-4, "ico.timing": "literal"}]
 
 
 def test_every_learner_is_tuned():

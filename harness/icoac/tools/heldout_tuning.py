@@ -77,7 +77,7 @@ def run_setting(args, learner: str, index: int, setting: dict[str, Any], ico_dir
 
 def tune(args, learner: str, ico_dirs: dict[int, Path] | None) -> dict[str, Any]:
     """The learner's rows and choice; with --report and unfinished settings, {"pending": ...}."""
-    rows = [run_setting(args, learner, i, s, ico_dirs) for i, s in enumerate(heldout.settings(learner))]
+    rows = [run_setting(args, learner, i, s, ico_dirs) for i, s in enumerate(heldout.settings(learner, args.plant))]
     if None in rows:
         return {"learner": learner, "pending": len(rows) - rows.count(None), "settings": len(rows)}
     ranked = heldout.rank(rows)
@@ -89,7 +89,7 @@ def tune(args, learner: str, ico_dirs: dict[int, Path] | None) -> dict[str, Any]
 def run(args) -> dict[str, Any]:
     """ICO, then every learner asked for, from ICO's chosen grids."""
     data: dict[str, Any] = {"plant": args.plant, "profile": "default", "configuration": "default", "set": [],
-                            "seeds": list(heldout.TUNING_SEEDS), "protocol": heldout.protocol(),
+                            "seeds": list(heldout.TUNING_SEEDS), "protocol": heldout.protocol(args.plant),
                             "n_tuning_cells": int(heldout.tuning_cells(args.plant).size),
                             "n_cells": int(heldout.heldout_mask(args.plant).size), "learners": {},
                             "git": results.git_info()}
@@ -101,7 +101,7 @@ def run(args) -> dict[str, Any]:
         if learner in args.learners:
             data["learners"][learner] = tune(args, learner, ico_dirs) if ico_dirs or \
                 not REGISTRY[learner].prior.takes_ico else \
-                {"learner": learner, "pending": 0, "settings": len(heldout.settings(learner))}
+                {"learner": learner, "pending": 0, "settings": len(heldout.settings(learner, args.plant))}
     builds = [b for t in data["learners"].values() for r in t.get("rows", []) for b in r["builds"]]
     data["cell_builds"] = [b for i, b in enumerate(builds) if b not in builds[:i]]
     return data
