@@ -51,6 +51,18 @@ def test_the_cart_poles_space_is_the_one_its_runs_used():
     assert H.settings("ico")[:2] == [{"ico.rate": 1e-4, "ico.timing": "code"}, {"ico.rate": 1e-4, "ico.timing": "literal"}]
 
 
+@pytest.mark.parametrize("algo", list(H.BASELINE_SPACES))
+def test_baselines_same_budget_zoo_first(algo):
+    """PPO's and SAC's spaces: SETTINGS settings each, the RL Zoo's start first, every name one the
+    algorithm's run takes (the Zoo's own or a Stable-Baselines3 default it leaves)."""
+    from icoac.studies.baselines import sb3
+    settings = H.baseline_settings(algo)
+    assert len(settings) == H.SETTINGS and len({H.key(s) for s in settings}) == H.SETTINGS
+    zoo = dict(sb3.ALGORITHMS[algo].hyper)
+    sb3_defaults = {"learning_rate": 3e-4, "gamma": 0.99}
+    assert all(settings[0][k] == zoo.get(k, sb3_defaults.get(k)) for k in settings[0])
+
+
 def test_every_learner_is_tuned():
     learners = {c.name for c in REGISTRY.values() if c.learns}
     assert set(H.SPACES) == learners

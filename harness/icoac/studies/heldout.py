@@ -75,6 +75,23 @@ PLANT_SPACES: Mapping[str, Mapping[str, Mapping[str, Sequence[Any]]]] = {
 }
 
 
+# PPO's and SAC's spaces (icoac.studies.baselines.sb3): hyperparameters over their RL Zoo start,
+# which comes first; the same SETTINGS x TUNING_SEEDS, each run at the algorithm's budget of env
+# steps, trained on the tuning cells only and scored on them by the same criterion (no trials to
+# success: ties go to the space's order). The same space on every plant.
+BASELINE_SPACES: Mapping[str, Mapping[str, Sequence[Any]]] = {
+    "ppo": {"learning_rate": [2.22425e-4, 1e-4, 5e-4, 1e-3], "gamma": [0.999, 0.99, 0.98]},
+    "sac": {"learning_rate": [3e-4, 1e-4, 1e-3], "learning_starts": [10_000, 1_000], "gamma": [0.99, 0.98]},
+}
+
+
+def baseline_settings(algo: str) -> list[dict[str, Any]]:
+    """PPO's or SAC's settings as hyperparameter overrides, in the space's order (the first: the
+    Zoo's)."""
+    space = BASELINE_SPACES[algo]
+    return [dict(zip(space, combo)) for combo in itertools.product(*space.values())]
+
+
 def spaces(plant: str) -> dict[str, Mapping[str, Sequence[Any]]]:
     """Every learner's space on the plant."""
     own = PLANT_SPACES.get(plant, {})
@@ -141,7 +158,9 @@ def protocol(plant: str = "cart_pole") -> dict[str, Any]:
             "settings": SETTINGS, "tie": TIE,
             "criterion": "mean success rate over the tuning seeds on the tuning cells; then fewer median trials "
                          "to success; then the space's order (its default first)",
-            "spaces": {name: {k: list(v) for k, v in space.items()} for name, space in spaces(plant).items()}}
+            "spaces": {name: {k: list(v) for k, v in space.items()} for name, space in spaces(plant).items()},
+            "baseline_spaces": {name: {k: list(v) for k, v in space.items()} for name, space in BASELINE_SPACES.items()}}
 
 
 assert all(len(settings(name, plant)) == SETTINGS for plant in ("cart_pole", *PLANT_SPACES) for name in SPACES)
+assert all(len(baseline_settings(name)) == SETTINGS for name in BASELINE_SPACES)
