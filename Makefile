@@ -43,7 +43,7 @@ FUZZ_SOURCES = $(shell git ls-tree HEAD $(FUZZ_C_SOURCES) 2>/dev/null | git hash
   cut -c1-12)$(shell git diff --quiet HEAD -- $(FUZZ_C_SOURCES) 2>/dev/null || echo -modified)
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_model fuzz_batch
 
-.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-baselines baselines baselines-venv test-fuzz fuzz fuzz-campaign fuzz-ledger bench tuning ablation \
+.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-baselines baselines baselines-venv test-fuzz fuzz fuzz-campaign fuzz-ledger bench tuning tuning-baselines ablation \
   bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
@@ -125,6 +125,13 @@ baselines: build baselines-venv
 	  --bench $(LIMITED_OUT) --data docs/data/rl-baselines-cart_pole-10N.json
 	$(VPY) -m icoac.tools.rl_baselines --plant furuta --out results/rl-baselines-furuta \
 	  --bench $(BENCH_OUT)-furuta --data docs/data/rl-baselines-furuta.json
+
+# The held-out tuning of PPO and SAC on PLANT (docs/tuning.md; the cart-pole's with its +-10 N),
+# resumable; its ranking in results/rl-baselines-tuning-$(PLANT)/tuning.json.
+TUNING_SETS_cart_pole := --set max_force=10
+tuning-baselines: build baselines-venv
+	$(VPY) -m icoac.tools.rl_baselines --plant $(PLANT) $(TUNING_SETS_$(PLANT)) --tune \
+	  --out results/rl-baselines-tuning-$(PLANT)
 
 build-fuzz: deps
 	cmake --preset fuzz >/dev/null

@@ -13,6 +13,7 @@ from icoac.core import binding as B
 from icoac.core.config import build_config, parse_sets
 from icoac.core.errors import UsageError
 from icoac.gym.plants import ModelParameters, model_start, plant_grid
+from icoac.studies import heldout
 from icoac.studies.baselines import sb3
 from icoac.tools import rl_baselines
 
@@ -71,3 +72,44 @@ def test_tool_resumes_and_reports(tmp_path, capsys):
     assert rl_baselines.main(["--plant", "cart_pole", "--out", str(tmp_path / "x"), "--report"]) == 2
     assert "max_force = 1e+06 is no actuator limit" in capsys.readouterr().err
     assert rl_baselines.main(argv + ["--steps", "0"]) == 2
+
+
+def test_training_starts_only_from_the_given_cells():
+    env = sb3.make_env(furuta(), cells=[5, 700])
+    first = [int(env.reset(seed=4)[1]["cell"])] + [int(env.reset()[1]["cell"]) for _ in range(40)]
+    assert set(first) == {5, 700}
+    assert "cell" not in env.reset(options={"state": [0.0, 0.0, 0.1, 0.0]})[1]
+    again = sb3.make_env(furuta(), cells=[5, 700])  # the same seed draws the same cells
+    assert [int(again.reset(seed=4)[1]["cell"])] + [int(again.reset()[1]["cell"]) for _ in range(40)] == first
+
+
+def test_tune_ranks_the_settings_on_the_tuning_cells(tmp_path, monkeypatch):
+    monkeypatch.setitem(heldout.BASELINE_SPACES, "ppo", {"learning_rate": [2.22425e-4, 1e-3]})
+    monkeypatch.setattr(heldout, "tuning_cells", lambda plant: np.array([3, 600, 900]))
+    out = tmp_path / "out"
+    argv = ["--plant", "furuta", "--algos", "ppo", "--steps", "64", "--set", "success_steps=20", "--out", str(out)]
+    assert rl_baselines.main(argv + ["--tune"]) == 0
+    data = json.loads((out / "tuning.json").read_text())
+    entry = data["algorithms"]["ppo"]
+    assert [r["order"] for r in entry["rows"]] == [r["order"] for r in heldout.rank(entry["rows"])]
+    assert entry["chosen"] == entry["rows"][0]["setting"] and data["n_tuning_cells"] == 3
+    for row in entry["rows"]:
+        for seed, rate in zip(heldout.TUNING_SEEDS, row["success_rates"]):
+            run = json.loads((out / "tuning" / "ppo" / row["key"] / f"seed-{seed}" / "result.json").read_text())
+            assert run["overrides"] == row["setting"] and run["training_cells"] == 3 and run["seed"] == seed
+            assert rate == np.mean([run["success"][c] == "1" for c in (3, 600, 900)])
+    # the evaluation run with a chosen setting records it
+    assert rl_baselines.main(argv + ["--seeds", "0", "--hyper", "learning_rate=1e-3"]) == 0
+    run = json.loads((out / "ppo" / "seed-0" / "result.json").read_text())
+    assert run["overrides"] == {"learning_rate": 1e-3} and run["training_cells"] == "all"
+
+
+@pytest.mark.parametrize("bad", [["--hyper", "learning_rate"], ["--hyper", "nonsense=1"], ["--hyper", "gamma=nan"],
+                                 ["--algos", "ppo", "sac", "--hyper", "gamma=0.9"],
+                                 ["--tune", "--hyper", "gamma=0.9"]])
+def test_bad_hyper_is_a_one_line_error(tmp_path, capsys, bad):
+    argv = ["--plant", "furuta", "--out", str(tmp_path / "x"), "--report"]
+    if "--algos" not in bad:
+        argv += ["--algos", "ppo"]
+    assert rl_baselines.main(argv + bad) == 2
+    assert "--hyper" in capsys.readouterr().err

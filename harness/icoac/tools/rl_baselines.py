@@ -9,7 +9,12 @@ Needs the [baselines] extra (`make baselines`). The plant's actuator limit (its 
 --set to change it) bounds the actions. Each (algorithm, seed) is OUT/<algo>/seed-<s>/ with the
 trained model and result.json; a stopped run resumes at the first unfinished one (one run is not
 resumed inside). --bench DIR (grids with the same plant parameters) adds the paired per-cell tests
-against its conditions, seed for seed. --report runs nothing."""
+against its conditions, seed for seed. --report runs nothing.
+
+--tune runs the held-out tuning instead (icoac.studies.heldout, BASELINE_SPACES; docs/tuning.md):
+each setting of each algorithm with the tuning seeds, trained on the plant's tuning cells only and
+scored on them, into OUT/tuning/<algo>/<setting>/seed-<s>/; OUT/tuning.json ranks the settings by
+the protocol's criterion. --hyper NAME=VALUE runs the evaluation with a chosen setting."""
 from __future__ import annotations
 
 import argparse
@@ -38,23 +43,27 @@ def _mask(text: str) -> np.ndarray:
     return np.frombuffer(text.encode(), dtype=np.uint8) == ord("1")
 
 
-def run_one(args, cfg, algo: str, seed: int, steps: int) -> dict[str, Any]:
-    """Train and evaluate one seed (or read its finished result)."""
-    out = args.out / algo / f"seed-{seed}"
+def run_one(args, cfg, algo: str, seed: int, steps: int, out: Path | None = None,
+            overrides: Mapping[str, Any] | None = None, cells: list[int] | None = None) -> dict[str, Any]:
+    """Train (on every cell, or on ``cells``) and evaluate on every cell one seed, into ``out``
+    (default OUT/<algo>/seed-<s>), or read its finished result."""
+    out = out if out is not None else args.out / algo / f"seed-{seed}"
     if (out / RESULT).is_file():
         return json.loads((out / RESULT).read_text())
     if args.report:
         return {}
     out.mkdir(parents=True, exist_ok=True)
     print(f"[{algo} seed {seed}] training {steps} steps", file=sys.stderr, flush=True)
-    trained = sb3.train(algo, cfg, seed, steps)
+    trained = sb3.train(algo, cfg, seed, steps, overrides, cells)
     trained.model.save(out / "model.zip")
     if trained.normalizer is not None:
         trained.normalizer.save(str(out / "vecnormalize.pkl"))
     t0 = time.monotonic()
     lasted, ok = sb3.evaluate(trained.act, cfg, seed)
     eval_wall = time.monotonic() - t0
-    result = {"algo": algo, "seed": seed, "steps": trained.steps, "episodes": trained.episodes,
+    result = {"algo": algo, "seed": seed, "overrides": dict(overrides or {}),
+              "training_cells": "all" if cells is None else len(cells),
+              "steps": trained.steps, "episodes": trained.episodes,
               "simulated_time": trained.steps * float(cfg.model.dt), "train_wall_time": trained.wall_time,
               "eval_wall_time": eval_wall, "success": "".join("1" if x else "0" for x in ok),
               "lasted": [int(v) for v in lasted], "git": results.git_info()}
@@ -99,8 +108,8 @@ def collect(args, cfg) -> dict[str, Any]:
         data["bench"] = str(args.bench)
     for algo in args.algos:
         steps = args.steps or sb3.ALGORITHMS[algo].budget
-        runs = {s: r for s in args.seeds if (r := run_one(args, cfg, algo, s, steps))}
-        entry: dict[str, Any] = {"settings": sb3.settings(algo, steps), "runs": runs}
+        runs = {s: r for s in args.seeds if (r := run_one(args, cfg, algo, s, steps, overrides=args.hyper))}
+        entry: dict[str, Any] = {"settings": sb3.settings(algo, steps, args.hyper), "runs": runs}
         if runs:
             masks = {s: _mask(r["success"]) for s, r in runs.items()}
             entry["all"] = stats.success(masks)
@@ -117,6 +126,54 @@ def collect(args, cfg) -> dict[str, Any]:
     data.update(profile="rl-baselines", configuration="default", git=results.git_info(),
                 seeds=sorted({int(s) for e in data["algorithms"].values() for s in e["runs"]}),
                 cell_builds=[g for i, g in enumerate(gits) if g not in gits[:i]])
+    return data
+
+
+def _hyper(items: list[str]) -> dict[str, Any]:
+    """--hyper NAME=VALUE items as numbers (a name given twice: the last)."""
+    out: dict[str, Any] = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        try:
+            value = float(text)
+        except ValueError:
+            value = None
+        if not sep or not name or value is None or not np.isfinite(value):
+            raise UsageError(f"--hyper takes NAME=NUMBER, got {item!r:.60}")
+        out[name] = int(value) if value.is_integer() and "." not in text and "e" not in text.lower() else value
+    return out
+
+
+def tune(args, cfg) -> dict[str, Any]:
+    """The held-out tuning of each algorithm (see the module's head): its rows, best first, and its
+    choice; an algorithm with unfinished runs under --report is listed as pending."""
+    cells = [int(i) for i in heldout.tuning_cells(cfg.plant_name)]
+    data: dict[str, Any] = {"plant": cfg.plant_name, "set": args.set, "protocol": heldout.protocol(cfg.plant_name),
+                            "n_tuning_cells": len(cells), "algorithms": {}, "git": results.git_info()}
+    for algo in args.algos:
+        steps = args.steps or sb3.ALGORITHMS[algo].budget
+        rows, pending = [], 0
+        for index, setting in enumerate(heldout.baseline_settings(algo)):
+            key = heldout.key(setting)
+            runs = [run_one(args, cfg, algo, seed, steps, args.out / "tuning" / algo / key / f"seed-{seed}",
+                            setting, cells) for seed in heldout.TUNING_SEEDS]
+            if not all(runs):
+                pending += 1
+                continue
+            rates = [float(_mask(r["success"])[cells].mean()) for r in runs]
+            rows.append({"order": index, "setting": setting, "key": key, "success_rate": float(np.mean(rates)),
+                         "success_rates": rates, "median_trials": None, "steps": steps,
+                         "wall_time": float(sum(r["train_wall_time"] + r["eval_wall_time"] for r in runs))})
+            print(f"[tuning] {algo} {key}: {100 * rows[-1]['success_rate']:.1f} % of the tuning cells",
+                  file=sys.stderr, flush=True)
+        entry: dict[str, Any] = {"settings": len(heldout.baseline_settings(algo)), "steps": steps}
+        if pending:
+            entry["pending"] = pending
+        else:
+            ranked = heldout.rank(rows)
+            entry.update(rows=ranked, chosen=ranked[0]["setting"], chosen_key=ranked[0]["key"],
+                         default_kept=ranked[0]["order"] == 0)
+        data["algorithms"][algo] = entry
     return data
 
 
@@ -164,19 +221,38 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--bench", type=Path, help="grids of the same plant to pair with (OUT/<condition>/seed-<s>)")
     ap.add_argument("--data", type=Path, help="also write the summary here (docs/data/...)")
     ap.add_argument("--report", action="store_true", help="run nothing: summarise the finished runs")
+    ap.add_argument("--tune", action="store_true", help="the held-out tuning of the algorithms (docs/tuning.md)")
+    ap.add_argument("--hyper", action="append", default=[], metavar="NAME=VALUE",
+                    help="a hyperparameter over the RL Zoo's start (a tuned setting), for the evaluation runs")
     args = ap.parse_args(argv)
 
     def body():
         if args.steps is not None and args.steps < 1:
             raise UsageError(f"--steps must be at least 1, got {args.steps}")
+        if args.tune and args.hyper:
+            raise UsageError("--tune runs the tuning space's settings; --hyper is for the evaluation runs")
+        args.hyper = _hyper(args.hyper)
+        if args.hyper and len(args.algos) != 1:
+            raise UsageError("--hyper sets one algorithm's hyperparameters: give --algos with one of them")
+        known = set(sb3.ALGORITHMS[args.algos[0]].hyper) | set(heldout.BASELINE_SPACES[args.algos[0]])
+        unknown = sorted(set(args.hyper) - known)
+        if unknown:
+            raise UsageError(f"--hyper {unknown[0]}: not a tuned hyperparameter of {args.algos[0]} "
+                             f"(valid: {', '.join(sorted(known))})")
         cfg = build_config(parse_sets(args.set, plant=args.plant), plant=args.plant)
         sb3.actuator_limit(cfg)
-        return collect(args, cfg)
+        return tune(args, cfg) if args.tune else collect(args, cfg)
     status, data = guarded(body)
     if data is None:
         return status
     text = json.dumps(data, indent=1)
     args.out.mkdir(parents=True, exist_ok=True)
+    if args.tune:
+        (args.out / "tuning.json").write_text(text)
+        for algo, entry in data["algorithms"].items():
+            state = f"chose {entry['chosen_key']}" if "chosen" in entry else f"{entry['pending']} settings unfinished"
+            print(f"{algo}: {state}")
+        return 0
     (args.out / "rl-baselines.json").write_text(text)
     if args.data is not None:
         args.data.write_text(text)

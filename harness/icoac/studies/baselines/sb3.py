@@ -2,8 +2,8 @@
 """PPO and SAC from Stable-Baselines3 (the ``[baselines]`` extra): the policies an RL user would
 train instead, on the plant's Gymnasium env (icoac.gym), on the same grid and success criterion.
 
-- Training: one policy over random grid cells. Each episode starts from a cell and a grid seed
-  drawn by the env's generator, lasts at most TRAIN_EPISODE_STEPS control periods, and earns 1 per
+- Training: one policy over random grid cells (or over a given set of them: the held-out tuning's
+  cells). Each episode starts from a cell and a grid seed drawn by the env's generator, lasts at most TRAIN_EPISODE_STEPS control periods, and earns 1 per
   period until the plant fails. Actions are rescaled to [-1, 1] and map linearly onto the plant's
   actuator limit (its ``max_*`` parameter: the cart's force, the Furuta's voltage), which every
   method meets in the plant itself. The budget is a number of env steps (control periods).
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -85,16 +85,37 @@ def _env_parameters(cfg: RunConfig) -> dict[str, Any]:
     return {**params, "init_velocity_noise": float(cfg.run.init_velocity_noise)}
 
 
-def make_env(cfg: RunConfig):
+def make_env(cfg: RunConfig, cells: Sequence[int] | None = None):
     """The plant's env for training: the configured model, episodes of TRAIN_EPISODE_STEPS, actions
-    in [-1, 1] onto the actuator limit, episode statistics kept (Monitor)."""
+    in [-1, 1] onto the actuator limit, episode statistics kept (Monitor); with cells, each episode
+    starts from one of them (drawn by the env's generator) instead of any cell of the grid."""
     import gymnasium
     from stable_baselines3.common.monitor import Monitor
     from icoac.gym.env import IcoacPlantEnv
     _, limit = actuator_limit(cfg)
     env = IcoacPlantEnv(gym_name(cfg.plant_name), force_limit=limit, **_env_parameters(cfg))
+    if cells is not None:
+        env = _StartCells(env, cells)
     env = gymnasium.wrappers.TimeLimit(env, TRAIN_EPISODE_STEPS)
     return Monitor(gymnasium.wrappers.RescaleAction(env, -1.0, 1.0))
+
+
+def _StartCells(env, cells: Sequence[int]):
+    """env whose reset draws its cell from ``cells`` (the env's generator) unless told one."""
+    import gymnasium
+    allowed = np.asarray(cells, dtype=np.int64)
+    if allowed.size == 0:
+        raise UsageError("training cells: none given")
+
+    class StartCells(gymnasium.Wrapper):
+        def reset(self, *, seed=None, options=None):
+            if seed is not None:  # seed the generator the draw below uses
+                self.env.reset(seed=seed)
+            options = dict(options or {})
+            if "state" not in options:
+                options.setdefault("cell", int(self.np_random.choice(allowed)))
+            return self.env.reset(options=options)
+    return StartCells(env)
 
 
 @dataclass
@@ -108,20 +129,28 @@ class Trained:
     normalizer: Any
 
 
-def train(algo: str, cfg: RunConfig, seed: int, steps: int) -> Trained:
+def hyperparameters(algo: str, overrides: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """The algorithm's hyperparameters: its RL Zoo start, then ``overrides`` (a tuning setting)."""
+    return {**ALGORITHMS[algo].hyper, **(overrides or {})}
+
+
+def train(algo: str, cfg: RunConfig, seed: int, steps: int, overrides: Mapping[str, Any] | None = None,
+          cells: Sequence[int] | None = None) -> Trained:
     """Train ``algo`` for ``steps`` env steps on the configured plant, seeded by ``seed`` (the
-    env's cell draws, the networks, the exploration)."""
+    env's cell draws, the networks, the exploration), with its hyperparameters (``overrides`` on
+    the Zoo's start), from random grid cells or from ``cells``."""
     sb3, torch = _sb3()
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
     spec = ALGORITHMS[algo]
+    hyper = hyperparameters(algo, overrides)
     torch.set_num_threads(1)
     t0 = time.monotonic()
-    venv = DummyVecEnv([lambda: make_env(cfg)])
+    venv = DummyVecEnv([lambda: make_env(cfg, cells)])
     venv.seed(seed)
     if spec.normalize:
-        venv = VecNormalize(venv, gamma=spec.hyper.get("gamma", 0.99))
+        venv = VecNormalize(venv, gamma=hyper.get("gamma", 0.99))
     cls = getattr(sb3, spec.label)
-    model = cls("MlpPolicy", venv, seed=seed, device="cpu", verbose=0, **spec.hyper)
+    model = cls("MlpPolicy", venv, seed=seed, device="cpu", verbose=0, **hyper)
     model.learn(total_timesteps=steps)
     monitor = venv.venv.envs[0] if spec.normalize else venv.envs[0]
     normalizer = venv if spec.normalize else None
@@ -160,11 +189,12 @@ def evaluate(act: Callable[[np.ndarray], np.ndarray], cfg: RunConfig, grid_seed:
     return lasted, ended == 0
 
 
-def settings(algo: str, steps: int) -> dict[str, Any]:
+def settings(algo: str, steps: int, overrides: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """What a run records of its algorithm's settings."""
     spec = ALGORITHMS[algo]
     sb3, torch = _sb3()
-    return {"algorithm": spec.label, "source": spec.source, "hyperparameters": dict(spec.hyper),
+    return {"algorithm": spec.label, "source": spec.source, "hyperparameters": hyperparameters(algo, overrides),
+            "overrides": dict(overrides or {}),
             "normalize": spec.normalize, "policy": "MlpPolicy", "steps": steps, "zoo_steps": spec.zoo_budget,
             "train_episode_steps": TRAIN_EPISODE_STEPS, "torch_threads": 1,
             "stable_baselines3": sb3.__version__, "torch": torch.__version__}
