@@ -125,7 +125,7 @@ def test_evaluation_against_the_bench_defaults(tmp_path, monkeypatch):
                       overrides=caps["rl"], info=info, progress=False)
     out = tmp_path / "tuning"
     assert T.main(["--out", str(out), "--learners", "ico-rl", "--evaluate", "--bench", str(bench_dir),
-                   "--quiet"]) == 0
+                   "--bench-data", str(tmp_path / "tuned.json"), "--quiet"]) == 0
     data = json.loads((out / "tuning.json").read_text())
     ev = data["evaluation"]
     assert ev["seeds"] == [0, 1] and ev["n_heldout"] == 1219
@@ -140,3 +140,17 @@ def test_evaluation_against_the_bench_defaults(tmp_path, monkeypatch):
     _, rec = results.load(out / "evaluation" / "ico-rl" / "seed-1")
     assert rec["prior_info"]["source"] == str((out / "evaluation" / "ico" / "seed-1").resolve())
     assert len(T.evaluation_table(data)) == 4
+    # the rerun learner's control ran with its choice and prior; the tuned bench links every grid
+    _, crec = results.load(out / "evaluation" / "ico-rl-control" / "seed-1")
+    assert crec["prior_info"]["source"] == rec["prior_info"]["source"] and ev["learners"]["ico-rl"]["control_rerun"]
+    assert crec["config"]["controller"]["learn"] is False and rec["config"]["controller"]["learn"] is True
+    assert crec["config"]["controller"]["actor"] == rec["config"]["controller"]["actor"]
+    assembled = out / "evaluation" / "bench"
+    for name in ("ico", "ico-rl", "ico-rl-control"):
+        assert (assembled / name / "seed-0").resolve() == (out / "evaluation" / name / "seed-0").resolve()
+    tuned = json.loads((tmp_path / "tuned.json").read_text())
+    assert tuned["tuned"]["chosen"]["ico"] == data["learners"]["ico"]["chosen_key"]
+    assert set(tuned["aggregate"]) >= {"ico", "ico-rl", "ico-rl-control"}
+    assert tuned["aggregate"]["ico-rl"]["success_rate"]["mean"] == pytest.approx(ev["learners"]["ico-rl"]["all"]["chosen"]["mean"])
+    from icoac.studies import tables
+    assert tables._plant_label(tuned) == "cart_pole (held-out tuned)"

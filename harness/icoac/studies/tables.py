@@ -143,7 +143,8 @@ def recommended(agg: Mapping[str, Any]) -> str | None:
 
 
 def _plant_label(data: Mapping[str, Any]) -> str:
-    return data.get("plant", "cart_pole") + (f" ({', '.join(data['set'])})" if data.get("set") else "")
+    notes = list(data.get("set") or []) + (["held-out tuned"] if data.get("tuned") else [])
+    return data.get("plant", "cart_pole") + (f" ({', '.join(notes)})" if notes else "")
 
 
 def headline_table(summaries: Sequence[Mapping[str, Any]]) -> list[str]:
