@@ -70,8 +70,9 @@ def provenance(data: Mapping[str, Any]) -> str:
     builds = [_commit(b) for b in data.get("cell_builds") or []]
     cells = f" (cells by {', '.join(builds)})" if builds and builds != [commit] else ""
     plant = f"plant {data['plant']}, " if data.get("plant") else ""
+    configuration = "each learner's held-out choice (docs/tuning.md)" if data.get("tuned") else data["configuration"]
     return (f"*From docs/data: {plant}profile {data['profile']}, seeds {data['seeds']}, configuration "
-            f"{data['configuration']}{' ' + ' '.join(data['set']) if data.get('set') else ''}, commit {commit}{cells}.*")
+            f"{configuration}{' ' + ' '.join(data['set']) if data.get('set') else ''}, commit {commit}{cells}.*")
 
 
 def render(text: str, data_dir: Path) -> str:
