@@ -119,6 +119,15 @@ def mcnemar(a: np.ndarray, b: np.ndarray) -> dict[str, Any]:
     return {"only_a": only_a, "only_b": only_b, "p": p}
 
 
+def success(masks: Mapping[int, np.ndarray]) -> dict[str, Any]:
+    """Success masks per seed ({seed: (cells,) bool}) -> the mean success over seeds, its sd over
+    seeds (0 for one seed) and its bootstrap interval over cells and seeds."""
+    stack = np.stack([np.asarray(masks[s], dtype=bool) for s in sorted(masks)])
+    per_seed = stack.mean(axis=1)
+    return {"mean": float(per_seed.mean()), "sd": float(per_seed.std(ddof=1)) if len(masks) > 1 else 0.0,
+            "ci95": interval(stack, rate)}
+
+
 def paired(a: Mapping[int, np.ndarray], b: Mapping[int, np.ndarray]) -> dict[str, Any]:
     """Two conditions' success masks per seed ({seed: (cells,) bool}) over the same cells -> the
     difference of their success rates in points (mean over the common seeds, its interval) and

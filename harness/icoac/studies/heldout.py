@@ -8,7 +8,8 @@ which cells and seeds tune, which evaluate, each learner's space, the budget and
 - Seeds: TUNING_SEEDS tune; the bench's seeds (0 to 4) evaluate. The two sets are disjoint, so
   no tuning run shares a start velocity or an exploration draw with an evaluation run.
 - Budget: every learner, ICO included, gets SETTINGS settings x len(TUNING_SEEDS) seeds, at the
-  default profile's caps (ICO 1e5 trials, the learners 1000).
+  default profile's caps (ICO 1e5 trials, the learners 1000), from its space on the plant (SPACES,
+  and PLANT_SPACES where a plant's defaults or units differ).
 - Criterion: the highest mean success rate over the tuning seeds on the tuning cells; ties (equal
   to 1e-9) go to fewer median trials to success, then to the earlier setting of the space (each
   space lists the current default first, so a tie keeps it).
@@ -31,6 +32,7 @@ TUNING_FRACTION = 0.3
 TUNING_SEEDS = (100, 101)
 SETTINGS = 12
 TIE = 1e-9
+TUNING_CELLS = "tuning"  # the cell spec that names the tuning cells (`ceiling --cells tuning`)
 
 # Each learner's space: parameter -> values, full factorial, SETTINGS settings each, the current
 # cart-pole default first. The four actor-critic priors share one space: the two readings with their
@@ -54,11 +56,52 @@ SPACES: Mapping[str, Mapping[str, Sequence[Any]]] = {
     "cma-es": {"search.cov_scale": [4, 1, 1.5, 2, 3, 6, 8, 12, 16, 32, 64, 256]},
 }
 
+# The other plants' spaces where their defaults differ from the cart-pole's (a learner not listed
+# takes SPACES'), each with the plant's default first. ICO's rate: the cart-pole's multiples of the
+# plant's default (0.1 to 30), or of the largest valid rate (1) below it. The Furuta's actor-critic noise in volts, under its +-10 V limit:
+# both of its defaults (1 V, 3 V) and the same six-value breadth.
+_FURUTA_NOISE = [0.3, 0.5, 1, 2, 3, 5]
+PLANT_SPACES: Mapping[str, Mapping[str, Mapping[str, Sequence[Any]]]] = {
+    "furuta": {
+        "ico": {"ico.rate": [0.01, 0.001, 0.003, 0.03, 0.1, 0.3], "ico.timing": ["code", "literal"]},
+        "ico-rl": {**SPACES["rl"], "actor.noise_std": [1] + [v for v in _FURUTA_NOISE if v != 1]},
+        "ico-mean-rl": {**SPACES["rl"], "actor.noise_std": [1] + [v for v in _FURUTA_NOISE if v != 1]},
+        "rl-ico-cov": {**SPACES["rl"], "actor.noise_std": [3] + [v for v in _FURUTA_NOISE if v != 3]},
+        "rl": {**SPACES["rl"], "actor.noise_std": [3] + [v for v in _FURUTA_NOISE if v != 3]},
+    },
+    "double_cart_pole": {
+        "ico": {"ico.rate": [1.0, 0.003, 0.01, 0.03, 0.1, 0.3], "ico.timing": ["code", "literal"]},
+    },
+}
 
-def settings(learner: str) -> list[dict[str, Any]]:
-    """The learner's settings as configuration overrides, in the space's order (the first: the
-    current default)."""
-    space = SPACES[learner]
+
+# PPO's and SAC's spaces (icoac.studies.baselines.sb3): hyperparameters over their RL Zoo start,
+# which comes first; the same SETTINGS x TUNING_SEEDS, each run at the algorithm's budget of env
+# steps, trained on the tuning cells only and scored on them by the same criterion (no trials to
+# success: ties go to the space's order). The same space on every plant.
+BASELINE_SPACES: Mapping[str, Mapping[str, Sequence[Any]]] = {
+    "ppo": {"learning_rate": [2.22425e-4, 1e-4, 5e-4, 1e-3], "gamma": [0.999, 0.99, 0.98]},
+    "sac": {"learning_rate": [3e-4, 1e-4, 1e-3], "learning_starts": [10_000, 1_000], "gamma": [0.99, 0.98]},
+}
+
+
+def baseline_settings(algo: str) -> list[dict[str, Any]]:
+    """PPO's or SAC's settings as hyperparameter overrides, in the space's order (the first: the
+    Zoo's)."""
+    space = BASELINE_SPACES[algo]
+    return [dict(zip(space, combo)) for combo in itertools.product(*space.values())]
+
+
+def spaces(plant: str) -> dict[str, Mapping[str, Sequence[Any]]]:
+    """Every learner's space on the plant."""
+    own = PLANT_SPACES.get(plant, {})
+    return {learner: own.get(learner, space) for learner, space in SPACES.items()}
+
+
+def settings(learner: str, plant: str = "cart_pole") -> list[dict[str, Any]]:
+    """The learner's settings on the plant as configuration overrides, in the space's order (the
+    first: the plant's current default)."""
+    space = spaces(plant)[learner]
     out = []
     for combo in itertools.product(*space.values()):
         setting: dict[str, Any] = {}
@@ -85,6 +128,14 @@ def tuning_cells(plant: str) -> np.ndarray:
     return np.sort(rng.choice(grid.cells, size=n, replace=False))
 
 
+def cell_spec(spec: Any, plant: str) -> Any:
+    """A command's --cells with the name TUNING_CELLS replaced by the plant's tuning cells (a list of
+    indices); any other spec unchanged."""
+    if isinstance(spec, str) and spec.strip() == TUNING_CELLS:
+        return [int(i) for i in tuning_cells(plant)]
+    return spec
+
+
 def heldout_mask(plant: str) -> np.ndarray:
     """True for the cells evaluation holds out (not tuned on), over the plant's whole grid."""
     mask = np.ones(geometry.of(plant).cells, dtype=bool)
@@ -101,13 +152,15 @@ def rank(rows: Sequence[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
     return sorted(rows, key=sort_key)
 
 
-def protocol() -> dict[str, Any]:
-    """The protocol as data (recorded beside every tuning result)."""
+def protocol(plant: str = "cart_pole") -> dict[str, Any]:
+    """The protocol on the plant as data (recorded beside every tuning result)."""
     return {"split_stream": SPLIT_STREAM, "tuning_fraction": TUNING_FRACTION, "tuning_seeds": list(TUNING_SEEDS),
             "settings": SETTINGS, "tie": TIE,
             "criterion": "mean success rate over the tuning seeds on the tuning cells; then fewer median trials "
                          "to success; then the space's order (its default first)",
-            "spaces": {name: {k: list(v) for k, v in space.items()} for name, space in SPACES.items()}}
+            "spaces": {name: {k: list(v) for k, v in space.items()} for name, space in spaces(plant).items()},
+            "baseline_spaces": {name: {k: list(v) for k, v in space.items()} for name, space in BASELINE_SPACES.items()}}
 
 
-assert all(len(settings(name)) == SETTINGS for name in SPACES)
+assert all(len(settings(name, plant)) == SETTINGS for plant in ("cart_pole", *PLANT_SPACES) for name in SPACES)
+assert all(len(baseline_settings(name)) == SETTINGS for name in BASELINE_SPACES)

@@ -14,7 +14,10 @@ OUT/tuning.json and OUT/summary.md hold each learner's ranking and choice.
 first again; the others' priors from its evaluated grids) into OUT/evaluation/, and sets it beside
 the bench's grids of the current defaults: success on the held-out cells and on all cells, and the
 paired difference. A learner that kept its default and takes nothing from ICO is the bench's grid
-itself, read, not rerun."""
+itself, read, not rerun. The no-learning control of a rerun learner runs too, with its learner's
+choice and prior. OUT/evaluation/bench/ then holds a whole bench of the tuned settings (links to
+those grids, and to --bench's for every condition that kept its grid), and --bench-data FILE
+writes its summary (`bench --summary-only`), labelled as tuned, for docs/data."""
 from __future__ import annotations
 
 import argparse
@@ -77,7 +80,7 @@ def run_setting(args, learner: str, index: int, setting: dict[str, Any], ico_dir
 
 def tune(args, learner: str, ico_dirs: dict[int, Path] | None) -> dict[str, Any]:
     """The learner's rows and choice; with --report and unfinished settings, {"pending": ...}."""
-    rows = [run_setting(args, learner, i, s, ico_dirs) for i, s in enumerate(heldout.settings(learner))]
+    rows = [run_setting(args, learner, i, s, ico_dirs) for i, s in enumerate(heldout.settings(learner, args.plant))]
     if None in rows:
         return {"learner": learner, "pending": len(rows) - rows.count(None), "settings": len(rows)}
     ranked = heldout.rank(rows)
@@ -89,7 +92,7 @@ def tune(args, learner: str, ico_dirs: dict[int, Path] | None) -> dict[str, Any]
 def run(args) -> dict[str, Any]:
     """ICO, then every learner asked for, from ICO's chosen grids."""
     data: dict[str, Any] = {"plant": args.plant, "profile": "default", "configuration": "default", "set": [],
-                            "seeds": list(heldout.TUNING_SEEDS), "protocol": heldout.protocol(),
+                            "seeds": list(heldout.TUNING_SEEDS), "protocol": heldout.protocol(args.plant),
                             "n_tuning_cells": int(heldout.tuning_cells(args.plant).size),
                             "n_cells": int(heldout.heldout_mask(args.plant).size), "learners": {},
                             "git": results.git_info()}
@@ -101,16 +104,57 @@ def run(args) -> dict[str, Any]:
         if learner in args.learners:
             data["learners"][learner] = tune(args, learner, ico_dirs) if ico_dirs or \
                 not REGISTRY[learner].prior.takes_ico else \
-                {"learner": learner, "pending": 0, "settings": len(heldout.settings(learner))}
+                {"learner": learner, "pending": 0, "settings": len(heldout.settings(learner, args.plant))}
     builds = [b for t in data["learners"].values() for r in t.get("rows", []) for b in r["builds"]]
     data["cell_builds"] = [b for i, b in enumerate(builds) if b not in builds[:i]]
     return data
 
 
-def _rates(masks: dict[int, np.ndarray]) -> dict[str, Any]:
-    """Mean success over seeds with its bootstrap interval (icoac.core.stats)."""
-    stack = np.stack([masks[s] for s in sorted(masks)])
-    return {"mean": float(stack.mean()), "ci95": stats.interval(stack, stats.rate)}
+def _run(args, condition: str, out: Path, seed: int, overrides: dict[str, Any], info) -> None:
+    """One grid of the evaluation, resumed if started."""
+    _, _, cancelled = run_condition(condition=condition, out=out, seed=seed, threads=args.threads,
+                                    overrides=overrides, resume=bool(results.present(out)),
+                                    progress=not args.quiet, info=info, plant=args.plant)
+    if cancelled:
+        raise KeyboardInterrupt
+
+
+def assemble(args, data: dict[str, Any]) -> Path:
+    """OUT/evaluation/bench/<condition>/seed-<s>: a link to the evaluation's grid of each condition
+    that was rerun with its learner's choice (its control with it), else to --bench's."""
+    ev = data["evaluation"]
+    root = args.out / "evaluation"
+    rerun = {name for name, e in ev["learners"].items() if e["rerun"]}
+    rerun |= {REGISTRY[name].control for name, e in ev["learners"].items() if e.get("control_rerun")}
+    target = root / "bench"
+    for condition in REGISTRY:
+        for seed in ev["seeds"]:
+            source = bench.seed_dir(root if condition in rerun else args.bench, condition, seed)
+            if not results.exists(source):
+                continue
+            link = bench.seed_dir(target, condition, seed)
+            link.parent.mkdir(parents=True, exist_ok=True)
+            if link.is_symlink() or link.exists():
+                link.unlink()
+            link.symlink_to(source.resolve(), target_is_directory=True)
+    ceiling = args.bench / "ceiling"  # the best single w found: no learner's setting in it
+    if ceiling.is_dir() and not (target / "ceiling").exists():
+        (target / "ceiling").symlink_to(ceiling.resolve(), target_is_directory=True)
+    return target
+
+
+def bench_summary(args, data: dict[str, Any]) -> None:
+    """The assembled bench's summary (`bench --summary-only`) into --bench-data, with the tuning's
+    choices recorded (and shown in the tables' plant label)."""
+    target = assemble(args, data)
+    opt = bench.BenchOptions(profile="default", out=target, data=args.bench_data, summary_only=True,
+                             quiet=args.quiet, plant=args.plant)
+    if bench.run_bench(opt) != 0:
+        raise KeyboardInterrupt
+    record = json.loads(args.bench_data.read_text())
+    record["tuned"] = {"protocol": "held-out (docs/tuning.md)", "tuning_git": data["git"],
+                       "chosen": {name: t["chosen_key"] for name, t in data["learners"].items() if "chosen_key" in t}}
+    args.bench_data.write_text(json.dumps(record, indent=1))
 
 
 def evaluate(args, data: dict[str, Any]) -> dict[str, Any]:
@@ -130,24 +174,23 @@ def evaluate(args, data: dict[str, Any]) -> dict[str, Any]:
         rule = REGISTRY[learner].prior
         reuse = t["default_kept"] and (rule is None or not rule.takes_ico or ico["default_kept"])
         chosen, default = {}, {}
+        control = REGISTRY[learner].control
         for seed in seeds:
             d = bench.seed_dir(args.bench if reuse else root, learner, seed)
             if not reuse:
                 info = None if rule is None else condition_prior(
                     learner, ico_dirs[seed] if rule.takes_ico else None, P.CENTRAL, P.DEFAULT_RIDGE,
                     plant=args.plant, overrides={**caps, **t["chosen"]})
-                _, _, cancelled = run_condition(
-                    condition=learner, out=d, seed=seed, threads=args.threads, overrides={**caps, **t["chosen"]},
-                    resume=bool(results.present(d)), progress=not args.quiet, info=info, plant=args.plant)
-                if cancelled:
-                    raise KeyboardInterrupt
+                for condition in (learner,) + ((control,) if control else ()):
+                    _run(args, condition, bench.seed_dir(root, condition, seed), seed, {**caps, **t["chosen"]}, info)
             chosen[seed] = metrics.success_mask(results.load(d)[0])
             default[seed] = metrics.success_mask(results.load(bench.seed_dir(args.bench, learner, seed))[0])
         out[learner] = {"chosen_key": t["chosen_key"], "default_kept": t["default_kept"], "rerun": not reuse,
-                        "all": {"chosen": _rates(chosen), "default": _rates(default),
+                        "control_rerun": bool(control) and not reuse,
+                        "all": {"chosen": stats.success(chosen), "default": stats.success(default),
                                 "paired": stats.paired(chosen, default)},
-                        "heldout": {"chosen": _rates({s: m[held] for s, m in chosen.items()}),
-                                    "default": _rates({s: m[held] for s, m in default.items()}),
+                        "heldout": {"chosen": stats.success({s: m[held] for s, m in chosen.items()}),
+                                    "default": stats.success({s: m[held] for s, m in default.items()}),
                                     "paired": stats.paired({s: m[held] for s, m in chosen.items()},
                                                            {s: m[held] for s, m in default.items()})}}
         print(f"[evaluation] {learner}: held-out {100 * out[learner]['heldout']['default']['mean']:.1f} -> "
@@ -258,15 +301,21 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--evaluate", action="store_true",
                     help="then run each choice on every cell with the bench's seeds, against --bench's defaults")
     ap.add_argument("--bench", type=Path, help="the bench whose grids are the defaults' (--evaluate)")
+    ap.add_argument("--bench-data", type=Path,
+                    help="with --evaluate: the summary of the bench of the tuned settings (docs/data/...)")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
     if args.evaluate and args.bench is None:
         ap.error("--evaluate needs --bench")
+    if args.bench_data is not None and not args.evaluate:
+        ap.error("--bench-data needs --evaluate")
 
     def body():
         data = run(args)
         if args.evaluate and "pending" not in data["learners"]["ico"]:
             data["evaluation"] = evaluate(args, data)
+            if args.bench_data is not None:
+                bench_summary(args, data)
         return data
     status, data = guarded(body)
     if data is None:
