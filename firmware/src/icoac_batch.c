@@ -18,8 +18,11 @@
  * tick's expression and order of operations (the dot product's pairing, the reflex force added
  * last), so the two agree without fast-math or contraction (-ffp-contract=off, GCC's default in
  * ISO C; -fno-trapping-math, which changes no value, lets GCC if-convert the loop).
- * Every other lane runs icoac_step on its own input: RL mode (its critic is per lane), a sensor
- * task, terminal ticks, ICO's learning ticks, errors of any kind, states not in a trial. */
+ * Every other lane runs icoac_step on its own input: RL mode, a sensor task, terminal ticks, ICO's
+ * learning ticks, errors of any kind, states not in a trial. An RL lane's critic exponentials
+ * (two per input, icoac_priv_factors_of) are computed first for all such lanes at once, in one
+ * vectorised loop, and handed to its tick (icoac_priv_step), which computes the same values
+ * itself when called alone. */
 #include "icoac_features.h"
 
 #define N ICOAC_MAX_INPUTS
@@ -74,7 +77,7 @@ typedef struct ICOAC_PRIV_MAY_ALIAS {
     lane_int_t preset[L]; /* the cart-pole's task with the preset's rule layout (icoac_step's instance) */
     /* the tick's rows */
     icoac_real_t raw[N][L]; /* the inputs */
-    icoac_real_t x[N][L];   /* scaled */
+    icoac_real_t x[N][L];   /* scaled; after the vector pass, the RL lanes' exponentials (exps_of) */
     icoac_real_t penalty[L];
     icoac_real_t force[L];
     lane_int_t vector[L]; /* 1: the vector pass's lane; cleared where its tick needs icoac_step */
@@ -94,6 +97,14 @@ ICOAC_STATIC_ASSERT(sizeof(batch_t) <= sizeof(icoac_batch_t), batch_fits_its_sto
 static batch_t *batch_of(icoac_batch_t *batch)
 {
     return (batch_t *)(void *)batch;
+}
+
+/* The rows of the vector pass's scaled inputs, free once it has run, as the RL lanes'
+ * exponentials of a group: [lane in the group][2 * input + e] (rl_exponentials). */
+ICOAC_STATIC_ASSERT((2 * N * GROUP) <= (N * L), exps_fit_in_the_scaled_rows);
+static icoac_real_t (*exps_of(batch_t *b))[2 * N]
+{
+    return (icoac_real_t(*)[2 * N])(void *)b->x;
 }
 
 /* 1 when v is finite (icoac_priv_finite as a compare, which vectorises). */
@@ -375,10 +386,10 @@ static void commit_lane(batch_t *b, const batch_args_t *a, int32_t l)
     a->status[l] = (int32_t)ICOAC_OK;
 }
 
-/* Lane l through icoac_step, on the input the lane was given. A state in a trial whose task has
- * more inputs than the call's rows gets ICOAC_ERR_NULL: its input is missing. Out of line: its
- * frame and icoac_step's are not the caller's. */
-ICOAC_PRIV_NOINLINE static void scalar_lane(batch_t *b, const batch_args_t *a, int32_t l)
+/* Lane l through icoac_step, on the input the lane was given (given: its critic's exponentials
+ * or NULL, icoac_priv_step). A state in a trial whose task has more inputs than the call's rows
+ * gets ICOAC_ERR_NULL: its input is missing. */
+static void scalar_lane(batch_t *b, const batch_args_t *a, int32_t l, const icoac_real_t *given)
 {
     icoac_state_t *const state = a->states[l];
     icoac_input_t *in = &b->in;
@@ -392,7 +403,7 @@ ICOAC_PRIV_NOINLINE static void scalar_lane(batch_t *b, const batch_args_t *a, i
         }
         in->flags = flags_of(a, l);
         in->reflex = (a->reflex != NULL) ? a->reflex[l] : ICOAC_R(0.0);
-        a->status[l] = (int32_t)icoac_step(state, in, &b->out);
+        a->status[l] = (int32_t)icoac_priv_step(state, in, &b->out, given);
         a->force[l] = b->out.force;
         /* a lane loaded from this state stays so: icoac_step changed none of its configuration */
         if ((b->state[l] == state) && (icoac_priv_state_c(state)->batch_token == b->token[l]) && (b->token[l] != 0u)) {
@@ -460,6 +471,77 @@ ICOAC_PRIV_NOINLINE static void vector_lanes(batch_t *b, const batch_args_t *a)
     }
 }
 
+/* e^a of every entry (icoac_priv_exp: the same bits as one call), in a loop the compiler
+ * vectorises. */
+BATCH_CLONES static void exp_all(icoac_real_t *values, int32_t count)
+{
+    int32_t k;
+    for (k = 0; k < count; ++k) {
+        values[k] = icoac_priv_exp(values[k]);
+    }
+}
+
+/* The critic's exponentials: per RL lane l of [g, g + GROUP) whose tick will reach its critic
+ * with the units this reads (the state in a trial, in RL mode, its input present), the arguments
+ * its tick would give icoac_priv_exp for input i (icoac_priv_factors_of) at exps[l - g][2i + e],
+ * e = 0 for up's, 1 for the edge's, then e^ of all at once. Returns the mask of such lanes (bit
+ * l - g), or 0 when there are too few of them for the vector loop. Out of line: its frame is not
+ * under the lanes' ticks. */
+ICOAC_PRIV_NOINLINE static uint32_t rl_exponentials(const batch_args_t *a, int32_t g, icoac_real_t exps[GROUP][2 * N])
+{
+    static const int32_t cartpole_units[ICOAC_CARTPOLE_INPUTS] = ICOAC_PRIV_CARTPOLE_UNITS;
+    uint32_t mask = 0u;
+    int32_t count = 0;
+    int32_t l;
+    int i;
+    for (l = g; l < (g + GROUP); ++l) {
+        const icoac_priv_state_t *st = (l < a->lanes && a->states[l] != NULL) ? icoac_priv_state_c(a->states[l]) : NULL;
+        for (i = 0; i < (2 * N); ++i) {
+            exps[l - g][i] = ICOAC_R(0.0);
+        }
+        if ((st != NULL) && (st->magic == ICOAC_PRIV_STATE_MAGIC) && (st->config.mode == (int32_t)ICOAC_MODE_RL) &&
+            (icoac_priv_inputs(&st->config) <= a->inputs)) {
+            const int cartpole = (st->grid.shape & ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) != 0u;
+            const int n = cartpole ? ICOAC_CARTPOLE_INPUTS : ((st->grid.n <= N) ? (int)st->grid.n : N);
+            for (i = 0; i < n; ++i) {
+                /* the count the critic's kernel reads: the preset's with the state's tag, else the
+                 * configuration's, which its shape check bounds (any other: not used) */
+                const int32_t units = cartpole ? cartpole_units[i] : st->config.critic.units[i];
+                if ((units >= 1) && (units <= ICOAC_CRITIC_UNITS_PER_INPUT_MAX)) {
+                    icoac_real_t distance;
+                    /* the input scalar_lane hands its tick */
+                    const icoac_real_t s = (i < a->inputs) ? a->s[((size_t)i * (size_t)a->lanes) + (size_t)l] : ICOAC_R(0.0);
+                    (void)icoac_priv_factor_nearest(s, st->config.critic.range[i], (int)units, &distance);
+                    exps[l - g][2 * i] = icoac_priv_factor_up_arg(distance);
+                    exps[l - g][(2 * i) + 1] = icoac_priv_factor_edge_arg(distance);
+                }
+            }
+            mask |= 1u << (uint32_t)(l - g);
+            ++count;
+        }
+    }
+    if (count < MIN_VECTOR_LANES) {
+        return 0u;
+    }
+    exp_all(&exps[0][0], 2 * N * GROUP);
+    return mask;
+}
+
+/* The lanes of [g, g + GROUP) that the vector pass left (vector = 0) through icoac_step, each RL
+ * lane with its critic's exponentials when the group has enough of them. Out of line: its frame
+ * and icoac_step's are not the caller's. */
+ICOAC_PRIV_NOINLINE static void scalar_lanes(batch_t *b, const batch_args_t *a, int32_t g)
+{
+    icoac_real_t (*const exps)[2 * N] = exps_of(b);
+    const uint32_t given = rl_exponentials(a, g, exps);
+    int32_t l;
+    for (l = g; (l < (g + GROUP)) && (l < a->lanes); ++l) {
+        if ((a->lanes < MIN_VECTOR_LANES) || (b->vector[l] == 0)) {
+            scalar_lane(b, a, l, (((given >> (uint32_t)(l - g)) & 1u) != 0u) ? exps[l - g] : NULL);
+        }
+    }
+}
+
 icoac_status_t icoac_step_batch(icoac_batch_t *batch, icoac_state_t *const states[], int32_t lanes,
                                 const icoac_real_t *s, int32_t inputs, const uint32_t *flags,
                                 const icoac_real_t *reflex, icoac_real_t *force, int32_t *status)
@@ -477,10 +559,10 @@ icoac_status_t icoac_step_batch(icoac_batch_t *batch, icoac_state_t *const state
         if (lanes >= MIN_VECTOR_LANES) {
             vector_lanes(b, &a);
         }
+        for (l = 0; l < lanes; l += GROUP) {
+            scalar_lanes(b, &a, l);
+        }
         for (l = 0; l < lanes; ++l) {
-            if ((lanes < MIN_VECTOR_LANES) || (b->vector[l] == 0)) {
-                scalar_lane(b, &a, l);
-            }
             if ((first == ICOAC_OK) && (status[l] != (int32_t)ICOAC_OK)) {
                 first = (icoac_status_t)status[l];
             }

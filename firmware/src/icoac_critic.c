@@ -140,7 +140,7 @@ static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, con
     for (i = 0; i < split; ++i) {
         /* units[i] is set for i < n (icoac_priv_critic_shape, or the cart-pole's constant): the
          * analyzer loses split < n through the shape's copy and calls it uninitialised */
-        icoac_priv_factors(s[i], critic->range[i], units[i], g); /* NOLINT(clang-analyzer-core.CallAndMessage) */
+        icoac_priv_factors(s[i], critic->range[i], units[i], NULL, g); /* NOLINT(clang-analyzer-core.CallAndMessage) */
         entries = icoac_priv_critic_expand_all(row_product, g, units[i], entries);
     }
     /* The cell inputs but the last: the products and indices of their kept units, expanded at
@@ -154,7 +154,7 @@ static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, con
     for (i = split; i < n - 1; ++i) {
         int begin;
         int end;
-        icoac_priv_factors(s[i], critic->range[i], units[i], g);
+        icoac_priv_factors(s[i], critic->range[i], units[i], NULL, g);
         kept_range(g, units[i], threshold, &begin, &end);
         entries = icoac_priv_critic_expand(cell_product + prefix_first, cell_index + prefix_first, g, units[i], begin,
                                            end, entries);
@@ -167,7 +167,7 @@ static inline icoac_real_t sparse_value(const icoac_critic_config_t *critic, con
         int begin;
         int end;
         int e;
-        icoac_priv_factors(s[n - 1], critic->range[n - 1], count, g);
+        icoac_priv_factors(s[n - 1], critic->range[n - 1], count, NULL, g);
         kept_range(g, count, threshold, &begin, &end);
         for (e = 0; e < entries; ++e) {
             const icoac_real_t p = cell_product[prefix_first + e];

@@ -50,8 +50,9 @@ static inline icoac_real_t select_kept(icoac_real_t b, icoac_real_t threshold, i
  * by the caller: rows and stride <= ICOAC_CRITIC_BLOCK_MAX, rows * stride <=
  * ICOAC_MAX_CRITIC_UNITS). */
 static inline icoac_real_t dense_value(const icoac_critic_config_t *critic, const icoac_real_t *v,
-                                       const icoac_real_t s[ICOAC_MAX_INPUTS], icoac_priv_critic_products_t *products,
-                                       int n_inputs, const int *units, int first_cell, int rows, int stride)
+                                       const icoac_real_t s[ICOAC_MAX_INPUTS], const icoac_real_t *given,
+                                       icoac_priv_critic_products_t *products, int n_inputs, const int *units,
+                                       int first_cell, int rows, int stride)
 {
     /* the callers' bounds, restated for the compiler: 1 <= n <= ICOAC_MAX_INPUTS, split < n */
     const int n = n_inputs < ICOAC_MAX_INPUTS ? n_inputs : ICOAC_MAX_INPUTS;
@@ -72,7 +73,7 @@ static inline icoac_real_t dense_value(const icoac_critic_config_t *critic, cons
     row_product[0] = ICOAC_R(1.0);
     ICOAC_PRIV_UNROLL
     for (i = 0; i < split; ++i) {
-        icoac_priv_factors(s[i], critic->range[i], units[i], g);
+        icoac_priv_factors(s[i], critic->range[i], units[i], (given != NULL) ? &given[2 * i] : NULL, g);
         entries = icoac_priv_critic_expand_all(row_product, g, units[i], entries);
     }
     cell_product[0] = ICOAC_R(1.0);
@@ -80,7 +81,7 @@ static inline icoac_real_t dense_value(const icoac_critic_config_t *critic, cons
     ICOAC_PRIV_UNROLL
     for (i = split; i < n; ++i) {
         const int count = units[i];
-        icoac_priv_factors(s[i], critic->range[i], count, g);
+        icoac_priv_factors(s[i], critic->range[i], count, (given != NULL) ? &given[2 * i] : NULL, g);
         if (i == split) {
             /* Only units of the first cell input with g >= the threshold can be kept (every factor
              * is <= 1); g is unimodal, so they are one run [begin, end) of it. */
@@ -145,6 +146,7 @@ static inline void dense_update(const icoac_critic_config_t *critic, icoac_real_
 ICOAC_PRIV_NOINLINE static icoac_real_t dense_value_general(const icoac_critic_config_t *critic,
                                                             const icoac_priv_grid_t *grid, const icoac_real_t *v,
                                                             const icoac_real_t s[ICOAC_MAX_INPUTS],
+                                                            const icoac_real_t *given,
                                                             icoac_priv_critic_products_t *products)
 {
     icoac_priv_shape_t shape;
@@ -156,19 +158,19 @@ ICOAC_PRIV_NOINLINE static icoac_real_t dense_value_general(const icoac_critic_c
         products->cell_end = 0u;
         return ICOAC_R(0.0);
     }
-    return dense_value(critic, v, s, products, shape.n, shape.units, shape.split, shape.rows, shape.cells);
+    return dense_value(critic, v, s, given, products, shape.n, shape.units, shape.split, shape.rows, shape.cells);
 }
 
 icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
                                            const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
-                                           icoac_priv_critic_products_t *products)
+                                           const icoac_real_t *given, icoac_priv_critic_products_t *products)
 {
     static const int cartpole_units[ICOAC_CARTPOLE_INPUTS] = ICOAC_PRIV_CARTPOLE_UNITS;
     if ((grid->shape & ICOAC_PRIV_SHAPE_CARTPOLE_CRITIC) != 0u) {
-        return dense_value(critic, v, s, products, ICOAC_CARTPOLE_INPUTS, cartpole_units, 2,
+        return dense_value(critic, v, s, given, products, ICOAC_CARTPOLE_INPUTS, cartpole_units, 2,
                            ICOAC_PRIV_CARTPOLE_ROWS, ICOAC_PRIV_CARTPOLE_CELLS);
     }
-    return dense_value_general(critic, grid, v, s, products);
+    return dense_value_general(critic, grid, v, s, given, products);
 }
 
 void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,

@@ -114,10 +114,53 @@ static inline float icoac_priv_log(float a)
     return ((float)e * ln2_hi + series) + (float)e * ln2_lo;
 }
 #else
+#if defined(ICOAC_CRITIC_DENSE) && ICOAC_CRITIC_DENSE && !(defined(ICOAC_REAL_DOUBLE) && ICOAC_REAL_DOUBLE)
+/* The float build of a host (the dense kernel): icoac's own e^a, in double with no branch and no
+ * table, so that a loop of it over many values vectorises (icoac_step_batch) with the same bits
+ * as one call: a = k ln2 + r, |r| <= ln2/2 (k rounded by adding 1.5 * 2^52), e^r by its Taylor
+ * series to r^9 (truncation < 7e-12 relative) in Estrin's order, 2^k from the exponent bits, one
+ * rounding to float. Within 1 ulp of the C library's expf (tests/c/test_fast_exp.c). a is
+ * clamped to [-110, 100] first: 0 below, Inf above float's range, NaN stays NaN. */
+static inline float icoac_priv_exp(float a)
+{
+    const double shift = 6755399441055744.0;
+    const double inv_ln2 = 1.4426950408889634074;
+    const double ln2 = 0.69314718055994530942;
+    union {
+        double d;
+        uint64_t u;
+    } k_bits;
+    union {
+        double d;
+        uint64_t u;
+    } scale;
+    double x = (double)a;
+    double k;
+    double r;
+    double r2;
+    double r4;
+    double p;
+    x = (x < -110.0) ? -110.0 : x;
+    x = (x > 100.0) ? 100.0 : x;
+    k = x * inv_ln2;
+    k = k + shift;
+    k_bits.d = k; /* k in the low bits of the mantissa */
+    k = k - shift;
+    r = x - k * ln2;
+    r2 = r * r;
+    r4 = r2 * r2;
+    p = ((1.0 + r) + r2 * (0.5 + r * (1.0 / 6.0))) +
+        r4 * ((((1.0 / 24.0) + r * (1.0 / 120.0)) + r2 * ((1.0 / 720.0) + r * (1.0 / 5040.0))) +
+              r4 * ((1.0 / 40320.0) + r * (1.0 / 362880.0)));
+    scale.u = (k_bits.u + 1023u) << 52; /* 2^k: k + 1023 in the exponent field */
+    return (float)(p * scale.d);
+}
+#else
 static inline icoac_real_t icoac_priv_exp(icoac_real_t a)
 {
     return ICOAC_PRIV_LIBM_EXP(a);
 }
+#endif
 
 static inline icoac_real_t icoac_priv_log(icoac_real_t a)
 {
@@ -279,15 +322,24 @@ static inline icoac_real_t icoac_priv_trace(const icoac_real_t m[ICOAC_MAX_INPUT
 #define ICOAC_PRIV_TICK_OK 1        /* committed */
 #define ICOAC_PRIV_TICK_CORRUPT 2 /* an unknown switch in the state's configuration: nothing committed */
 
+/* icoac_step, with the critic's exponentials of the input computed by the caller: given holds
+ * e^(up's argument) and e^(edge's argument) of input i at given[2i], given[2i + 1]
+ * (icoac_priv_factors_of), or is NULL (icoac_step: the tick computes them). icoac_step_batch
+ * computes them for many states at once. */
+icoac_status_t icoac_priv_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out,
+                               const icoac_real_t *given);
+
 /* ICO rule, both timings (icoac_ico.c). */
 int icoac_priv_ico_tick(const icoac_config_t *cfg, icoac_priv_state_t *st,
                         const icoac_real_t scaled[ICOAC_MAX_INPUTS], icoac_real_t penalty, int terminal,
                         icoac_output_t *out);
 
 /* Actor-critic tick: critic and actor on the transition into s, then act (icoac_rl.c), for a
- * task of n inputs. */
+ * task of n inputs. given: NULL, or the critic's exponentials of s computed by the caller
+ * (icoac_priv_step). */
 int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_MAX_INPUTS],
-                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out, int n);
+                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out, int n,
+                       const icoac_real_t *given);
 
 /* Critic (method.md, critic): V(s) with the units it kept, and the TD update v_k += step * b_k
  * over such units. Two kernels compute the same units:
@@ -327,19 +379,12 @@ static inline icoac_real_t icoac_priv_critic_floor(const icoac_critic_config_t *
  * width sigma = R/n, (s - c_j)/sigma = d_j = o - 2j with o = s*n/R + n - 1. Relative to the
  * nearest centre j* (distance d), a_{j*+1}/a_{j*} = exp(2d - 2) =: up, a_{j*-1}/a_{j*} =
  * exp(-2d - 2) = e^-4 / up, and each further step out multiplies the ratio by e^-4: one
- * exponential per dimension instead of n. a_{j*} = 1, so far-away states never give 0/0. */
-static inline void icoac_priv_factors_of(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
+ * exponential per dimension instead of n. a_{j*} = 1, so far-away states never give 0/0.
+ * First the nearest centre j* and the distance d to it: */
+static inline int icoac_priv_factor_nearest(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *distance)
 {
-    const icoac_real_t exp_minus_4 = ICOAC_R(0.018315638888734180294);
     const icoac_real_t offset = value * ((icoac_real_t)n / range) + (icoac_real_t)(n - 1);
-    icoac_real_t up = ICOAC_R(0.0);
-    icoac_real_t down = ICOAC_R(0.0);
-    icoac_real_t ratio;
-    icoac_real_t distance;
-    icoac_real_t total = ICOAC_R(0.0);
-    icoac_real_t inv_total;
     int nearest;
-    int j;
     if (!(offset > ICOAC_R(0.0))) {
         nearest = 0;
     } else if (offset >= (icoac_real_t)(2 * (n - 1))) {
@@ -347,13 +392,42 @@ static inline void icoac_priv_factors_of(icoac_real_t value, icoac_real_t range,
     } else {
         nearest = (int)(offset * ICOAC_R(0.5) + ICOAC_R(0.5));
     }
-    distance = offset - (icoac_real_t)(2 * nearest);
+    *distance = offset - (icoac_real_t)(2 * nearest);
+    return nearest;
+}
+/* The arguments of the two exponentials: up's, 2d - 2, and the last centre's down, -2d - 2. */
+static inline icoac_real_t icoac_priv_factor_up_arg(icoac_real_t distance)
+{
+    return ICOAC_R(2.0) * distance - ICOAC_R(2.0);
+}
+static inline icoac_real_t icoac_priv_factor_edge_arg(icoac_real_t distance)
+{
+    return ICOAC_R(-2.0) * distance - ICOAC_R(2.0);
+}
+/* given: NULL, or e^(up's argument) and e^(edge's argument) computed by the caller for this value
+ * (icoac_step_batch, for many states at once); they are the values this function would take. */
+static inline void icoac_priv_factors_of(icoac_real_t value, icoac_real_t range, int n, const icoac_real_t *given,
+                                         icoac_real_t *g)
+{
+    const icoac_real_t exp_minus_4 = ICOAC_R(0.018315638888734180294);
+    icoac_real_t up = ICOAC_R(0.0);
+    icoac_real_t down = ICOAC_R(0.0);
+    icoac_real_t ratio;
+    icoac_real_t distance;
+    icoac_real_t total = ICOAC_R(0.0);
+    icoac_real_t inv_total;
+    const int nearest = icoac_priv_factor_nearest(value, range, n, &distance);
+    int j;
     if (nearest < n - 1) {
-        up = icoac_priv_exp(ICOAC_R(2.0) * distance - ICOAC_R(2.0));
+        up = (given != NULL) ? given[0] : icoac_priv_exp(icoac_priv_factor_up_arg(distance));
     }
     if (nearest > 0) {
         /* inside the grid |distance| <= 1, so up >= e^-4 and down = e^-4 / up <= 1 */
-        down = nearest < n - 1 ? exp_minus_4 / up : icoac_priv_exp(ICOAC_R(-2.0) * distance - ICOAC_R(2.0));
+        if (nearest < n - 1) {
+            down = exp_minus_4 / up;
+        } else {
+            down = (given != NULL) ? given[1] : icoac_priv_exp(icoac_priv_factor_edge_arg(distance));
+        }
     }
     /* Both chains run over the whole array and select, so no branch depends on nearest. */
     for (j = 0; j < n; ++j) {
@@ -405,13 +479,14 @@ int icoac_priv_critic_shape(const icoac_critic_config_t *critic, const icoac_pri
 #if defined(__GNUC__) && defined(ICOAC_CRITIC_DENSE) && ICOAC_CRITIC_DENSE
 __attribute__((__always_inline__)) /* hosts: inline in the dense kernel (measured: RL tick -4 %) */
 #endif
-static inline void icoac_priv_factors(icoac_real_t value, icoac_real_t range, int n, icoac_real_t *g)
+static inline void icoac_priv_factors(icoac_real_t value, icoac_real_t range, int n, const icoac_real_t *given,
+                                      icoac_real_t *g)
 {
     switch (n) {
-    case 2: icoac_priv_factors_of(value, range, 2, g); break;
-    case 3: icoac_priv_factors_of(value, range, 3, g); break;
-    case 6: icoac_priv_factors_of(value, range, 6, g); break;
-    default: icoac_priv_factors_of(value, range, n, g); break;
+    case 2: icoac_priv_factors_of(value, range, 2, given, g); break;
+    case 3: icoac_priv_factors_of(value, range, 3, given, g); break;
+    case 6: icoac_priv_factors_of(value, range, 6, given, g); break;
+    default: icoac_priv_factors_of(value, range, n, given, g); break;
     }
 }
 /* The products of the factors g of one input over its index range [begin, end) with each of the
@@ -470,7 +545,7 @@ void icoac_priv_critic_update_sparse_shaped(const icoac_priv_grid_t *grid, icoac
                                             const icoac_priv_critic_list_t *list, icoac_real_t step);
 icoac_real_t icoac_priv_critic_value_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
                                            const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
-                                           icoac_priv_critic_products_t *products);
+                                           const icoac_real_t *given, icoac_priv_critic_products_t *products);
 void icoac_priv_critic_update_dense(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
                                     icoac_real_t *v, const icoac_priv_critic_products_t *products,
                                     icoac_real_t step);
@@ -489,11 +564,12 @@ static inline void icoac_priv_critic_clear(icoac_priv_critic_active_t *active)
 
 static inline icoac_real_t icoac_priv_critic_value(const icoac_critic_config_t *critic, const icoac_priv_grid_t *grid,
                                                    const icoac_real_t *v, const icoac_real_t s[ICOAC_MAX_INPUTS],
-                                                   icoac_priv_critic_active_t *active)
+                                                   const icoac_real_t *given, icoac_priv_critic_active_t *active)
 {
 #if defined(ICOAC_CRITIC_DENSE) && ICOAC_CRITIC_DENSE
-    return icoac_priv_critic_value_dense(critic, grid, v, s, &active->dense);
+    return icoac_priv_critic_value_dense(critic, grid, v, s, given, &active->dense);
 #else
+    (void)given; /* the dense kernel's: hosts */
     return icoac_priv_critic_value_sparse(critic, grid, v, s, &active->sparse);
 #endif
 }

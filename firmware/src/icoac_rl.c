@@ -22,7 +22,8 @@ static icoac_real_t clip_td(icoac_real_t delta, icoac_real_t td_clip)
  * by at most critic_rate * td_clip <= 1e4 per tick. Writes every output field but reflex,
  * penalty, weight_norm and status. */
 static inline int rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_MAX_INPUTS],
-                          const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out, int n)
+                          const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out, int n,
+                          const icoac_real_t *given)
 {
     icoac_real_t w[ICOAC_MAX_INPUTS];
     icoac_real_t h[ICOAC_MAX_INPUTS];
@@ -48,7 +49,7 @@ static inline int rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, con
     int i;
     if (!terminal || cfg->critic.quirks) {
         /* fills the spare slot: the current one stays the eligibility of this update */
-        value = icoac_priv_critic_value(&cfg->critic, &st->grid, st->v, s, &st->active[slot_prev ^ 1]);
+        value = icoac_priv_critic_value(&cfg->critic, &st->grid, st->v, s, given, &st->active[slot_prev ^ 1]);
         if (terminal != 0) {
             value = ICOAC_R(0.0); /* quirks: only the kept units of s_t+1 were wanted */
         }
@@ -127,10 +128,11 @@ static inline int rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, con
 }
 
 int icoac_priv_rl_tick(const icoac_config_t *cfg, icoac_priv_state_t *st, const icoac_real_t s[ICOAC_MAX_INPUTS],
-                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out, int n)
+                       const icoac_real_t scaled[ICOAC_MAX_INPUTS], int terminal, icoac_output_t *out, int n,
+                       const icoac_real_t *given)
 {
     if (n == ICOAC_CARTPOLE_INPUTS) {
-        return rl_tick(cfg, st, s, scaled, terminal, out, ICOAC_CARTPOLE_INPUTS);
+        return rl_tick(cfg, st, s, scaled, terminal, out, ICOAC_CARTPOLE_INPUTS, given);
     }
-    return rl_tick(cfg, st, s, scaled, terminal, out, ICOAC_MAX_INPUTS);
+    return rl_tick(cfg, st, s, scaled, terminal, out, ICOAC_MAX_INPUTS, given);
 }

@@ -61,7 +61,7 @@ ICOAC_PRIV_NOINLINE static icoac_status_t not_in_trial(icoac_priv_state_t *st, i
  * has the preset's layout) and for the configuration's (bounded to the arrays); icoac_step
  * selects one per tick. */
 static inline icoac_status_t tick(icoac_priv_state_t *st, const icoac_input_t *in, icoac_output_t *out, int n,
-                                  int rules, int sensor, int cartpole_rules)
+                                  int rules, int sensor, int cartpole_rules, const icoac_real_t *given)
 {
     const icoac_config_t *cfg = &st->config;
     const icoac_real_t *const inputs = in->s; /* entries n and up are not read */
@@ -90,7 +90,7 @@ static inline icoac_status_t tick(icoac_priv_state_t *st, const icoac_input_t *i
     out->reflex = zone.reflex;
     out->penalty = zone.penalty;
     if (cfg->mode == ICOAC_MODE_RL) {
-        ok = icoac_priv_rl_tick(cfg, st, inputs, scaled, terminal, out, n);
+        ok = icoac_priv_rl_tick(cfg, st, inputs, scaled, terminal, out, n, given);
     } else if (cfg->mode == ICOAC_MODE_SEARCH) {
         ok = icoac_priv_search_tick(cfg, st, scaled, terminal, out);
     } else if (cfg->mode == ICOAC_MODE_ICO) {
@@ -115,14 +115,20 @@ static inline icoac_status_t tick(icoac_priv_state_t *st, const icoac_input_t *i
 
 /* The general instance: the configuration's task. */
 ICOAC_PRIV_NOINLINE static icoac_status_t tick_general(icoac_priv_state_t *st, const icoac_input_t *in,
-                                                       icoac_output_t *out)
+                                                       icoac_output_t *out, const icoac_real_t *given)
 {
     const icoac_task_config_t *task = &st->config.task;
     const int sensor = task->late_source != ICOAC_LATE_RULES;
-    return tick(st, in, out, icoac_priv_inputs(&st->config), sensor ? 0 : icoac_priv_rules(task), sensor, 0);
+    return tick(st, in, out, icoac_priv_inputs(&st->config), sensor ? 0 : icoac_priv_rules(task), sensor, 0, given);
 }
 
 icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out)
+{
+    return icoac_priv_step(state, in, out, NULL); /* a tail call: no frame of its own */
+}
+
+icoac_status_t icoac_priv_step(icoac_state_t *state, const icoac_input_t *in, icoac_output_t *out,
+                               const icoac_real_t *given)
 {
     icoac_priv_state_t *st = icoac_priv_state(state);
     if ((state == NULL) || (in == NULL) || (out == NULL)) {
@@ -139,7 +145,7 @@ icoac_status_t icoac_step(icoac_state_t *state, const icoac_input_t *in, icoac_o
      * instance reads exactly the inputs and rules the copy names, whatever else the state holds */
     if (st->config.task.n_inputs == ICOAC_CARTPOLE_INPUTS && st->config.task.late_source == ICOAC_LATE_RULES &&
         st->config.task.n_rules == ICOAC_CARTPOLE_RULES) {
-        return tick(st, in, out, ICOAC_CARTPOLE_INPUTS, ICOAC_CARTPOLE_RULES, 0, 1);
+        return tick(st, in, out, ICOAC_CARTPOLE_INPUTS, ICOAC_CARTPOLE_RULES, 0, 1, given);
     }
-    return tick_general(st, in, out);
+    return tick_general(st, in, out, given);
 }

@@ -214,16 +214,16 @@ static inline void lane_input(const sim_block_t *block, int32_t l, int32_t n_inp
 /* Every running lane's controller ticks on its input, and its force becomes the lane's plant
  * input, or a lane whose controller reported an error ends (its cell's result written): state[l]
  * becomes its SIM_LANE_*. Returns how many lanes ended. One icoac_step_batch for the lanes; a
- * configuration whose ticks have no vector path there (RL mode, a sensor task: icoac_batch.c),
- * or a block of too few lanes for it, steps each lane with icoac_step instead, which spares the
- * batch's bookkeeping. */
+ * configuration whose ticks have nothing vectorised there (ICO or search on a sensor task:
+ * icoac_batch.c), or a block of too few lanes for it, steps each lane with icoac_step instead,
+ * which spares the batch's bookkeeping. */
 static int block_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lanes, int *state)
 {
     const icoac_config_t *cfg = job->cfg;
     const int32_t n = block->lanes;
     int32_t l;
     int ended = 0;
-    if (cfg->mode == ICOAC_MODE_RL || cfg->task.late_source != ICOAC_LATE_RULES || n < ICOAC_BATCH_MIN_VECTOR_LANES) {
+    if ((cfg->mode != ICOAC_MODE_RL && cfg->task.late_source != ICOAC_LATE_RULES) || n < ICOAC_BATCH_MIN_VECTOR_LANES) {
         for (l = 0; l < n; ++l) {
             if (state[l] == SIM_LANE_RUNNING) {
                 icoac_input_t in;

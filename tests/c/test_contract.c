@@ -140,7 +140,7 @@ static void check_scan(const icoac_config_t *cfg, const icoac_real_t *v, const i
     }
     TEST_ASSERT_TRUE(list[1].index[0] == 0 && list[1].cells == 0);
     memset(products, 0, sizeof products);
-    value = icoac_priv_critic_value_dense(&cfg->critic, &grid, v, s, &products[0]);
+    value = icoac_priv_critic_value_dense(&cfg->critic, &grid, v, s, NULL, &products[0]);
     /* factors computed from NaN are NaN of either sign (IEEE 754 leaves it open): a positive one
      * counts as kept (V NaN, which the tick rejects), a negative one as dropped (V 0) */
     TEST_ASSERT_TRUE(isnan((double)value) || value == ICOAC_R(0.0));

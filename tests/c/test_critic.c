@@ -134,7 +134,7 @@ static icoac_real_t kernel_value(int kernel, const icoac_config_t *cfg, const ic
                                  icoac_priv_critic_active_t *active)
 {
     const icoac_priv_grid_t geometry = grid_geometry(cfg);
-    return kernel == DENSE ? icoac_priv_critic_value_dense(&cfg->critic, &geometry, v, s, &active->dense)
+    return kernel == DENSE ? icoac_priv_critic_value_dense(&cfg->critic, &geometry, v, s, NULL, &active->dense)
                            : icoac_priv_critic_value_sparse(&cfg->critic, &geometry, v, s, &active->sparse);
 }
 
