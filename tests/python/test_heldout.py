@@ -35,7 +35,7 @@ def test_splits_differ_by_plant_and_seeds_are_disjoint():
 
 
 @pytest.mark.parametrize("plant", sorted(p for p in PLANTS if PLANTS[p].has_task))
-@pytest.mark.parametrize("learner", list(H.SPACES))
+@pytest.mark.parametrize("learner", list(H.LEARNERS))
 def test_same_budget_default_first_every_setting_valid(learner, plant):
     settings = H.settings(learner, plant)
     assert len(settings) == H.SETTINGS and len({H.key(s) for s in settings}) == H.SETTINGS
@@ -46,9 +46,24 @@ def test_same_budget_default_first_every_setting_valid(learner, plant):
 
 
 def test_the_cart_poles_space_is_the_one_its_runs_used():
-    """The cart-pole's tuning ran with SPACES as committed in 22d5b07: a plant's own spaces leave it."""
-    assert H.spaces("cart_pole") == dict(H.SPACES)
+    """The cart-pole's tuning ran with the spaces committed in 22d5b07, the Furuta's with those of
+    e3b0352: deriving them from each plant's defaults leaves them as they were."""
+    gradient = {"actor.update": "gradient", "actor.rate": 0.001}
+    mean = {"actor.update": "mean", "actor.likelihood_std": 0.1, "actor.scale": 0.1}
+    cart = H.spaces("cart_pole")
+    assert cart["ico"] == {"ico.rate": [1e-4, 1e-5, 3e-5, 3e-4, 1e-3, 3e-3], "ico.timing": ["code", "literal"]}
+    for learner, reading, noise in (("ico-rl", [gradient, mean], [3, 1, 2, 5, 8, 12]),
+                                    ("ico-mean-rl", [gradient, mean], [3, 1, 2, 5, 8, 12]),
+                                    ("rl-ico-cov", [mean, gradient], [5, 1, 2, 3, 8, 12]),
+                                    ("rl", [mean, gradient], [12, 1, 2, 3, 5, 8])):
+        assert cart[learner] == {"reading": reading, "actor.noise_std": noise, "actor.explore_ticks": [1000]}
+    assert cart["search"] == {"search.cov_scale": [4, 1, 2, 8, 16, 64], "search.floor": [1, 0.1]}
     assert H.settings("ico")[:2] == [{"ico.rate": 1e-4, "ico.timing": "code"}, {"ico.rate": 1e-4, "ico.timing": "literal"}]
+    furuta = H.spaces("furuta")
+    assert furuta["ico"]["ico.rate"] == [0.01, 0.001, 0.003, 0.03, 0.1, 0.3]
+    assert furuta["ico-rl"]["actor.noise_std"] == [1, 0.3, 0.5, 2, 3, 5] and furuta["ico-rl"]["reading"] == [mean, gradient]
+    assert furuta["rl"]["actor.noise_std"] == [3, 0.3, 0.5, 1, 2, 5]
+    assert H.spaces("double_cart_pole")["ico"]["ico.rate"] == [1, 0.1, 0.3, 0.03, 0.01, 0.003]
 
 
 @pytest.mark.parametrize("algo", list(H.BASELINE_SPACES))
@@ -65,7 +80,7 @@ def test_baselines_same_budget_zoo_first(algo):
 
 def test_every_learner_is_tuned():
     learners = {c.name for c in REGISTRY.values() if c.learns}
-    assert set(H.SPACES) == learners
+    assert set(H.LEARNERS) == learners
 
 
 def test_criterion():
@@ -89,8 +104,8 @@ def test_runner_takes_icos_chosen_grids(tmp_path, monkeypatch):
     """Two settings each for ICO and ICO->RL on six tuning cells at small caps: the ranking is the
     criterion's, and ICO->RL's prior comes from ICO's chosen setting, seed for seed."""
     monkeypatch.setattr(H, "tuning_cells", lambda plant: np.array([560, 600, 610, 612, 640, 700]))
-    monkeypatch.setattr(H, "SPACES", {"ico": {"ico.rate": [1e-4, 1e-3]},
-                                      "ico-rl": {"actor.noise_std": [3, 1]}})
+    monkeypatch.setattr(H, "spaces", lambda plant: {"ico": {"ico.rate": [1e-4, 1e-3]},
+                                                    "ico-rl": {"actor.noise_std": [3, 1]}})
     monkeypatch.setitem(bench.PROFILES, "default", {**bench.PROFILES["default"],
                                                      "ico": {"max_trials": 3000, "success_steps": 1000},
                                                      "rl": {"max_trials": 200, "success_steps": 1000}})
@@ -114,7 +129,7 @@ def test_evaluation_against_the_bench_defaults(tmp_path, monkeypatch):
     evaluated ICO grids; the table sets the held-out and all-cell rates beside the bench's."""
     caps = {"ico": {"max_trials": 200, "success_steps": 200}, "rl": {"max_trials": 20, "success_steps": 200}}
     monkeypatch.setattr(H, "tuning_cells", lambda plant: np.array([171, 200, 612, 613, 1020, 1053]))
-    monkeypatch.setattr(H, "SPACES", {"ico": {"ico.rate": [1e-4, 1e-2]}, "ico-rl": {"actor.noise_std": [3]}})
+    monkeypatch.setattr(H, "spaces", lambda plant: {"ico": {"ico.rate": [1e-4, 1e-2]}, "ico-rl": {"actor.noise_std": [3]}})
     monkeypatch.setitem(bench.PROFILES, "default", {**bench.PROFILES["default"], "seeds": 2, **caps})
     bench_dir = tmp_path / "bench"
     for seed in (0, 1):

@@ -8,8 +8,8 @@ which cells and seeds tune, which evaluate, each learner's space, the budget and
 - Seeds: TUNING_SEEDS tune; the bench's seeds (0 to 4) evaluate. The two sets are disjoint, so
   no tuning run shares a start velocity or an exploration draw with an evaluation run.
 - Budget: every learner, ICO included, gets SETTINGS settings x len(TUNING_SEEDS) seeds, at the
-  default profile's caps (ICO 1e5 trials, the learners 1000), from its space on the plant (SPACES,
-  and PLANT_SPACES where a plant's defaults or units differ).
+  default profile's caps (ICO 1e5 trials, the learners 1000), from its space on the plant
+  (spaces(): derived from the plant's defaults and input unit).
 - Criterion: the highest mean success rate over the tuning seeds on the tuning cells; ties (equal
   to 1e-9) go to fewer median trials to success, then to the earlier setting of the space (each
   space lists the current default first, so a tie keeps it).
@@ -34,45 +34,60 @@ SETTINGS = 12
 TIE = 1e-9
 TUNING_CELLS = "tuning"  # the cell spec that names the tuning cells (`ceiling --cells tuning`)
 
-# Each learner's space: parameter -> values, full factorial, SETTINGS settings each, the current
-# cart-pole default first. The four actor-critic priors share one space: the two readings with their
-# defaults (gradient beta = 0.001; mean sigma_L = 0.1, alpha = 0.1) x the exploration noise, with
-# exploration until tick 1000 (the defaults of all four); the two searches share the breadth x the
-# floor; CMA-ES gets its start breadth (sigma0^2 = cov_scale; the check takes 1 to 1000).
-_ACTOR_CRITIC = {
-    "reading": [{"actor.update": "gradient", "actor.rate": 0.001},
-                {"actor.update": "mean", "actor.likelihood_std": 0.1, "actor.scale": 0.1}],
-    "actor.noise_std": [3, 1, 2, 5, 8, 12],
-    "actor.explore_ticks": [1000],
-}
-SPACES: Mapping[str, Mapping[str, Sequence[Any]]] = {
-    "ico": {"ico.rate": [1e-4, 1e-5, 3e-5, 3e-4, 1e-3, 3e-3], "ico.timing": ["code", "literal"]},
-    "ico-rl": _ACTOR_CRITIC,
-    "ico-mean-rl": _ACTOR_CRITIC,
-    "rl-ico-cov": {**_ACTOR_CRITIC, "reading": _ACTOR_CRITIC["reading"][::-1], "actor.noise_std": [5, 1, 2, 3, 8, 12]},
-    "rl": {**_ACTOR_CRITIC, "reading": _ACTOR_CRITIC["reading"][::-1], "actor.noise_std": [12, 1, 2, 3, 5, 8]},
+# The learners, ICO first (the others may take its output).
+LEARNERS = ("ico", "ico-rl", "ico-mean-rl", "rl-ico-cov", "rl", "ico-search", "search", "cma-es")
+# Each learner's space on a plant (spaces()): parameter -> values, full factorial, SETTINGS settings
+# each, the plant's default first. Derived from the plant's own defaults, so no plant is named here:
+# - ICO: its rate at the first six of these multiples of the plant's default rate that the rate's
+#   valid range takes, x the two timings.
+# - The four actor-critic priors: the two readings (gradient beta = 0.001; mean sigma_L = 0.1,
+#   alpha = 0.1), the plant's default reading first, x the exploration noise from the list of the
+#   plant's input unit (newtons; the Furuta's volts under its +-10 V: both of its defaults and the
+#   same breadth), the default first, exploring until tick 1000 (the defaults of all four).
+# - The two searches share the breadth x the floor; CMA-ES gets its start breadth (sigma0^2 =
+#   cov_scale; the check takes 1 to 1000). These do not depend on the plant.
+_ICO_MULTIPLES = (1, 0.1, 0.3, 3, 10, 30, 0.03, 0.01, 0.003)
+_NOISE_BY_UNIT = {"N": (1, 2, 3, 5, 8, 12), "V": (0.3, 0.5, 1, 2, 3, 5)}
+_READINGS = {"gradient": {"actor.update": "gradient", "actor.rate": 0.001},
+             "mean": {"actor.update": "mean", "actor.likelihood_std": 0.1, "actor.scale": 0.1}}
+_ACTOR_CRITIC = ("ico-rl", "ico-mean-rl", "rl-ico-cov", "rl")
+_FIXED: Mapping[str, Mapping[str, Sequence[Any]]] = {
     "ico-search": {"search.cov_scale": [64, 1, 4, 16, 256, 1000], "search.floor": [1, 0.1]},
     "search": {"search.cov_scale": [4, 1, 2, 8, 16, 64], "search.floor": [1, 0.1]},
     "cma-es": {"search.cov_scale": [4, 1, 1.5, 2, 3, 6, 8, 12, 16, 32, 64, 256]},
 }
 
-# The other plants' spaces where their defaults differ from the cart-pole's (a learner not listed
-# takes SPACES'), each with the plant's default first. ICO's rate: the cart-pole's multiples of the
-# plant's default (0.1 to 30), or of the largest valid rate (1) below it. The Furuta's actor-critic noise in volts, under its +-10 V limit:
-# both of its defaults (1 V, 3 V) and the same six-value breadth.
-_FURUTA_NOISE = [0.3, 0.5, 1, 2, 3, 5]
-PLANT_SPACES: Mapping[str, Mapping[str, Mapping[str, Sequence[Any]]]] = {
-    "furuta": {
-        "ico": {"ico.rate": [0.01, 0.001, 0.003, 0.03, 0.1, 0.3], "ico.timing": ["code", "literal"]},
-        "ico-rl": {**SPACES["rl"], "actor.noise_std": [1] + [v for v in _FURUTA_NOISE if v != 1]},
-        "ico-mean-rl": {**SPACES["rl"], "actor.noise_std": [1] + [v for v in _FURUTA_NOISE if v != 1]},
-        "rl-ico-cov": {**SPACES["rl"], "actor.noise_std": [3] + [v for v in _FURUTA_NOISE if v != 3]},
-        "rl": {**SPACES["rl"], "actor.noise_std": [3] + [v for v in _FURUTA_NOISE if v != 3]},
-    },
-    "double_cart_pole": {
-        "ico": {"ico.rate": [1.0, 0.003, 0.01, 0.03, 0.1, 0.3], "ico.timing": ["code", "literal"]},
-    },
-}
+
+def _default_first(default: Any, values: Sequence[Any]) -> list[Any]:
+    return [default] + [v for v in values if v != default]
+
+
+def spaces(plant: str) -> dict[str, Mapping[str, Sequence[Any]]]:
+    """Every learner's space on the plant (see LEARNERS' comment)."""
+    from icoac.core import binding as B
+    from icoac.core.config import ConfigError, build_config
+
+    def valid(overrides: Mapping[str, Any], learner: str) -> bool:
+        try:
+            build_config(overrides, condition=learner, plant=plant)
+        except ConfigError:
+            return False
+        return True
+    out: dict[str, Mapping[str, Sequence[Any]]] = {}
+    rate = float(build_config(condition="ico", plant=plant).controller.ico.rate)
+    rates = [float(f"{rate * m:.6g}") for m in _ICO_MULTIPLES]
+    out["ico"] = {"ico.rate": [r for r in rates if valid({"ico.rate": r}, "ico")][:6],
+                  "ico.timing": ["code", "literal"]}
+    updates = {value: name for name, value in B.ACTOR_UPDATES.items()}
+    noises = _NOISE_BY_UNIT[B.plant_info(plant)["input"][1]]
+    for learner in _ACTOR_CRITIC:
+        actor = build_config(condition=learner, plant=plant).controller.actor
+        noise = float(f"{float(actor.noise_std):.6g}")
+        out[learner] = {"reading": [_READINGS[r] for r in _default_first(updates[int(actor.update)], list(_READINGS))],
+                        "actor.noise_std": _default_first(int(noise) if noise.is_integer() else noise, noises),
+                        "actor.explore_ticks": [1000]}
+    out.update(_FIXED)
+    return {learner: out[learner] for learner in LEARNERS}
 
 
 # PPO's and SAC's spaces (icoac.studies.baselines.sb3): hyperparameters over their RL Zoo start,
@@ -90,12 +105,6 @@ def baseline_settings(algo: str) -> list[dict[str, Any]]:
     Zoo's)."""
     space = BASELINE_SPACES[algo]
     return [dict(zip(space, combo)) for combo in itertools.product(*space.values())]
-
-
-def spaces(plant: str) -> dict[str, Mapping[str, Sequence[Any]]]:
-    """Every learner's space on the plant."""
-    own = PLANT_SPACES.get(plant, {})
-    return {learner: own.get(learner, space) for learner, space in SPACES.items()}
 
 
 def settings(learner: str, plant: str = "cart_pole") -> list[dict[str, Any]]:
@@ -162,5 +171,4 @@ def protocol(plant: str = "cart_pole") -> dict[str, Any]:
             "baseline_spaces": {name: {k: list(v) for k, v in space.items()} for name, space in BASELINE_SPACES.items()}}
 
 
-assert all(len(settings(name, plant)) == SETTINGS for plant in ("cart_pole", *PLANT_SPACES) for name in SPACES)
 assert all(len(baseline_settings(name)) == SETTINGS for name in BASELINE_SPACES)

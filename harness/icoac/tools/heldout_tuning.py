@@ -36,7 +36,7 @@ from icoac.studies import prior as P
 from icoac.studies.conditions import condition_prior, run_condition
 from icoac.tools.resumable import guarded
 
-ORDER = tuple(heldout.SPACES)  # ICO first: the others may take its output
+ORDER = heldout.LEARNERS  # ICO first: the others may take its output
 
 
 def finished(out: Path) -> bool:
