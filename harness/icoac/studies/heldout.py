@@ -26,6 +26,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from icoac.core import geometry
+from icoac.core.options import CART_POLE
 
 SPLIT_STREAM = 0x7E57_5E7
 TUNING_FRACTION = 0.3
@@ -107,7 +108,7 @@ def baseline_settings(algo: str) -> list[dict[str, Any]]:
     return [dict(zip(space, combo)) for combo in itertools.product(*space.values())]
 
 
-def settings(learner: str, plant: str = "cart_pole") -> list[dict[str, Any]]:
+def settings(learner: str, plant: str = CART_POLE) -> list[dict[str, Any]]:
     """The learner's settings on the plant as configuration overrides, in the space's order (the
     first: the plant's current default)."""
     space = spaces(plant)[learner]
@@ -161,7 +162,7 @@ def rank(rows: Sequence[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
     return sorted(rows, key=sort_key)
 
 
-def protocol(plant: str = "cart_pole") -> dict[str, Any]:
+def protocol(plant: str = CART_POLE) -> dict[str, Any]:
     """The protocol on the plant as data (recorded beside every tuning result)."""
     return {"split_stream": SPLIT_STREAM, "tuning_fraction": TUNING_FRACTION, "tuning_seeds": list(TUNING_SEEDS),
             "settings": SETTINGS, "tie": TIE,
