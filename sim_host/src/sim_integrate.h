@@ -8,13 +8,14 @@
 #include "icoac_sim/icoac_sim.h"
 
 #define SIM_DERIVATIVES static inline __attribute__((always_inline)) void
-/* A plant's step, compiled for each vector width; the loader picks the machine's. Not with clang:
+/* A loop over a block's lanes (a plant's step, the engine's failure test and inputs), compiled
+ * for each vector width; the loader picks the machine's. Not with clang:
  * clang 14 gives the clones' resolver of a static function external linkage, so that two plants'
  * `step`s clash at link time; its builds run the baseline (SSE2) code. */
 #if defined(__clang__)
-#define SIM_BATCH_STEP
+#define SIM_VECTOR_CLONES
 #else
-#define SIM_BATCH_STEP __attribute__((target_clones("default", "avx2", "avx512f")))
+#define SIM_VECTOR_CLONES __attribute__((target_clones("default", "avx2", "avx512f")))
 #endif
 
 /* An actuator's saturation at +-limit (a plant's max_force or max_voltage), inside its

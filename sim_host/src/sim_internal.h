@@ -15,11 +15,12 @@
  * Non-finite velocities fail too (icoac_sim_model_failed contract: "or not finite"); otherwise the
  * next tick hands them to the controller, which rejects the observation and the cell ends
  * as ICOAC_SIM_ERROR instead of a failed trial. */
-static inline int32_t sim_cart_pole_failed(double x_limit, double theta_limit, const double s[4])
+static inline int32_t sim_cart_pole_failed(double x_limit, double theta_limit, const double *s, int32_t stride)
 {
-    /* & rather than &&: no branch, so that the engine's loop over a block's lanes vectorises */
-    return !((s[0] >= -x_limit) & (s[0] <= x_limit) & (s[2] >= -theta_limit) & (s[2] <= theta_limit) &
-             (fabs(s[1]) <= DBL_MAX) & (fabs(s[3]) <= DBL_MAX));
+    /* & rather than &&: no branch, so that the engine's loop over a block's lanes vectorises;
+     * component i at s[i * stride] (1: one state; the block's lanes: a lane of its arrays) */
+    return !((s[0] >= -x_limit) & (s[0] <= x_limit) & (s[2 * stride] >= -theta_limit) &
+             (s[2 * stride] <= theta_limit) & (fabs(s[stride]) <= DBL_MAX) & (fabs(s[3 * stride]) <= DBL_MAX));
 }
 
 /* The cart-pole's step (plants/cart_pole.c) and where its limits sit in its parameter block
@@ -76,7 +77,8 @@ typedef struct {
     double s[ICOAC_SIM_MAX_STATE * ICOAC_SIM_MAX_LANES];
     double u[ICOAC_SIM_MAX_LANES];
     icoac_real_t in[ICOAC_MAX_INPUTS * ICOAC_SIM_MAX_LANES]; /* the controllers' inputs, laid out as s (sim_real) */
-    int32_t failed[ICOAC_SIM_MAX_LANES];                     /* the plant's failure test of each lane's state */
+    int64_t failed[ICOAC_SIM_MAX_LANES]; /* the plant's failure test of each lane's state (64 bits: the
+                                           width of its double compares, so that its loop vectorises) */
     icoac_batch_t batch;                                     /* the controllers' ticks (icoac_step_batch) */
     icoac_state_t *ctrl[ICOAC_SIM_MAX_LANES];                /* the running lanes' controllers, NULL for the others */
     icoac_real_t force[ICOAC_SIM_MAX_LANES];

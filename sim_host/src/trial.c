@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "icoac_sim/icoac_sim.h"
+#include "sim_integrate.h"
 #include "sim_internal.h"
 
 #if defined(__SSE2__)
@@ -253,6 +254,26 @@ static int block_act(const sim_job_t *job, sim_block_t *block, sim_lane_t *lanes
     return ended;
 }
 
+/* The controllers' inputs from the plant states (sim_real of each of count values). */
+SIM_VECTOR_CLONES static void block_inputs(const double *restrict s, int32_t count, icoac_real_t *restrict in)
+{
+    int32_t i;
+    for (i = 0; i < count; ++i) {
+        in[i] = sim_real(s[i]);
+    }
+}
+
+/* The cart-pole's failure test of every lane; through restrict pointers, so that GCC sees the
+ * states and the results apart and vectorises the loop. */
+SIM_VECTOR_CLONES static void cart_pole_failures(double x_limit, double theta_limit, const double *restrict s, int32_t lanes,
+                               int64_t *restrict failed)
+{
+    int32_t l;
+    for (l = 0; l < lanes; ++l) {
+        failed[l] = sim_cart_pole_failed(x_limit, theta_limit, &s[l], lanes);
+    }
+}
+
 /* The plant step of every lane, then each lane's failure test and next input, all in loops over
  * the lanes. The cart-pole's step and failure test are called directly: through the descriptor,
  * the ICO tick of every paper benchmark cost more. */
@@ -262,15 +283,11 @@ static void block_step(const sim_job_t *job, sim_block_t *block)
     const double *p = model->param;
     const int32_t lanes = block->lanes;
     const int32_t n_inputs = job->cfg->task.n_inputs;
-    int32_t i, l;
+    int32_t l;
     if (model->plant == ICOAC_SIM_CART_POLE) {
-        const double *s = block->s;
         const double x_limit = p[SIM_CART_POLE_X_LIMIT], theta_limit = p[SIM_CART_POLE_THETA_LIMIT];
         sim_cart_pole_step(p, model->dt, model->integrator, block->s, block->u, lanes);
-        for (l = 0; l < lanes; ++l) {
-            const double x[4] = {s[l], s[lanes + l], s[2 * lanes + l], s[3 * lanes + l]};
-            block->failed[l] = sim_cart_pole_failed(x_limit, theta_limit, x);
-        }
+        cart_pole_failures(x_limit, theta_limit, block->s, lanes, block->failed);
     } else {
         job->desc->step(p, model->dt, model->integrator, block->s, block->u, lanes);
         for (l = 0; l < lanes; ++l) {
@@ -279,9 +296,7 @@ static void block_step(const sim_job_t *job, sim_block_t *block)
             block->failed[l] = job->desc->failed(p, x);
         }
     }
-    for (i = 0; i < n_inputs * lanes; ++i) { /* the inputs' layout is the states' */
-        block->in[i] = sim_real(block->s[i]);
-    }
+    block_inputs(block->s, n_inputs * lanes, block->in); /* the inputs' layout is the states' */
 }
 
 /* After the plant step of a lane that acted: a failure or the success length ends the trial, and

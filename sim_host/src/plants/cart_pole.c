@@ -28,7 +28,7 @@ SIM_DERIVATIVES derivatives(const double *p, const double *s, double command, do
     ds[3] = theta_acc;
 }
 
-SIM_BATCH_STEP void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *s,
+SIM_VECTOR_CLONES void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *s,
                                        const double *forces, int32_t lanes)
 {
     sim_integrate(derivatives, 4, p, dt, integrator, s, forces, lanes);
@@ -36,7 +36,7 @@ SIM_BATCH_STEP void sim_cart_pole_step(const double *p, double dt, int32_t integ
 
 static int32_t failed(const double *p, const double *s)
 {
-    return sim_cart_pole_failed(p[X_LIMIT], p[THETA_LIMIT], s);
+    return sim_cart_pole_failed(p[X_LIMIT], p[THETA_LIMIT], s, 1);
 }
 
 /* Cart plus a uniform rod of half-length l (inertia m l^2 / 3 about its centre), height 0 at

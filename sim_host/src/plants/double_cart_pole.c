@@ -58,7 +58,7 @@ SIM_DERIVATIVES derivatives(const double *p, const double *s, double command, do
     ds[5] = (k02 * r0 + k12 * r1 + k22 * r2) / det;
 }
 
-SIM_BATCH_STEP static void step(const double *p, double dt, int32_t integrator, double *s,
+SIM_VECTOR_CLONES static void step(const double *p, double dt, int32_t integrator, double *s,
                                 const double *forces, int32_t lanes)
 {
     sim_integrate(derivatives, 6, p, dt, integrator, s, forces, lanes);

@@ -63,7 +63,7 @@ SIM_DERIVATIVES derivatives(const double *p, const double *s, double voltage, do
     ds[3] = (m11 * r2 - m12 * r1) / det;
 }
 
-SIM_BATCH_STEP static void step(const double *p, double dt, int32_t integrator, double *s,
+SIM_VECTOR_CLONES static void step(const double *p, double dt, int32_t integrator, double *s,
                                 const double *voltages, int32_t lanes)
 {
     sim_integrate(derivatives, 4, p, dt, integrator, s, voltages, lanes);
