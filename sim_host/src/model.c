@@ -129,7 +129,7 @@ int32_t icoac_sim_model_failed(const icoac_sim_model_t *model, const double stat
     if (failed == 0) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
-    *failed = desc->failed(model->param, state);
+    desc->failed(model->param, state, 1, failed);
     return ICOAC_SIM_OK;
 }
 

@@ -8,6 +8,10 @@
 #include "icoac_sim/icoac_sim.h"
 
 #define SIM_DERIVATIVES static inline __attribute__((always_inline)) void
+/* A plant's failure test of one state (1: outside its limits or not finite), inlined into
+ * sim_test_lanes's loop; written with & rather than && and as !(inside), so that the loop has no
+ * branch and NaN fails. */
+#define SIM_STATE_TEST static inline __attribute__((always_inline)) int32_t
 /* A loop over a block's lanes (a plant's step, the engine's failure test and inputs), compiled
  * for each vector width; the loader picks the machine's. Not with clang:
  * clang 14 gives the clones' resolver of a static function external linkage, so that two plants'
@@ -23,6 +27,21 @@
 static inline double sim_saturate(double u, double limit)
 {
     return u > limit ? limit : (u < -limit ? -limit : u);
+}
+
+/* failed[l] = test(p, lane l's state) for each of the lanes states of s (the step's layout), n
+ * components each: a plant's `failed`, declared SIM_VECTOR_CLONES, calls it with its own test. */
+static inline __attribute__((always_inline)) void sim_test_lanes(int32_t (*test)(const double *, const double *), int n,
+                                                                 const double *p, const double *restrict s,
+                                                                 int32_t lanes, int32_t *restrict failed)
+{
+    int32_t l;
+    int i;
+    for (l = 0; l < lanes; ++l) {
+        double x[ICOAC_SIM_MAX_STATE];
+        for (i = 0; i < n; ++i) x[i] = s[i * lanes + l];
+        failed[l] = test(p, x);
+    }
 }
 
 /* Advance each of the lanes states of s (component i of lane l at s[i * lanes + l]) by one dt

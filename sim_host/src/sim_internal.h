@@ -11,25 +11,10 @@
 /* Time step of every default plant and model (s). */
 #define SIM_DT_DEFAULT 0.01
 
-/* Failure test of the plant (method.md) with strict limits; written so that NaN counts as failure.
- * Non-finite velocities fail too (icoac_sim_model_failed contract: "or not finite"); otherwise the
- * next tick hands them to the controller, which rejects the observation and the cell ends
- * as ICOAC_SIM_ERROR instead of a failed trial. */
-static inline int32_t sim_cart_pole_failed(double x_limit, double theta_limit, const double *s, int32_t stride)
-{
-    /* & rather than &&: no branch, so that the engine's loop over a block's lanes vectorises;
-     * component i at s[i * stride] (1: one state; the block's lanes: a lane of its arrays) */
-    return !((s[0] >= -x_limit) & (s[0] <= x_limit) & (s[2 * stride] >= -theta_limit) &
-             (s[2 * stride] <= theta_limit) & (fabs(s[stride]) <= DBL_MAX) & (fabs(s[3 * stride]) <= DBL_MAX));
-}
-
-/* The cart-pole's step (plants/cart_pole.c) and where its limits sit in its parameter block
- * (x_limit, then theta_limit), so that the trial loop can call the one and test the others
- * without going through the descriptor. */
+/* The cart-pole's step (plants/cart_pole.c), which the trial loop calls without going through
+ * the descriptor. */
 void sim_cart_pole_step(const double *p, double dt, int32_t integrator, double *s, const double *forces,
                         int32_t lanes);
-#define SIM_CART_POLE_X_LIMIT 4
-#define SIM_CART_POLE_THETA_LIMIT 5
 
 /* Check the controller configuration, model and (if not NULL) run parameters, and that the
  * controller build takes the plant's observation (params.c). */
@@ -77,8 +62,7 @@ typedef struct {
     double s[ICOAC_SIM_MAX_STATE * ICOAC_SIM_MAX_LANES];
     double u[ICOAC_SIM_MAX_LANES];
     icoac_real_t in[ICOAC_MAX_INPUTS * ICOAC_SIM_MAX_LANES]; /* the controllers' inputs, laid out as s (sim_real) */
-    int64_t failed[ICOAC_SIM_MAX_LANES]; /* the plant's failure test of each lane's state (64 bits: the
-                                           width of its double compares, so that its loop vectorises) */
+    int32_t failed[ICOAC_SIM_MAX_LANES];                     /* the plant's failure test of each lane's state */
     icoac_batch_t batch;                                     /* the controllers' ticks (icoac_step_batch) */
     icoac_state_t *ctrl[ICOAC_SIM_MAX_LANES];                /* the running lanes' controllers, NULL for the others */
     icoac_real_t force[ICOAC_SIM_MAX_LANES];

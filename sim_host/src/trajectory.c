@@ -20,6 +20,7 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_model_t 
     double s[ICOAC_SIM_MAX_STATE];
     size_t row;
     int64_t k;
+    int32_t failed = 0;
     uint32_t fpu_mode;
     int32_t status = sim_check_all(cfg, model, 0);
     if (status != ICOAC_SIM_OK) {
@@ -53,7 +54,8 @@ int32_t icoac_sim_trajectory(const icoac_config_t *cfg, const icoac_sim_model_t 
         desc->step(model->param, model->dt, model->integrator, s, &forces[k], 1);
         memcpy(states + row * (size_t)(k + 1), s, row * sizeof s[0]);
         *n_steps = k + 1;
-        if (desc->failed(model->param, s)) {
+        desc->failed(model->param, s, 1, &failed);
+        if (failed != 0) {
             break;
         }
     }

@@ -263,39 +263,21 @@ SIM_VECTOR_CLONES static void block_inputs(const double *restrict s, int32_t cou
     }
 }
 
-/* The cart-pole's failure test of every lane; through restrict pointers, so that GCC sees the
- * states and the results apart and vectorises the loop. */
-SIM_VECTOR_CLONES static void cart_pole_failures(double x_limit, double theta_limit, const double *restrict s, int32_t lanes,
-                               int64_t *restrict failed)
-{
-    int32_t l;
-    for (l = 0; l < lanes; ++l) {
-        failed[l] = sim_cart_pole_failed(x_limit, theta_limit, &s[l], lanes);
-    }
-}
-
 /* The plant step of every lane, then each lane's failure test and next input, all in loops over
- * the lanes. The cart-pole's step and failure test are called directly: through the descriptor,
- * the ICO tick of every paper benchmark cost more. */
+ * the lanes. The cart-pole's step is called directly: through the descriptor, the ICO tick of
+ * every paper benchmark cost more (when a block held two lanes). */
 static void block_step(const sim_job_t *job, sim_block_t *block)
 {
     const icoac_sim_model_t *model = job->model;
     const double *p = model->param;
     const int32_t lanes = block->lanes;
     const int32_t n_inputs = job->cfg->task.n_inputs;
-    int32_t l;
     if (model->plant == ICOAC_SIM_CART_POLE) {
-        const double x_limit = p[SIM_CART_POLE_X_LIMIT], theta_limit = p[SIM_CART_POLE_THETA_LIMIT];
         sim_cart_pole_step(p, model->dt, model->integrator, block->s, block->u, lanes);
-        cart_pole_failures(x_limit, theta_limit, block->s, lanes, block->failed);
     } else {
         job->desc->step(p, model->dt, model->integrator, block->s, block->u, lanes);
-        for (l = 0; l < lanes; ++l) {
-            double x[ICOAC_SIM_MAX_STATE];
-            lane_state(block, l, job->desc->n_state, x);
-            block->failed[l] = job->desc->failed(p, x);
-        }
     }
+    job->desc->failed(p, block->s, lanes, block->failed);
     block_inputs(block->s, n_inputs * lanes, block->in); /* the inputs' layout is the states' */
 }
 

@@ -35,7 +35,7 @@ DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.s
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
 ABI_VERSION = 10
-SIM_ABI_VERSION = 7
+SIM_ABI_VERSION = 8
 
 
 class IcoacError(HarnessError):

@@ -12,7 +12,7 @@
 extern "C" {
 #endif
 
-#define ICOAC_SIM_ABI_VERSION 7
+#define ICOAC_SIM_ABI_VERSION 8
 
 /* Status of sim functions: values below 100 are icoac_status_t, passed through. */
 typedef enum {
@@ -187,8 +187,9 @@ typedef void (*icoac_sim_step_fn)(const double *p, double dt, int32_t integrator
                                   int32_t lanes);
 /* ds = ds/dt at state s under input u. */
 typedef void (*icoac_sim_derivatives_fn)(const double *p, const double *s, double u, double *ds);
-/* 1 when s is outside the plant's limits or not finite, else 0. */
-typedef int32_t (*icoac_sim_failed_fn)(const double *p, const double *s);
+/* failed[l] = 1 when lane l of the lanes states of s (the step's layout; one lane: the state in
+ * order) is outside the plant's limits or not finite, else 0. */
+typedef void (*icoac_sim_failed_fn)(const double *p, const double *s, int32_t lanes, int32_t *failed);
 /* Total mechanical energy (J) of s. */
 typedef double (*icoac_sim_energy_fn)(const double *p, const double *s);
 

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Frictionless cart-pole (Barto, Sutton & Anderson 1983, with g = +9.8; method.md, plant): the
  * registry's first plant, the paper's. */
+#include <float.h>
 #include <math.h>
 
 #include "icoac_sim/icoac_sim.h"
@@ -8,7 +9,7 @@
 #include "sim_trig.h"
 #include "sim_internal.h"
 
-enum { GRAVITY, CART_MASS, POLE_MASS, HALF_LENGTH, X_LIMIT = SIM_CART_POLE_X_LIMIT, THETA_LIMIT, MAX_FORCE, N_PARAMS };
+enum { GRAVITY, CART_MASS, POLE_MASS, HALF_LENGTH, X_LIMIT, THETA_LIMIT, MAX_FORCE, N_PARAMS };
 
 /* d/dt (x, x_dot, theta, theta_dot) under force (saturated at max_force): Sutton's equations. */
 SIM_DERIVATIVES derivatives(const double *p, const double *s, double command, double *ds)
@@ -34,9 +35,18 @@ SIM_VECTOR_CLONES void sim_cart_pole_step(const double *p, double dt, int32_t in
     sim_integrate(derivatives, 4, p, dt, integrator, s, forces, lanes);
 }
 
-static int32_t failed(const double *p, const double *s)
+/* Strict limits (method.md). Non-finite velocities fail too (icoac_sim_model_failed's contract:
+ * "or not finite"); otherwise the next tick would hand them to the controller, which rejects the
+ * observation, and the cell would end as ICOAC_SIM_ERROR instead of a failed trial. */
+SIM_STATE_TEST outside(const double *p, const double *s)
 {
-    return sim_cart_pole_failed(p[X_LIMIT], p[THETA_LIMIT], s, 1);
+    return !((s[0] >= -p[X_LIMIT]) & (s[0] <= p[X_LIMIT]) & (s[2] >= -p[THETA_LIMIT]) & (s[2] <= p[THETA_LIMIT]) &
+             (fabs(s[1]) <= DBL_MAX) & (fabs(s[3]) <= DBL_MAX));
+}
+
+SIM_VECTOR_CLONES static void failed(const double *p, const double *s, int32_t lanes, int32_t *out)
+{
+    sim_test_lanes(outside, 4, p, s, lanes, out);
 }
 
 /* Cart plus a uniform rod of half-length l (inertia m l^2 / 3 about its centre), height 0 at

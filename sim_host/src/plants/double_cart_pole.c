@@ -6,6 +6,7 @@
  * Lagrange's equations, derived in docs/plants.md.
  *
  * State (x, x_dot, theta1, theta1_dot, theta2, theta2_dot). */
+#include <float.h>
 #include <math.h>
 
 #include "icoac_sim/icoac_sim.h"
@@ -65,10 +66,15 @@ SIM_VECTOR_CLONES static void step(const double *p, double dt, int32_t integrato
 }
 
 /* Outside the track or either link's angle limit (strict), or not finite; NaN fails. */
-static int32_t failed(const double *p, const double *s)
+SIM_STATE_TEST outside(const double *p, const double *s)
 {
-    return !(fabs(s[0]) <= p[X_LIMIT] && fabs(s[2]) <= p[ANGLE_LIMIT] && fabs(s[4]) <= p[ANGLE_LIMIT] &&
-             isfinite(s[1]) && isfinite(s[3]) && isfinite(s[5]));
+    return !((fabs(s[0]) <= p[X_LIMIT]) & (fabs(s[2]) <= p[ANGLE_LIMIT]) & (fabs(s[4]) <= p[ANGLE_LIMIT]) &
+             (fabs(s[1]) <= DBL_MAX) & (fabs(s[3]) <= DBL_MAX) & (fabs(s[5]) <= DBL_MAX));
+}
+
+SIM_VECTOR_CLONES static void failed(const double *p, const double *s, int32_t lanes, int32_t *out)
+{
+    sim_test_lanes(outside, 6, p, s, lanes, out);
 }
 
 static double energy(const double *p, const double *s)

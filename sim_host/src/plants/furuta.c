@@ -15,6 +15,7 @@
  * The viscous damping of both joints is that of Quanser's parameter script for this unit
  * (qube2_rotpen_param.m). The model without damping and limit is the variant
  * --set arm_damping=0 --set pendulum_damping=0 --set max_voltage=1e6 (docs/plants.md). */
+#include <float.h>
 #include <math.h>
 
 #include "icoac_sim/icoac_sim.h"
@@ -70,10 +71,15 @@ SIM_VECTOR_CLONES static void step(const double *p, double dt, int32_t integrato
 }
 
 /* Outside the arm or pendulum limit (strict), or not finite; NaN fails. */
-static int32_t failed(const double *p, const double *s)
+SIM_STATE_TEST outside(const double *p, const double *s)
 {
-    return !(fabs(s[0]) <= p[ARM_LIMIT] && fabs(s[2]) <= p[PENDULUM_LIMIT] && isfinite(s[1]) &&
-             isfinite(s[3]));
+    return !((fabs(s[0]) <= p[ARM_LIMIT]) & (fabs(s[2]) <= p[PENDULUM_LIMIT]) & (fabs(s[1]) <= DBL_MAX) &
+             (fabs(s[3]) <= DBL_MAX));
+}
+
+SIM_VECTOR_CLONES static void failed(const double *p, const double *s, int32_t lanes, int32_t *out)
+{
+    sim_test_lanes(outside, 4, p, s, lanes, out);
 }
 
 static double energy(const double *p, const double *s)
