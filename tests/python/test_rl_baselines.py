@@ -98,6 +98,18 @@ def test_tune_ranks_the_settings_on_the_tuning_cells(tmp_path, monkeypatch):
             run = json.loads((out / "tuning" / "ppo" / row["key"] / f"seed-{seed}" / "result.json").read_text())
             assert run["overrides"] == row["setting"] and run["training_cells"] == 3 and run["seed"] == seed
             assert rate == np.mean([run["success"][c] == "1" for c in (3, 600, 900)])
+    # two runs at once (--jobs, each a process of its own) train and score the same as one at a time
+    parallel = tmp_path / "parallel"
+    assert rl_baselines.main(argv[:-1] + [str(parallel), "--tune", "--jobs", "2"]) == 0
+    def without_wall(rows):
+        return [{k: v for k, v in r.items() if k != "wall_time"} for r in rows]
+    rows = json.loads((parallel / "tuning.json").read_text())["algorithms"]["ppo"]["rows"]
+    assert without_wall(rows) == without_wall(entry["rows"])
+    for row in entry["rows"]:
+        for seed in heldout.TUNING_SEEDS:
+            one, two = (json.loads((d / "tuning" / "ppo" / row["key"] / f"seed-{seed}" / "result.json").read_text())
+                        for d in (out, parallel))
+            assert (one["success"], one["lasted"], one["episodes"]) == (two["success"], two["lasted"], two["episodes"])
     # the evaluation run with a chosen setting records it
     assert rl_baselines.main(argv + ["--seeds", "0", "--hyper", "learning_rate=1e-3"]) == 0
     run = json.loads((out / "ppo" / "seed-0" / "result.json").read_text())

@@ -8,8 +8,9 @@ over random grid cells and evaluated on every cell of that seed's grid:
 Needs the [baselines] extra (`make baselines`). The plant's actuator limit (its max_... parameter,
 --set to change it) bounds the actions. Each (algorithm, seed) is OUT/<algo>/seed-<s>/ with the
 trained model and result.json; a stopped run resumes at the first unfinished one (one run is not
-resumed inside). --bench DIR (grids with the same plant parameters) adds the paired per-cell tests
-against its conditions, seed for seed. --report runs nothing.
+resumed inside); --jobs N runs N of them at once, each in its own process on one thread. --bench
+DIR (grids with the same plant parameters) adds the paired per-cell tests against its conditions,
+seed for seed. --report runs nothing.
 
 --tune runs the held-out tuning instead (icoac.studies.heldout, BASELINE_SPACES; docs/tuning.md):
 each setting of each algorithm with the tuning seeds, trained on the plant's tuning cells only and
@@ -18,7 +19,9 @@ the protocol's criterion. --hyper NAME=VALUE runs the evaluation with a chosen s
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
 import json
+import multiprocessing
 import os
 import sys
 import time
@@ -47,7 +50,7 @@ def run_one(args, cfg, algo: str, seed: int, steps: int, out: Path | None = None
             overrides: Mapping[str, Any] | None = None, cells: list[int] | None = None) -> dict[str, Any]:
     """Train (on every cell, or on ``cells``) and evaluate on every cell one seed, into ``out``
     (default OUT/<algo>/seed-<s>), or read its finished result."""
-    out = out if out is not None else args.out / algo / f"seed-{seed}"
+    out = _out(args, algo, seed, steps, out)
     if (out / RESULT).is_file():
         return json.loads((out / RESULT).read_text())
     if args.report:
@@ -73,6 +76,28 @@ def run_one(args, cfg, algo: str, seed: int, steps: int, out: Path | None = None
     print(f"[{algo} seed {seed}] {100 * ok.mean():.1f} % of {ok.size} cells; train {trained.wall_time:.0f} s, "
           f"evaluation {eval_wall:.0f} s", file=sys.stderr, flush=True)
     return result
+
+
+def _run_job(job) -> None:
+    run_one(*job)
+
+
+def run_all(args, cfg, jobs: list[tuple]) -> None:
+    """The unfinished ones of ``jobs`` (run_one's arguments after args and cfg), --jobs at a time,
+    each in a process of its own; the callers then read their results. Nothing under --report."""
+    todo = [(args, cfg, *job) for job in jobs if not args.report and not (_out(args, *job) / RESULT).is_file()]
+    if args.jobs <= 1 or len(todo) <= 1:
+        for job in todo:
+            _run_job(job)
+        return
+    # spawned, not forked: the parent may hold torch's threads
+    with concurrent.futures.ProcessPoolExecutor(max_workers=args.jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
+        for done in concurrent.futures.as_completed([pool.submit(_run_job, job) for job in todo]):
+            done.result()
+
+
+def _out(args, algo: str, seed: int, steps: int, out: Path | None = None, *_) -> Path:
+    return out if out is not None else args.out / algo / f"seed-{seed}"
 
 
 def bench_masks(args, cfg, seeds: list[int]) -> dict[str, dict[int, np.ndarray]]:
@@ -106,6 +131,8 @@ def collect(args, cfg) -> dict[str, Any]:
     others = bench_masks(args, cfg, args.seeds) if args.bench is not None else {}
     if args.bench is not None:
         data["bench"] = str(args.bench)
+    run_all(args, cfg, [(algo, s, args.steps or sb3.ALGORITHMS[algo].budget, None, args.hyper)
+                        for algo in args.algos for s in args.seeds])
     for algo in args.algos:
         steps = args.steps or sb3.ALGORITHMS[algo].budget
         runs = {s: r for s in args.seeds if (r := run_one(args, cfg, algo, s, steps, overrides=args.hyper))}
@@ -150,13 +177,19 @@ def tune(args, cfg) -> dict[str, Any]:
     cells = [int(i) for i in heldout.tuning_cells(cfg.plant_name)]
     data: dict[str, Any] = {"plant": cfg.plant_name, "set": args.set, "protocol": heldout.protocol(cfg.plant_name),
                             "n_tuning_cells": len(cells), "algorithms": {}, "git": results.git_info()}
+    def out(algo, key, seed):
+        return args.out / "tuning" / algo / key / f"seed-{seed}"
+    run_all(args, cfg, [(algo, seed, args.steps or sb3.ALGORITHMS[algo].budget, out(algo, heldout.key(setting), seed),
+                         setting, cells)
+                        for algo in args.algos for setting in heldout.baseline_settings(algo)
+                        for seed in heldout.TUNING_SEEDS])
     for algo in args.algos:
         steps = args.steps or sb3.ALGORITHMS[algo].budget
         rows, pending = [], 0
         for index, setting in enumerate(heldout.baseline_settings(algo)):
             key = heldout.key(setting)
-            runs = [run_one(args, cfg, algo, seed, steps, args.out / "tuning" / algo / key / f"seed-{seed}",
-                            setting, cells) for seed in heldout.TUNING_SEEDS]
+            runs = [run_one(args, cfg, algo, seed, steps, out(algo, key, seed), setting, cells)
+                    for seed in heldout.TUNING_SEEDS]
             if not all(runs):
                 pending += 1
                 continue
@@ -221,6 +254,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--bench", type=Path, help="grids of the same plant to pair with (OUT/<condition>/seed-<s>)")
     ap.add_argument("--data", type=Path, help="also write the summary here (docs/data/...)")
     ap.add_argument("--report", action="store_true", help="run nothing: summarise the finished runs")
+    ap.add_argument("--jobs", type=int, default=1, help="training runs at once, each a process on one thread")
     ap.add_argument("--tune", action="store_true", help="the held-out tuning of the algorithms (docs/tuning.md)")
     ap.add_argument("--hyper", action="append", default=[], metavar="NAME=VALUE",
                     help="a hyperparameter over the RL Zoo's start (a tuned setting), for the evaluation runs")
@@ -229,6 +263,8 @@ def main(argv: list[str] | None = None) -> int:
     def body():
         if args.steps is not None and args.steps < 1:
             raise UsageError(f"--steps must be at least 1, got {args.steps}")
+        if not 1 <= args.jobs <= (os.cpu_count() or 1) * 4:
+            raise UsageError(f"--jobs must be from 1 to {(os.cpu_count() or 1) * 4}, got {args.jobs}")
         if args.tune and args.hyper:
             raise UsageError("--tune runs the tuning space's settings; --hyper is for the evaluation runs")
         args.hyper = _hyper(args.hyper)
