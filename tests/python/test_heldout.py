@@ -169,3 +169,12 @@ def test_evaluation_against_the_bench_defaults(tmp_path, monkeypatch):
     assert tuned["aggregate"]["ico-rl"]["success_rate"]["mean"] == pytest.approx(ev["learners"]["ico-rl"]["all"]["chosen"]["mean"])
     from icoac.studies import tables
     assert tables._plant_label(tuned) == "cart_pole (held-out tuned)"
+
+
+def test_prior_reading_table_in_the_plants_unit():
+    from icoac.tools import heldout_tuning
+    rows = [{"setting": {"actor.update": "mean", "actor.noise_std": 0.5}, "success_rate": 0.25}]
+    furuta = heldout_tuning.prior_reading_table({"plant": "furuta", "learners": {"rl": {"rows": rows}}})
+    assert "σ_u = 0.5 V" in furuta[0] and "| 25.0 |" in furuta[3]
+    cart = heldout_tuning.prior_reading_table({"plant": "cart_pole", "learners": {"rl": {"rows": rows}}})
+    assert "σ_u = 0.5 N" in cart[0]

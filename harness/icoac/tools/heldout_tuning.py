@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from icoac.core import binding as B
 from icoac.core import metrics, results, stats
 from icoac.core.plants import PLANTS
 from icoac.core.registry import REGISTRY
@@ -252,7 +253,8 @@ def prior_reading_table(data: dict[str, Any]) -> list[str]:
     if not names:
         return []
     noises = sorted({r["setting"]["actor.noise_std"] for n in names for r in rows_of(n)})
-    lines = ["| prior (learner) | reading | " + " | ".join(f"σ_u = {v:g} N" for v in noises) + " |",
+    unit = B.plant_info(data["plant"])["input"][1]  # the noise is in the plant's input unit
+    lines = ["| prior (learner) | reading | " + " | ".join(f"σ_u = {v:g} {unit}" for v in noises) + " |",
              "|---|---|" + "---|" * len(noises)]
     for name in names:
         for reading in READING_OF:
