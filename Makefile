@@ -243,9 +243,11 @@ sweeps-plants: build venv
 	cp results/sweeps-double_cart_pole/summary.md docs/sweeps-double_cart_pole.md
 
 # The held-out tuning of every learner on PLANT (docs/tuning.md), resumable; its choices in
-# results/tuning-$(PLANT)/summary.md.
+# results/tuning-$(PLANT)/summary.md. Its record, docs/data/tuning-$(PLANT).json, grows after every
+# finished setting, and a run starts from it (commit it to keep a long tuning across machines).
 tuning: build venv
-	$(VPY) -m icoac.tools.heldout_tuning --plant $(PLANT) --out results/tuning-$(PLANT)
+	$(VPY) -m icoac.tools.heldout_tuning --plant $(PLANT) --out results/tuning-$(PLANT) \
+	    --data docs/data/tuning-$(PLANT).json
 
 # How much ICO the prior needs (method.md, L10): on the cart-pole bench's ICO grids (make bench
 # first); the table in docs/results.md comes from docs/data/ico-ablation.json.

@@ -178,3 +178,33 @@ def test_prior_reading_table_in_the_plants_unit():
     assert "σ_u = 0.5 V" in furuta[0] and "| 25.0 |" in furuta[3]
     cart = heldout_tuning.prior_reading_table({"plant": "cart_pole", "learners": {"rl": {"rows": rows}}})
     assert "σ_u = 0.5 N" in cart[0]
+
+
+def test_a_tuning_goes_on_from_its_data_record(tmp_path, monkeypatch):
+    """--data is the record a later run starts from: its settings are not run again, ICO's chosen
+    grids (the priors of the learners after it) are rerun and must give the recorded rates, and a
+    record of another protocol is refused."""
+    monkeypatch.setattr(H, "tuning_cells", lambda plant: np.array([560, 600, 610, 612]))
+    monkeypatch.setattr(H, "spaces", lambda plant: {"ico": {"ico.rate": [1e-4, 1e-3]},
+                                                    "ico-rl": {"actor.noise_std": [3, 1]}})
+    monkeypatch.setitem(bench.PROFILES, "default", {**bench.PROFILES["default"],
+                                                     "ico": {"max_trials": 2000, "success_steps": 1000},
+                                                     "rl": {"max_trials": 100, "success_steps": 1000}})
+    record = tmp_path / "record.json"
+    args = ["--learners", "ico-rl", "--data", str(record), "--quiet"]
+    assert T.main(["--out", str(tmp_path / "first"), *args]) == 0
+    first = json.loads(record.read_text())
+    assert T.main(["--out", str(tmp_path / "second"), *args]) == 0
+    second = json.loads(record.read_text())
+    assert second["learners"] == first["learners"]
+    ran = sorted(p.parent.name + "/" + p.name for p in (tmp_path / "second").glob("*/*") if p.is_dir())
+    assert ran == ["ico/" + first["learners"]["ico"]["chosen_key"]]  # only ICO's chosen grids, for the priors
+    chosen = next(r for r in first["learners"]["ico"]["rows"] if r["key"] == first["learners"]["ico"]["chosen_key"])
+    chosen["success_rates"] = [0.5, 0.5]
+    record.write_text(json.dumps(first))
+    with pytest.raises(SystemExit, match="not the recorded"):
+        T.main(["--out", str(tmp_path / "third"), *args])
+    first["protocol"]["tuning_seeds"] = [7, 8]
+    record.write_text(json.dumps(first))
+    with pytest.raises(SystemExit, match="another plant's or protocol's"):
+        T.main(["--out", str(tmp_path / "fourth"), *args])

@@ -10,6 +10,11 @@ tuning cells). Every (learner, setting, seed) is a results directory
 OUT/<learner>/<setting>/seed-<s>/, so a stopped run resumes where it stopped (rerun the command).
 OUT/tuning.json and OUT/summary.md hold each learner's ranking and choice.
 
+--data FILE (docs/data/...) is written after every finished setting and read at the start: a
+setting whose row it holds (same plant and protocol) is not run again. So a tuning longer than a
+machine's life goes on from its committed record; only ICO's chosen grids, which the learners after
+it take as priors, are rerun when they are missing, and must give the recorded rates.
+
 --evaluate --bench DIR then runs each learner's choice on every cell with the bench's seeds (ICO
 first again; the others' priors from its evaluated grids) into OUT/evaluation/, and sets it beside
 the bench's grids of the current defaults: success on the held-out cells and on all cells, and the
@@ -44,10 +49,13 @@ def finished(out: Path) -> bool:
     return results.exists(out) and bool(results.load(out)[1].get("complete"))
 
 
-def run_setting(args, learner: str, index: int, setting: dict[str, Any], ico_dirs: dict[int, Path] | None
-                ) -> dict[str, Any] | None:
+def run_setting(args, learner: str, index: int, setting: dict[str, Any], ico_dirs: dict[int, Path] | None,
+                rerun: bool = False) -> dict[str, Any] | None:
     """Every tuning seed of one setting; its row of the ranking (None with --report when a seed's
-    grid is not finished: nothing runs then)."""
+    grid is not finished: nothing runs then). A row --data holds is read, unless `rerun`."""
+    kept = args.kept.get((learner, heldout.key(setting)))
+    if kept is not None and not rerun:
+        return kept
     caps = bench.PROFILES["default"]["ico" if learner == "ico" else "rl"]
     cells_spec = [int(i) for i in heldout.tuning_cells(args.plant)]
     rates, trials, cost, wall, records = [], [], 0, 0.0, []
@@ -79,15 +87,46 @@ def run_setting(args, learner: str, index: int, setting: dict[str, Any], ico_dir
     return row
 
 
-def tune(args, learner: str, ico_dirs: dict[int, Path] | None) -> dict[str, Any]:
-    """The learner's rows and choice; with --report and unfinished settings, {"pending": ...}."""
-    rows = [run_setting(args, learner, i, s, ico_dirs) for i, s in enumerate(heldout.settings(learner, args.plant))]
+def kept_rows(args) -> dict[tuple[str, str], dict[str, Any]]:
+    """The rows of the settings --data already holds, by (learner, setting key)."""
+    if args.data is None or not args.data.exists():
+        return {}
+    old = json.loads(args.data.read_text())
+    if old.get("plant") != args.plant or old.get("protocol") != heldout.protocol(args.plant):
+        raise SystemExit(f"error: {args.data} holds another plant's or protocol's tuning; move it aside")
+    return {(name, r["key"]): r for name, t in old["learners"].items() for r in t.get("rows", [])}
+
+
+def save(args, data: dict[str, Any]) -> None:
+    """The record so far: OUT/tuning.json, and --data."""
+    args.out.mkdir(parents=True, exist_ok=True)
+    text = json.dumps(data, indent=1)
+    (args.out / "tuning.json").write_text(text)
+    if args.data is not None:
+        args.data.write_text(text)
+
+
+def tune(args, learner: str, ico_dirs: dict[int, Path] | None, data: dict[str, Any]) -> dict[str, Any]:
+    """The learner's rows and choice into data["learners"]; while settings are unfinished,
+    {"pending": ...} with the finished rows. Saved after each setting (not with --report)."""
+    settings = heldout.settings(learner, args.plant)
+    rows = []
+    for i, s in enumerate(settings):
+        rows.append(run_setting(args, learner, i, s, ico_dirs))
+        done = [r for r in rows if r is not None]
+        data["learners"][learner] = {"learner": learner, "pending": len(done), "settings": len(settings), "rows": done}
+        if not args.report:
+            save(args, data)
     if None in rows:
-        return {"learner": learner, "pending": len(rows) - rows.count(None), "settings": len(rows)}
+        return data["learners"][learner]
     ranked = heldout.rank(rows)
-    return {"learner": learner, "rows": rows, "chosen": ranked[0]["setting"], "chosen_key": ranked[0]["key"],
-            "default_kept": ranked[0]["order"] == 0, "trials": sum(r["trials"] for r in rows),
-            "wall_time": sum(r["wall_time"] for r in rows)}
+    data["learners"][learner] = {
+        "learner": learner, "rows": rows, "chosen": ranked[0]["setting"], "chosen_key": ranked[0]["key"],
+        "default_kept": ranked[0]["order"] == 0, "trials": sum(r["trials"] for r in rows),
+        "wall_time": sum(r["wall_time"] for r in rows)}
+    if not args.report:
+        save(args, data)
+    return data["learners"][learner]
 
 
 def run(args) -> dict[str, Any]:
@@ -97,15 +136,22 @@ def run(args) -> dict[str, Any]:
                             "n_tuning_cells": int(heldout.tuning_cells(args.plant).size),
                             "n_cells": int(heldout.heldout_mask(args.plant).size), "learners": {},
                             "git": results.git_info()}
-    ico = tune(args, "ico", None)
-    data["learners"]["ico"] = ico
+    ico = tune(args, "ico", None, data)
     ico_dirs = None if "pending" in ico else \
         {s: args.out / "ico" / ico["chosen_key"] / f"seed-{s}" for s in heldout.TUNING_SEEDS}
+    if ico_dirs and not args.report and not all(finished(d) for d in ico_dirs.values()):
+        chosen = next(r for r in ico["rows"] if r["key"] == ico["chosen_key"])
+        again = run_setting(args, "ico", chosen["order"], chosen["setting"], None, rerun=True)
+        if again["success_rates"] != chosen["success_rates"]:
+            raise SystemExit(f"error: ICO's chosen setting {chosen['key']} rerun gives {again['success_rates']}, "
+                             f"not the recorded {chosen['success_rates']}: the code changed since the record")
     for learner in ORDER[1:]:
         if learner in args.learners:
-            data["learners"][learner] = tune(args, learner, ico_dirs) if ico_dirs or \
-                not REGISTRY[learner].prior.takes_ico else \
-                {"learner": learner, "pending": 0, "settings": len(heldout.settings(learner, args.plant))}
+            if ico_dirs or not REGISTRY[learner].prior.takes_ico:
+                tune(args, learner, ico_dirs, data)
+            else:
+                data["learners"][learner] = {"learner": learner, "pending": 0,
+                                             "settings": len(heldout.settings(learner, args.plant))}
     builds = [b for t in data["learners"].values() for r in t.get("rows", []) for b in r["builds"]]
     data["cell_builds"] = [b for i, b in enumerate(builds) if b not in builds[:i]]
     return data
@@ -297,7 +343,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--learners", nargs="+", choices=ORDER, default=list(ORDER),
                     help="the learners to tune (ICO always runs first: the others take its chosen grids)")
     ap.add_argument("--threads", type=int, default=0)
-    ap.add_argument("--data", type=Path, help="also write tuning.json here (docs/data/...)")
+    ap.add_argument("--data", type=Path, help="also write tuning.json here (docs/data/...), after every finished "
+                    "setting; the settings it holds are not run again")
     ap.add_argument("--report", action="store_true",
                     help="run nothing: report the learners whose settings have all finished")
     ap.add_argument("--evaluate", action="store_true",
@@ -307,6 +354,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="with --evaluate: the summary of the bench of the tuned settings (docs/data/...)")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
+    args.kept = kept_rows(args)
     if args.evaluate and args.bench is None:
         ap.error("--evaluate needs --bench")
     if args.bench_data is not None and not args.evaluate:
@@ -322,10 +370,7 @@ def main(argv: list[str] | None = None) -> int:
     status, data = guarded(body)
     if data is None:
         return status
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "tuning.json").write_text(json.dumps(data, indent=1))
-    if args.data is not None:
-        args.data.write_text(json.dumps(data, indent=1))
+    save(args, data)
     (args.out / "summary.md").write_text(markdown(data))
     print(markdown(data))
     return 0
