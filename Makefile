@@ -133,7 +133,8 @@ baselines: build baselines-venv
 TUNING_SETS_cart_pole := --set max_force=10
 tuning-baselines: build baselines-venv
 	$(VPY) -m icoac.tools.rl_baselines --plant $(PLANT) $(TUNING_SETS_$(PLANT)) --tune \
-	  --out results/rl-baselines-tuning-$(PLANT) --jobs $(BASELINE_JOBS)
+	  --out results/rl-baselines-tuning-$(PLANT) --jobs $(BASELINE_JOBS) \
+	  --data docs/data/rl-baselines-tuning-$(PLANT).json
 
 build-fuzz: deps
 	cmake --preset fuzz >/dev/null

@@ -35,6 +35,7 @@ import numpy as np
 
 from icoac.core import binding as B
 from icoac.core import metrics, results, stats
+from icoac.core.errors import ResultsError, UsageError
 from icoac.core.plants import PLANTS
 from icoac.core.registry import REGISTRY
 from icoac.studies import bench, heldout
@@ -93,7 +94,7 @@ def kept_rows(args) -> dict[tuple[str, str], dict[str, Any]]:
         return {}
     old = json.loads(args.data.read_text())
     if old.get("plant") != args.plant or old.get("protocol") != heldout.protocol(args.plant):
-        raise SystemExit(f"error: {args.data} holds another plant's or protocol's tuning; move it aside")
+        raise UsageError(f"{args.data} holds another plant's or protocol's tuning; move it aside")
     return {(name, r["key"]): r for name, t in old["learners"].items() for r in t.get("rows", [])}
 
 
@@ -143,8 +144,8 @@ def run(args) -> dict[str, Any]:
         chosen = next(r for r in ico["rows"] if r["key"] == ico["chosen_key"])
         again = run_setting(args, "ico", chosen["order"], chosen["setting"], None, rerun=True)
         if again["success_rates"] != chosen["success_rates"]:
-            raise SystemExit(f"error: ICO's chosen setting {chosen['key']} rerun gives {again['success_rates']}, "
-                             f"not the recorded {chosen['success_rates']}: the code changed since the record")
+            raise ResultsError(f"ICO's chosen setting {chosen['key']} rerun gives {again['success_rates']}, "
+                               f"not the recorded {chosen['success_rates']}: the code changed since the record")
     for learner in ORDER[1:]:
         if learner in args.learners:
             if ico_dirs or not REGISTRY[learner].prior.takes_ico:
@@ -354,13 +355,13 @@ def main(argv: list[str] | None = None) -> int:
                     help="with --evaluate: the summary of the bench of the tuned settings (docs/data/...)")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
-    args.kept = kept_rows(args)
     if args.evaluate and args.bench is None:
         ap.error("--evaluate needs --bench")
     if args.bench_data is not None and not args.evaluate:
         ap.error("--bench-data needs --evaluate")
 
     def body():
+        args.kept = kept_rows(args)
         data = run(args)
         if args.evaluate and "pending" not in data["learners"]["ico"]:
             data["evaluation"] = evaluate(args, data)

@@ -15,7 +15,9 @@ seed for seed. --report runs nothing.
 --tune runs the held-out tuning instead (icoac.studies.heldout, BASELINE_SPACES; docs/tuning.md):
 each setting of each algorithm with the tuning seeds, trained on the plant's tuning cells only and
 scored on them, into OUT/tuning/<algo>/<setting>/seed-<s>/; OUT/tuning.json ranks the settings by
-the protocol's criterion. --hyper NAME=VALUE runs the evaluation with a chosen setting."""
+the protocol's criterion. With --data FILE that record is written after every finished run and read
+at the start: the runs it holds are not trained again, so a tuning longer than a machine's life goes
+on from its committed record. --hyper NAME=VALUE runs the evaluation with a chosen setting."""
 from __future__ import annotations
 
 import argparse
@@ -26,7 +28,7 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import numpy as np
 
@@ -48,8 +50,9 @@ def _mask(text: str) -> np.ndarray:
 
 def run_one(args, cfg, algo: str, seed: int, steps: int, out: Path | None = None,
             overrides: Mapping[str, Any] | None = None, cells: list[int] | None = None) -> dict[str, Any]:
-    """Train (on every cell, or on ``cells``) and evaluate on every cell one seed, into ``out``
-    (default OUT/<algo>/seed-<s>), or read its finished result."""
+    """Train and evaluate one seed on every cell, or on ``cells`` (the success string then
+    follows their order), into ``out`` (default OUT/<algo>/seed-<s>), or read its finished
+    result."""
     out = _out(args, algo, seed, steps, out)
     if (out / RESULT).is_file():
         return json.loads((out / RESULT).read_text())
@@ -62,7 +65,7 @@ def run_one(args, cfg, algo: str, seed: int, steps: int, out: Path | None = None
     if trained.normalizer is not None:
         trained.normalizer.save(str(out / "vecnormalize.pkl"))
     t0 = time.monotonic()
-    lasted, ok = sb3.evaluate(trained.act, cfg, seed)
+    lasted, ok = sb3.evaluate(trained.act, cfg, seed, cells)
     eval_wall = time.monotonic() - t0
     result = {"algo": algo, "seed": seed, "overrides": dict(overrides or {}),
               "training_cells": "all" if cells is None else len(cells),
@@ -82,18 +85,21 @@ def _run_job(job) -> None:
     run_one(*job)
 
 
-def run_all(args, cfg, jobs: list[tuple]) -> None:
+def run_all(args, cfg, jobs: list[tuple], done: Callable[[], None] = lambda: None) -> None:
     """The unfinished ones of ``jobs`` (run_one's arguments after args and cfg), --jobs at a time,
-    each in a process of its own; the callers then read their results. Nothing under --report."""
+    each in a process of its own, calling ``done`` after each; the callers then read their
+    results. Nothing under --report."""
     todo = [(args, cfg, *job) for job in jobs if not args.report and not (_out(args, *job) / RESULT).is_file()]
     if args.jobs <= 1 or len(todo) <= 1:
         for job in todo:
             _run_job(job)
+            done()
         return
     # spawned, not forked: the parent may hold torch's threads
     with concurrent.futures.ProcessPoolExecutor(max_workers=args.jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
-        for done in concurrent.futures.as_completed([pool.submit(_run_job, job) for job in todo]):
-            done.result()
+        for finished in concurrent.futures.as_completed([pool.submit(_run_job, job) for job in todo]):
+            finished.result()
+            done()
 
 
 def _out(args, algo: str, seed: int, steps: int, out: Path | None = None, *_) -> Path:
@@ -171,43 +177,80 @@ def _hyper(items: list[str]) -> dict[str, Any]:
     return out
 
 
+def _kept_runs(args, plant: str) -> dict[str, Any]:
+    """The runs the tuning record --data holds: {algo: {setting key: {seed: summary}}}."""
+    if args.data is None or not args.data.exists():
+        return {}
+    old = json.loads(args.data.read_text())
+    if old.get("plant") != plant or old.get("set") != args.set or old.get("protocol") != heldout.protocol(plant):
+        raise UsageError(f"{args.data} holds the tuning of another plant, --set or protocol; move it aside")
+    return {algo: entry.get("runs", {}) for algo, entry in old["algorithms"].items()}
+
+
 def tune(args, cfg) -> dict[str, Any]:
     """The held-out tuning of each algorithm (see the module's head): its rows, best first, and its
-    choice; an algorithm with unfinished runs under --report is listed as pending."""
+    choice; an algorithm with unfinished runs is listed as pending, with its finished runs."""
     cells = [int(i) for i in heldout.tuning_cells(cfg.plant_name)]
+    runs = _kept_runs(args, cfg.plant_name)
     data: dict[str, Any] = {"plant": cfg.plant_name, "set": args.set, "protocol": heldout.protocol(cfg.plant_name),
                             "n_tuning_cells": len(cells), "algorithms": {}, "git": results.git_info()}
+
     def out(algo, key, seed):
         return args.out / "tuning" / algo / key / f"seed-{seed}"
-    run_all(args, cfg, [(algo, seed, args.steps or sb3.ALGORITHMS[algo].budget, out(algo, heldout.key(setting), seed),
-                         setting, cells)
+
+    def steps_of(algo):
+        return args.steps or sb3.ALGORITHMS[algo].budget
+
+    def summarise() -> None:
+        """Each finished run's summary into the record, then each algorithm's rows or pending."""
+        for algo in args.algos:
+            for setting in heldout.baseline_settings(algo):
+                key = heldout.key(setting)
+                for seed in heldout.TUNING_SEEDS:
+                    kept = runs.setdefault(algo, {}).setdefault(key, {})
+                    if str(seed) in kept or not (out(algo, key, seed) / RESULT).is_file():
+                        continue
+                    r = json.loads((out(algo, key, seed) / RESULT).read_text())
+                    if len(r["success"]) != len(cells):
+                        raise UsageError(f"{out(algo, key, seed)} was not scored on the tuning cells; move it aside")
+                    kept[str(seed)] = {"success_rate": float(_mask(r["success"]).mean()), "steps": r["steps"],
+                                       "episodes": r["episodes"], "train_wall_time": r["train_wall_time"],
+                                       "eval_wall_time": r["eval_wall_time"], "git": r["git"]}
+            data["algorithms"][algo] = _ranking(algo, steps_of(algo), runs[algo])
+        if args.data is not None and not args.report:
+            args.data.write_text(json.dumps(data, indent=1))
+
+    run_all(args, cfg, [(algo, seed, steps_of(algo), out(algo, heldout.key(setting), seed), setting, cells)
                         for algo in args.algos for setting in heldout.baseline_settings(algo)
-                        for seed in heldout.TUNING_SEEDS])
-    for algo in args.algos:
-        steps = args.steps or sb3.ALGORITHMS[algo].budget
-        rows, pending = [], 0
-        for index, setting in enumerate(heldout.baseline_settings(algo)):
-            key = heldout.key(setting)
-            runs = [run_one(args, cfg, algo, seed, steps, out(algo, key, seed), setting, cells)
-                    for seed in heldout.TUNING_SEEDS]
-            if not all(runs):
-                pending += 1
-                continue
-            rates = [float(_mask(r["success"])[cells].mean()) for r in runs]
-            rows.append({"order": index, "setting": setting, "key": key, "success_rate": float(np.mean(rates)),
-                         "success_rates": rates, "median_trials": None, "steps": steps,
-                         "wall_time": float(sum(r["train_wall_time"] + r["eval_wall_time"] for r in runs))})
-            print(f"[tuning] {algo} {key}: {100 * rows[-1]['success_rate']:.1f} % of the tuning cells",
-                  file=sys.stderr, flush=True)
-        entry: dict[str, Any] = {"settings": len(heldout.baseline_settings(algo)), "steps": steps}
-        if pending:
-            entry["pending"] = pending
-        else:
-            ranked = heldout.rank(rows)
-            entry.update(rows=ranked, chosen=ranked[0]["setting"], chosen_key=ranked[0]["key"],
-                         default_kept=ranked[0]["order"] == 0)
-        data["algorithms"][algo] = entry
+                        for seed in heldout.TUNING_SEEDS
+                        if str(seed) not in runs.get(algo, {}).get(heldout.key(setting), {})],
+            done=summarise)
+    summarise()
     return data
+
+
+def _ranking(algo: str, steps: int, runs: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
+    """An algorithm's entry of the tuning record from its finished runs: the rows of the settings
+    whose seeds have all finished, best first, and the choice, or the count still pending."""
+    rows, pending = [], 0
+    for index, setting in enumerate(heldout.baseline_settings(algo)):
+        key = heldout.key(setting)
+        done = [runs.get(key, {}).get(str(seed)) for seed in heldout.TUNING_SEEDS]
+        if None in done:
+            pending += 1
+            continue
+        rates = [r["success_rate"] for r in done]
+        rows.append({"order": index, "setting": setting, "key": key, "success_rate": float(np.mean(rates)),
+                     "success_rates": rates, "median_trials": None, "steps": steps,
+                     "wall_time": float(sum(r["train_wall_time"] + r["eval_wall_time"] for r in done))})
+    entry: dict[str, Any] = {"settings": len(heldout.baseline_settings(algo)), "steps": steps, "runs": dict(runs)}
+    if pending:
+        entry["pending"] = pending
+    else:
+        ranked = heldout.rank(rows)
+        entry.update(rows=ranked, chosen=ranked[0]["setting"], chosen_key=ranked[0]["key"],
+                     default_kept=ranked[0]["order"] == 0)
+    return entry
 
 
 def _points(p: Mapping[str, Any]) -> str:
@@ -252,7 +295,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--steps", type=int, help="env steps per training run (default: each algorithm's budget)")
     ap.add_argument("--out", required=True, type=Path)
     ap.add_argument("--bench", type=Path, help="grids of the same plant to pair with (OUT/<condition>/seed-<s>)")
-    ap.add_argument("--data", type=Path, help="also write the summary here (docs/data/...)")
+    ap.add_argument("--data", type=Path, help="also write the summary here (docs/data/...); with --tune, the "
+                    "record written after every run, whose runs are not trained again")
     ap.add_argument("--report", action="store_true", help="run nothing: summarise the finished runs")
     ap.add_argument("--jobs", type=int, default=1, help="training runs at once, each a process on one thread")
     ap.add_argument("--tune", action="store_true", help="the held-out tuning of the algorithms (docs/tuning.md)")

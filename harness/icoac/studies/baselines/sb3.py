@@ -165,14 +165,18 @@ def train(algo: str, cfg: RunConfig, seed: int, steps: int, overrides: Mapping[s
                    time.monotonic() - t0, model, normalizer)
 
 
-def evaluate(act: Callable[[np.ndarray], np.ndarray], cfg: RunConfig, grid_seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """(periods lasted, success) of each cell of the plant's grid seeded by grid_seed under the
-    deterministic policy, from the start of the cell's first trial: a cell succeeds when it
-    survives success_steps periods (the period a cell fails in counts as lasted)."""
+def evaluate(act: Callable[[np.ndarray], np.ndarray], cfg: RunConfig, grid_seed: int,
+             only: Sequence[int] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(periods lasted, success) of each cell of the plant's grid seeded by grid_seed (or of the
+    cells ``only``, in that order) under the deterministic policy, from the start of the cell's
+    first trial: a cell succeeds when it survives success_steps periods (the period a cell fails
+    in counts as lasted)."""
     _, limit = actuator_limit(cfg)
     index = int(cfg.model.plant)
     n = len(B.plant_info(index)["state"])
     cells = plant_grid(index, grid_seed)
+    if only is not None:
+        cells = cells[np.asarray(only, dtype=np.intp)]
     parameters = ModelParameters(cfg.model, float(cfg.run.init_velocity_noise))
     states = np.stack([model_start(parameters, cells[i:i + 1]) for i in range(cells.size)])
     ended = np.zeros(cells.size, dtype=np.int32)
