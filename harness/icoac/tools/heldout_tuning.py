@@ -109,13 +109,15 @@ def save(args, data: dict[str, Any]) -> None:
 
 def tune(args, learner: str, ico_dirs: dict[int, Path] | None, data: dict[str, Any]) -> dict[str, Any]:
     """The learner's rows and choice into data["learners"]; while settings are unfinished,
-    {"pending": ...} with the finished rows. Saved after each setting (not with --report)."""
+    {"pending": the number unfinished, ...} with the finished rows. Saved after each setting (not
+    with --report)."""
     settings = heldout.settings(learner, args.plant)
     rows = []
     for i, s in enumerate(settings):
         rows.append(run_setting(args, learner, i, s, ico_dirs))
         done = [r for r in rows if r is not None]
-        data["learners"][learner] = {"learner": learner, "pending": len(done), "settings": len(settings), "rows": done}
+        data["learners"][learner] = {"learner": learner, "pending": len(settings) - len(done),
+                                     "settings": len(settings), "rows": done}
         if not args.report:
             save(args, data)
     if None in rows:
@@ -151,8 +153,8 @@ def run(args) -> dict[str, Any]:
             if ico_dirs or not REGISTRY[learner].prior.takes_ico:
                 tune(args, learner, ico_dirs, data)
             else:
-                data["learners"][learner] = {"learner": learner, "pending": 0,
-                                             "settings": len(heldout.settings(learner, args.plant))}
+                n = len(heldout.settings(learner, args.plant))
+                data["learners"][learner] = {"learner": learner, "pending": n, "settings": n}
     builds = [b for t in data["learners"].values() for r in t.get("rows", []) for b in r["builds"]]
     data["cell_builds"] = [b for i, b in enumerate(builds) if b not in builds[:i]]
     return data
@@ -275,8 +277,9 @@ def choices_table(data: dict[str, Any]) -> list[str]:
              "|---|---|---|---|---|---|"]
     for name, t in data["learners"].items():
         if "pending" in t:
-            lines.append(f"| {REGISTRY[name].label} | unfinished ({t['pending']} of {t['settings']} settings "
-                         "finished) | | | | |")
+            done = t["settings"] - t["pending"]
+            lines.append(f"| {REGISTRY[name].label} | unfinished ({done} of {t['settings']} settings finished) "
+                         "| | | | |")
             continue
         best = heldout.rank(t["rows"])[0]
         default = next(r for r in t["rows"] if r["order"] == 0)
