@@ -128,6 +128,9 @@ def test_policies_trained_once_join_the_headline_of_their_plant_and_settings():
     lines = tables.headline_table([bench, trained, {**trained, "set": []}])
     assert [line.split(" | ")[1] for line in lines[2:]] == ["**search** (use)", "ICO->RL", "PPO (trained once)"]
     assert lines[-1].startswith("| cart_pole (max_force=10) |") and "| 321 | 2e+03 | 250 |" in lines[-1]
+    # the untuned PPO and SAC are not set beside a bench of held-out tuned settings
+    tuned = tables.headline_table([{**bench, "tuned": {"chosen": {}}}, trained])
+    assert [line.split(" | ")[1] for line in tuned[2:]] == ["**search** (use)", "ICO->RL"]
     rows = rl_baselines.table(trained)
     assert "against ICO->RL (points)" in rows[0] and "-3.5 (-5.0 to -2.0), p ≤ 0.001" in rows[2]
     assert "| 2e+05 (1e+06) | 2 |" in rows[2]

@@ -150,7 +150,7 @@ def _plant_label(data: Mapping[str, Any]) -> str:
 def headline_table(summaries: Sequence[Mapping[str, Any]]) -> list[str]:
     """Per plant (one bench data file each): the recommended method, then HEADLINE_ROWS, then the
     policies trained once over the grid (PPO, SAC: an rl-baselines data file of the same plant and
-    settings); each with its success, 95 % interval, and the whole grid's total cost (_total_cost;
+    settings, beside the untuned bench only: theirs is untuned too); each with its success, 95 % interval, and the whole grid's total cost (_total_cost;
     a policy trained once: its training episodes and steps, and its training and evaluation wall
     time)."""
     lines = ["| plant | method | success, all cells (95 % interval) | trials, whole grid | "
@@ -171,7 +171,7 @@ def headline_table(summaries: Sequence[Mapping[str, Any]]) -> list[str]:
         for cond in [best] + [c for c in HEADLINE_ROWS if c in agg and c != best]:
             name = f"**{REGISTRY[cond].label}** (use)" if cond == best else REGISTRY[cond].label
             lines.append(row(plant, name, agg[cond]["success_rate"], _total_cost(agg[cond])))
-        for other in trained:
+        for other in ([] if "tuned" in data else trained):
             if (other["plant"], list(other["set"])) == (data.get("plant", "cart_pole"), list(data.get("set") or [])):
                 for e in other["algorithms"].values():
                     if "all" in e:
