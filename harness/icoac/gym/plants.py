@@ -106,7 +106,7 @@ class ModelParameters:
 
 
 def gym_name(registry_name: str) -> str:
-    """The env name of a C registry plant: "double_cart_pole" -> "DoubleCartPole"."""
+    """The env name of a C registry plant: its words capitalised and joined ("a_b" -> "AB")."""
     return "".join(word.capitalize() for word in registry_name.split("_"))
 
 

@@ -78,8 +78,8 @@ def check_plant(env: gymnasium.Env, plant: str) -> None:
 class IcoacPolicy:
     """A controller state initialised from ``config`` (a RunConfig: its controller and prior; e.g.
     icoac.studies.ceiling.fixed.fixed_config(w) for a fixed w) or else from ``condition``, ``overrides``,
-    ``prior`` and ``plant`` as icoac.core.config.build_config takes them (``plant="furuta"`` for
-    icoac/Furuta-v0: the Furuta's task settings). ``seed`` seeds the exploration noise (icoac_init)."""
+    ``prior`` and ``plant`` as icoac.core.config.build_config takes them (a registry plant's name:
+    its own task settings, for that plant's env). ``seed`` seeds the exploration noise (icoac_init)."""
 
     def __init__(self, config: RunConfig | None = None, *, condition: str = "ico",
                  overrides: Mapping[str, Any] | None = None, prior: B.Prior | None = None, seed: int = 0,
