@@ -107,11 +107,9 @@ $(VENV)/.baselines: $(VENV)/.installed
 	  print(tomllib.load(open("pyproject.toml", "rb"))["project"]["optional-dependencies"]["baselines"][0])')"
 	@touch $@
 
-# The smoke tests of the PPO and SAC adapters (marker baselines), which need that extra; their file
-# alone, since collecting test_target_profile.py puts a module named `profile` before the standard
-# one that torch imports.
+# The smoke tests of the PPO and SAC adapters (marker baselines), which need that extra.
 test-baselines: build baselines-venv
-	$(VPY) -m pytest -q tests/python/test_rl_baselines.py -m baselines $(PYTEST_ARGS)
+	$(VPY) -m pytest -q tests/python -m baselines $(PYTEST_ARGS)
 
 # PPO and SAC on the Furuta pendulum (its +-10 V; paired with the grids of `make bench
 # BENCH_PLANTS=furuta`) and on the cart-pole at +-10 N (Barto et al.'s force), whose learners' bench

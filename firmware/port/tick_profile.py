@@ -10,7 +10,7 @@ sqrtf, expf, a soft-float helper, ...) is counted as the library's when the libr
 The library's total per tick is what report.py measures with the SysTick, give or take the
 example's loop and the few instructions of each call.
 
-  python3 firmware/port/profile.py [--preset cortex-m4f] [--top 15] [--loop rl_literal]
+  python3 firmware/port/tick_profile.py [--preset cortex-m4f] [--top 15] [--loop rl_literal]
 
 The trace is read through a pipe (about 16 million instructions, one to two minutes).
 """

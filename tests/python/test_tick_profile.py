@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: Apache-2.0
-"""firmware/port/profile.py's trace reader: per timed tick loop of the port example, the library's
+"""firmware/port/tick_profile.py's trace reader: per timed tick loop of the port example, the library's
 instructions per function (C runtime calls counted for their caller's side), stub loops skipped."""
 import importlib.util
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
-spec = importlib.util.spec_from_file_location("target_profile", REPO / "firmware" / "port" / "profile.py")
-profile = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(profile)
+spec = importlib.util.spec_from_file_location("tick_profile", REPO / "firmware" / "port" / "tick_profile.py")
+tick_profile = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(tick_profile)
 
 LIBRARY = {"icoac_step", "icoac_priv_rl_tick", "mean_step"}
 
@@ -32,7 +32,7 @@ def test_loops_count_the_library_per_function_and_skip_stub_loops():
     tick = [("icoac_step", 10), ("icoac_priv_rl_tick", 20), ("memset", 3), ("icoac_priv_rl_tick", 2),
             ("mean_step.isra.0", 7), ("icoac_step", 1)]
     stub = [("step_stub", 4)]
-    got = list(profile.loops_of(iter(trace(loop(stub, 3), loop(tick, 3), [("main", 9)], loop(stub, 2),
+    got = list(tick_profile.loops_of(iter(trace(loop(stub, 3), loop(tick, 3), [("main", 9)], loop(stub, 2),
                                            loop(tick, 2))), LIBRARY))
     assert [ticks for _, ticks in got] == [3, 2]
     counts, ticks = got[0]
