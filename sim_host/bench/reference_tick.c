@@ -75,10 +75,15 @@ static double now_seconds(void)
 
 int main(int argc, char **argv)
 {
-    const long ticks = argc > 1 ? atol(argv[1]) : 5000000L;
+    char *end = NULL;
+    const long ticks = argc > 1 ? strtol(argv[1], &end, 10) : 5000000L;
     long done = 0, k;
     int cell;
     double t0, sink = 0.0;
+    if (argc > 2 || (argc == 2 && (*argv[1] == '\0' || *end != '\0' || ticks < 16))) {
+        fprintf(stderr, "usage: reference_tick [TICKS]  (an integer >= 16; default 5000000)\n");
+        return 2;
+    }
 #if defined(__SSE2__)
     _mm_setcsr(_mm_getcsr() | 0x8040); /* flush to zero, denormals are zero */
 #endif
