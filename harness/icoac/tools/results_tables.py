@@ -22,7 +22,7 @@ from typing import Any, Callable, Mapping
 
 from icoac.studies import tables
 from icoac.studies.bench import summary_markdown
-from icoac.tools import heldout_tuning, ico_ablation, one_w, rl_baselines
+from icoac.tools import heldout_tuning, ico_ablation, one_w, rl_baselines, speed_ab
 from icoac.tools.pages import update_or_check
 
 BLOCK = re.compile(r"(<!-- table: (?P<name>[a-z-]+) (?P<file>[\w.-]+\.json(,[\w.-]+\.json)*) -->\n)(?P<body>.*?)"
@@ -56,6 +56,8 @@ TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
     "prior-reading": heldout_tuning.prior_reading_table,
     "tuning-evaluation": heldout_tuning.evaluation_table,
     "rl-baselines": rl_baselines.table,
+    "speed-ab": speed_ab.table,
+    "speed-lanes": speed_ab.lanes_table,
 }
 
 
@@ -66,6 +68,8 @@ def _commit(git: Mapping[str, Any]) -> str:
 def provenance(data: Mapping[str, Any]) -> str:
     """The line under a table: what the summary was made from, and the builds that wrote its cells
     when they are not the summarising commit."""
+    if data.get("kind") == "speed":
+        return speed_ab.provenance(data)
     commit = _commit(data.get("git") or {})
     builds = [_commit(b) for b in data.get("cell_builds") or []]
     cells = f" (cells by {', '.join(builds)})" if builds and builds != [commit] else ""
