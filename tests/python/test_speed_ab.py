@@ -72,6 +72,7 @@ def test_rounds_alternate_and_the_tables_are_medians(tmp_path):
     rows = speed_ab.table(record)
     assert rows[2] == "| plain-C reference ICO tick (ns) | 33.0 (31.0-35.0) | (the same program) | 1 |"
     assert rows[3] == "| ICO tick, engine (ns) | 40.0 (30.0-50.0); 2 lanes | 22.0 (20.0-90.0); 16 lanes | 0.67 |"
+    assert rows[4] == "| ICO tick, one cell alone (ns) | 80.0 (80.0-80.0) | 80.0 (80.0-80.0) | 2.42 |"
     assert speed_ab.lanes_table(record)[2] == "| cart_pole | ico | 32.0 | 60.0 |"
     assert "3 rounds interleaved" in results_tables.provenance(record)
 

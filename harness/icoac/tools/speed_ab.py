@@ -139,7 +139,7 @@ def table(data: Mapping[str, Any]) -> list[str]:
     b, a = runs["before"], runs["after"]
 
     def lanes(side: Sequence[Mapping[str, Any]], key: str) -> str:
-        return f"; {side[0][key]} lanes" if side[0].get(key) else ""
+        return f"; {side[0][key]} lanes" if key.endswith("_lanes") else ""
 
     rows = [f"| measurement | before ({_commit(data['before'])}) | after ({_commit(data['after'])}) "
             "| after ÷ reference |", "|---|---|---|---|",
