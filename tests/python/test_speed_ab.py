@@ -74,7 +74,7 @@ def test_rounds_alternate_and_the_tables_are_medians(tmp_path):
     assert rows[3] == "| ICO tick, engine (ns) | 40.0 (30.0-50.0); 2 lanes | 22.0 (20.0-90.0); 16 lanes | 0.67 |"
     assert rows[4] == "| ICO tick, one cell alone (ns) | 80.0 (80.0-80.0) | 80.0 (80.0-80.0) | 2.42 |"
     assert speed_ab.lanes_table(record)[2] == "| cart_pole | ico | 32.0 | 60.0 |"
-    assert "3 rounds interleaved" in results_tables.provenance(record)
+    assert "medians of 3 rounds interleaved" in results_tables.provenance(record)
 
 
 def test_a_missing_or_failing_program_is_a_one_line_error(tmp_path, capsys):

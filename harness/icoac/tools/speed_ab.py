@@ -173,9 +173,9 @@ def provenance(data: Mapping[str, Any]) -> str:
     """The line under a speed table: the builds, the rounds and the machine."""
     m, load = data["machine"], data["load_average"]
     return (f"*From docs/data: `icoac_bench` of {_commit(data['before'])} (before) and {_commit(data['after'])} "
-            f"(after), `reference_tick` of the after build, {data['rounds']} rounds interleaved, medians "
-            f"(ranges); {m['cpu']}, {m['cores']} cores, {', '.join(m['vector']).upper()}; load average "
-            f"{load['start']:.1f} at the start, {load['end']:.1f} at the end; {data['timestamp']}.*")
+            f"(after), `reference_tick` of the after build, medians of {data['rounds']} rounds interleaved; "
+            f"{m['cpu']}, {m['cores']} cores, {', '.join(m['vector']).upper()}; 1-minute load "
+            f"average {load['start']:.1f} at the start, {load['end']:.1f} at the end; {data['timestamp']}.*")
 
 
 def main(argv: list[str] | None = None) -> int:
