@@ -103,7 +103,7 @@ static double ns_per_grid_tick(int32_t plant, int mode, int64_t lanes, int64_t s
     icoac_sim_run_t run;
     int64_t i, n = 0;
     double t0, elapsed;
-    if (grid == 0 || cells == 0 || icoac_sim_plant_task(plant, &cfg) != ICOAC_SIM_OK ||
+    if (grid == 0 || cells == 0 || icoac_sim_plant_task(plant, 0, &cfg) != ICOAC_SIM_OK ||
         icoac_sim_model_default(&model, plant) != ICOAC_SIM_OK ||
         icoac_sim_plant_grid(plant, grid, n_grid, 1u) != ICOAC_SIM_OK) {
         fprintf(stderr, "icoac_bench: cannot set up plant %d\n", (int)plant);

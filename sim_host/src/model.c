@@ -29,7 +29,7 @@ int32_t icoac_sim_model_default(icoac_sim_model_t *model, int32_t index)
 }
 
 /* 0 or a normal number in [min, max]: no subnormal reaches the engine, whose threads flush them. */
-static int param_valid(double v, const icoac_sim_param_t *range)
+int sim_param_valid(double v, const icoac_sim_param_t *range)
 {
     return (v == 0.0 || isnormal(v)) && v >= range->min && v <= range->max;
 }
@@ -46,7 +46,7 @@ int32_t icoac_sim_model_check(const icoac_sim_model_t *model)
         return ICOAC_SIM_ERR_BAD_PLANT;
     }
     for (i = 0; i < ICOAC_SIM_MAX_PARAMS; ++i) {
-        if (i < desc->n_params ? !param_valid(model->param[i], &desc->params[i]) : model->param[i] != 0.0) {
+        if (i < desc->n_params ? !sim_param_valid(model->param[i], &desc->params[i]) : model->param[i] != 0.0) {
             return ICOAC_SIM_ERR_BAD_PLANT;
         }
     }

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "icoac_sim/icoac_sim.h"
+#include "sim_internal.h"
 
 #define SIM_PLANTS(X) X(sim_cart_pole) X(sim_furuta) X(sim_double_cart_pole)
 
@@ -33,18 +34,26 @@ int32_t icoac_sim_plant_find(const char *name)
     return -1;
 }
 
-int32_t icoac_sim_plant_task(int32_t index, icoac_config_t *cfg)
+int32_t icoac_sim_plant_task(int32_t index, const double *knob, icoac_config_t *cfg)
 {
     const icoac_sim_plant_desc_t *desc = icoac_sim_plant_info(index);
+    double value[ICOAC_SIM_MAX_TASK_KNOBS];
+    int32_t i;
     if (cfg == 0) {
         return ICOAC_SIM_ERR_BAD_ARGUMENT;
     }
-    if (desc == 0 || desc->task == 0) {
+    if (desc == 0 || desc->task == 0 || desc->task->n_knobs < 0 || desc->task->n_knobs > ICOAC_SIM_MAX_TASK_KNOBS) {
         return ICOAC_SIM_ERR_BAD_PLANT;
+    }
+    for (i = 0; i < desc->task->n_knobs; ++i) {
+        value[i] = knob == 0 ? desc->task->knobs[i].value : knob[i];
+        if (!sim_param_valid(value[i], &desc->task->knobs[i])) {
+            return ICOAC_SIM_ERR_BAD_PLANT;
+        }
     }
     icoac_config_default(cfg);
     if (desc->task->apply != 0) {
-        desc->task->apply(cfg);
+        desc->task->apply(value, cfg);
     }
     return ICOAC_SIM_OK;
 }

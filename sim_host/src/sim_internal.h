@@ -23,6 +23,8 @@ int32_t sim_check_all(const icoac_config_t *cfg, const icoac_sim_model_t *model,
 
 /* Initial velocity noise a: 0, or in [ICOAC_SIM_NOISE_MIN, ICOAC_SIM_NOISE_MAX] (params.c). */
 int sim_velocity_noise_valid(double a);
+/* 1 when v is 0 or a normal number in [range->min, range->max] (a plant parameter or task knob). */
+int sim_param_valid(double v, const icoac_sim_param_t *range);
 
 /* Uniform in (-a, a) from the plant's own generator, in double. */
 static inline double sim_uniform_symmetric(icoac_rng_t *rng, double a)

@@ -211,7 +211,7 @@ static void find_task_plants(void)
     icoac_config_t cfg;
     n_task_plants = 0;
     for (p = 0; p < icoac_sim_plant_count() && n_task_plants < 8; ++p) {
-        if (icoac_sim_plant_task(p, &cfg) == ICOAC_SIM_OK) {
+        if (icoac_sim_plant_task(p, 0, &cfg) == ICOAC_SIM_OK) {
             task_plants[n_task_plants++] = p;
         }
     }
@@ -226,7 +226,7 @@ static void find_task_plants(void)
 static void plant_task(int32_t p, icoac_config_t *cfg)
 {
 #if TEST_BATCH_PLANTS
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(p, cfg));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(p, 0, cfg));
 #else
     TEST_ASSERT_EQUAL_INT(0, p);
     icoac_config_default(cfg);

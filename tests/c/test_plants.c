@@ -304,7 +304,7 @@ static void test_trial_start(void)
         icoac_rng_t rng;
         double states[2 * ICOAC_SIM_MAX_STATE], forces[1], s[ICOAC_SIM_MAX_STATE];
         int64_t n_steps = 0;
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(i, &cfg));
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(i, NULL, &cfg));
         TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_default(&model, i));
         memset(&cell, 0, sizeof cell);
         cell.x0 = 0.7;
@@ -410,11 +410,11 @@ static void test_task_presets(void)
     for (i = 0; i < n; ++i) {
         const icoac_sim_plant_desc_t *d = plant(i);
         if (d->task == NULL) {
-            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_task(i, &cfg));
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_task(i, NULL, &cfg));
             continue;
         }
         TEST_ASSERT_TRUE(strlen(d->task->source) > 0 && d->task->n_learners >= 0);
-        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(i, &cfg));
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(i, NULL, &cfg));
         TEST_ASSERT_EQUAL_INT(d->n_state, cfg.task.n_inputs);
         TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&cfg));
         for (c = 0; c < sizeof conditions / sizeof conditions[0]; ++c) {
@@ -431,15 +431,59 @@ static void test_task_presets(void)
             }
         }
     }
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_task(n, &cfg));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_task(n, NULL, &cfg));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_learner(-1, "rl", &cfg));
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_task(0, NULL));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_task(0, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_plant_learner(0, NULL, &cfg));
     /* the cart-pole's task is the controller's defaults */
     icoac_config_default(&before);
-    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(ICOAC_SIM_CART_POLE, &cfg));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(ICOAC_SIM_CART_POLE, NULL, &cfg));
     TEST_ASSERT_EQUAL_MEMORY(&before, &cfg, sizeof cfg);
     TEST_ASSERT_EQUAL_INT(1, plant(ICOAC_SIM_CART_POLE)->task->paper);
+}
+
+/* A task's knobs: their defaults are the task (NULL gives the same configuration), each at another
+ * value within its range changes the configuration and keeps it valid, and a knob outside its range
+ * or not finite is refused with the configuration left as it was. */
+static void test_task_knobs(void)
+{
+    const int32_t n = icoac_sim_plant_count();
+    icoac_config_t cfg, defaults, moved;
+    double knob[ICOAC_SIM_MAX_TASK_KNOBS];
+    int32_t i, k, with_knobs = 0;
+    for (i = 0; i < n; ++i) {
+        const icoac_sim_task_t *task = plant(i)->task;
+        if (task == NULL) {
+            continue;
+        }
+        TEST_ASSERT_TRUE(task->n_knobs >= 0 && task->n_knobs <= ICOAC_SIM_MAX_TASK_KNOBS);
+        with_knobs += task->n_knobs > 0;
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(i, NULL, &defaults));
+        for (k = 0; k < task->n_knobs; ++k) {
+            const icoac_sim_param_t *p = &task->knobs[k];
+            TEST_ASSERT_TRUE(strlen(p->name) > 0 && strlen(p->doc) > 0 && p->min <= p->value && p->value <= p->max);
+            knob[k] = p->value;
+        }
+        TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(i, knob, &cfg));
+        TEST_ASSERT_EQUAL_MEMORY(&defaults, &cfg, sizeof cfg);
+        for (k = 0; k < task->n_knobs; ++k) {
+            const icoac_sim_param_t *p = &task->knobs[k];
+            const double bad[3] = {p->max * 2.0 + 1.0, p->min - 1.0, NAN};
+            size_t b;
+            knob[k] = p->value == p->max ? p->min : 0.5 * (p->value + p->max);
+            TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_plant_task(i, knob, &moved));
+            TEST_ASSERT_EQUAL_INT(ICOAC_OK, icoac_config_check(&moved));
+            TEST_ASSERT_TRUE(memcmp(&moved, &defaults, sizeof moved) != 0);
+            for (b = 0; b < 3; ++b) {
+                knob[k] = bad[b];
+                cfg = moved;
+                TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_PLANT, icoac_sim_plant_task(i, knob, &cfg));
+                TEST_ASSERT_EQUAL_MEMORY(&moved, &cfg, sizeof cfg);
+            }
+            knob[k] = p->value;
+        }
+    }
+    TEST_ASSERT_TRUE(with_knobs >= 2);
 }
 
 int main(void)
@@ -455,5 +499,6 @@ int main(void)
     RUN_TEST(test_trial_start);
     RUN_TEST(test_energy_conserved);
     RUN_TEST(test_task_presets);
+    RUN_TEST(test_task_knobs);
     return UNITY_END();
 }

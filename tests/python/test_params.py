@@ -110,7 +110,7 @@ def test_design_page_agrees_with_the_c_table():
 
 def test_plants_page_has_every_plant_table_from_c(tmp_path):
     """docs/plants.md holds one generated table per registry plant, each row a descriptor
-    parameter (then dt and the integrator) with its tier and description."""
+    parameter (then dt and the integrator, then its task's knobs) with its tier and description."""
     page = ROOT / "docs" / "plants.md"
     assert PT.main([str(page), "--check"]) == 0
     text = page.read_text()
@@ -118,7 +118,8 @@ def test_plants_page_has_every_plant_table_from_c(tmp_path):
         info = B.plant_info(index)
         assert f"<!-- plant-params {info['name']}:begin -->" in text
         rows = P.plant_rows(info["name"])
-        assert [r["name"] for r in rows] == [p["name"] for p in info["params"]] + ["dt", "integrator"]
+        knobs = [k["name"] for k in (info["task"] or {}).get("knobs", [])]
+        assert [r["name"] for r in rows] == [p["name"] for p in info["params"]] + ["dt", "integrator"] + knobs
         assert all(r["tier"] in ("essential", "advanced") and r["description"] for r in rows)
     stale = text.replace("| essential | gravitational acceleration |", "| advanced | gravitational acceleration |", 1)
     copy = tmp_path / "plants.md"

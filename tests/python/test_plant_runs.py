@@ -3,7 +3,6 @@
 plant's grid in every metric and map, the task settings and their sweep, refusals by name."""
 import ctypes
 import json
-import math
 import re
 from dataclasses import replace
 from pathlib import Path
@@ -13,7 +12,7 @@ import pytest
 
 from icoac.core import binding as B
 from icoac import cli
-from icoac.core import config, geometry, grid, metrics, plants, results
+from icoac.core import geometry, grid, metrics, plants, results
 from icoac.studies import prior as P
 from icoac.core.config import build_config, config_from_dict
 from icoac.tools import plant_sweeps
@@ -71,7 +70,7 @@ def test_a_plant_without_a_task_is_refused(monkeypatch):
         build_config(plant="furuta")
     # C refuses it too: an index out of the registry has no task
     cfg = B.Config()
-    assert B.lib.icoac_sim_plant_task(B.lib.icoac_sim_plant_count(), ctypes.byref(cfg)) == B.SIM_ERR_BAD_PLANT
+    assert B.lib.icoac_sim_plant_task(B.lib.icoac_sim_plant_count(), None, ctypes.byref(cfg)) == B.SIM_ERR_BAD_PLANT
     assert B.lib.icoac_sim_plant_learner(-1, b"rl", ctypes.byref(cfg)) == B.SIM_ERR_BAD_PLANT
 
 
@@ -167,18 +166,14 @@ def test_sweep_ranking_and_the_furuta_choice():
             {"key": "b", "seed": "0", "success_rate": "0.295", "median_trials": "100"},
             {"key": "c", "seed": "0", "success_rate": "0.10", "median_trials": ""}]
     assert [r["key"] for r in plant_sweeps.ranked(rows)] == ["b", "a", "c"]  # within one point: fewer trials
-    # each swept plant's C task is the choice its sweep's summary records, and its learner settings
-    # the learner sweeps' choices
+    # each swept plant's C task (its knobs' defaults) is the choice its sweep's summary records, and
+    # its learner settings the learner sweeps' choices
     for plant in plant_sweeps.TASK_SPACES:
         text = (REPO / "docs" / f"sweeps-{plant}.md").read_text()
         choice = plant_sweeps.setting_of(re.search(r"## Choice\s+`([^`]+)`", text).group(1))
-        swept = B.Config()
-        B.lib.icoac_config_default(ctypes.byref(swept))
-        for name, value in plant_sweeps.task_overrides(plant, choice).items():
-            config._set_field(swept, config.canonical(name), value)
-        task = B.Config()
-        plants.spec(plant).task_config(task)
-        assert bytes(task) == bytes(swept), plant
+        assert set(choice) - {"ico.rate", "policy.gain"} == set(plants.PLANTS[plant].knobs), plant
+        swept, task = build_config(choice, plant=plant).controller, build_config(plant=plant).controller
+        assert bytes(swept) == bytes(task), plant
         for learner in set(plants.PLANTS[plant].learners) & set(plant_sweeps.LEARNER_SPACE):
             picked = json.loads(re.search(rf"## Learner {learner}: .*?Choice: `([^`]+)`", text, re.S).group(1))
             assert build_config(picked, condition=learner, plant=plant).to_dict() == \

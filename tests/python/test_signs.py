@@ -96,8 +96,8 @@ def test_a_task_that_gives_signs_keeps_them(monkeypatch):
     derived = list(C.build_config(plant=plant).controller.task.input_sign)
     task_config = plants.PlantSpec.task_config
 
-    def with_signs(spec, cfg):
-        task_config(spec, cfg)
+    def with_signs(spec, cfg, knobs=None):
+        task_config(spec, cfg, knobs)
         cfg.task.input_sign[0] = -1
         cfg.task.input_sign[1] = 1
     monkeypatch.setattr(plants.PlantSpec, "task_config", with_signs)

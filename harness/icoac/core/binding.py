@@ -35,7 +35,7 @@ DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.s
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
 ABI_VERSION = 10
-SIM_ABI_VERSION = 8
+SIM_ABI_VERSION = 9
 
 
 class IcoacError(HarnessError):
@@ -419,7 +419,8 @@ class Learner(ctypes.Structure):
 
 class PlantTask(ctypes.Structure):
     """icoac_sim_task_t: the controller task a plant is benchmarked with (applied by C)."""
-    _fields_ = [("source", ctypes.c_char_p), ("apply", ctypes.c_void_p), ("n_learners", ctypes.c_int32),
+    _fields_ = [("source", ctypes.c_char_p), ("apply", ctypes.c_void_p), ("n_knobs", ctypes.c_int32),
+                ("reserved", ctypes.c_int32), ("knobs", ctypes.POINTER(Param)), ("n_learners", ctypes.c_int32),
                 ("paper", ctypes.c_int32), ("learners", ctypes.POINTER(Learner)),
                 ("prior_all_finished", ctypes.c_char_p)]
 
@@ -616,7 +617,7 @@ _PROTOTYPES = {
     "icoac_sim_plant_count": ([], ctypes.c_int32),
     "icoac_sim_plant_info": ([ctypes.c_int32], _P(PlantDesc)),
     "icoac_sim_plant_find": ([ctypes.c_char_p], ctypes.c_int32),
-    "icoac_sim_plant_task": ([ctypes.c_int32, _P(Config)], ctypes.c_int32),
+    "icoac_sim_plant_task": ([ctypes.c_int32, _P(ctypes.c_double), _P(Config)], ctypes.c_int32),
     "icoac_sim_plant_learner": ([ctypes.c_int32, ctypes.c_char_p, _P(Config)], ctypes.c_int32),
     "icoac_sim_model_default": ([_P(Model), ctypes.c_int32], ctypes.c_int32),
     "icoac_sim_model_check": ([_P(Model)], ctypes.c_int32),
@@ -745,7 +746,7 @@ def plant_info(plant: Union[int, str]) -> dict:
         "rows": sweep(d.rows), "cols": sweep(d.cols),
         "start": list(d.start[:n]), "drawn": [bool(v) for v in d.drawn[:n]], "observed": list(d.observed[:n]),
         "has_energy": bool(d.energy),
-        "task": _task_info(d.task.contents) if d.task else None,
+        "task": _task_info(d.name.decode(), d.task.contents) if d.task else None,
     }
 
 
@@ -759,8 +760,9 @@ def _param_info(plant: str, p: Param) -> dict:
             "tier": tier, "doc": doc}
 
 
-def _task_info(t: PlantTask) -> dict:
+def _task_info(plant: str, t: PlantTask) -> dict:
     return {"source": t.source.decode(), "paper": bool(t.paper),
+            "knobs": [_param_info(plant, t.knobs[i]) for i in range(t.n_knobs)],
             "learners": [t.learners[i].conditions.decode().split() for i in range(t.n_learners)],
             "prior_all_finished": t.prior_all_finished.decode() if t.prior_all_finished else None}
 

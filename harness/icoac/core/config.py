@@ -85,18 +85,22 @@ def _short(value: Any, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def canonical(name: Any) -> str:
-    """``name`` if it names a parameter; ConfigError (listing the valid names) for anything else."""
+def canonical(name: Any, plant: str = CART_POLE) -> str:
+    """``name`` if it names a parameter; ConfigError (listing the valid names, the plant's own
+    parameters and task knobs among them) for anything else."""
     if isinstance(name, str) and name in _GROUP_OF:
         return name
+    valid = list(ALL_FIELDS)
+    if plant != CART_POLE:
+        valid = [n for n in valid if _GROUP_OF[n] != "plant"] + sorted(plant_params(plant)) + sorted(task_knobs(plant))
     hint = ""
     if isinstance(name, str):
-        by_part = {**{n.rpartition(".")[2]: n for n in ALL_FIELDS}, **{n: n for n in ALL_FIELDS}}
+        by_part = {**{n.rpartition(".")[2]: n for n in valid}, **{n: n for n in valid}}
         close = difflib.get_close_matches(name, list(by_part), n=1)  # by full name or by field
         hint = f" (did you mean {by_part[close[0]]}?)" if close else ""
     raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
-                      f"unknown parameter {_short(name)}{hint}; valid names: {', '.join(ALL_FIELDS)} "
-                      "(python -m icoac params)")
+                      f"unknown parameter {_short(name)}{hint}; valid names: {', '.join(valid)} "
+                      f"(python -m icoac params{'' if plant == CART_POLE else ' --plant ' + plant})")
 
 
 def group_of(name: str) -> str:
@@ -300,18 +304,24 @@ def plant_params(plant: str) -> set[str]:
     return {p["name"] for p in B.plant_info(B.plant_index(plant))["params"]} | {"dt", "integrator"}
 
 
+def task_knobs(plant: str) -> set[str]:
+    """The names --set takes for the knobs of a registry plant's task (its C file)."""
+    task = B.plant_info(B.plant_index(plant))["task"]
+    return {k["name"] for k in task["knobs"]} if task else set()
+
+
 def parse_sets(items: Iterable[str] | None, option: str = "--set", plant: str = CART_POLE) -> dict[str, Any]:
     """``NAME=VALUE`` strings -> {canonical name: value} (a plant's parameters by their own names).
     UsageError for an item without '=' and for a field given twice (under any of its names);
     ConfigError for an unknown name."""
     out: dict[str, Any] = {}
     given: dict[str, str] = {}
-    own = plant_params(plant)
+    own = plant_params(plant) | task_knobs(plant)
     for item in items or []:
         if "=" not in item:
             raise UsageError(f"{option} expects name=value, got {_short(item)}")
         name, value = item.split("=", 1)
-        name = name.strip() if name.strip() in own else canonical(name.strip())
+        name = name.strip() if name.strip() in own else canonical(name.strip(), plant)
         if name in given:
             raise given_twice(name, f"{option} {given[name]}", f"{option} {item[:60]}")
         given[name] = item[:60]
@@ -593,10 +603,10 @@ def check_prior(prior: B.Prior, n: int) -> None:
 def build_config(overrides: Mapping[str, Any] | None = None, condition: str | None = None,
                  prior: B.Prior | None = None, check: bool = True, plant: str = CART_POLE,
                  derive_signs: bool = True) -> RunConfig:
-    """C defaults and the plant's task (its C file), then the condition's overrides and the plant's
-    settings of that learner, then ``overrides`` by field name (a later name for
-    the same field wins); validated by C. A registry plant other than the
-    cart-pole takes the overrides named after its parameters (and dt, integrator). With
+    """C defaults and the plant's task (its C file, written from its knobs: their defaults, or the
+    overrides named after them), then the condition's overrides and the plant's settings of that
+    learner, then ``overrides`` by field name (a later name for the same field wins); validated by
+    C. A registry plant takes the overrides named after its parameters (and dt, integrator). With
     derive_signs, task.input_sign comes from the plant's LQR gain (icoac.core.signs) unless the plant's
     task, the condition or ``overrides`` gives it (--set task.input_sign=1: the paper's signs)."""
     if overrides is not None and not isinstance(overrides, Mapping):
@@ -605,7 +615,9 @@ def build_config(overrides: Mapping[str, Any] | None = None, condition: str | No
         raise ConfigError(B.ERR_BAD_PRIOR, f"prior must be an icoac_prior_t, got {type(prior).__name__}")
     cfg = RunConfig(prior=prior)
     spec = plant_spec(plant)
-    spec.task_config(cfg.controller)  # the C defaults, then the plant's task
+    items = list((overrides or {}).items())
+    knobs = {name: value for name, value in items if name in spec.knobs}
+    spec.task_config(cfg.controller, knobs)  # the C defaults, then the plant's task from its knobs
     task_signs = list(cfg.controller.task.input_sign) != [1] * B.MAX_INPUTS  # the task gives its signs
     B.lib.icoac_sim_run_default(ctypes.byref(cfg.run))
     condition_items: list[tuple[Any, Any]] = []
@@ -614,16 +626,15 @@ def build_config(overrides: Mapping[str, Any] | None = None, condition: str | No
             raise ConfigError(B.SIM_ERR_BAD_ARGUMENT,
                               f"unknown condition {_short(condition)}; valid: {', '.join(CONDITIONS)}")
         condition_items = list(CONDITION_OVERRIDES[condition].items())
-    items = list((overrides or {}).items())
     params = plant_params(plant)
     cfg.model = build_model(plant, {name: value for name, value in items if name in params})
-    items = [(name, value) for name, value in items if name not in params]
+    items = [(name, value) for name, value in items if name not in params and name not in knobs]
 
     given = set()
 
     def set_items(pairs: list[tuple[Any, Any]]) -> None:
         for name, value in pairs:
-            name = canonical(name)
+            name = canonical(name, plant)
             if group_of(name) == "plant":
                 raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {plant} has no parameter {name}")
             _set_field(cfg._struct(name), name, value)
@@ -691,7 +702,7 @@ def config_from_dict(data: Mapping[str, Any], check: bool = True) -> RunConfig:
             plant = values.get("name", CART_POLE)
             if not isinstance(plant, str):
                 raise ConfigError(B.SIM_ERR_BAD_PLANT, f"plant name must be a string, got {_short(plant)}")
-            own = plant_params(plant)
+            own = plant_params(plant) | task_knobs(plant)
             for name, value in values.items():
                 if name != "name":
                     if name not in own and group_of(canonical(name)) != "plant":

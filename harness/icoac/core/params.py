@@ -67,16 +67,20 @@ def _integrator(value: int) -> str:
 
 def plant_rows(plant: str, tier: str | None = None) -> list[dict[str, str]]:
     """One dict of COLUMNS per parameter of a registry plant (its descriptor's table; tier: those
-    only), then its model's dt and integrator."""
+    only), then its model's dt and integrator, then its task's knobs."""
     model = B.model_default(plant)
-    table = [{"name": p["name"], "unit": p["unit"], "default": _num(p["value"]),
-              "range": f"[{_num(p['min'])}, {_num(p['max'])}]", "tier": p["tier"], "description": p["doc"]}
-             for p in B.plant_info(plant)["params"]]
+    info = B.plant_info(plant)
+
+    def row(p: dict) -> dict[str, str]:
+        return {"name": p["name"], "unit": p["unit"], "default": _num(p["value"]),
+                "range": f"[{_num(p['min'])}, {_num(p['max'])}]", "tier": p["tier"], "description": p["doc"]}
+    table = [row(p) for p in info["params"]]
     table += [{"name": "dt", "unit": "s", "default": _num(model.dt), "range": f"[{_num(B.DT_MIN)}, {_num(B.DT_MAX)}]",
                "tier": "advanced", "description": "integration step, one controller tick"},
               {"name": "integrator", "unit": "", "default": _integrator(model.integrator),
                "range": ", ".join(B.INTEGRATORS), "tier": "advanced",
                "description": "explicit Euler (Sutton's update order) or classical RK4"}]
+    table += [row(k) for k in (info["task"] or {}).get("knobs", [])]
     return [dict(r, modes="all") for r in table if tier is None or r["tier"] == tier]
 
 

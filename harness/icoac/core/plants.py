@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The plants a benchmark runs, each described once, in its C file (sim_host/src/plants/,
 docs/plants.md): dynamics, parameters, failure test, grid, and the controller task it is
-benchmarked with (icoac_sim_task_t: input ranges, rule table, critic grid, learner settings). This
+benchmarked with (icoac_sim_task_t: input ranges, rule table, critic grid, learner settings,
+written from the task's knobs). This
 module reads the C registry: PLANTS has every registry plant, and spec(name) refuses a plant whose
 file has no task, rather than run it on another plant's settings.
 
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import ctypes
 from dataclasses import dataclass
+from typing import Any, Mapping
 
 from icoac.core import binding as B
 from icoac.core.registry import CONDITIONS
@@ -29,6 +31,7 @@ class PlantSpec:
     title: str
     task_source: str | None  # where its task's settings come from; None: it has no task
     learners: tuple[str, ...] = ()  # the conditions its task has settings for
+    knobs: tuple[str, ...] = ()  # the names of its task's knobs, in their C order
     paper: bool = False  # the paper's plant and task: its published results apply
     prior_cells: str = PRIOR_CELLS[0]
     prior_why: str = ""
@@ -37,14 +40,34 @@ class PlantSpec:
     def has_task(self) -> bool:
         return self.task_source is not None
 
-    def task_config(self, cfg: B.Config) -> None:
-        """cfg = the C defaults, then the plant's task (icoac_sim_plant_task)."""
-        B.check_status(B.lib.icoac_sim_plant_task(self.index, ctypes.byref(cfg)), f"plant {self.name} task")
+    def task_config(self, cfg: B.Config, knobs: Mapping[str, float] | None = None) -> None:
+        """cfg = the C defaults, then the plant's task written from its knobs (icoac_sim_plant_task):
+        their defaults, replaced by ``knobs`` by name."""
+        values = {k["name"]: k["value"] for k in B.plant_info(self.index)["task"]["knobs"]} if self.has_task else {}
+        for name, value in (knobs or {}).items():
+            if name not in values:
+                raise B.ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {self.name}'s task has no knob {name!r}; its knobs: "
+                                    f"{', '.join(values) or 'none'}")
+            values[name] = _knob_value(self.name, name, value)
+        array = (ctypes.c_double * max(1, len(values)))(*values.values())
+        if B.lib.icoac_sim_plant_task(self.index, array, ctypes.byref(cfg)) != B.SIM_OK:
+            # the knob C refused, named with its range from the C table
+            for k in B.plant_info(self.index)["task"]["knobs"]:
+                if not k["min"] <= values[k["name"]] <= k["max"]:
+                    raise B.ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {self.name} task knob {k['name']}="
+                                        f"{values[k['name']]:g} is outside [{k['min']:g}, {k['max']:g}] {k['unit']}")
+            B.check_status(B.SIM_ERR_BAD_PLANT, f"plant {self.name} task")
 
     def learner_config(self, condition: str, cfg: B.Config) -> None:
         """The plant's settings of a learning condition over cfg, if it has some."""
         B.check_status(B.lib.icoac_sim_plant_learner(self.index, condition.encode(), ctypes.byref(cfg)),
                        f"plant {self.name} learner settings")
+
+
+def _knob_value(plant: str, name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise B.ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {plant} task knob {name} must be a number, got {value!r:.40}")
+    return float(value)
 
 
 def _spec(index: int) -> PlantSpec:
@@ -58,7 +81,11 @@ def _spec(index: int) -> PlantSpec:
         raise B.LibraryError(f"plant {info['name']}: its task's learner settings name "
                              f"{', '.join(unknown) or 'a condition twice'}; conditions: {', '.join(CONDITIONS)}")
     why = task["prior_all_finished"]
-    return PlantSpec(info["name"], index, info["title"], task["source"], learners, task["paper"],
+    knobs = tuple(k["name"] for k in task["knobs"])
+    taken = set(knobs) & ({p["name"] for p in info["params"]} | {"dt", "integrator"})
+    if taken:
+        raise B.LibraryError(f"plant {info['name']}: task knob {sorted(taken)[0]} has the name of a plant parameter")
+    return PlantSpec(info["name"], index, info["title"], task["source"], learners, knobs, task["paper"],
                      PRIOR_CELLS[1] if why else PRIOR_CELLS[0], why or "")
 
 

@@ -36,7 +36,6 @@ import math
 import sys
 import time
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -62,88 +61,31 @@ OTHER_READING_NOISE = (0.3, 1.0, 3.0)
 LEARNER_FAILED = 200
 LEARNER_MAX_TRIALS = 1000
 
-# The cart-pole's reflex zone along its track as a fraction of its range (ICOAC_SIM_ZONE_FRACTION).
-ZONE_FRACTION = float(B.constant("ICOAC_SIM_ZONE_FRACTION"))
-
-
-def _param(plant: str, name: str) -> float:
-    return {p["name"]: p["value"] for p in B.plant_info(plant)["params"]}[name]
-
-
-def furuta_task(plant: str, setting: dict[str, float]) -> dict[str, Any]:
-    """The Furuta's controller settings of a task setting: input ranges (arm angle, arm velocity,
-    pendulum angle = its failure limit, pendulum velocity), the critic grid over the same ranges,
-    the reflex zone (ZONE_FRACTION of the arm range; the pendulum's at zone_deg), ICO's rate and
-    the policy gain. The cart-pole's rule table and critic units carry over."""
-    limit = _param(plant, "pendulum_limit")
-    ranges = [setting["arm_range"], setting["arm_velocity_range"], limit, setting["pendulum_velocity_range"]]
-    z, zx = math.radians(setting["zone_deg"]), ZONE_FRACTION * setting["arm_range"]
-    return {"policy.input_range": ranges, "critic.range": ranges,
-            # the cart-pole's rules 0 and 2 on the pendulum at +-z, 1 and 3 on the arm at -+zx
-            "task.rule_threshold": [z, -zx, -z, zx] + [0.0] * (B.MAX_RULES - 4),
-            "ico.rate": setting["ico.rate"], "policy.gain": setting["policy.gain"]}
-
-
-# The double pendulum's critic units per input (x, x_dot, theta1, theta1_dot, theta2, theta2_dot):
-# the build's ICOAC_MAX_CRITIC_UNITS (216), three along both angles and the lower link's velocity.
-DOUBLE_CRITIC_UNITS = (2, 2, 3, 3, 3, 2)
-
-
-def double_task(plant: str, setting: dict[str, float]) -> dict[str, Any]:
-    """The double pendulum's controller settings of a task setting: six inputs, scaled to the
-    track and angle limits and to the swept velocity ranges (both links' alike); the critic grid
-    over the same ranges; six rules, first match wins: the lower link beyond +-zone_deg gives the
-    cart-pole's reflex (+1 when it leans toward +x), the cart beyond ZONE_FRACTION of the track
-    gives cart_reflex times the push back to the centre (+1: the cart-pole's; -1: away, the sign
-    of the plant's LQR gain on x), and the upper link beyond +-zone_deg gives upper_reflex times its sign (+1: push
-    under it as under the lower link; -1: tip the lower link under it, the sign of the plant's LQR
-    gain); ICO's rate and the policy gain."""
-    x_limit, limit = _param(plant, "x_limit"), _param(plant, "angle_limit")
-    v = setting["link_velocity_range"]
-    ranges = [x_limit, setting["cart_velocity_range"], limit, v, limit, v]
-    z, zx = math.radians(setting["zone_deg"]), ZONE_FRACTION * x_limit
-    up, cart = setting["upper_reflex"], setting["cart_reflex"]
-    above, below = B.RULE_SIDES["above"], B.RULE_SIDES["below"]
-    return {"task.n_inputs": 6, "task.n_rules": 6, "task.rule_input": [2, 0, 2, 0, 4, 4],
-            "task.rule_side": [above, below, below, above, above, below],
-            "task.rule_threshold": [z, -zx, -z, zx, z, -z], "task.rule_reflex": [1.0, cart, -1.0, -cart, up, -up],
-            "policy.input_range": ranges, "critic.range": ranges, "critic.units": list(DOUBLE_CRITIC_UNITS),
-            "ico.rate": setting["ico.rate"], "policy.gain": setting["policy.gain"]}
-
-
-# Each swept plant's task: the space its sweep draws settings from (icoac.tools.plant_sweeps) and
-# the controller settings of a setting.
-TASK_SPACES: dict[str, tuple[tuple[tuple[str, tuple[float, ...]], ...], Any]] = {
-    "furuta": ((("arm_range", (0.5, 1.0, 1.5708, 3.0)),
-                ("arm_velocity_range", (1.0, 2.3, 6.4, 15.0, 40.0)),
-                ("pendulum_velocity_range", (0.3, 0.6, 1.0, 2.0, 5.6)),
-                ("zone_deg", (11.5, 10.0, 8.0, 6.0)),
-                ("ico.rate", (1e-4, 1e-3, 1e-2)),
-                ("policy.gain", (1.0, 3.0, 10.0))), furuta_task),
-    # Each space put its best at its edges, and the next extends those dimensions beyond it: the
-    # first (rate 0.01, gain 30 N, both velocity ranges and the zone at their largest), the second
-    # (cart velocity range 10 m/s, rate 0.1, gain 3 N).
-    "double_cart_pole": ((("cart_velocity_range", (1.0, 2.0, 3.5, 6.0, 10.0, 17.0, 30.0)),
-                          ("link_velocity_range", (0.5, 1.0, 2.0, 4.0, 8.0)),
-                          ("zone_deg", (11.0, 10.0, 8.0, 6.0, 4.0)),
-                          ("upper_reflex", (1.0, -1.0)),
-                          ("cart_reflex", (1.0, -1.0)),
-                          ("ico.rate", (1e-4, 1e-3, 1e-2, 1e-1, 0.3, 1.0)),
-                          ("policy.gain", (0.3, 1.0, 3.0, 10.0, 30.0, 100.0))), double_task),
+# Each swept plant's task space: values of its task's knobs (its C file, `icoac params --plant`),
+# ICO's rate and the policy gain; a setting is a configuration override of each. Each of the double
+# pendulum's spaces put its best at its edges, and the next extends those dimensions beyond it: the
+# first (rate 0.01, gain 30 N, both velocity ranges and the zone at their largest), the second
+# (cart velocity range 10 m/s, rate 0.1, gain 3 N).
+TASK_SPACES: dict[str, tuple[tuple[str, tuple[float, ...]], ...]] = {
+    "furuta": (("arm_range", (0.5, 1.0, 1.5708, 3.0)),
+               ("arm_velocity_range", (1.0, 2.3, 6.4, 15.0, 40.0)),
+               ("pendulum_velocity_range", (0.3, 0.6, 1.0, 2.0, 5.6)),
+               ("zone_deg", (11.5, 10.0, 8.0, 6.0)),
+               ("ico.rate", (1e-4, 1e-3, 1e-2)),
+               ("policy.gain", (1.0, 3.0, 10.0))),
+    "double_cart_pole": (("cart_velocity_range", (1.0, 2.0, 3.5, 6.0, 10.0, 17.0, 30.0)),
+                         ("link_velocity_range", (0.5, 1.0, 2.0, 4.0, 8.0)),
+                         ("zone_deg", (11.0, 10.0, 8.0, 6.0, 4.0)),
+                         ("upper_reflex", (1.0, -1.0)),
+                         ("cart_reflex", (1.0, -1.0)),
+                         ("ico.rate", (1e-4, 1e-3, 1e-2, 1e-1, 0.3, 1.0)),
+                         ("policy.gain", (0.3, 1.0, 3.0, 10.0, 30.0, 100.0))),
 }
-
-
-def task_overrides(plant: str, setting: dict[str, float]) -> dict[str, Any]:
-    """The controller settings of a setting of the plant's task space (TASK_SPACES)."""
-    return TASK_SPACES[plant][1](plant, setting)
-
-
-# The Furuta's task setting, chosen by its sweep (docs/sweeps-furuta.md).
 
 
 def space(plant: str) -> tuple:
     """The plant's task space: (name, values) pairs (TASK_SPACES)."""
-    return TASK_SPACES[plant][0]
+    return TASK_SPACES[plant]
 
 
 def samples(plant: str, seed: int = 1) -> list[dict]:
@@ -158,7 +100,7 @@ def key(setting: dict) -> str:
 
 def overrides(plant: str, setting: dict) -> dict:
     """The controller settings of a sample, with the sweep's caps."""
-    return {**task_overrides(plant, setting), "max_trials": MAX_TRIALS, "success_steps": SUCCESS_STEPS}
+    return {**setting, "max_trials": MAX_TRIALS, "success_steps": SUCCESS_STEPS}
 
 
 def run_one(plant: str, setting: dict, seed: int, cells: list[int]) -> dict:
@@ -241,8 +183,9 @@ def report(plant: str, out: Path) -> Path:
              "Criterion, fixed before the runs: ICO's success rate (all cells, mean over seeds); settings within "
              "one point of the best are ordered by fewer median trials to success.", "",
              f"Space: {', '.join(f'{n} in {list(v)}' for n, v in space(plant))}; the angles are scaled to their "
-             "failure limits and the critic grid spans the same ranges (TASK_SPACES in harness/icoac/tools/plant_sweeps.py "
-             "says how a setting becomes the controller's task). Stage 1: "
+             "failure limits and the critic grid spans the same ranges (the names other than ico.rate and policy.gain "
+             f"are knobs of the plant's task, which its C file writes the controller's task from: `python -m icoac "
+             f"params --plant {plant}`). Stage 1: "
              f"{SAMPLES} settings drawn from it (seeded), ICO on the quick profile's "
              f"{len(plant_grid.quick_cells())} spread cells, "
              f"seed 0, cap {MAX_TRIALS} trials, success {SUCCESS_STEPS} steps. Stage 2: the best {STAGE_2_TOP} "

@@ -12,7 +12,7 @@
 extern "C" {
 #endif
 
-#define ICOAC_SIM_ABI_VERSION 8
+#define ICOAC_SIM_ABI_VERSION 9
 
 /* Status of sim functions: values below 100 are icoac_status_t, passed through. */
 typedef enum {
@@ -148,6 +148,7 @@ const icoac_sim_param_row_t *icoac_sim_param_table(int32_t *count);
  * conditions and controller task. The cart-pole is the registry's first plant. */
 #define ICOAC_SIM_MAX_STATE 6   /* state components of any plant */
 #define ICOAC_SIM_MAX_PARAMS 16 /* parameters of any plant */
+#define ICOAC_SIM_MAX_TASK_KNOBS 8 /* knobs of any plant's task */
 #define ICOAC_SIM_CART_POLE 0   /* registry index of the cart-pole */
 
 /* A named, unit-carrying quantity: a state component or the plant's input. */
@@ -205,10 +206,16 @@ typedef struct {
 } icoac_sim_learner_t;
 
 /* The controller task a plant is benchmarked with (docs/plants.md): its inputs' ranges, rule
- * table, critic grid and learner settings, chosen for this plant. */
+ * table, critic grid and learner settings, chosen for this plant. The task is written from its
+ * knobs: named values (a reflex zone, a velocity range...) whose defaults are the task's choice
+ * and which a sweep of the task varies. */
 typedef struct {
-    const char *source;                 /* where the settings come from, one line */
-    void (*apply)(icoac_config_t *cfg); /* writes the task over icoac_config_default's; NULL: those are it */
+    const char *source; /* where the settings come from, one line */
+    /* writes the task from knob[n_knobs] over icoac_config_default's; NULL: those are it */
+    void (*apply)(const double *knob, icoac_config_t *cfg);
+    int32_t n_knobs;                /* <= ICOAC_SIM_MAX_TASK_KNOBS */
+    int32_t reserved;               /* 0 */
+    const icoac_sim_param_t *knobs; /* n_knobs entries: name, unit, the task's value, range, tier, doc */
     int32_t n_learners;
     int32_t paper; /* 1: the paper's plant and task, so that its published results apply */
     const icoac_sim_learner_t *learners; /* n_learners entries; a condition in at most one */
@@ -256,9 +263,11 @@ int32_t icoac_sim_plant_count(void);
 const icoac_sim_plant_desc_t *icoac_sim_plant_info(int32_t index);
 int32_t icoac_sim_plant_find(const char *name);
 
-/* icoac_config_default, then the task of plant index (icoac_sim_task_t); ICOAC_SIM_ERR_BAD_PLANT
- * for an unknown plant or one without a task (cfg left as it was). */
-int32_t icoac_sim_plant_task(int32_t index, icoac_config_t *cfg);
+/* icoac_config_default, then the task of plant index (icoac_sim_task_t) written from knob (its
+ * task's n_knobs values in order; NULL: their defaults). ICOAC_SIM_ERR_BAD_PLANT for an unknown
+ * plant, one without a task, or a knob that is not finite or outside its range (cfg left as it
+ * was). */
+int32_t icoac_sim_plant_task(int32_t index, const double *knob, icoac_config_t *cfg);
 /* The plant's settings of the learning condition named condition over cfg, when its task has
  * some (else cfg is left as it was); ICOAC_SIM_ERR_BAD_PLANT as icoac_sim_plant_task. */
 int32_t icoac_sim_plant_learner(int32_t index, const char *condition, icoac_config_t *cfg);

@@ -77,7 +77,7 @@ static const icoac_sim_param_t params[N_PARAMS] = {
 };
 
 /* The paper's task: the controller's defaults. */
-static const icoac_sim_task_t task = {"the C defaults (the paper's task)", 0, 0, 1, 0, 0};
+static const icoac_sim_task_t task = {"the C defaults (the paper's task)", 0, 0, 0, 0, 0, 1, 0, 0};
 
 const icoac_sim_plant_desc_t sim_cart_pole = {
     "cart_pole",

@@ -108,23 +108,40 @@ static const icoac_sim_param_t params[N_PARAMS] = {
      "|force| applied saturates at it (1e6: practically none)"},
 };
 
-/* Its task, chosen by its sweep (docs/sweeps-double_cart_pole.md): six inputs scaled to the track
- * and angle limits, 30 m/s and 4 rad/s (both links); the critic over the same ranges, 216 units;
- * six rules, first match wins: the lower link beyond 10 deg gives the cart-pole's reflex, the cart
- * beyond ICOAC_SIM_ZONE_FRACTION of the track a push away from the centre (the sign of the plant's
- * LQR gain on x), the upper link beyond 10 deg a push tipping the lower link under it; ICO rate 1,
- * gain 10 N. */
-static void task_settings(icoac_config_t *cfg)
+/* Its task: six inputs scaled to the track and angle limits and to the velocity ranges (both links
+ * alike); the critic over the same ranges, 216 units; six rules, first match wins: the lower link
+ * beyond the zone gives the cart-pole's reflex, the cart beyond ICOAC_SIM_ZONE_FRACTION of the
+ * track a push of CART_REFLEX times the push back to the centre, the upper link beyond the zone a
+ * push of UPPER_REFLEX times its sign; ICO rate 1, gain 10 N. The knobs' values were chosen by its
+ * sweep (docs/sweeps-double_cart_pole.md): both reflexes -1 (the signs of the plant's LQR gains on
+ * x and theta2: away from the centre; tipping the lower link under the upper). */
+enum { CART_VELOCITY_RANGE, LINK_VELOCITY_RANGE, ZONE, UPPER_REFLEX, CART_REFLEX, N_KNOBS };
+
+static const icoac_sim_param_t knobs[N_KNOBS] = {
+    {"cart_velocity_range", "m/s", 30.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+     "task: the cart velocity scaled to it"},
+    {"link_velocity_range", "rad/s", 4.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+     "task: both links' angular velocities scaled to it"},
+    {"zone_deg", "deg", 10.0, ICOAC_SIM_PHYS_MIN, 90.0, "advanced",
+     "task: the links' reflex zones start at this angle"},
+    {"upper_reflex", "", -1.0, -1.0, 1.0, "advanced",
+     "task: the upper link's reflex, times its sign (+1: push under it; -1: tip the lower link under it)"},
+    {"cart_reflex", "", -1.0, -1.0, 1.0, "advanced",
+     "task: the cart's reflex near the track's end (+1: push back to the centre; -1: away)"},
+};
+
+static void task_settings(const double *knob, icoac_config_t *cfg)
 {
-    const double limit = params[ANGLE_LIMIT].value, z = 10.0 * (ICOAC_SIM_PI / 180.0);
+    const double limit = params[ANGLE_LIMIT].value, z = knob[ZONE] * (ICOAC_SIM_PI / 180.0);
     const double zx = ICOAC_SIM_ZONE_FRACTION * params[X_LIMIT].value;
-    const double range[6] = {params[X_LIMIT].value, 30.0, limit, 4.0, limit, 4.0};
+    const double v = knob[LINK_VELOCITY_RANGE], up = knob[UPPER_REFLEX], cart = knob[CART_REFLEX];
+    const double range[6] = {params[X_LIMIT].value, knob[CART_VELOCITY_RANGE], limit, v, limit, v};
     const int32_t units[6] = {2, 2, 3, 3, 3, 2};
     const int32_t input[6] = {2, 0, 2, 0, 4, 4};
     const int32_t side[6] = {ICOAC_RULE_ABOVE, ICOAC_RULE_BELOW, ICOAC_RULE_BELOW,
                              ICOAC_RULE_ABOVE, ICOAC_RULE_ABOVE, ICOAC_RULE_BELOW};
     const double threshold[6] = {z, -zx, -z, zx, z, -z};
-    const double reflex[6] = {1.0, -1.0, -1.0, 1.0, -1.0, 1.0};
+    const double reflex[6] = {1.0, cart, -1.0, -cart, up, -up};
     int i;
     cfg->task.n_inputs = 6;
     cfg->task.n_rules = 6;
@@ -146,7 +163,7 @@ static void task_settings(icoac_config_t *cfg)
 static const icoac_sim_task_t task = {
     "its sweep (docs/sweeps-double_cart_pole.md): velocity scaling, reflex zone and the upper link's "
     "reflex sign, ICO rate, gain",
-    task_settings, 0, 0, 0,
+    task_settings, N_KNOBS, 0, knobs, 0, 0, 0,
     "ICO balances at most 1 of its cells at the default caps (no prior of 2 or more successful cells "
     "in any frame), but it learns weights in every cell: the ICO prior averages them, balanced or not"};
 

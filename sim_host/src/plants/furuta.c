@@ -120,14 +120,28 @@ static const icoac_sim_param_t params[N_PARAMS] = {
      "|V| applied saturates at it (the unit's amplifier: 10 V; 1e6: practically none)"},
 };
 
-/* Its task, chosen by its sweep (docs/sweeps-furuta.md): inputs (arm angle, arm velocity,
- * pendulum angle up to its limit, pendulum velocity) and critic over the same ranges, the
- * cart-pole's rule table and critic units, the reflex zone at ICOAC_SIM_ZONE_FRACTION of the arm
- * range and 8 deg of the pendulum, ICO rate 0.01, gain 1 V. */
-static void task_settings(icoac_config_t *cfg)
+/* Its task: inputs (arm angle, arm velocity, pendulum angle up to its limit, pendulum velocity)
+ * and critic over the same ranges, the cart-pole's rule table and critic units, the reflex zone at
+ * ICOAC_SIM_ZONE_FRACTION of the arm range and at ZONE of the pendulum, ICO rate 0.01, gain 1 V;
+ * the knobs' values were chosen by its sweep (docs/sweeps-furuta.md). */
+enum { ARM_RANGE, ARM_VELOCITY_RANGE, PENDULUM_VELOCITY_RANGE, ZONE, N_KNOBS };
+
+static const icoac_sim_param_t knobs[N_KNOBS] = {
+    {"arm_range", "rad", 1.0, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+     "task: the arm angle scaled to it (and the critic's grid over it)"},
+    {"arm_velocity_range", "rad/s", 2.3, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+     "task: the arm velocity scaled to it"},
+    {"pendulum_velocity_range", "rad/s", 0.6, ICOAC_SIM_PHYS_MIN, ICOAC_SIM_PHYS_MAX, "advanced",
+     "task: the pendulum velocity scaled to it"},
+    {"zone_deg", "deg", 8.0, ICOAC_SIM_PHYS_MIN, 90.0, "advanced",
+     "task: the pendulum's reflex zone starts at this angle"},
+};
+
+static void task_settings(const double *knob, icoac_config_t *cfg)
 {
-    const double range[4] = {1.0, 2.3, params[PENDULUM_LIMIT].value, 0.6};
-    const double zone_arm = ICOAC_SIM_ZONE_FRACTION * range[0], zone_pendulum = 8.0 * (ICOAC_SIM_PI / 180.0);
+    const double range[4] = {knob[ARM_RANGE], knob[ARM_VELOCITY_RANGE], params[PENDULUM_LIMIT].value,
+                             knob[PENDULUM_VELOCITY_RANGE]};
+    const double zone_arm = ICOAC_SIM_ZONE_FRACTION * range[0], zone_pendulum = knob[ZONE] * (ICOAC_SIM_PI / 180.0);
     const double threshold[4] = {zone_pendulum, -zone_arm, -zone_pendulum, zone_arm}; /* the rules' order */
     int i;
     for (i = 0; i < 4; ++i) {
@@ -158,8 +172,8 @@ static const icoac_sim_learner_t learners[2] = {{"ico-rl ico-mean-rl", ico_mean_
                                                 {"rl rl-ico-cov", zero_mean_learners}};
 
 static const icoac_sim_task_t task = {
-    "its sweep (docs/sweeps-furuta.md): input scaling, reflex zone, ICO rate, gain", task_settings, 2, 0,
-    learners, 0};
+    "its sweep (docs/sweeps-furuta.md): input scaling, reflex zone, ICO rate, gain", task_settings, N_KNOBS, 0, knobs, 2,
+    0, learners, 0};
 
 const icoac_sim_plant_desc_t sim_furuta = {
     "furuta",
