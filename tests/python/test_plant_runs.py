@@ -12,7 +12,7 @@ import pytest
 
 from icoac.core import binding as B
 from icoac import cli
-from icoac.core import geometry, grid, metrics, plants, results
+from icoac.core import config, geometry, grid, metrics, plants, results
 from icoac.studies import prior as P
 from icoac.core.config import build_config, config_from_dict
 from icoac.tools import plant_sweeps
@@ -241,3 +241,20 @@ def test_cell_subsets_follow_each_plant_grid(plant):
     keys = g.frame_keys()
     assert keys[0].startswith(g.col_start()) and keys[1].startswith(g.row_start())
     assert [k.endswith("_deg") for k in keys] == [g.col_unit == "deg", g.row_unit == "deg"]
+
+
+def test_task_knobs_are_set_by_name_and_checked_by_c():
+    """A knob of a plant's task is set like a parameter, the C task writes the configuration from
+    it, and a knob out of its range, of another plant or not a number is a one-line error."""
+    default = build_config(plant="furuta").controller
+    moved = build_config(config.parse_sets(["zone_deg=6"], plant="furuta"), plant="furuta").controller
+    assert moved.task.rule_threshold[0] < default.task.rule_threshold[0]
+    assert list(moved.policy.input_range) == list(default.policy.input_range)
+    for overrides, plant, message in (({"zone_deg": 91.0}, "furuta", r"zone_deg=91 is outside \[1e-06, 90\] deg"),
+                                      ({"zone_deg": "6"}, "furuta", "must be a number"),
+                                      ({"zone_deg": 6.0}, "cart_pole", "unknown parameter 'zone_deg'")):
+        with pytest.raises(B.ConfigError, match=message) as err:
+            build_config(overrides, plant=plant)
+        assert "\n" not in str(err.value)
+    with pytest.raises(B.ConfigError, match=r"did you mean cart_velocity_range\?.*params --plant double_cart_pole"):
+        config.parse_sets(["cart_velocity_rang=3"], plant="double_cart_pole")

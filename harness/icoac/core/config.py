@@ -21,6 +21,7 @@ import numpy as np
 from icoac.core import binding as B
 from icoac.core import geometry, literals, options
 from icoac.core.options import CART_POLE
+from icoac.core.plants import PLANTS
 from icoac.core.plants import spec as plant_spec
 from icoac.core.registry import CONDITIONS, REGISTRY
 from icoac.core.signs import derive_input_signs
@@ -306,8 +307,8 @@ def plant_params(plant: str) -> set[str]:
 
 def task_knobs(plant: str) -> set[str]:
     """The names --set takes for the knobs of a registry plant's task (its C file)."""
-    task = B.plant_info(B.plant_index(plant))["task"]
-    return {k["name"] for k in task["knobs"]} if task else set()
+    B.plant_index(plant)  # an unknown name: the registry's message
+    return set(PLANTS[plant].knobs)
 
 
 def parse_sets(items: Iterable[str] | None, option: str = "--set", plant: str = CART_POLE) -> dict[str, Any]:
