@@ -60,6 +60,7 @@ def run_one(args, cfg, algo: str, seed: int, steps: int, out: Path | None = None
         return {}
     out.mkdir(parents=True, exist_ok=True)
     print(f"[{algo} seed {seed}] training {steps} steps", file=sys.stderr, flush=True)
+    git = results.git_info()  # the tree the run starts from (it may change while the run trains)
     trained = sb3.train(algo, cfg, seed, steps, overrides, cells)
     trained.model.save(out / "model.zip")
     if trained.normalizer is not None:
@@ -72,7 +73,7 @@ def run_one(args, cfg, algo: str, seed: int, steps: int, out: Path | None = None
               "steps": trained.steps, "episodes": trained.episodes,
               "simulated_time": trained.steps * float(cfg.model.dt), "train_wall_time": trained.wall_time,
               "eval_wall_time": eval_wall, "success": "".join("1" if x else "0" for x in ok),
-              "lasted": [int(v) for v in lasted], "git": results.git_info()}
+              "lasted": [int(v) for v in lasted], "git": git}
     tmp = out / (RESULT + ".tmp")
     tmp.write_text(json.dumps(result))
     os.replace(tmp, out / RESULT)
