@@ -43,7 +43,7 @@ FUZZ_SOURCES = $(shell git ls-tree HEAD $(FUZZ_C_SOURCES) 2>/dev/null | git hash
   cut -c1-12)$(shell git diff --quiet HEAD -- $(FUZZ_C_SOURCES) 2>/dev/null || echo -modified)
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_model fuzz_batch
 
-.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-baselines baselines baselines-venv test-fuzz fuzz fuzz-campaign fuzz-ledger bench tuning tuning-baselines ablation \
+.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-baselines baselines baselines-tuned baselines-venv test-fuzz fuzz fuzz-campaign fuzz-ledger bench tuning tuning-baselines ablation \
   bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
@@ -133,6 +133,16 @@ tuning-baselines: build baselines-venv
 	$(VPY) -m icoac.tools.rl_baselines --plant $(PLANT) $(TUNING_SETS_$(PLANT)) --tune \
 	  --out results/rl-baselines-tuning-$(PLANT) --jobs $(BASELINE_JOBS) \
 	  --data docs/data/rl-baselines-tuning-$(PLANT).json
+
+# PPO and SAC on PLANT with the choices of that finished tuning, evaluated as `make baselines` does
+# (every cell, the evaluation seeds; paired with the same bench's grids where they are there,
+# else `--report` adds the pairing later without training again).
+BASELINE_BENCH_cart_pole := $(LIMITED_OUT)
+BASELINE_BENCH_furuta := $(BENCH_OUT)-furuta
+baselines-tuned: build baselines-venv
+	$(VPY) -m icoac.tools.rl_baselines --plant $(PLANT) $(TUNING_SETS_$(PLANT)) \
+	  --tuned docs/data/rl-baselines-tuning-$(PLANT).json --out results/rl-baselines-tuned-$(PLANT) \
+	  --bench $(BASELINE_BENCH_$(PLANT)) --jobs $(BASELINE_JOBS) --data docs/data/rl-baselines-tuned-$(PLANT).json
 
 build-fuzz: deps
 	cmake --preset fuzz >/dev/null

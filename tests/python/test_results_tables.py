@@ -131,6 +131,16 @@ def test_policies_trained_once_join_the_headline_of_their_plant_and_settings():
     # the untuned PPO and SAC are not set beside a bench of held-out tuned settings
     tuned = tables.headline_table([{**bench, "tuned": {"chosen": {}}}, trained])
     assert [line.split(" | ")[1] for line in tuned[2:]] == ["**search** (use)", "ICO->RL"]
+    # PPO and SAC held-out tuned: beside the tuned bench when there is one, else beside the untuned
+    ppo_tuned = {**trained, "tuned": {"record": "r.json", "chosen": {"ppo": "gamma=0.99"}}}
+    both = tables.headline_table([bench, {**bench, "tuned": {"chosen": {"ico": "rate=0.003"}}}, trained, ppo_tuned])
+    assert [line.split(" | ")[1] for line in both[2:]] == ["**search** (use)", "ICO->RL", "PPO (trained once)",
+                                                           "**search** (use)", "ICO->RL",
+                                                           "PPO (held-out tuned, trained once)"]
+    assert both[-1].startswith("| cart_pole (max_force=10, held-out tuned) | PPO")
+    alone = tables.headline_table([bench, ppo_tuned])
+    assert [line.split(" | ")[1] for line in alone[2:]] == ["**search** (use)", "ICO->RL",
+                                                            "PPO (held-out tuned, trained once)"]
     rows = rl_baselines.table(trained)
     assert "against ICO->RL (points)" in rows[0] and "-3.5 (-5.0 to -2.0), p ≤ 0.001" in rows[2]
     assert "| 2e+05 (1e+06) | 2 |" in rows[2]

@@ -124,11 +124,29 @@ def test_tune_ranks_the_settings_on_the_tuning_cells(tmp_path, monkeypatch):
     assert rl_baselines.main(argv + ["--seeds", "0", "--hyper", "learning_rate=1e-3"]) == 0
     run = json.loads((out / "ppo" / "seed-0" / "result.json").read_text())
     assert run["overrides"] == {"learning_rate": 1e-3} and run["training_cells"] == "all"
+    # ... and a finished record's choice (--tuned), which a run of other settings does not stand in for
+    evaluated = tmp_path / "evaluated.json"
+    tuned = argv[:-1] + [str(tmp_path / "tuned"), "--seeds", "0", "--tuned", str(record)]
+    assert rl_baselines.main(tuned + ["--data", str(evaluated)]) == 0
+    data = json.loads(evaluated.read_text())
+    chosen = json.loads(record.read_text())["algorithms"]["ppo"]["chosen"]
+    assert data["algorithms"]["ppo"]["runs"]["0"]["overrides"] == chosen == data["algorithms"]["ppo"]["settings"]["overrides"]
+    assert data["tuned"] == {"record": str(record), "chosen": {"ppo": heldout.key(chosen)}}
+    assert rl_baselines.main(argv + ["--seeds", "0", "--tuned", str(record), "--report"]) == (
+        0 if chosen == {"learning_rate": 1e-3} else 2)
+    # the record's table: the choice in bold, first
+    lines = rl_baselines.tuning_table(json.loads(record.read_text()))
+    assert lines[2].startswith(f"| PPO | **learning_rate {chosen['learning_rate']:g}** |") and len(lines) == 4
+    # a record with a setting unfinished has no choice to evaluate
+    unfinished = json.loads(record.read_text())
+    unfinished["algorithms"]["ppo"]["runs"].popitem()
+    (tmp_path / "unfinished.json").write_text(json.dumps(unfinished))
+    assert rl_baselines.main(argv + ["--seeds", "0", "--tuned", str(tmp_path / "unfinished.json"), "--report"]) == 2
 
 
 @pytest.mark.parametrize("bad", [["--hyper", "learning_rate"], ["--hyper", "nonsense=1"], ["--hyper", "gamma=nan"],
                                  ["--algos", "ppo", "sac", "--hyper", "gamma=0.9"],
-                                 ["--tune", "--hyper", "gamma=0.9"]])
+                                 ["--tune", "--hyper", "gamma=0.9"], ["--tuned", "r.json", "--hyper", "gamma=0.9"]])
 def test_bad_hyper_is_a_one_line_error(tmp_path, capsys, bad):
     argv = ["--plant", "furuta", "--out", str(tmp_path / "x"), "--report"]
     if "--algos" not in bad:

@@ -150,19 +150,29 @@ def _plant_label(data: Mapping[str, Any]) -> str:
 def headline_table(summaries: Sequence[Mapping[str, Any]]) -> list[str]:
     """Per plant (one bench data file each): the recommended method, then HEADLINE_ROWS, then the
     policies trained once over the grid (PPO, SAC: an rl-baselines data file of the same plant and
-    settings, beside the untuned bench only: theirs is untuned too); each with its success, 95 % interval, and the whole grid's total cost (_total_cost;
-    a policy trained once: its training episodes and steps, and its training and evaluation wall
-    time)."""
+    settings, beside the bench tuned as they are; tuned ones, where the plant has no tuned bench,
+    beside the untuned one, never the other way round); each with its success,
+    95 % interval, and the whole grid's total cost (_total_cost; a policy trained once: its training
+    episodes and steps, and its training and evaluation wall time)."""
     lines = ["| plant | method | success, all cells (95 % interval) | trials, whole grid | "
              "simulated time (s) | wall time (s) |", "|---|---|---|---|---|---|"]
     benches = [d for d in summaries if "aggregate" in d]
-    trained = [d for d in summaries if "algorithms" in d]
+
+    def same(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
+        return (a.get("plant", "cart_pole"), list(a.get("set") or [])) == (b.get("plant", "cart_pole"), list(b.get("set") or []))
+    beside: dict[int, list[Mapping[str, Any]]] = {}
+    for other in (d for d in summaries if "algorithms" in d):
+        matches = [i for i, d in enumerate(benches) if same(d, other)]
+        tuned_alike = [i for i in matches if ("tuned" in benches[i]) == ("tuned" in other)]
+        place = tuned_alike or (matches if "tuned" in other else [])
+        if place:
+            beside.setdefault(place[0], []).append(other)
 
     def row(plant: str, name: str, success: Mapping[str, Any], cost: Mapping[str, Any]) -> str:
         total = " | ".join(f"{cost[k]['mean']:.3g}" if k in cost else "n/a"
                            for k in ("trials", "simulated_time", "wall_time"))
         return f"| {plant} | {name} | {rate(success)} | {total} |"
-    for data in benches:
+    for index, data in enumerate(benches):
         agg = data["aggregate"]
         best = recommended(agg)
         if best is None:
@@ -171,11 +181,11 @@ def headline_table(summaries: Sequence[Mapping[str, Any]]) -> list[str]:
         for cond in [best] + [c for c in HEADLINE_ROWS if c in agg and c != best]:
             name = f"**{REGISTRY[cond].label}** (use)" if cond == best else REGISTRY[cond].label
             lines.append(row(plant, name, agg[cond]["success_rate"], _total_cost(agg[cond])))
-        for other in ([] if "tuned" in data else trained):
-            if (other["plant"], list(other["set"])) == (data.get("plant", "cart_pole"), list(data.get("set") or [])):
-                for e in other["algorithms"].values():
-                    if "all" in e:
-                        lines.append(row(plant, f"{e['settings']['algorithm']} (trained once)", e["all"], e["cost"]))
+        for other in beside.get(index, []):
+            how = "held-out tuned, trained once" if "tuned" in other else "trained once"
+            for e in other["algorithms"].values():
+                if "all" in e:
+                    lines.append(row(plant, f"{e['settings']['algorithm']} ({how})", e["all"], e["cost"]))
     return lines if len(lines) > 2 else []
 
 

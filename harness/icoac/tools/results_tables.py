@@ -56,6 +56,7 @@ TABLES: dict[str, Callable[[Mapping[str, Any]], list[str]]] = {
     "prior-reading": heldout_tuning.prior_reading_table,
     "tuning-evaluation": heldout_tuning.evaluation_table,
     "rl-baselines": rl_baselines.table,
+    "baseline-tuning": rl_baselines.tuning_table,
     "speed-ab": speed_ab.table,
     "speed-lanes": speed_ab.lanes_table,
 }

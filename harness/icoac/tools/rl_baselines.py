@@ -17,7 +17,9 @@ each setting of each algorithm with the tuning seeds, trained on the plant's tun
 scored on them, into OUT/tuning/<algo>/<setting>/seed-<s>/; OUT/tuning.json ranks the settings by
 the protocol's criterion. With --data FILE that record is written after every finished run and read
 at the start: the runs it holds are not trained again, so a tuning longer than a machine's life goes
-on from its committed record. --hyper NAME=VALUE runs the evaluation with a chosen setting."""
+on from its committed record. --tuned RECORD runs the evaluation with each algorithm's choice in
+that finished tuning record (the same plant and --set); --hyper NAME=VALUE with a setting of one's
+own."""
 from __future__ import annotations
 
 import argparse
@@ -55,7 +57,11 @@ def run_one(args, cfg, algo: str, seed: int, steps: int, out: Path | None = None
     result."""
     out = _out(args, algo, seed, steps, out)
     if (out / RESULT).is_file():
-        return json.loads((out / RESULT).read_text())
+        done = json.loads((out / RESULT).read_text())
+        if done["overrides"] != dict(overrides or {}):
+            raise UsageError(f"{out} was trained with {done['overrides'] or 'the defaults'}, not "
+                             f"{dict(overrides or {}) or 'the defaults'}; move it aside")
+        return done
     if args.report:
         return {}
     out.mkdir(parents=True, exist_ok=True)
@@ -138,12 +144,15 @@ def collect(args, cfg) -> dict[str, Any]:
     others = bench_masks(args, cfg, args.seeds) if args.bench is not None else {}
     if args.bench is not None:
         data["bench"] = str(args.bench)
-    run_all(args, cfg, [(algo, s, args.steps or sb3.ALGORITHMS[algo].budget, None, args.hyper)
+    if args.tuned is not None:
+        data["tuned"] = {"record": str(args.tuned), "chosen": {a: heldout.key(h) for a, h in args.hyper.items()}}
+    run_all(args, cfg, [(algo, s, args.steps or sb3.ALGORITHMS[algo].budget, None, args.hyper.get(algo))
                         for algo in args.algos for s in args.seeds])
     for algo in args.algos:
         steps = args.steps or sb3.ALGORITHMS[algo].budget
-        runs = {s: r for s in args.seeds if (r := run_one(args, cfg, algo, s, steps, overrides=args.hyper))}
-        entry: dict[str, Any] = {"settings": sb3.settings(algo, steps, args.hyper), "runs": runs}
+        hyper = args.hyper.get(algo)
+        runs = {s: r for s in args.seeds if (r := run_one(args, cfg, algo, s, steps, overrides=hyper))}
+        entry: dict[str, Any] = {"settings": sb3.settings(algo, steps, hyper), "runs": runs}
         if runs:
             masks = {s: _mask(r["success"]) for s, r in runs.items()}
             entry["all"] = stats.success(masks)
@@ -178,14 +187,38 @@ def _hyper(items: list[str]) -> dict[str, Any]:
     return out
 
 
+def _tuning_record(args, path: Path, plant: str) -> dict[str, Any]:
+    """A tuning record of this plant, --set and protocol."""
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, ValueError) as err:
+        raise UsageError(f"cannot read the tuning record {path}: {err}") from None
+    if record.get("plant") != plant or record.get("set") != args.set or record.get("protocol") != heldout.protocol(plant):
+        raise UsageError(f"{path} holds the tuning of another plant, --set or protocol")
+    return record
+
+
 def _kept_runs(args, plant: str) -> dict[str, Any]:
     """The runs the tuning record --data holds: {algo: {setting key: {seed: summary}}}."""
     if args.data is None or not args.data.exists():
         return {}
-    old = json.loads(args.data.read_text())
-    if old.get("plant") != plant or old.get("set") != args.set or old.get("protocol") != heldout.protocol(plant):
-        raise UsageError(f"{args.data} holds the tuning of another plant, --set or protocol; move it aside")
+    old = _tuning_record(args, args.data, plant)
     return {algo: entry.get("runs", {}) for algo, entry in old["algorithms"].items()}
+
+
+def _chosen(args, plant: str) -> dict[str, dict[str, Any]]:
+    """Each algorithm's choice by the criterion from the runs of the tuning record --tuned, which
+    must all have finished."""
+    algorithms = _tuning_record(args, args.tuned, plant)["algorithms"]
+    out = {}
+    for algo in args.algos:
+        if algo not in algorithms:
+            raise UsageError(f"{args.tuned}: {algo} was not tuned")
+        entry = _ranking(algo, algorithms[algo]["steps"], algorithms[algo]["runs"])
+        if "chosen" not in entry:
+            raise UsageError(f"{args.tuned}: {algo} has no choice yet ({entry['pending']} settings unfinished)")
+        out[algo] = entry["chosen"]
+    return out
 
 
 def tune(args, cfg) -> dict[str, Any]:
@@ -194,7 +227,9 @@ def tune(args, cfg) -> dict[str, Any]:
     cells = [int(i) for i in heldout.tuning_cells(cfg.plant_name)]
     runs = _kept_runs(args, cfg.plant_name)
     data: dict[str, Any] = {"plant": cfg.plant_name, "set": args.set, "protocol": heldout.protocol(cfg.plant_name),
-                            "n_tuning_cells": len(cells), "algorithms": {}, "git": results.git_info()}
+                            "profile": "rl-baselines tuning", "configuration": "the Zoo's start",
+                            "seeds": list(heldout.TUNING_SEEDS), "n_tuning_cells": len(cells), "algorithms": {},
+                            "git": results.git_info()}
 
     def out(algo, key, seed):
         return args.out / "tuning" / algo / key / f"seed-{seed}"
@@ -218,6 +253,8 @@ def tune(args, cfg) -> dict[str, Any]:
                                        "episodes": r["episodes"], "train_wall_time": r["train_wall_time"],
                                        "eval_wall_time": r["eval_wall_time"], "git": r["git"]}
             data["algorithms"][algo] = _ranking(algo, steps_of(algo), runs[algo])
+        gits = [r["git"] for by_key in runs.values() for by_seed in by_key.values() for r in by_seed.values()]
+        data["cell_builds"] = [g for i, g in enumerate(gits) if g not in gits[:i]]
         if args.data is not None and not args.report:
             args.data.write_text(json.dumps(data, indent=1))
 
@@ -230,9 +267,9 @@ def tune(args, cfg) -> dict[str, Any]:
     return data
 
 
-def _ranking(algo: str, steps: int, runs: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
-    """An algorithm's entry of the tuning record from its finished runs: the rows of the settings
-    whose seeds have all finished, best first, and the choice, or the count still pending."""
+def _rows(algo: str, steps: int, runs: Mapping[str, Mapping[str, Any]]) -> tuple[list[dict[str, Any]], int]:
+    """The rows of the settings whose seeds have all finished, in the space's order, and the count
+    of the others."""
     rows, pending = [], 0
     for index, setting in enumerate(heldout.baseline_settings(algo)):
         key = heldout.key(setting)
@@ -244,6 +281,13 @@ def _ranking(algo: str, steps: int, runs: Mapping[str, Mapping[str, Any]]) -> di
         rows.append({"order": index, "setting": setting, "key": key, "success_rate": float(np.mean(rates)),
                      "success_rates": rates, "median_trials": None, "steps": steps,
                      "wall_time": float(sum(r["train_wall_time"] + r["eval_wall_time"] for r in done))})
+    return rows, pending
+
+
+def _ranking(algo: str, steps: int, runs: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
+    """An algorithm's entry of the tuning record from its finished runs: the rows of the settings
+    whose seeds have all finished, best first, and the choice, or the count still pending."""
+    rows, pending = _rows(algo, steps, runs)
     entry: dict[str, Any] = {"settings": len(heldout.baseline_settings(algo)), "steps": steps, "runs": dict(runs)}
     if pending:
         entry["pending"] = pending
@@ -252,6 +296,29 @@ def _ranking(algo: str, steps: int, runs: Mapping[str, Mapping[str, Any]]) -> di
         entry.update(rows=ranked, chosen=ranked[0]["setting"], chosen_key=ranked[0]["key"],
                      default_kept=ranked[0]["order"] == 0)
     return entry
+
+
+def tuning_table(data: Mapping[str, Any]) -> list[str]:
+    """The tuning record's settings per algorithm, best first by the criterion once every run is
+    in (the choice in bold), else in the space's order with the count unfinished: success on the
+    tuning cells per tuning seed and their mean, and the wall time of both runs."""
+    seeds = data["seeds"]
+    lines = ["| algorithm | setting (over the Zoo's start) | " + " | ".join(f"seed {s}" for s in seeds) +
+             " | mean success, tuning cells | wall time, both seeds (s) |", "|---|---|" + "---|" * (len(seeds) + 2)]
+    for algo, entry in data["algorithms"].items():
+        label = sb3.ALGORITHMS[algo].label
+        rows = entry.get("rows") or _rows(algo, entry["steps"], entry["runs"])[0]
+        for row in rows:
+            setting = ", ".join(f"{k} {v:g}" for k, v in sorted(row["setting"].items()))
+            chosen = row["key"] == entry.get("chosen_key")
+            mean = tables.percent(row["success_rate"])
+            lines.append(f"| {label} | {'**' + setting + '**' if chosen else setting} | " +
+                         " | ".join(tables.percent(r) for r in row["success_rates"]) +
+                         f" | {'**' + mean + '**' if chosen else mean} | {row['wall_time']:.0f} |")
+        if entry.get("pending"):
+            lines.append(f"| {label} | {entry['pending']} of {entry['settings']} settings unfinished |" +
+                         " |" * (len(seeds) + 2))
+    return lines
 
 
 def _points(p: Mapping[str, Any]) -> str:
@@ -302,7 +369,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=1, help="training runs at once, each a process on one thread")
     ap.add_argument("--tune", action="store_true", help="the held-out tuning of the algorithms (docs/tuning.md)")
     ap.add_argument("--hyper", action="append", default=[], metavar="NAME=VALUE",
-                    help="a hyperparameter over the RL Zoo's start (a tuned setting), for the evaluation runs")
+                    help="a hyperparameter over the RL Zoo's start, for the evaluation runs of one algorithm")
+    ap.add_argument("--tuned", type=Path, metavar="RECORD",
+                    help="evaluate each algorithm with its choice in this finished tuning record (--tune --data)")
     args = ap.parse_args(argv)
 
     def body():
@@ -310,18 +379,22 @@ def main(argv: list[str] | None = None) -> int:
             raise UsageError(f"--steps must be at least 1, got {args.steps}")
         if not 1 <= args.jobs <= (os.cpu_count() or 1) * 4:
             raise UsageError(f"--jobs must be from 1 to {(os.cpu_count() or 1) * 4}, got {args.jobs}")
-        if args.tune and args.hyper:
-            raise UsageError("--tune runs the tuning space's settings; --hyper is for the evaluation runs")
-        args.hyper = _hyper(args.hyper)
-        if args.hyper and len(args.algos) != 1:
+        if args.tune and (args.hyper or args.tuned):
+            raise UsageError("--tune runs the tuning space's settings; --hyper and --tuned are for the evaluation runs")
+        if args.hyper and args.tuned:
+            raise UsageError("--hyper and --tuned both set the hyperparameters: give one")
+        hyper = _hyper(args.hyper)
+        if hyper and len(args.algos) != 1:
             raise UsageError("--hyper sets one algorithm's hyperparameters: give --algos with one of them")
         known = set(sb3.ALGORITHMS[args.algos[0]].hyper) | set(heldout.BASELINE_SPACES[args.algos[0]])
-        unknown = sorted(set(args.hyper) - known)
+        unknown = sorted(set(hyper) - known)
         if unknown:
             raise UsageError(f"--hyper {unknown[0]}: not a tuned hyperparameter of {args.algos[0]} "
                              f"(valid: {', '.join(sorted(known))})")
         cfg = build_config(parse_sets(args.set, plant=args.plant), plant=args.plant)
         sb3.actuator_limit(cfg)
+        # each algorithm's overrides of the Zoo's start
+        args.hyper = _chosen(args, cfg.plant_name) if args.tuned else {args.algos[0]: hyper} if hyper else {}
         return tune(args, cfg) if args.tune else collect(args, cfg)
     status, data = guarded(body)
     if data is None:
