@@ -136,13 +136,15 @@ tuning-baselines: build baselines-venv
 
 # PPO and SAC on PLANT with the choices of that finished tuning, evaluated as `make baselines` does
 # (every cell, the evaluation seeds; paired with the same bench's grids where they are there,
-# else `--report` adds the pairing later without training again).
+# else `--report` adds the pairing later without training again). BASELINE_ARGS: more options
+# (`--algos ppo`, `--seeds 0 1 2`).
 BASELINE_BENCH_cart_pole := $(LIMITED_OUT)
 BASELINE_BENCH_furuta := $(BENCH_OUT)-furuta
 baselines-tuned: build baselines-venv
 	$(VPY) -m icoac.tools.rl_baselines --plant $(PLANT) $(TUNING_SETS_$(PLANT)) \
 	  --tuned docs/data/rl-baselines-tuning-$(PLANT).json --out results/rl-baselines-tuned-$(PLANT) \
-	  --bench $(BASELINE_BENCH_$(PLANT)) --jobs $(BASELINE_JOBS) --data docs/data/rl-baselines-tuned-$(PLANT).json
+	  --bench $(BASELINE_BENCH_$(PLANT)) --jobs $(BASELINE_JOBS) --data docs/data/rl-baselines-tuned-$(PLANT).json \
+	  $(BASELINE_ARGS)
 
 build-fuzz: deps
 	cmake --preset fuzz >/dev/null
