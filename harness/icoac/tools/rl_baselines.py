@@ -255,7 +255,7 @@ def tune(args, cfg) -> dict[str, Any]:
             data["algorithms"][algo] = _ranking(algo, steps_of(algo), runs[algo])
         gits = [r["git"] for by_key in runs.values() for by_seed in by_key.values() for r in by_seed.values()]
         data["cell_builds"] = [g for i, g in enumerate(gits) if g not in gits[:i]]
-        if args.data is not None and not args.report:
+        if args.data is not None:  # under --report too: the record rewritten from the runs it holds
             args.data.write_text(json.dumps(data, indent=1))
 
     run_all(args, cfg, [(algo, seed, steps_of(algo), out(algo, heldout.key(setting), seed), setting, cells)
