@@ -137,7 +137,8 @@ def test_tune_ranks_the_settings_on_the_tuning_cells(tmp_path, monkeypatch):
     assert rl_baselines.main(tuned + ["--data", str(evaluated)]) == 0
     data = json.loads(evaluated.read_text())
     chosen = json.loads(record.read_text())["algorithms"]["ppo"]["chosen"]
-    assert data["algorithms"]["ppo"]["runs"]["0"]["overrides"] == chosen == data["algorithms"]["ppo"]["settings"]["overrides"]
+    entry = data["algorithms"]["ppo"]
+    assert entry["runs"]["0"]["overrides"] == chosen == entry["settings"]["overrides"]
     assert data["tuned"] == {"record": str(record), "chosen": {"ppo": heldout.key(chosen)}}
     assert rl_baselines.main(argv + ["--seeds", "0", "--tuned", str(record), "--report"]) == (
         0 if chosen == {"learning_rate": 1e-3} else 2)

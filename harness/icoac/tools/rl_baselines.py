@@ -193,7 +193,7 @@ def _tuning_record(args, path: Path, plant: str) -> dict[str, Any]:
         record = json.loads(path.read_text())
     except (OSError, ValueError) as err:
         raise UsageError(f"cannot read the tuning record {path}: {err}") from None
-    if record.get("plant") != plant or record.get("set") != args.set or record.get("protocol") != heldout.protocol(plant):
+    if (record.get("plant"), record.get("set"), record.get("protocol")) != (plant, args.set, heldout.protocol(plant)):
         raise UsageError(f"{path} holds the tuning of another plant, --set or protocol")
     return record
 
