@@ -153,3 +153,29 @@ def test_a_block_over_several_summaries(tmp_path):
     with pytest.raises(SystemExit, match="unknown table"):
         RT.render("<!-- table: comparison bench-default.json,bench-default-furuta.json -->\n<!-- end table -->\n",
                   DATA)
+
+
+def test_the_baseline_tuning_table_ranks_only_a_finished_algorithm():
+    """The PPO/SAC tuning record's table: while settings are unfinished, the finished ones in the
+    space's order and the count left; once all are in, best first by the criterion, the choice in
+    bold (ties to the Zoo's start, the space's first setting)."""
+    from icoac.studies import heldout
+    from icoac.tools import rl_baselines
+    settings = heldout.baseline_settings("ppo")
+
+    def run(rate):
+        return {"success_rate": rate, "train_wall_time": 100.0, "eval_wall_time": 5.0}
+    rates = {heldout.key(s): 0.5 for s in settings}
+    rates[heldout.key(settings[3])] = 0.9
+    runs = {heldout.key(settings[1]): {"100": run(0.2), "101": run(0.4)},
+            heldout.key(settings[0]): {"100": run(0.1), "101": run(0.1)}}
+    record = {"seeds": [100, 101], "algorithms": {"ppo": rl_baselines._ranking("ppo", 200000, runs)}}
+    lines = rl_baselines.tuning_table(record)
+    assert [line.split(" | ")[4] for line in lines[2:4]] == ["10.0 %", "30.0 %"]  # the space's order
+    assert lines[4] == "| PPO | 10 of 12 settings unfinished | | | | |" and "**" not in "".join(lines)
+    runs = {key: {"100": run(rate), "101": run(rate)} for key, rate in rates.items()}
+    record["algorithms"]["ppo"] = rl_baselines._ranking("ppo", 200000, runs)
+    lines = rl_baselines.tuning_table(record)
+    assert len(lines) == 2 + 12 and "| **90.0 %** | 210 |" in lines[2]
+    assert lines[2].split(" | ")[1] == "**" + ", ".join(f"{k} {v:g}" for k, v in sorted(settings[3].items())) + "**"
+    assert lines[3].split(" | ")[1] == ", ".join(f"{k} {v:g}" for k, v in sorted(settings[0].items()))  # tie: first

@@ -120,6 +120,13 @@ def test_tune_ranks_the_settings_on_the_tuning_cells(tmp_path, monkeypatch):
     assert not (tmp_path / "second" / "tuning").exists()
     assert rl_baselines.main(argv[:-1] + [str(tmp_path / "third"), "--tune", "--data", str(record),
                                           "--set", "success_steps=30"]) == 2
+    # --report rewrites the record from the runs it holds, training nothing
+    kept = json.loads(record.read_text())
+    record.write_text(json.dumps({k: v for k, v in kept.items() if k != "cell_builds"}))
+    assert rl_baselines.main(argv[:-1] + [str(tmp_path / "fourth"), "--tune", "--report", "--data", str(record)]) == 0
+    rewritten = json.loads(record.read_text())
+    assert rewritten["cell_builds"] == kept["cell_builds"] and rewritten["algorithms"] == kept["algorithms"]
+    assert rewritten["seeds"] == list(heldout.TUNING_SEEDS) and not (tmp_path / "fourth" / "tuning").exists()
     # the evaluation run with a chosen setting records it
     assert rl_baselines.main(argv + ["--seeds", "0", "--hyper", "learning_rate=1e-3"]) == 0
     run = json.loads((out / "ppo" / "seed-0" / "result.json").read_text())
@@ -130,7 +137,8 @@ def test_tune_ranks_the_settings_on_the_tuning_cells(tmp_path, monkeypatch):
     assert rl_baselines.main(tuned + ["--data", str(evaluated)]) == 0
     data = json.loads(evaluated.read_text())
     chosen = json.loads(record.read_text())["algorithms"]["ppo"]["chosen"]
-    assert data["algorithms"]["ppo"]["runs"]["0"]["overrides"] == chosen == data["algorithms"]["ppo"]["settings"]["overrides"]
+    entry = data["algorithms"]["ppo"]
+    assert entry["runs"]["0"]["overrides"] == chosen == entry["settings"]["overrides"]
     assert data["tuned"] == {"record": str(record), "chosen": {"ppo": heldout.key(chosen)}}
     assert rl_baselines.main(argv + ["--seeds", "0", "--tuned", str(record), "--report"]) == (
         0 if chosen == {"learning_rate": 1e-3} else 2)

@@ -158,11 +158,11 @@ def headline_table(summaries: Sequence[Mapping[str, Any]]) -> list[str]:
              "simulated time (s) | wall time (s) |", "|---|---|---|---|---|---|"]
     benches = [d for d in summaries if "aggregate" in d]
 
-    def same(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
-        return (a.get("plant", "cart_pole"), list(a.get("set") or [])) == (b.get("plant", "cart_pole"), list(b.get("set") or []))
+    def settings(d: Mapping[str, Any]) -> tuple[str, list[str]]:
+        return d.get("plant", "cart_pole"), list(d.get("set") or [])
     beside: dict[int, list[Mapping[str, Any]]] = {}
     for other in (d for d in summaries if "algorithms" in d):
-        matches = [i for i, d in enumerate(benches) if same(d, other)]
+        matches = [i for i, d in enumerate(benches) if settings(d) == settings(other)]
         tuned_alike = [i for i in matches if ("tuned" in benches[i]) == ("tuned" in other)]
         place = tuned_alike or (matches if "tuned" in other else [])
         if place:

@@ -193,7 +193,7 @@ def _tuning_record(args, path: Path, plant: str) -> dict[str, Any]:
         record = json.loads(path.read_text())
     except (OSError, ValueError) as err:
         raise UsageError(f"cannot read the tuning record {path}: {err}") from None
-    if record.get("plant") != plant or record.get("set") != args.set or record.get("protocol") != heldout.protocol(plant):
+    if (record.get("plant"), record.get("set"), record.get("protocol")) != (plant, args.set, heldout.protocol(plant)):
         raise UsageError(f"{path} holds the tuning of another plant, --set or protocol")
     return record
 
@@ -336,10 +336,10 @@ def table(data: Mapping[str, Any]) -> list[str]:
     """PPO and SAC on one plant: budget, success (all and held-out cells), cost, and the paired
     difference against the bench's conditions (points, their interval, McNemar's largest p)."""
     paired = [c for c in PAIRED_WITH if any(c in e.get("paired", {}) for e in data["algorithms"].values())]
-    lines = ["| method | env steps (RL Zoo's) | seeds | success, all cells (95 % interval) | held-out cells | "
-             "training episodes | simulated time (s) | wall time (s) | " +
-             " | ".join(f"against {REGISTRY[c].label} (points)" for c in paired) + " |",
-             "|---|---|---|---|---|---|---|---|" + "---|" * len(paired)]
+    header = ["method", "env steps (RL Zoo's)", "seeds", "success, all cells (95 % interval)", "held-out cells",
+              "training episodes", "simulated time (s)", "wall time (s)"] + \
+        [f"against {REGISTRY[c].label} (points)" for c in paired]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for algo, e in data["algorithms"].items():
         if "all" not in e:
             continue
