@@ -355,7 +355,7 @@ def table(data: Mapping[str, Any]) -> list[str]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m icoac.tools.rl_baselines", description=__doc__.split("\n")[0])
-    ap.add_argument("--plant", default="cart_pole", choices=tuple(PLANTS))
+    ap.add_argument("--plant", default=next(iter(PLANTS)), choices=tuple(PLANTS), help="default: the registry's first")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                     help="a plant or run parameter (success_steps: the evaluation's horizon)")
     ap.add_argument("--algos", nargs="+", choices=tuple(sb3.ALGORITHMS), default=list(sb3.ALGORITHMS))
