@@ -112,25 +112,24 @@ test-baselines: build baselines-venv
 	$(VPY) -m pytest -q tests/python -m baselines $(PYTEST_ARGS)
 
 # PPO and SAC on the Furuta pendulum (its +-10 V; paired with the grids of `make bench
-# BENCH_PLANTS=furuta`) and on the cart-pole at +-10 N (Barto et al.'s force), whose learners' bench
-# at that limit runs first (docs/results.md, "PPO and SAC"). BENCH_ARGS=--resume continues a
-# stopped bench; the baselines resume by themselves and train BASELINE_JOBS runs at once (one core
-# each). The double pendulum has no actuator limit yet, which PPO and SAC need.
+# BENCH_PLANTS=furuta`) and on the cart-pole held to a real actuator's limit (`--limited`: Barto et
+# al.'s +-10 N), whose learners' bench at that limit runs first (docs/results.md, "PPO and SAC").
+# BENCH_ARGS=--resume continues a stopped bench; the baselines resume by themselves and train
+# BASELINE_JOBS runs at once (one core each). The double pendulum's (its C file's 25 N) have not run.
 LIMITED_OUT := results/bench-cart_pole-10N
 BASELINE_JOBS ?= $(shell nproc)
 baselines: build baselines-venv
-	$(VPY) -m icoac bench --out $(LIMITED_OUT) --set max_force=10 --figures $(LIMITED_OUT)/figures \
+	$(VPY) -m icoac bench --out $(LIMITED_OUT) --limited --figures $(LIMITED_OUT)/figures \
 	  --data docs/data/bench-default-cart_pole-10N.json $(BENCH_ARGS)
-	$(VPY) -m icoac.tools.rl_baselines --plant cart_pole --set max_force=10 --out results/rl-baselines-cart_pole-10N \
+	$(VPY) -m icoac.tools.rl_baselines --plant cart_pole --limited --out results/rl-baselines-cart_pole-10N \
 	  --bench $(LIMITED_OUT) --data docs/data/rl-baselines-cart_pole-10N.json --jobs $(BASELINE_JOBS)
 	$(VPY) -m icoac.tools.rl_baselines --plant furuta --out results/rl-baselines-furuta \
 	  --bench $(BENCH_OUT)-furuta --data docs/data/rl-baselines-furuta.json --jobs $(BASELINE_JOBS)
 
-# The held-out tuning of PPO and SAC on PLANT (docs/tuning.md; the cart-pole's with its +-10 N),
+# The held-out tuning of PPO and SAC on PLANT held to its actuator's limit (docs/tuning.md),
 # resumable; its ranking in results/rl-baselines-tuning-$(PLANT)/tuning.json.
-TUNING_SETS_cart_pole := --set max_force=10
 tuning-baselines: build baselines-venv
-	$(VPY) -m icoac.tools.rl_baselines --plant $(PLANT) $(TUNING_SETS_$(PLANT)) --tune \
+	$(VPY) -m icoac.tools.rl_baselines --plant $(PLANT) --limited --tune \
 	  --out results/rl-baselines-tuning-$(PLANT) --jobs $(BASELINE_JOBS) \
 	  --data docs/data/rl-baselines-tuning-$(PLANT).json
 
@@ -141,7 +140,7 @@ tuning-baselines: build baselines-venv
 BASELINE_BENCH_cart_pole := $(LIMITED_OUT)
 BASELINE_BENCH_furuta := $(BENCH_OUT)-furuta
 baselines-tuned: build baselines-venv
-	$(VPY) -m icoac.tools.rl_baselines --plant $(PLANT) $(TUNING_SETS_$(PLANT)) \
+	$(VPY) -m icoac.tools.rl_baselines --plant $(PLANT) --limited \
 	  --tuned docs/data/rl-baselines-tuning-$(PLANT).json --out results/rl-baselines-tuned-$(PLANT) \
 	  --bench $(BASELINE_BENCH_$(PLANT)) --jobs $(BASELINE_JOBS) --data docs/data/rl-baselines-tuned-$(PLANT).json \
 	  $(BASELINE_ARGS)

@@ -112,6 +112,9 @@ _duration = _positive_float(1e300, "a finite duration > 0 (s)")
 
 PLANT_HELP = ("registry plant (docs/plants.md; default cart_pole): its grid, dynamics and task settings "
               "(its C file, sim_host/src/plants/); its parameters by name through --set")
+LIMITED_HELP = ("hold the plant to a real actuator's limit, as its C file gives it (the cart-pole's +-10 N, the "
+                "double pendulum's 25 N): --set LIMIT=VALUE before any other --set; none where the default is "
+                "that limit (the Furuta's +-10 V)")
 SET_HELP = ("override a parameter (repeatable): NAME is group.field (policy.gain, ico.timing, critic.range, "
             "actor.noise_std, ...), a plant or run parameter (dt, integrator, max_trials, ...) or a flat "
             "alias (gain, ico_timing, noise_std, ...); reals must be finite and normal, integers must fit "
@@ -219,6 +222,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="named configuration applied before --set: the defaults, or the paper's literal "
                         "reading of the actor-critic (posterior actor, exploration always on, per-tick updates)")
     g.add_argument("--set", action="append", metavar="NAME=VALUE", help=SET_HELP)
+    g.add_argument("--limited", action="store_true", help=LIMITED_HELP)
     g.add_argument("--plant", type=_plant, default=None, help=PLANT_HELP)
     g.add_argument("--cells", default=None, help="subset of the plant grid's cell indices (row-major, from 0), e.g. 0,5,600-610")
     again = g.add_mutually_exclusive_group()
@@ -268,6 +272,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="named configuration applied before --set: the defaults, or the paper's literal "
                         "reading of the actor-critic (posterior actor, exploration always on, per-tick updates)")
     b.add_argument("--set", action="append", metavar="NAME=VALUE", help=SET_HELP)
+    b.add_argument("--limited", action="store_true", help=LIMITED_HELP)
     b.add_argument("--resume", action="store_true", help="continue earlier results instead of starting over")
     b.add_argument("--quiet", action="store_true", help="no progress bars")
     b.add_argument("--ceiling", default=None, metavar="CEILING",
@@ -508,6 +513,9 @@ def main(argv=None) -> int:
     try:
         args = build_parser().parse_args(argv)
         try:
+            if getattr(args, "limited", False):
+                from icoac.core.plants import PLANTS
+                args.set = PLANTS[args.plant or O.CART_POLE].limited(args.set)
             return args.func(args)
         except OSError as exc:  # the file system refused a read or write
             name = f": {exc.filename!r}" if getattr(exc, "filename", None) else ""

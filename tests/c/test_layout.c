@@ -21,6 +21,7 @@ static const type_size_t types[] = {
     {"icoac_sim_run_t", sizeof(icoac_sim_run_t)},     {"icoac_sim_cell_t", sizeof(icoac_sim_cell_t)},
     {"icoac_sim_axis_t", sizeof(icoac_sim_axis_t)},   {"icoac_sim_param_t", sizeof(icoac_sim_param_t)},
     {"icoac_sim_sweep_t", sizeof(icoac_sim_sweep_t)}, {"icoac_sim_plant_desc_t", sizeof(icoac_sim_plant_desc_t)},
+    {"icoac_sim_actuator_t", sizeof(icoac_sim_actuator_t)},
     {"icoac_sim_learner_t", sizeof(icoac_sim_learner_t)}, {"icoac_sim_task_t", sizeof(icoac_sim_task_t)},
     {"icoac_sim_model_t", sizeof(icoac_sim_model_t)},       {"icoac_rng_t", sizeof(icoac_rng_t)},
 };
@@ -91,7 +92,7 @@ static void test_constants_table(void)
     TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == ICOAC_ABI_VERSION);
     TEST_ASSERT_TRUE(constant("ICOAC_ABI_VERSION") == 10);
     TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == ICOAC_SIM_ABI_VERSION);
-    TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == 9);
+    TEST_ASSERT_TRUE(constant("ICOAC_SIM_ABI_VERSION") == 10);
     TEST_ASSERT_TRUE(constant("ICOAC_CARTPOLE_INPUTS") == ICOAC_CARTPOLE_INPUTS);
     TEST_ASSERT_TRUE(constant("ICOAC_CARTPOLE_CRITIC_UNITS") == ICOAC_CARTPOLE_CRITIC_UNITS);
     TEST_ASSERT_TRUE(constant("ICOAC_STATE_SIZE") == ICOAC_STATE_SIZE);
@@ -242,6 +243,7 @@ static void test_fields_spot_checks(void)
     SPOT(icoac_sim_param_t, max);
     SPOT(icoac_sim_param_t, doc);
     SPOT(icoac_sim_sweep_t, degrees);
+    SPOT(icoac_sim_actuator_t, limit);
     SPOT(icoac_sim_plant_desc_t, observed);
     SPOT(icoac_sim_plant_desc_t, energy);
     SPOT(icoac_sim_plant_desc_t, task);

@@ -16,6 +16,36 @@ static const icoac_sim_plant_desc_t *plant(int32_t i)
     return d;
 }
 
+/* The actuator's limit is a valid value of its parameter, at which the input saturates: any larger
+ * input moves the plant as the limit does, a smaller one does not. */
+static void check_actuator(const icoac_sim_plant_desc_t *d, const icoac_sim_model_t *defaults)
+{
+    const icoac_sim_actuator_t *a = &d->actuator;
+    icoac_sim_model_t model = *defaults;
+    double at[ICOAC_SIM_MAX_STATE], beyond[ICOAC_SIM_MAX_STATE], within[ICOAC_SIM_MAX_STATE];
+    int32_t c, differs = 0;
+    if (a->param == -1) { /* none: the input is not saturated */
+        TEST_ASSERT_TRUE(a->limit == 0.0 && a->source == NULL);
+        return;
+    }
+    TEST_ASSERT_TRUE(a->param >= 0 && a->param < d->n_params);
+    TEST_ASSERT_TRUE(a->source != NULL && strlen(a->source) > 0);
+    TEST_ASSERT_TRUE(a->limit > 0.0 && a->limit >= d->params[a->param].min && a->limit <= d->params[a->param].max);
+    model.param[a->param] = a->limit;
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_check(&model));
+    memcpy(at, d->start, sizeof at);
+    memcpy(beyond, d->start, sizeof beyond);
+    memcpy(within, d->start, sizeof within);
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step(&model, at, a->limit));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step(&model, beyond, 3.0 * a->limit));
+    TEST_ASSERT_EQUAL_INT(ICOAC_SIM_OK, icoac_sim_model_step(&model, within, 0.5 * a->limit));
+    for (c = 0; c < d->n_state; ++c) {
+        TEST_ASSERT_TRUE(beyond[c] == at[c]);
+        differs |= within[c] != at[c];
+    }
+    TEST_ASSERT_TRUE(differs);
+}
+
 static void test_registry(void)
 {
     const int32_t n = icoac_sim_plant_count();
@@ -64,6 +94,7 @@ static void test_registry(void)
         for (c = 0; c < d->n_state; ++c) {
             TEST_ASSERT_TRUE(s[c] == 0.0);
         }
+        check_actuator(d, &model);
     }
     TEST_ASSERT_EQUAL_INT(ICOAC_SIM_ERR_BAD_ARGUMENT, icoac_sim_model_default(NULL, 0));
     {

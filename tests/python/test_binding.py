@@ -60,7 +60,7 @@ def test_state_is_opaque_aligned_storage():
 
 def test_abi_versions():
     assert B.lib.icoac_abi_version() == B.ABI_VERSION == B.CONSTANTS["ICOAC_ABI_VERSION"] == 10
-    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 9
+    assert B.lib.icoac_sim_abi_version() == B.SIM_ABI_VERSION == B.CONSTANTS["ICOAC_SIM_ABI_VERSION"] == 10
     info = B.abi_info()
     assert info["sizeof_real"] in (4, 8)
     # the host build's defaults: the dense critic kernel, two lanes per engine thread

@@ -69,6 +69,28 @@ def test_grid_resume_and_mismatch(tmp_path):
     assert "Traceback" not in res.stderr
 
 
+def test_limited_holds_each_plant_to_its_actuator(tmp_path):
+    """--limited runs the plant at the actuator limit its C file gives; where the default is that
+    limit it adds nothing; with a --set of the same parameter it is a one-line error."""
+    from icoac.core import binding as B
+    from icoac.core.plants import PLANTS
+    for name in PLANTS:
+        actuator = B.plant_info(name)["actuator"]
+        out = tmp_path / name
+        res = run("grid", "--plant", name, "--limited", "--condition", "lqr", "--cells", "0", "--max-trials", "1",
+                  "--success-steps", "20", "--quiet", "--out", str(out))
+        assert res.returncode == 0, res.stderr
+        plant = json.loads((out / "run.json").read_text())["config"]["plant"]
+        assert plant[actuator["param"]] == actuator["limit"]
+        default = next(p["value"] for p in B.plant_info(name)["params"] if p["name"] == actuator["param"])
+        assert PLANTS[name].limited_sets() == ([] if default == actuator["limit"] else
+                                               [f"{actuator['param']}={actuator['limit']:g}"])
+    res = run("grid", "--plant", "double_cart_pole", "--limited", "--set", "max_force=30", "--out", str(tmp_path / "x"))
+    assert res.returncode == 2 and res.stderr.strip() == ("icoac: error: --limited and --set max_force=30 both set "
+                                                          "max_force; give one")
+    assert not (tmp_path / "x").exists()
+
+
 def test_sigint_then_resume(tmp_path):
     out = tmp_path / "s"
     args = [sys.executable, "-m", "icoac", "grid", "--out", str(out), "--cells", "590-640", "--threads", "1",

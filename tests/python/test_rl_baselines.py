@@ -12,6 +12,7 @@ import pytest
 from icoac.core import binding as B
 from icoac.core.config import build_config, parse_sets
 from icoac.core.errors import UsageError
+from icoac.core.plants import PLANTS
 from icoac.gym.plants import ModelParameters, model_start, plant_grid
 from icoac.studies import heldout
 from icoac.studies.baselines import sb3
@@ -54,8 +55,10 @@ def test_actuator_limit_is_the_plants():
     assert sb3.actuator_limit(furuta()) == ("max_voltage", 10.0)
     assert sb3.actuator_limit(furuta(max_voltage=4)) == ("max_voltage", 4.0)
     cart = build_config({}, plant="cart_pole")
-    with pytest.raises(UsageError, match=r"max_force = 1e\+06 is no actuator limit; set one"):
+    with pytest.raises(UsageError, match=r"max_force = 1e\+06 is no actuator limit; hold it to a real actuator's"):
         sb3.actuator_limit(cart)
+    limited = build_config(parse_sets(PLANTS["cart_pole"].limited_sets(), plant="cart_pole"), plant="cart_pole")
+    assert sb3.actuator_limit(limited) == ("max_force", B.plant_info("cart_pole")["actuator"]["limit"])
 
 
 def test_tool_resumes_and_reports(tmp_path, capsys):

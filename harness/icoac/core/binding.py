@@ -35,7 +35,7 @@ DEFAULT_LIBRARY = REPO_ROOT / "build" / "release" / "sim_host" / "libicoac_sim.s
 
 # The ABI versions the mirrors below are written for (everything else is read from the library).
 ABI_VERSION = 10
-SIM_ABI_VERSION = 9
+SIM_ABI_VERSION = 10
 
 
 class IcoacError(HarnessError):
@@ -425,6 +425,12 @@ class PlantTask(ctypes.Structure):
                 ("prior_all_finished", ctypes.c_char_p)]
 
 
+class Actuator(ctypes.Structure):
+    """icoac_sim_actuator_t: a plant's saturation parameter and a real actuator's limit."""
+    _fields_ = [("param", ctypes.c_int32), ("reserved", ctypes.c_int32), ("limit", ctypes.c_double),
+                ("source", ctypes.c_char_p)]
+
+
 class PlantDesc(ctypes.Structure):
     """icoac_sim_plant_desc_t: a registry plant (read only; its functions are opaque pointers)."""
     _fields_ = [
@@ -432,6 +438,7 @@ class PlantDesc(ctypes.Structure):
         ("title", ctypes.c_char_p),
         ("source", ctypes.c_char_p),
         ("input", Axis),
+        ("actuator", Actuator),
         ("n_state", ctypes.c_int32),
         ("n_params", ctypes.c_int32),
         ("state", Axis * MAX_STATE),
@@ -490,6 +497,7 @@ MIRRORS: dict[str, tuple[Mirror, str | None]] = {
     "icoac_sim_axis_t": (Axis, None),
     "icoac_sim_param_t": (Param, None),
     "icoac_sim_sweep_t": (Sweep, None),
+    "icoac_sim_actuator_t": (Actuator, None),
     "icoac_sim_learner_t": (Learner, None),
     "icoac_sim_task_t": (PlantTask, None),
     "icoac_sim_plant_desc_t": (PlantDesc, None),
@@ -727,7 +735,8 @@ def plant_index(name: str) -> int:
 def plant_info(plant: Union[int, str]) -> dict:
     """A registry plant's descriptor as plain data: name, title, source, input (name, unit),
     state [(name, unit)], params [{name, unit, value, min, max, tier, doc}], rows and cols of its grid
-    ({component, count, first, step, degrees}), start, drawn, observed, has_energy, and its task
+    ({component, count, first, step, degrees}), start, drawn, observed, has_energy, actuator
+    ({param, limit, source}; None when its input is not saturated), and its task
     (None when it has none): {source, paper, learners (condition names), prior_all_finished}."""
     index = plant_index(plant) if isinstance(plant, str) else int(plant)
     ptr = lib.icoac_sim_plant_info(index)
@@ -741,6 +750,7 @@ def plant_info(plant: Union[int, str]) -> dict:
         "index": index,
         "name": d.name.decode(), "title": d.title.decode(), "source": d.source.decode(),
         "input": (d.input.name.decode(), d.input.unit.decode()),
+        "actuator": _actuator(d),
         "state": [(d.state[i].name.decode(), d.state[i].unit.decode()) for i in range(n)],
         "params": [_param_info(d.name.decode(), p) for p in (d.params[i] for i in range(d.n_params))],
         "rows": sweep(d.rows), "cols": sweep(d.cols),
@@ -748,6 +758,16 @@ def plant_info(plant: Union[int, str]) -> dict:
         "has_energy": bool(d.energy),
         "task": _task_info(d.name.decode(), d.task.contents) if d.task else None,
     }
+
+
+def _actuator(d: PlantDesc) -> dict | None:
+    a = d.actuator
+    if a.param == -1:
+        return None
+    if not 0 <= a.param < d.n_params or not a.source:
+        raise LibraryError(f"plant {d.name.decode()}: its actuator needs a parameter index below {d.n_params} (or -1: "
+                           "none) and a source (docs/plants.md)")
+    return {"param": d.params[a.param].name.decode(), "limit": a.limit, "source": a.source.decode()}
 
 
 def _param_info(plant: str, p: Param) -> dict:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 from icoac.core import binding as B
+from icoac.core.errors import UsageError
 from icoac.core.registry import CONDITIONS
 
 # The cells of an ICO grid an ICO prior may average (PlantSpec.prior_cells): the paper's
@@ -57,6 +58,30 @@ class PlantSpec:
                     raise B.ConfigError(B.SIM_ERR_BAD_PLANT, f"plant {self.name} task knob {k['name']}="
                                         f"{values[k['name']]:g} is outside [{k['min']:g}, {k['max']:g}] {k['unit']}")
             B.check_status(B.SIM_ERR_BAD_PLANT, f"plant {self.name} task")
+
+    def actuator(self) -> dict:
+        """{param, limit, source} of its C file's icoac_sim_actuator_t; a UsageError when it has none."""
+        actuator = B.plant_info(self.index)["actuator"]
+        if actuator is None:
+            raise UsageError(f"plant {self.name} has no actuator limit in its C file (icoac_sim_actuator_t)")
+        return actuator
+
+    def limited_sets(self) -> list[str]:
+        """The --set items that hold the plant to a real actuator's limit (its C file's
+        icoac_sim_actuator_t; `--limited`): none where its default is that limit."""
+        info = B.plant_info(self.index)
+        actuator = self.actuator()
+        default = next(p["value"] for p in info["params"] if p["name"] == actuator["param"])
+        return [] if default == actuator["limit"] else [f"{actuator['param']}={actuator['limit']:g}"]
+
+    def limited(self, sets: list[str] | None) -> list[str]:
+        """`--limited` with these --set items: limited_sets() before them; a UsageError when they
+        set the actuator's parameter too."""
+        param = self.actuator()["param"]
+        clash = [s for s in sets or [] if s.split("=", 1)[0].strip() == param]
+        if clash:
+            raise UsageError(f"--limited and --set {clash[0]} both set {param}; give one")
+        return self.limited_sets() + list(sets or [])
 
     def learner_config(self, condition: str, cfg: B.Config) -> None:
         """The plant's settings of a learning condition over cfg, if it has some."""

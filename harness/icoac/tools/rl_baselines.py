@@ -5,8 +5,8 @@ over random grid cells and evaluated on every cell of that seed's grid:
     python -m icoac.tools.rl_baselines --plant furuta --out results/rl-baselines-furuta \\
         --bench results/bench-furuta --data docs/data/rl-baselines-furuta.json
 
-Needs the [baselines] extra (`make baselines`). The plant's actuator limit (its max_... parameter,
---set to change it) bounds the actions. Each (algorithm, seed) is OUT/<algo>/seed-<s>/ with the
+Needs the [baselines] extra (`make baselines`). The plant's actuator limit (the parameter its C
+file names; --limited holds it to a real actuator's, --set to any other) bounds the actions. Each (algorithm, seed) is OUT/<algo>/seed-<s>/ with the
 trained model and result.json; a stopped run resumes at the first unfinished one (one run is not
 resumed inside); --jobs N runs N of them at once, each in its own process on one thread. --bench
 DIR (grids with the same plant parameters) adds the paired per-cell tests against its conditions,
@@ -358,6 +358,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--plant", default=next(iter(PLANTS)), choices=tuple(PLANTS), help="default: the registry's first")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                     help="a plant or run parameter (success_steps: the evaluation's horizon)")
+    ap.add_argument("--limited", action="store_true",
+                    help="hold the plant to a real actuator's limit, as its C file gives it (`icoac grid --help`)")
     ap.add_argument("--algos", nargs="+", choices=tuple(sb3.ALGORITHMS), default=list(sb3.ALGORITHMS))
     ap.add_argument("--seeds", nargs="+", type=int, default=list(range(bench.PROFILES["default"]["seeds"])))
     ap.add_argument("--steps", type=int, help="env steps per training run (default: each algorithm's budget)")
@@ -375,6 +377,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     def body():
+        if args.limited:
+            args.set = PLANTS[args.plant].limited(args.set)
         if args.steps is not None and args.steps < 1:
             raise UsageError(f"--steps must be at least 1, got {args.steps}")
         if not 1 <= args.jobs <= (os.cpu_count() or 1) * 4:

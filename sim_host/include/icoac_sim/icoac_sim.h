@@ -12,7 +12,7 @@
 extern "C" {
 #endif
 
-#define ICOAC_SIM_ABI_VERSION 9
+#define ICOAC_SIM_ABI_VERSION 10
 
 /* Status of sim functions: values below 100 are icoac_status_t, passed through. */
 typedef enum {
@@ -180,6 +180,16 @@ typedef struct {
     int32_t reserved; /* 0 */
 } icoac_sim_sweep_t;
 
+/* A plant's actuator: the parameter at which its input saturates, and the limit of a real
+ * actuator of this plant, which a comparison with bounded-action learners (PPO, SAC) holds every
+ * method to (`--limited`; docs/results.md). */
+typedef struct {
+    int32_t param;      /* index in the plant's params of the saturation limit; -1: none */
+    int32_t reserved;   /* 0 */
+    double limit;       /* a real actuator's limit, in that parameter's unit and range (none: 0) */
+    const char *source; /* where that limit comes from, one line (none: NULL) */
+} icoac_sim_actuator_t;
+
 /* One integration step of the plant's ODE for lanes states at once (a lockstep batch of cells),
  * lane l advanced by dt under input u[l] with the integrator (icoac_sim_integrator_t); p holds
  * the parameter block. s is a structure of arrays: component i of lane l at s[i * lanes + l]
@@ -229,6 +239,7 @@ typedef struct {
     const char *title;  /* one line for humans */
     const char *source; /* where the equations and default parameters come from */
     icoac_sim_axis_t input;
+    icoac_sim_actuator_t actuator;
     int32_t n_state;    /* <= ICOAC_SIM_MAX_STATE */
     int32_t n_params;   /* <= ICOAC_SIM_MAX_PARAMS */
     icoac_sim_axis_t state[ICOAC_SIM_MAX_STATE];

@@ -85,6 +85,7 @@ const icoac_sim_plant_desc_t sim_cart_pole = {
     "Barto, Sutton & Anderson, IEEE Trans. SMC 13(5), 1983; Florian, 'Correct equations for the "
     "dynamics of the cart-pole system', 2007",
     {"force", "N"},
+    {MAX_FORCE, 0, 10.0, "Barto, Sutton & Anderson 1983: the cart is pushed with +-10 N"},
     4,
     N_PARAMS,
     {{"x", "m"}, {"x_dot", "m/s"}, {"theta", "rad"}, {"theta_dot", "rad/s"}},

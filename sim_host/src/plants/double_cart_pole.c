@@ -173,6 +173,8 @@ const icoac_sim_plant_desc_t sim_double_cart_pole = {
     "Bogdanov, 'Optimal control of a double inverted pendulum on a cart', OGI School of Science & "
     "Engineering, OHSU, technical report CSE-04-006, 2004",
     {"force", "N"},
+    {MAX_FORCE, 0, 25.0, "none published for this cart: the cart-pole's force per weight (10 N to "
+                         "1.1 kg x 9.8 m/s^2) at this plant's 2.75 kg"},
     6,
     N_PARAMS,
     {{"x", "m"}, {"x_dot", "m/s"}, {"theta1", "rad"}, {"theta1_dot", "rad/s"}, {"theta2", "rad"},

@@ -181,6 +181,7 @@ const icoac_sim_plant_desc_t sim_furuta = {
     "Quanser QUBE-Servo 2 User Manual (system parameters); Acosta, Math. Probl. Eng. 2010, "
     "article 742894; Cazzolato & Prime, J. Control Sci. Eng. 2011",
     {"voltage", "V"},
+    {MAX_VOLTAGE, 0, 10.0, "Quanser QUBE-Servo 2 User Manual: the amplifier's +-10 V (the default)"},
     4,
     N_PARAMS,
     {{"theta", "rad"}, {"theta_dot", "rad/s"}, {"alpha", "rad"}, {"alpha_dot", "rad/s"}},

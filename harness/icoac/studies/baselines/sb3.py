@@ -5,7 +5,7 @@ train instead, on the plant's Gymnasium env (icoac.gym), on the same grid and su
 - Training: one policy over random grid cells (or over a given set of them: the held-out tuning's
   cells). Each episode starts from a cell and a grid seed drawn by the env's generator, lasts at most TRAIN_EPISODE_STEPS control periods, and earns 1 per
   period until the plant fails. Actions are rescaled to [-1, 1] and map linearly onto the plant's
-  actuator limit (its ``max_*`` parameter: the cart's force, the Furuta's voltage), which every
+  actuator limit (the parameter its C file names: the cart's force, the Furuta's voltage), which every
   method meets in the plant itself. The budget is a number of env steps (control periods).
 - Evaluation: the deterministic policy from every cell of the grid of a seed, from the start state
   the engine gives that cell's first trial, for ``success_steps`` periods (the learners'
@@ -27,6 +27,7 @@ import numpy as np
 from icoac.core import binding as B
 from icoac.core.config import RunConfig, model_to_dict
 from icoac.core.errors import UsageError
+from icoac.core.plants import PLANTS
 from icoac.gym.plants import ModelParameters, gym_name, model_start, plant_grid
 
 TRAIN_EPISODE_STEPS = 1000  # 10 s at 100 Hz, the Zoo's MuJoCo episode length
@@ -66,17 +67,14 @@ def _sb3():
 
 
 def actuator_limit(cfg: RunConfig) -> tuple[str, float]:
-    """(name, value) of the plant's input saturation, its ``max_*`` parameter; a UsageError when
-    it has none or it is beyond the controller's output bound (no limit an action space can map)."""
-    params = model_to_dict(cfg.model)
-    names = [name for name in params if name.startswith("max_")]
-    if len(names) != 1:
-        raise UsageError(f"plant {cfg.plant_name} has no actuator limit parameter (max_...)")
-    limit = float(params[names[0]])
+    """(name, value) of the plant's input saturation (its C file's actuator parameter); a UsageError
+    when it is beyond the controller's output bound (no limit an action space can map)."""
+    name = PLANTS[cfg.plant_name].actuator()["param"]
+    limit = float(model_to_dict(cfg.model)[name])
     if not limit < float(B.constant("ICOAC_FORCE_MAX")):
-        raise UsageError(f"plant {cfg.plant_name}: {names[0]} = {limit:g} is no actuator limit; "
-                         f"set one (--set {names[0]}=...)")
-    return names[0], limit
+        raise UsageError(f"plant {cfg.plant_name}: {name} = {limit:g} is no actuator limit; hold it to a real "
+                         f"actuator's with --limited (or --set {name}=...)")
+    return name, limit
 
 
 def _env_parameters(cfg: RunConfig) -> dict[str, Any]:
