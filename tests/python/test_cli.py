@@ -84,7 +84,7 @@ def test_limited_holds_each_plant_to_its_actuator(tmp_path):
         assert plant[actuator["param"]] == actuator["limit"]
         default = next(p["value"] for p in B.plant_info(name)["params"] if p["name"] == actuator["param"])
         assert PLANTS[name].limited_sets() == ([] if default == actuator["limit"] else
-                                               [f"{actuator['param']}={actuator['limit']:g}"])
+                                               [f"{actuator['param']}={actuator['limit']:.15g}"])
     res = run("grid", "--plant", "double_cart_pole", "--limited", "--set", "max_force=30", "--out", str(tmp_path / "x"))
     assert res.returncode == 2 and res.stderr.strip() == ("icoac: error: --limited and --set max_force=30 both set "
                                                           "max_force; give one")

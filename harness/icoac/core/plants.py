@@ -72,7 +72,7 @@ class PlantSpec:
         info = B.plant_info(self.index)
         actuator = self.actuator()
         default = next(p["value"] for p in info["params"] if p["name"] == actuator["param"])
-        return [] if default == actuator["limit"] else [f"{actuator['param']}={actuator['limit']:g}"]
+        return [] if default == actuator["limit"] else [f"{actuator['param']}={actuator['limit']:.15g}"]
 
     def limited(self, sets: list[str] | None) -> list[str]:
         """`--limited` with these --set items: limited_sets() before them; a UsageError when they

@@ -68,7 +68,8 @@ def _sb3():
 
 def actuator_limit(cfg: RunConfig) -> tuple[str, float]:
     """(name, value) of the plant's input saturation (its C file's actuator parameter); a UsageError
-    when it is beyond the controller's output bound (no limit an action space can map)."""
+    when the plant has none or it is beyond the controller's output bound (no limit an action space
+    can map)."""
     name = PLANTS[cfg.plant_name].actuator()["param"]
     limit = float(model_to_dict(cfg.model)[name])
     if not limit < float(B.constant("ICOAC_FORCE_MAX")):
