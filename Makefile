@@ -43,7 +43,7 @@ FUZZ_SOURCES = $(shell git ls-tree HEAD $(FUZZ_C_SOURCES) 2>/dev/null | git hash
   cut -c1-12)$(shell git diff --quiet HEAD -- $(FUZZ_C_SOURCES) 2>/dev/null || echo -modified)
 FUZZ_TARGETS := fuzz_controller fuzz_controller_double fuzz_controller_fast_exp fuzz_state fuzz_state_double fuzz_state_mcu fuzz_model fuzz_batch
 
-.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-baselines baselines baselines-tuned baselines-venv test-fuzz fuzz fuzz-campaign fuzz-ledger bench tuning tuning-baselines ablation \
+.PHONY: all deps venv build dist build-asan build-fuzz lint test test-c test-asan test-python test-baselines limited-bench baselines baselines-tuned baselines-venv test-fuzz fuzz fuzz-campaign fuzz-ledger bench tuning tuning-baselines ablation \
   bench-speed clean target-report sweeps sweeps-rl-alone sweeps-plants bench-plant
 
 all: build
@@ -111,18 +111,26 @@ $(VENV)/.baselines: $(VENV)/.installed
 test-baselines: build baselines-venv
 	$(VPY) -m pytest -q tests/python -m baselines $(PYTEST_ARGS)
 
-# PPO and SAC on the Furuta pendulum (its +-10 V; paired with the grids of `make bench
-# BENCH_PLANTS=furuta`) and on the cart-pole held to a real actuator's limit (`--limited`: Barto et
-# al.'s +-10 N), whose learners' bench at that limit runs first (docs/results.md, "PPO and SAC").
-# BENCH_ARGS=--resume continues a stopped bench; the baselines resume by themselves and train
-# BASELINE_JOBS runs at once (one core each). The double pendulum's (its C file's 25 N) have not run.
-LIMITED_OUT := results/bench-cart_pole-10N
+# The learners' bench of PLANT held to its actuator's limit (`--limited`: the cart-pole's +-10 N of
+# Barto et al., the double pendulum's 25 N, as their C files give them), which PPO and SAC pair
+# with; the Furuta's default bench (`make bench BENCH_PLANTS=furuta`) is at its +-10 V already.
+# BENCH_ARGS=--resume continues a stopped bench.
+LIMIT_TAG_cart_pole := 10N
+LIMIT_TAG_double_cart_pole := 25N
+LIMITED_OUT = results/bench-$(PLANT)-$(LIMIT_TAG_$(PLANT))
+limited-bench: build venv
+	@[ -n "$(LIMIT_TAG_$(PLANT))" ] || { echo "limited-bench: $(PLANT) has no limited variant (its default is its limit)"; exit 2; }
+	$(VPY) -m icoac bench --plant $(PLANT) --out $(LIMITED_OUT) --limited --figures $(LIMITED_OUT)/figures \
+	  --data docs/data/bench-default-$(PLANT)-$(LIMIT_TAG_$(PLANT)).json $(BENCH_ARGS)
+
+# PPO and SAC at the RL Zoo's settings (docs/results.md, "PPO and SAC") on the cart-pole at +-10 N
+# (its limited bench runs first) and on the Furuta, paired with those learners' grids. They resume
+# by themselves and train BASELINE_JOBS runs at once (one core each).
 BASELINE_JOBS ?= $(shell nproc)
 baselines: build baselines-venv
-	$(VPY) -m icoac bench --out $(LIMITED_OUT) --limited --figures $(LIMITED_OUT)/figures \
-	  --data docs/data/bench-default-cart_pole-10N.json $(BENCH_ARGS)
+	$(MAKE) --no-print-directory limited-bench PLANT=cart_pole
 	$(VPY) -m icoac.tools.rl_baselines --plant cart_pole --limited --out results/rl-baselines-cart_pole-10N \
-	  --bench $(LIMITED_OUT) --data docs/data/rl-baselines-cart_pole-10N.json --jobs $(BASELINE_JOBS)
+	  --bench results/bench-cart_pole-10N --data docs/data/rl-baselines-cart_pole-10N.json --jobs $(BASELINE_JOBS)
 	$(VPY) -m icoac.tools.rl_baselines --plant furuta --out results/rl-baselines-furuta \
 	  --bench $(BENCH_OUT)-furuta --data docs/data/rl-baselines-furuta.json --jobs $(BASELINE_JOBS)
 
@@ -134,11 +142,14 @@ tuning-baselines: build baselines-venv
 	  --data docs/data/rl-baselines-tuning-$(PLANT).json
 
 # PPO and SAC on PLANT with the choices of that finished tuning, evaluated as `make baselines` does
-# (every cell, the evaluation seeds; paired with the same bench's grids where they are there,
-# else `--report` adds the pairing later without training again). BASELINE_ARGS: more options
-# (`--algos ppo`, `--seeds 0 1 2`).
-BASELINE_BENCH_cart_pole := $(LIMITED_OUT)
-BASELINE_BENCH_furuta := $(BENCH_OUT)-furuta
+# (every cell, the evaluation seeds), paired with the learners' grids at the same limit where they
+# are there (else `--report` adds the pairing later without training again): the limited bench of
+# the cart-pole and the double pendulum (whose learners were tuned without the limit), the Furuta's
+# learners at their held-out choices (`python -m icoac.tools.heldout_tuning --plant furuta
+# --evaluate`, docs/tuning.md). BASELINE_ARGS: more options (`--algos ppo`, `--seeds 0 1 2`).
+BASELINE_BENCH_cart_pole := results/bench-cart_pole-10N
+BASELINE_BENCH_furuta := results/tuning-furuta/evaluation/bench
+BASELINE_BENCH_double_cart_pole := results/bench-double_cart_pole-25N
 baselines-tuned: build baselines-venv
 	$(VPY) -m icoac.tools.rl_baselines --plant $(PLANT) --limited \
 	  --tuned docs/data/rl-baselines-tuning-$(PLANT).json --out results/rl-baselines-tuned-$(PLANT) \
