@@ -62,6 +62,24 @@ def test_median_interval():
     assert stats.interval(np.full((2, 10), np.nan), stats.median_of_successes) is None
 
 
+def test_statistics_take_a_block_of_resamples_at_once():
+    """The statistics reduce the last axis of any array (the bootstrap passes seeds x resamples x
+    cells): the success rate per row, and the median of a row's successes equal to numpy's median of
+    its non-NaN values, NaN for a row without one, for odd and even counts."""
+    rng = np.random.default_rng(3)
+    trials = rng.integers(1, 1000, (4, 6, 9)).astype(float)
+    trials[rng.random(trials.shape) < 0.4] = np.nan
+    trials[0, 0] = np.nan
+    medians = stats.median_of_successes(trials)
+    assert medians.shape == (4, 6)
+    for index in np.ndindex(4, 6):
+        row = trials[index][~np.isnan(trials[index])]
+        assert np.isnan(medians[index]) if row.size == 0 else medians[index] == np.median(row), index
+    assert np.isnan(medians[0, 0]) and np.unique(np.count_nonzero(~np.isnan(trials), axis=-1) % 2).size == 2
+    success = ~np.isnan(trials)
+    assert np.array_equal(stats.rate(success), success.sum(axis=-1) / 9)
+
+
 def test_difference_interval_is_paired():
     """A condition against itself differs by exactly 0 in every resample; against a copy with 30
     more successes out of 1000, by 3 points with a narrow interval (the pairing removes the
