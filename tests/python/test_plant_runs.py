@@ -180,6 +180,26 @@ def test_sweep_ranking_and_the_furuta_choice():
                 build_config(condition=learner, plant=plant).to_dict()
 
 
+def test_learner_sweeps_pin_each_reading(monkeypatch, tmp_path):
+    """Every learner sweep sets its actor reading explicitly, its own as well as the other's: the
+    Furuta's ICO->RL defaults to the mean reading, so a "gradient" sweep that left the reading to
+    the plant's defaults would run the mean reading under the gradient's name."""
+    runs = []
+    monkeypatch.setattr(plant_sweeps, "run_sweep", runs.append)
+    monkeypatch.setattr(plant_sweeps, "learner_cells", lambda ico_dir: {"ico-failed": [600], "spread": [601]})
+    plant_sweeps.run_learners(tmp_path / "ico", tmp_path / "out")
+    reading_of = {tmp_path / "out" / "learners" / f"{stem}-{label}": reading
+                  for condition in plant_sweeps.LEARNER_SPACE
+                  for stem, (reading, _) in plant_sweeps.learner_dirs(tmp_path / "out", condition).items()
+                  for label in ("ico-failed", "spread")}
+    assert sorted(o.out for o in runs) == sorted(reading_of) and len(set(reading_of.values())) == 2
+    for options in runs:
+        pinned = dict(x.split("=") for x in options.sets)
+        actor = build_config(pinned, condition=options.condition, plant="furuta").to_dict()["controller"]["actor"]
+        reading = plant_sweeps.READINGS[reading_of[options.out]]
+        assert {k: actor[k.split(".")[1]] for k in reading} == reading, options.out
+
+
 def test_figures_and_sweep_take_the_recorded_plant(capsys, tmp_path):
     out = tmp_path / "fur"
     assert main(capsys, "grid", "--plant", "furuta", "--out", out, "--cells", CELLS, *TINY_ARGS)[0] == 0

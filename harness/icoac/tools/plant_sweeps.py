@@ -254,7 +254,8 @@ def learner_dirs(out: Path, condition: str) -> dict[str, tuple[str, list[float]]
 def run_learners(ico_dir: Path, out: Path) -> None:
     for condition, (name, _) in LEARNER_SPACE.items():
         for stem, (reading, values) in learner_dirs(out, condition).items():
-            fixed = [] if reading == OWN_READING[condition] else [f"{k}={v}" for k, v in READINGS[reading].items()]
+            # both readings pinned: a plant's learner defaults may hold either (the Furuta's ICO->RL the mean)
+            fixed = [f"{k}={v}" for k, v in READINGS[reading].items()]
             for label, cells in learner_cells(ico_dir).items():
                 run_sweep(SweepOptions(prior_from=ico_dir, out=out / "learners" / f"{stem}-{label}",
                                        params=[f"{name}={','.join(f'{v:g}' for v in values)}"], condition=condition,
@@ -269,8 +270,7 @@ def learner_ranking(out: Path, condition: str) -> list[dict]:
         def rows(label):
             return {r["key"]: r for r in read_rows(out / "learners" / f"{stem}-{label}" / "sweep.csv")}
         failed, spread = rows("ico-failed"), rows("spread")
-        table += [{"key": json.dumps({**({} if reading == OWN_READING[condition] else READINGS[reading]),
-                                      **json.loads(k)}),
+        table += [{"key": json.dumps({**READINGS[reading], **json.loads(k)}),
                    "reading": reading,
                    "ico_failed": float(r["success_rate_ico_failed"] or r["success_rate_mean"]),
                    "spread": float(spread[k]["success_rate_mean"]) if k in spread else math.nan,
