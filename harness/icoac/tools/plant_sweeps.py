@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The sweep that chose a plant's task settings (its C file's task), as one command:
 
-    python -m icoac.tools.plant_sweeps --plant furuta --out results/sweeps-furuta
+    python -m icoac.tools.plant_sweeps --plant PLANT --out results/sweeps-PLANT
 
 The task settings are what the controller needs to know of a plant beyond the cart-pole's
 defaults: the input scaling (arm angle, arm velocity and pendulum velocity ranges; the pendulum
@@ -254,7 +254,7 @@ def learner_dirs(out: Path, condition: str) -> dict[str, tuple[str, list[float]]
 def run_learners(ico_dir: Path, out: Path) -> None:
     for condition, (name, _) in LEARNER_SPACE.items():
         for stem, (reading, values) in learner_dirs(out, condition).items():
-            # both readings pinned: a plant's learner defaults may hold either (the Furuta's ICO->RL the mean)
+            # both readings pinned: a plant's learner defaults (its C file) may hold either
             fixed = [f"{k}={v}" for k, v in READINGS[reading].items()]
             for label, cells in learner_cells(ico_dir).items():
                 run_sweep(SweepOptions(prior_from=ico_dir, out=out / "learners" / f"{stem}-{label}",

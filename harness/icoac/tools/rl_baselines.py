@@ -2,8 +2,8 @@
 """PPO and SAC (Stable-Baselines3, icoac.studies.baselines.sb3) on a plant, trained once per seed
 over random grid cells and evaluated on every cell of that seed's grid:
 
-    python -m icoac.tools.rl_baselines --plant furuta --out results/rl-baselines-furuta \\
-        --bench results/bench-furuta --data docs/data/rl-baselines-furuta.json
+    python -m icoac.tools.rl_baselines --plant PLANT --out results/rl-baselines-PLANT \\
+        --bench results/bench-PLANT --data docs/data/rl-baselines-PLANT.json
 
 Needs the [baselines] extra (`make baselines`). The plant's actuator limit (the parameter its C
 file names; --limited holds it to a real actuator's, --set to any other) bounds the actions. Each (algorithm, seed) is OUT/<algo>/seed-<s>/ with the
